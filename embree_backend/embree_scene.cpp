@@ -1,0 +1,129 @@
+#include "embree_backend/embree_scene.h"
+
+#include "shared/sampling.h"
+
+#include <stdexcept>
+
+namespace spw {
+namespace {
+void onEmbreeError(void* user, RTCError code, const char* message) {
+    auto* error = static_cast<std::string*>(user);
+    if (error->empty()) *error = "Embree error " + std::to_string(int(code)) + ": " + (message ? message : "");
+}
+} // namespace
+
+EmbreeScene::EmbreeScene(const Scene& scene) : src_(scene) {
+    device_ = rtcNewDevice(nullptr);
+    if (!device_) throw std::runtime_error("cannot create the Embree device (error " +
+                                           std::to_string(int(rtcGetDeviceError(nullptr))) + ")");
+    rtcSetDeviceErrorFunction(device_, onEmbreeError, &error_);
+    scene_ = rtcNewScene(device_);
+    rtcSetSceneFlags(scene_, RTC_SCENE_FLAG_ROBUST);
+    rtcSetSceneBuildQuality(scene_, RTC_BUILD_QUALITY_HIGH);
+
+    for (const Shader& s : scene.shaders) shaders_.push_back(s.params);
+
+    emitterBase_.assign(scene.meshes.size(), -1);
+    double totalPower = 0.0;
+    for (size_t m = 0; m < scene.meshes.size(); ++m) {
+        const Mesh& mesh = scene.meshes[m];
+        RTCGeometry g = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
+        auto* vb = static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                                               3 * sizeof(float), mesh.positions.size()));
+        for (size_t i = 0; i < mesh.positions.size(); ++i)
+            for (int k = 0; k < 3; ++k) vb[3 * i + k] = mesh.positions[i][k];
+        auto* ib = static_cast<unsigned*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                                                  3 * sizeof(unsigned), mesh.triangles.size()));
+        for (size_t i = 0; i < mesh.triangles.size(); ++i)
+            for (int k = 0; k < 3; ++k) ib[3 * i + k] = mesh.triangles[i][k];
+        rtcCommitGeometry(g);
+        rtcAttachGeometryByID(scene_, g, unsigned(m));
+        rtcReleaseGeometry(g);
+
+        const ShaderParams& sp = shaders_[size_t(mesh.shader)];
+        if (maxComponent(sp.emission) <= 0.0f) continue;
+        brightest_ = std::max(brightest_, maxComponent(sp.emission));
+        emitterBase_[m] = int(emitters_.size());
+        bool twoSided = (sp.flags & kShaderTwoSided) != 0;
+        for (const uvec3& t : mesh.triangles) {
+            Emitter e{};
+            e.p0 = mesh.positions[t.x];
+            e.e1 = mesh.positions[t.y] - e.p0;
+            e.e2 = mesh.positions[t.z] - e.p0;
+            vec3 c = glm::cross(e.e1, e.e2);
+            e.area = 0.5f * glm::length(c);
+            e.normal = glm::normalize(c);
+            e.twoSided = twoSided ? 1u : 0u;
+            e.radiance = sp.emission;
+            // Power = L * area * pi per emitting side.
+            double power = double(luminance(sp.emission)) * e.area * kPi * (twoSided ? 2.0 : 1.0);
+            e.pickPdf = float(power); // normalised below
+            totalPower += power;
+            emitters_.push_back(e);
+        }
+    }
+    if (totalPower > 0.0) {
+        double running = 0.0;
+        for (Emitter& e : emitters_) {
+            running += e.pickPdf;
+            e.pickPdf = float(e.pickPdf / totalPower);
+            cdf_.push_back(float(running / totalPower));
+        }
+        cdf_.back() = 1.0f;
+    } else {
+        emitters_.clear(); // emission [0, 0, 0]: nothing to sample
+        emitterBase_.assign(scene.meshes.size(), -1);
+    }
+    rtcCommitScene(scene_);
+    checkError("building the scene");
+}
+
+EmbreeScene::~EmbreeScene() {
+    if (scene_) rtcReleaseScene(scene_);
+    if (device_) rtcReleaseDevice(device_);
+}
+
+void EmbreeScene::checkError(const char* what) const {
+    if (!error_.empty()) throw std::runtime_error(error_ + " (while " + what + ")");
+}
+
+SceneView EmbreeScene::view() const {
+    SceneView v;
+    v.shaders = shaders_.data();
+    v.emitters = emitters_.data();
+    v.emitterCdf = cdf_.data();
+    v.emitterCount = uint(emitters_.size());
+    return v;
+}
+
+void EmbreeScene::surfaceHit(uint geomID, uint primID, float u, float v, float t, SurfaceHit& hit) const {
+    const Mesh& mesh = src_.meshes[geomID];
+    const uvec3 tri = mesh.triangles[primID];
+    const vec3 p0 = mesh.positions[tri.x], p1 = mesh.positions[tri.y], p2 = mesh.positions[tri.z];
+    const float w = 1.0f - u - v;
+    hit.p = w * p0 + u * p1 + v * p2;
+    hit.t = t;
+    hit.ng = glm::normalize(glm::cross(p1 - p0, p2 - p0));
+    hit.ns = hit.ng;
+    if (!mesh.normals.empty()) {
+        vec3 n = w * mesh.normals[tri.x] + u * mesh.normals[tri.y] + v * mesh.normals[tri.z];
+        float len = glm::length(n);
+        if (len > 0.0f) hit.ns = n / len;
+    }
+    hit.shader = uint(mesh.shader);
+    int base = emitterBase_[geomID];
+    hit.emitter = base >= 0 ? uint(base) + primID : kNoEmitter;
+    hit.albedo = vec3(0.0f);
+    hit.pad0 = 0;
+}
+
+} // namespace spw
+
+namespace spw {
+vec2 EmbreeScene::uvAt(uint geomID, uint primID, float u, float v) const {
+    const Mesh& mesh = src_.meshes[geomID];
+    if (mesh.uvs.empty()) return vec2(0.0f);
+    const uvec3 tri = mesh.triangles[primID];
+    return (1.0f - u - v) * mesh.uvs[tri.x] + u * mesh.uvs[tri.y] + v * mesh.uvs[tri.z];
+}
+} // namespace spw

@@ -1,0 +1,36 @@
+// Camera rays: the pixel sampler (Independent, Grid, Stratified) picks a point in the pixel, the
+// camera (PinHole, ThinLens) turns it into a world-space ray. Both are pure functions of
+// (seed, pixel, sample), so the sorted backends can recompute a sample's film position when its
+// contribution arrives instead of carrying it in every ray.
+#pragma once
+
+#include "host/scene.h"
+
+namespace spw {
+
+struct CameraRay {
+    vec3 origin;
+    vec3 dir;     // unit
+    vec2 filmPos; // continuous pixel coordinates: pixel (x, y) spans [x, x+1) x [y, y+1)
+};
+
+class CameraModel {
+  public:
+    // `sampleBase`: n of the n x n samples per pixel and iteration (after --spp).
+    CameraModel(const Scene& scene, int sampleBase);
+
+    // `sample` is the index within the iteration (it picks the Grid/Stratified cell);
+    // `sampleIndex` the render-wide one that keys the random numbers.
+    CameraRay generate(uint x, uint y, uint sample, uint sampleIndex, uint seed) const;
+    vec2 filmPosition(uint x, uint y, uint sample, uint sampleIndex, uint seed) const;
+
+  private:
+    Camera cam_;
+    SamplerType sampler_;
+    int width_, height_, base_;
+    float tanX_, tanY_;
+    mat3 rot_;
+    vec3 eye_;
+};
+
+} // namespace spw

@@ -1,0 +1,60 @@
+// The film. Samples are splatted through the pixel filter into 64-bit fixed-point accumulators
+// with atomic integer adds: integer addition is associative, so an iteration's sums are the
+// same bit for bit whatever the thread count, batch size or order in which paths finish. Each
+// value is rounded to the fixed-point grid stochastically with a hash of the sample's key, so
+// the rounding is unbiased and still deterministic. At the end of an iteration the integer sums
+// are folded, pixel by pixel, into double-precision accumulators that hold the whole render.
+//
+// The fixed-point scale is picked from the scene's brightest emitter so that one sample of it
+// sits at 2^40: that leaves 2^23 such samples per pixel and iteration before saturation and
+// resolves 2^-40 of it. Non-finite samples are counted and dropped, never added.
+#pragma once
+
+#include "host/scene.h"
+
+#include <atomic>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+namespace spw {
+
+class Film {
+  public:
+    Film(int width, int height, const Filter& filter, float brightestRadiance);
+
+    int width() const { return width_; }
+    int height() const { return height_; }
+
+    void beginIteration();
+    // Thread-safe. Once per camera sample: adds the sample's filter weight.
+    void addSample(vec2 filmPos);
+    // Thread-safe. Any number of times per sample: adds radiance it carried to the camera.
+    // `key` makes the stochastic rounding deterministic (mix the path id and bounce into it).
+    void splat(vec2 filmPos, vec3 radiance, uint key);
+    void endIteration();
+
+    // The render so far: sum of weighted radiance / sum of weights, RGB, row-major.
+    std::vector<float> image() const;
+    // The last completed iteration alone (for per-iteration statistics).
+    std::vector<float> lastIterationImage() const { return lastIteration_; }
+
+    std::uint64_t nonFiniteSamples() const { return nonFinite_.load(); }
+    std::uint64_t saturatedSamples() const { return saturated_.load(); }
+    double fixedPointScale() const { return scale_; }
+
+  private:
+    void filtered(vec2 filmPos, vec3 radiance, float weight, uint key);
+    void add(int px, int py, vec3 value, float weight, uint key);
+
+    int width_, height_;
+    Filter filter_;
+    double scale_;       // radiance units -> fixed-point units
+    double weightScale_; // filter weight -> fixed-point units
+    std::unique_ptr<std::atomic<std::int64_t>[]> acc_; // 4 per pixel: r, g, b, weight
+    std::vector<double> sum_;                          // 4 per pixel, whole render
+    std::vector<float> lastIteration_;
+    std::atomic<std::uint64_t> nonFinite_{0}, saturated_{0};
+};
+
+} // namespace spw

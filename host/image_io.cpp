@@ -1,0 +1,82 @@
+#include "host/image_io.h"
+
+#include <OpenImageIO/imageio.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <filesystem>
+
+namespace spw {
+namespace {
+
+std::string extension(const std::string& path) {
+    std::string e = std::filesystem::path(path).extension().string();
+    std::transform(e.begin(), e.end(), e.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+    return e;
+}
+
+std::uint8_t linearToSrgb8(float v) {
+    if (!(v > 0.0f)) return 0; // also maps NaN to black
+    float s = v <= 0.0031308f ? 12.92f * v : 1.055f * std::pow(v, 1.0f / 2.4f) - 0.055f;
+    return std::uint8_t(std::lround(std::clamp(s, 0.0f, 1.0f) * 255.0f));
+}
+
+float srgbToLinear(float c) { return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f); }
+
+} // namespace
+
+bool isSupportedOutput(const std::string& path) {
+    std::string e = extension(path);
+    return e == ".exr" || e == ".png";
+}
+
+void writeImage(const std::string& path, const ImageRGB& image) {
+    if (!isSupportedOutput(path)) throw std::runtime_error("cannot write '" + path + "': use .exr or .png");
+    auto out = OIIO::ImageOutput::create(path);
+    if (!out) throw std::runtime_error("cannot write '" + path + "': " + OIIO::geterror());
+    const bool png = extension(path) == ".png";
+    OIIO::ImageSpec spec(image.width, image.height, 3, png ? OIIO::TypeDesc::UINT8 : OIIO::TypeDesc::FLOAT);
+    spec.attribute("oiio:ColorSpace", png ? "sRGB" : "Linear");
+    spec.attribute("Software", "Spillway");
+    if (!out->open(path, spec)) throw std::runtime_error("cannot write '" + path + "': " + out->geterror());
+    bool ok;
+    if (png) {
+        std::vector<std::uint8_t> bytes(image.rgb.size());
+        std::transform(image.rgb.begin(), image.rgb.end(), bytes.begin(), linearToSrgb8);
+        ok = out->write_image(OIIO::TypeDesc::UINT8, bytes.data());
+    } else {
+        ok = out->write_image(OIIO::TypeDesc::FLOAT, image.rgb.data());
+    }
+    std::string err = ok ? "" : out->geterror();
+    if (!out->close() && ok) err = out->geterror(), ok = false;
+    if (!ok) {
+        std::error_code ec;
+        std::filesystem::remove(path, ec);
+        throw std::runtime_error("cannot write '" + path + "': " + err);
+    }
+}
+
+ImageRGB readImage(const std::string& path) {
+    auto in = OIIO::ImageInput::open(path);
+    if (!in) throw std::runtime_error("cannot read image '" + path + "': " + OIIO::geterror());
+    const OIIO::ImageSpec& spec = in->spec();
+    ImageRGB img;
+    img.width = spec.width;
+    img.height = spec.height;
+    const int nc = spec.nchannels;
+    std::vector<float> all(size_t(spec.width) * spec.height * nc);
+    if (!in->read_image(0, 0, 0, nc, OIIO::TypeDesc::FLOAT, all.data()))
+        throw std::runtime_error("cannot read image '" + path + "': " + in->geterror());
+    std::string cs = spec.get_string_attribute("oiio:ColorSpace");
+    const bool srgb = cs == "sRGB" || (cs.empty() && spec.format == OIIO::TypeDesc::UINT8);
+    img.rgb.resize(size_t(spec.width) * spec.height * 3);
+    for (size_t i = 0; i < size_t(spec.width) * spec.height; ++i)
+        for (int c = 0; c < 3; ++c) {
+            float v = all[i * nc + std::min(c, nc - 1)];
+            img.rgb[i * 3 + c] = srgb ? srgbToLinear(v) : v;
+        }
+    return img;
+}
+
+} // namespace spw

@@ -1,0 +1,22 @@
+// Images in and out through OpenImageIO: linear float EXR, or 8-bit sRGB PNG, by extension.
+#pragma once
+
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace spw {
+
+struct ImageRGB {
+    int width = 0, height = 0;
+    std::vector<float> rgb; // linear, row-major, 3 floats a pixel
+};
+
+// True for the extensions writeImage understands (.exr, .png; any case).
+bool isSupportedOutput(const std::string& path);
+// Throws std::runtime_error naming the path when the file cannot be written.
+void writeImage(const std::string& path, const ImageRGB& image);
+// Reads any image OpenImageIO reads; 8-bit sRGB data are linearised. Throws on failure.
+ImageRGB readImage(const std::string& path);
+
+} // namespace spw

@@ -1,0 +1,146 @@
+// The spillway command line. Exit status: 0 success, 1 runtime failure (disk, device),
+// 2 bad input (usage or scene error).
+#include "host/image_io.h"
+#include "host/progress.h"
+#include "host/render.h"
+#include "host/scene.h"
+
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <string>
+#include <unistd.h>
+#include <vector>
+
+#ifndef SPILLWAY_VERSION
+#define SPILLWAY_VERSION "0.0.0"
+#endif
+
+namespace {
+
+const char* kUsage = R"(Spillway: a breadth-first, sorted-deferred-shading path tracer.
+
+usage:
+  spillway render SCENE [options]   render a scene file (see SCENE_FORMAT.md)
+  spillway --help                   this text
+  spillway --version                the version
+
+render options:
+  -o, --output FILE     image to write: .exr (linear float) or .png (8-bit sRGB);
+                        default: the scene's name with .exr, in the current folder
+  --spp N               total samples per pixel (overrides sample base x iterations)
+  --backend NAME        reference (a depth-first path tracer on Embree)
+  --threads N           worker threads (default: every core)
+  --seed S              random seed (overrides settings: seed)
+  --stats FILE.json     write render statistics (rays, stage seconds, ...) as JSON
+  --quiet               no progress bar
+
+exit status: 0 done, 1 runtime failure, 2 bad usage or scene error
+)";
+
+struct UsageError : std::runtime_error {
+    using std::runtime_error::runtime_error;
+};
+
+long long parseInteger(const std::string& flag, const std::string& v, long long lo, long long hi) {
+    size_t used = 0;
+    long long n = 0;
+    try {
+        n = std::stoll(v, &used);
+    } catch (const std::exception&) {
+        used = 0;
+    }
+    if (used != v.size() || v.empty()) throw UsageError(flag + " takes an integer, not '" + v + "'");
+    if (n < lo || n > hi)
+        throw UsageError(flag + " must be in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
+    return n;
+}
+
+int renderCommand(const std::vector<std::string>& args) {
+    std::string scenePath, output, statsPath;
+    bool quiet = false;
+    spw::RenderConfig config;
+    for (size_t i = 0; i < args.size(); ++i) {
+        const std::string& a = args[i];
+        auto value = [&]() -> std::string {
+            if (i + 1 >= args.size()) throw UsageError(a + " needs a value");
+            return args[++i];
+        };
+        if (a == "-o" || a == "--output") output = value();
+        else if (a == "--spp") config.spp = int(parseInteger(a, value(), 1, 1 << 24));
+        else if (a == "--backend") config.backend = value();
+        else if (a == "--threads") config.threads = int(parseInteger(a, value(), 1, 1024));
+        else if (a == "--seed") config.seed = std::uint32_t(parseInteger(a, value(), 0, 0xFFFFFFFFLL));
+        else if (a == "--stats") statsPath = value();
+        else if (a == "--quiet") quiet = true;
+        else if (!a.empty() && a[0] == '-') throw UsageError("unknown option '" + a + "'");
+        else if (scenePath.empty()) scenePath = a;
+        else throw UsageError("more than one scene given ('" + scenePath + "', '" + a + "')");
+    }
+    if (scenePath.empty()) throw UsageError("render needs a scene file");
+    if (config.backend != "reference")
+        throw UsageError("unknown backend '" + config.backend + "' (reference)");
+    if (output.empty()) output = std::filesystem::path(scenePath).stem().string() + ".exr";
+    if (!spw::isSupportedOutput(output)) throw UsageError("output '" + output + "' must end in .exr or .png");
+
+    spw::Scene scene = spw::loadScene(scenePath);
+    for (const spw::Mesh& m : scene.meshes)
+        if (m.droppedTriangles > 0)
+            std::fprintf(stderr, "spillway: warning: %s: dropped %d zero-area triangle%s\n", m.name.c_str(),
+                         m.droppedTriangles, m.droppedTriangles == 1 ? "" : "s");
+
+    spw::ProgressBar progress(!quiet && isatty(STDERR_FILENO));
+    const spw::SamplingPlan plan = spw::planSampling(scene.image, config.spp);
+    const int sppPerIteration = plan.sampleBase * plan.sampleBase;
+    auto result = spw::render(scene, config, [&](int done, int total, const spw::Film&) {
+        progress.update(done, total, done * sppPerIteration, total * sppPerIteration);
+    });
+    progress.finish();
+
+    {
+        spw::StageTimer t(result->stats.stages, "write image");
+        spw::writeImage(output, {scene.image.width, scene.image.height, result->film->image()});
+    }
+    if (result->stats.nonFiniteSamples > 0)
+        std::fprintf(stderr, "spillway: warning: %llu non-finite samples were dropped\n",
+                     (unsigned long long)result->stats.nonFiniteSamples);
+    if (!statsPath.empty()) {
+        std::ofstream out(statsPath);
+        out << result->stats.toJson().dump(2) << "\n";
+        if (!out) throw std::runtime_error("cannot write stats file '" + statsPath + "'");
+    }
+    return 0;
+}
+
+} // namespace
+
+int main(int argc, char** argv) {
+    std::vector<std::string> args(argv + 1, argv + argc);
+    try {
+        if (args.empty()) {
+            std::fputs(kUsage, stderr);
+            return 2;
+        }
+        if (args[0] == "--help" || args[0] == "-h" || args[0] == "help") {
+            std::fputs(kUsage, stdout);
+            return 0;
+        }
+        if (args[0] == "--version") {
+            std::printf("spillway %s\n", SPILLWAY_VERSION);
+            return 0;
+        }
+        if (args[0] == "render") return renderCommand({args.begin() + 1, args.end()});
+        throw UsageError("unknown command '" + args[0] + "' (try spillway --help)");
+    } catch (const UsageError& e) {
+        std::fprintf(stderr, "spillway: %s\n", e.what());
+        return 2;
+    } catch (const spw::SceneError& e) {
+        std::fprintf(stderr, "%s\n", e.what());
+        return 2;
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "spillway: error: %s\n", e.what());
+        return 1;
+    }
+}

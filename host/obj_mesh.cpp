@@ -1,0 +1,103 @@
+#include "host/obj_mesh.h"
+
+#include <tiny_obj_loader.h>
+
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <tuple>
+
+namespace spw {
+namespace {
+
+// tinyobjloader does not report line numbers: find the line of the n-th vertex statement.
+int lineOfVertex(const std::string& path, size_t vertexIndex) {
+    std::ifstream in(path);
+    std::string line;
+    size_t seen = 0;
+    for (int lineNo = 1; std::getline(in, line); ++lineNo) {
+        size_t i = line.find_first_not_of(" \t");
+        if (i != std::string::npos && line.compare(i, 2, "v ") == 0 && seen++ == vertexIndex) return lineNo;
+    }
+    return 0;
+}
+
+} // namespace
+
+Mesh loadObjMesh(const std::string& path, const mat4& objectToWorld, const std::string& sceneFile,
+                 int sceneLine) {
+    tinyobj::ObjReaderConfig cfg;
+    cfg.triangulate = true;
+    cfg.vertex_color = false;
+    cfg.mtl_search_path = "";
+    tinyobj::ObjReader reader;
+    // Materials are ignored (shaders come from the scene): parse the geometry only.
+    std::ifstream file(path);
+    std::stringstream text;
+    text << file.rdbuf();
+    if (!file || !reader.ParseFromString(text.str(), "", cfg)) {
+        std::string why = reader.Error();
+        while (!why.empty() && (why.back() == '\n' || why.back() == '\r')) why.pop_back();
+        throw SceneError(sceneFile, sceneLine, "cannot read OBJ file '" + path + "': " + why);
+    }
+    const tinyobj::attrib_t& a = reader.GetAttrib();
+    for (size_t i = 0; i < a.vertices.size(); ++i)
+        if (!std::isfinite(a.vertices[i]))
+            throw SceneError(path, lineOfVertex(path, i / 3), "vertex coordinate is not a finite number");
+    for (size_t i = 0; i < a.normals.size(); ++i)
+        if (!std::isfinite(a.normals[i]))
+            throw SceneError(sceneFile, sceneLine, "OBJ file '" + path + "' has a non-finite normal");
+
+    Mesh mesh;
+    mesh.name = path;
+    const mat3 normalXf = glm::transpose(glm::inverse(mat3(objectToWorld)));
+    bool hasNormals = !a.normals.empty();
+    bool hasUvs = !a.texcoords.empty();
+    // One mesh vertex per distinct (position, normal, uv) triple of the OBJ.
+    std::map<std::tuple<int, int, int>, uint> remap;
+    for (const tinyobj::shape_t& shape : reader.GetShapes()) {
+        const auto& idx = shape.mesh.indices;
+        for (size_t f = 0; f + 2 < idx.size(); f += 3) {
+            uvec3 tri;
+            for (int k = 0; k < 3; ++k) {
+                const tinyobj::index_t& ix = idx[f + k];
+                auto key = std::make_tuple(ix.vertex_index, hasNormals ? ix.normal_index : -1,
+                                           hasUvs ? ix.texcoord_index : -1);
+                auto [it, inserted] = remap.try_emplace(key, uint(mesh.positions.size()));
+                if (inserted) {
+                    vec3 p(a.vertices[3 * ix.vertex_index], a.vertices[3 * ix.vertex_index + 1],
+                           a.vertices[3 * ix.vertex_index + 2]);
+                    mesh.positions.push_back(vec3(objectToWorld * vec4(p, 1.0f)));
+                    if (hasNormals) {
+                        vec3 n(0.0f);
+                        if (ix.normal_index >= 0)
+                            n = vec3(a.normals[3 * ix.normal_index], a.normals[3 * ix.normal_index + 1],
+                                     a.normals[3 * ix.normal_index + 2]);
+                        n = normalXf * n;
+                        float len = glm::length(n);
+                        mesh.normals.push_back(len > 0.0f ? n / len : vec3(0.0f));
+                    }
+                    if (hasUvs) {
+                        vec2 uv(0.0f);
+                        if (ix.texcoord_index >= 0)
+                            uv = vec2(a.texcoords[2 * ix.texcoord_index], a.texcoords[2 * ix.texcoord_index + 1]);
+                        mesh.uvs.push_back(uv);
+                    }
+                }
+                tri[k] = it->second;
+            }
+            vec3 e1 = mesh.positions[tri.y] - mesh.positions[tri.x];
+            vec3 e2 = mesh.positions[tri.z] - mesh.positions[tri.x];
+            vec3 c = glm::cross(e1, e2);
+            if (!(glm::dot(c, c) > 0.0f) || !std::isfinite(glm::dot(c, c))) {
+                ++mesh.droppedTriangles;
+                continue;
+            }
+            mesh.triangles.push_back(tri);
+        }
+    }
+    return mesh;
+}
+
+} // namespace spw

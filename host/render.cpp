@@ -1,0 +1,95 @@
+#include "host/render.h"
+
+#include "embree_backend/embree_scene.h"
+#include "embree_backend/reference_renderer.h"
+#include "host/backend.h"
+#include "host/camera.h"
+#include "host/textures.h"
+
+#include <tbb/global_control.h>
+#include <tbb/info.h>
+
+#include <chrono>
+#include <fstream>
+#include <stdexcept>
+
+namespace spw {
+namespace {
+
+std::string cpuName() {
+    std::ifstream in("/proc/cpuinfo");
+    std::string line;
+    while (std::getline(in, line))
+        if (line.rfind("model name", 0) == 0) {
+            auto p = line.find(':');
+            if (p != std::string::npos) return line.substr(line.find_first_not_of(" \t", p + 1));
+        }
+    return "unknown CPU";
+}
+
+} // namespace
+
+SamplingPlan planSampling(const ImageSettings& image, std::optional<int> spp) {
+    if (!spp) return {image.sampleBase, image.iterations};
+    const int n2 = image.samplesPerIteration();
+    // Keep the scene's n x n pattern when it divides the request; otherwise one sample per pass.
+    if (*spp % n2 == 0) return {image.sampleBase, *spp / n2};
+    return {1, *spp};
+}
+
+std::unique_ptr<RenderResult> render(const Scene& scene, const RenderConfig& config,
+                                     const IterationCallback& onIteration) {
+    if (config.backend != "reference")
+        throw std::invalid_argument("unknown backend '" + config.backend + "' (reference)");
+    const auto start = std::chrono::steady_clock::now();
+    const int threads = config.threads > 0 ? config.threads : tbb::info::default_concurrency();
+    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
+
+    auto result = std::make_unique<RenderResult>();
+    RenderStats& stats = result->stats;
+    const SamplingPlan plan = planSampling(scene.image, config.spp);
+    stats.backend = config.backend;
+    stats.device = cpuName();
+    stats.width = scene.image.width;
+    stats.height = scene.image.height;
+    stats.spp = plan.sampleBase * plan.sampleBase * plan.iterations;
+    stats.iterations = plan.iterations;
+    stats.threads = threads;
+
+    std::unique_ptr<EmbreeScene> embree;
+    {
+        StageTimer t(stats.stages, "build bvh");
+        embree = std::make_unique<EmbreeScene>(scene);
+    }
+    TextureResolver textures(scene);
+    CameraModel camera(scene, plan.sampleBase);
+
+    RenderParams params{};
+    params.seed = config.seed.value_or(scene.settings.seed);
+    params.samplesPerIteration = uint(plan.sampleBase * plan.sampleBase);
+    params.minDepth = uint(scene.settings.minDepth);
+    params.maxDepth = uint(scene.settings.maxDepth);
+    params.threshold = scene.settings.threshold;
+    params.strategy = config.strategy;
+    params.emitterCount = uint(embree->emitters().size());
+
+    RenderContext ctx{scene, config, *embree, textures, camera, params, threads, stats};
+    result->film = std::make_unique<Film>(scene.image.width, scene.image.height, scene.filter,
+                                          embree->brightestEmission());
+    std::unique_ptr<Backend> backend = std::make_unique<ReferenceRenderer>(ctx);
+    for (int it = 0; it < plan.iterations; ++it) {
+        backend->renderIteration(uint(it), *result->film);
+        {
+            StageTimer t(stats.stages, "accumulate");
+            result->film->endIteration();
+        }
+        embree->checkError("tracing");
+        if (onIteration) onIteration(it + 1, plan.iterations, *result->film);
+    }
+    stats.nonFiniteSamples = result->film->nonFiniteSamples();
+    stats.saturatedSamples = result->film->saturatedSamples();
+    stats.wallSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return result;
+}
+
+} // namespace spw

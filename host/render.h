@@ -1,0 +1,35 @@
+// One render, start to finish: builds what the scene needs, picks the backend, runs the
+// iterations into the film and fills in the stats. The CLI and the tests both call this.
+#pragma once
+
+#include "host/film.h"
+#include "host/render_config.h"
+#include "host/scene.h"
+#include "host/stats.h"
+
+#include <functional>
+#include <memory>
+
+namespace spw {
+
+struct RenderResult {
+    std::unique_ptr<Film> film;
+    RenderStats stats;
+};
+
+// Called after every iteration with (iterations done, iterations in all, the film).
+using IterationCallback = std::function<void(int, int, const Film&)>;
+
+// The effective sampling after --spp: samples per pixel and iteration, and iterations.
+struct SamplingPlan {
+    int sampleBase;
+    int iterations;
+};
+SamplingPlan planSampling(const ImageSettings& image, std::optional<int> spp);
+
+// Throws std::invalid_argument for a bad configuration (unknown backend) and
+// std::runtime_error for a failure while rendering.
+std::unique_ptr<RenderResult> render(const Scene& scene, const RenderConfig& config,
+                                     const IterationCallback& onIteration = {});
+
+} // namespace spw

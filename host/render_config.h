@@ -1,0 +1,19 @@
+// Everything about a render that is not the scene: passed explicitly, never global.
+#pragma once
+
+#include "shared/types.h"
+
+#include <optional>
+#include <string>
+
+namespace spw {
+
+struct RenderConfig {
+    std::string backend = "reference";
+    int threads = 0;                    // 0: every core
+    std::optional<int> spp;             // overrides sample base and iterations
+    std::optional<std::uint32_t> seed;  // overrides settings.seed
+    uint strategy = kStrategyMis;       // light/BSDF sampling ablation (tests, benchmarks)
+};
+
+} // namespace spw

@@ -1,0 +1,426 @@
+// The YAML scene loader: SCENE_FORMAT.md made executable. Every value is checked for type and
+// range where it is read, and every error names the file and line of the offending node.
+#include "host/obj_mesh.h"
+#include "host/scene.h"
+
+#include <glm/gtc/matrix_transform.hpp>
+#include <yaml-cpp/yaml.h>
+
+#include <cmath>
+#include <filesystem>
+#include <functional>
+#include <initializer_list>
+#include <limits>
+#include <set>
+
+namespace fs = std::filesystem;
+
+namespace spw {
+namespace {
+
+// Largest image the loader accepts; keeps film and ray ids well inside 32-bit indices.
+constexpr long long kMaxPixels = 1LL << 26;
+constexpr int kMaxDimension = 1 << 15;
+constexpr int kMaxSampleBase = 256;
+
+class Reader {
+  public:
+    explicit Reader(std::string file) : file_(std::move(file)) {}
+
+    [[noreturn]] void fail(const YAML::Node& at, const std::string& message) const {
+        throw SceneError(file_, at.Mark().line + 1, message);
+    }
+    [[noreturn]] void fail(int line, const std::string& message) const {
+        throw SceneError(file_, line, message);
+    }
+
+    // A map node whose keys are all in `allowed`; returns (key, value) pairs in file order.
+    void checkKeys(const YAML::Node& map, const std::string& what,
+                   std::initializer_list<const char*> allowed) const {
+        if (!map.IsMap()) fail(map, what + " must be a map of keys to values");
+        for (auto it = map.begin(); it != map.end(); ++it) {
+            std::string key = it->first.as<std::string>();
+            bool known = false;
+            for (const char* a : allowed) known = known || key == a;
+            if (!known) fail(it->first, "unknown key '" + key + "' in " + what);
+        }
+    }
+
+    std::string string(const YAML::Node& n, const std::string& what) const {
+        if (!n.IsScalar()) fail(n, what + " must be a string");
+        return n.as<std::string>();
+    }
+
+    double number(const YAML::Node& n, const std::string& what) const {
+        if (!n.IsScalar()) fail(n, what + " must be a number");
+        double v;
+        if (!YAML::convert<double>::decode(n, v)) fail(n, what + " must be a number, not '" + n.Scalar() + "'");
+        if (!std::isfinite(v)) fail(n, what + " must be finite");
+        return v;
+    }
+
+    double number(const YAML::Node& n, const std::string& what, double lo, double hi) const {
+        double v = number(n, what);
+        if (v < lo || v > hi)
+            fail(n, what + " must be in [" + fmt(lo) + ", " + fmt(hi) + "], not " + fmt(v));
+        return v;
+    }
+
+    long long integer(const YAML::Node& n, const std::string& what, long long lo, long long hi) const {
+        if (!n.IsScalar()) fail(n, what + " must be an integer");
+        long long v;
+        if (!YAML::convert<long long>::decode(n, v))
+            fail(n, what + " must be an integer, not '" + n.Scalar() + "'");
+        if (v < lo || v > hi)
+            fail(n, what + " must be in [" + std::to_string(lo) + ", " + std::to_string(hi) +
+                        "], not " + std::to_string(v));
+        return v;
+    }
+
+    bool boolean(const YAML::Node& n, const std::string& what) const {
+        bool v;
+        if (!n.IsScalar() || !YAML::convert<bool>::decode(n, v)) fail(n, what + " must be true or false");
+        return v;
+    }
+
+    template <int N>
+    glm::vec<N, float> vec(const YAML::Node& n, const std::string& what, double lo = -HUGE_VAL,
+                           double hi = HUGE_VAL) const {
+        if (!n.IsSequence() || n.size() != N)
+            fail(n, what + " must be a list of " + std::to_string(N) + " numbers");
+        glm::vec<N, float> v;
+        for (int i = 0; i < N; ++i) v[i] = float(number(n[i], what, lo, hi));
+        return v;
+    }
+
+    const std::string& file() const { return file_; }
+
+  private:
+    static std::string fmt(double v) {
+        if (std::isinf(v)) return v > 0 ? "inf" : "-inf";
+        std::string s = std::to_string(v);
+        s.erase(s.find_last_not_of('0') + 1);
+        if (!s.empty() && s.back() == '.') s.pop_back();
+        return s;
+    }
+    std::string file_;
+};
+
+// R = Rz * Ry * Rx, degrees.
+mat4 rotationXYZ(vec3 degrees) {
+    mat4 r(1.0f);
+    r = glm::rotate(r, glm::radians(degrees.z), vec3(0, 0, 1));
+    r = glm::rotate(r, glm::radians(degrees.y), vec3(0, 1, 0));
+    r = glm::rotate(r, glm::radians(degrees.x), vec3(1, 0, 0));
+    return r;
+}
+
+// translation * rotation * scale, reading whichever of the three keys are present.
+mat4 readTransform(const Reader& rd, const YAML::Node& n, const std::string& what, bool scale3) {
+    mat4 m(1.0f);
+    if (n["translation"]) m = glm::translate(m, rd.vec<3>(n["translation"], what + " translation"));
+    if (n["rotation"]) m = m * rotationXYZ(rd.vec<3>(n["rotation"], what + " rotation"));
+    if (scale3 && n["scale"]) {
+        const YAML::Node& s = n["scale"];
+        vec3 sc = s.IsScalar() ? vec3(float(rd.number(s, what + " scale"))) : rd.vec<3>(s, what + " scale");
+        if (sc.x == 0 || sc.y == 0 || sc.z == 0) rd.fail(s, what + " scale must not be zero");
+        m = glm::scale(m, sc);
+    }
+    return m;
+}
+
+void readImage(const Reader& rd, const YAML::Node& n, ImageSettings& img) {
+    rd.checkKeys(n, "image", {"width", "height", "sample base", "iterations"});
+    if (n["width"]) img.width = int(rd.integer(n["width"], "image width", 1, kMaxDimension));
+    if (n["height"]) img.height = int(rd.integer(n["height"], "image height", 1, kMaxDimension));
+    if (n["sample base"])
+        img.sampleBase = int(rd.integer(n["sample base"], "sample base", 1, kMaxSampleBase));
+    if (n["iterations"]) img.iterations = int(rd.integer(n["iterations"], "iterations", 1, 1 << 24));
+    if ((long long)img.width * img.height > kMaxPixels)
+        rd.fail(n, "image of " + std::to_string(img.width) + "x" + std::to_string(img.height) +
+                       " pixels is larger than the " + std::to_string(kMaxPixels) + " pixels Spillway renders");
+}
+
+void readSettings(const Reader& rd, const YAML::Node& n, Settings& s) {
+    rd.checkKeys(n, "settings", {"min depth", "max depth", "threshold", "bucket size", "shading size",
+                                 "bin exponent", "memory budget", "seed"});
+    if (n["min depth"]) s.minDepth = int(rd.integer(n["min depth"], "min depth", 0, 1 << 16));
+    if (n["max depth"]) s.maxDepth = int(rd.integer(n["max depth"], "max depth", 0, 1 << 16));
+    if (n["threshold"]) s.threshold = float(rd.number(n["threshold"], "threshold", 0.0, 1e30));
+    if (n["bucket size"]) s.bucketSize = int(rd.integer(n["bucket size"], "bucket size", 1, 4096));
+    if (n["shading size"]) s.shadingSize = int(rd.integer(n["shading size"], "shading size", 1, 1 << 24));
+    if (n["bin exponent"]) s.binExponent = int(rd.integer(n["bin exponent"], "bin exponent", 4, 24));
+    if (n["memory budget"])
+        s.memoryBudgetMiB = rd.number(n["memory budget"], "memory budget", 1.0 / 1024, 1 << 20);
+    if (n["seed"]) s.seed = std::uint32_t(rd.integer(n["seed"], "seed", 0, 0xFFFFFFFFLL));
+}
+
+void readCamera(const Reader& rd, const YAML::Node& n, Camera& c) {
+    rd.checkKeys(n, "camera", {"type", "translation", "rotation", "look at", "focal length", "fov",
+                               "aperture radius", "focal distance", "film width"});
+    if (n["type"]) {
+        std::string t = rd.string(n["type"], "camera type");
+        if (t == "PinHole") c.type = CameraType::PinHole;
+        else if (t == "ThinLens") c.type = CameraType::ThinLens;
+        else rd.fail(n["type"], "unknown camera type '" + t + "' (PinHole or ThinLens)");
+    }
+    if (n["look at"]) {
+        const YAML::Node& la = n["look at"];
+        if (n["translation"] || n["rotation"])
+            rd.fail(la, "camera takes either 'look at' or translation/rotation, not both");
+        rd.checkKeys(la, "look at", {"eye", "target", "up"});
+        if (!la["eye"] || !la["target"]) rd.fail(la, "look at needs eye and target");
+        vec3 eye = rd.vec<3>(la["eye"], "look at eye");
+        vec3 target = rd.vec<3>(la["target"], "look at target");
+        vec3 up = la["up"] ? rd.vec<3>(la["up"], "look at up") : vec3(0, 1, 0);
+        vec3 fwd = target - eye;
+        if (glm::length(fwd) == 0) rd.fail(la, "look at eye and target are the same point");
+        if (glm::length(glm::cross(glm::normalize(fwd), up)) < 1e-6f)
+            rd.fail(la, "look at up is parallel to the viewing direction");
+        c.cameraToWorld = glm::inverse(glm::lookAt(eye, target, up));
+    } else {
+        c.cameraToWorld = readTransform(rd, n, "camera", false);
+    }
+    if (n["focal length"]) c.focalLength = float(rd.number(n["focal length"], "focal length", 1e-6, 1e9));
+    if (n["film width"]) c.filmWidth = float(rd.number(n["film width"], "film width", 1e-6, 1e9));
+    if (n["fov"]) {
+        c.fovDegrees = float(rd.number(n["fov"], "fov", 1e-4, 179.9));
+    }
+    if (n["aperture radius"])
+        c.apertureRadius = float(rd.number(n["aperture radius"], "aperture radius", 0.0, 1e30));
+    if (n["focal distance"])
+        c.focalDistance = float(rd.number(n["focal distance"], "focal distance", 1e-30, 1e30));
+    if (c.type == CameraType::PinHole && (n["aperture radius"] || n["focal distance"]))
+        rd.fail(n, "aperture radius and focal distance need camera type ThinLens");
+}
+
+void readFilter(const Reader& rd, const YAML::Node& n, Filter& f) {
+    rd.checkKeys(n, "filter", {"type", "width"});
+    std::string t = n["type"] ? rd.string(n["type"], "filter type") : "Box";
+    if (t == "Box") f = {FilterType::Box, 0.5f};
+    else if (t == "Tent") f = {FilterType::Tent, 1.0f};
+    else if (t == "Gaussian") f = {FilterType::Gaussian, 1.5f};
+    else rd.fail(n["type"], "unknown filter type '" + t + "' (Box, Tent or Gaussian)");
+    if (n["width"]) {
+        float w = float(rd.number(n["width"], "filter width", 1e-3, 16.0));
+        if (f.type != FilterType::Box) f.radius = w;
+    }
+}
+
+SamplerType readSampler(const Reader& rd, const YAML::Node& n) {
+    rd.checkKeys(n, "sampler", {"type"});
+    std::string t = n["type"] ? rd.string(n["type"], "sampler type") : "Independent";
+    if (t == "Independent") return SamplerType::Independent;
+    if (t == "Grid") return SamplerType::Grid;
+    if (t == "Stratified") return SamplerType::Stratified;
+    rd.fail(n["type"], "unknown sampler type '" + t + "' (Independent, Grid or Stratified)");
+}
+
+int readTexture(const Reader& rd, const YAML::Node& n, const fs::path& dir, Scene& scene) {
+    rd.checkKeys(n, "texture", {"type", "colour", "string", "filename", "upper", "lower", "mask"});
+    if (!n["type"]) rd.fail(n, "texture needs a type (Constant, Standard or Layered)");
+    std::string t = rd.string(n["type"], "texture type");
+    Texture tex;
+    auto only = [&](std::initializer_list<const char*> keys) { rd.checkKeys(n, t + " texture", keys); };
+    if (t == "Constant") {
+        only({"type", "colour"});
+        tex.type = TextureType::Constant;
+        if (n["colour"]) tex.colour = rd.vec<3>(n["colour"], "texture colour", 0.0, 1.0);
+    } else if (t == "Standard") {
+        only({"type", "string", "filename"});
+        tex.type = TextureType::Standard;
+        YAML::Node f = n["string"] ? n["string"] : n["filename"];
+        if (!f) rd.fail(n, "Standard texture needs 'string' (or 'filename'): the image file");
+        fs::path p = dir / rd.string(f, "texture file");
+        if (!fs::is_regular_file(p)) rd.fail(f, "texture file '" + p.string() + "' does not exist");
+        tex.path = fs::absolute(p).lexically_normal().string();
+    } else if (t == "Layered") {
+        only({"type", "upper", "lower", "mask"});
+        tex.type = TextureType::Layered;
+        for (const char* k : {"upper", "lower", "mask"})
+            if (!n[k]) rd.fail(n, std::string("Layered texture needs '") + k + "'");
+        tex.upper = readTexture(rd, n["upper"], dir, scene);
+        tex.lower = readTexture(rd, n["lower"], dir, scene);
+        tex.mask = readTexture(rd, n["mask"], dir, scene);
+    } else {
+        rd.fail(n["type"], "unknown texture type '" + t + "' (Constant, Standard or Layered)");
+    }
+    scene.textures.push_back(tex);
+    return int(scene.textures.size()) - 1;
+}
+
+void readShader(const Reader& rd, const YAML::Node& n, const fs::path& dir, Scene& scene) {
+    if (!n.IsMap() || !n["type"]) rd.fail(n, "shader needs a type (Null, Lambert or Emissive)");
+    std::string t = rd.string(n["type"], "shader type");
+    Shader s;
+    s.typeName = t;
+    s.line = n.Mark().line + 1;
+    ShaderParams& p = s.params;
+    p.model = kModelNull;
+    p.colour = vec3(1.0f);
+    p.reflectance = 1.0f;
+    p.emission = vec3(0.0f);
+    if (t == "Conductor" || t == "Dielectric")
+        rd.fail(n["type"], "shader type '" + t + "' is not supported yet");
+    if (t == "Null" || t == "Emissive") {
+        rd.checkKeys(n, t + " shader", {"type", "emission", "two sided"});
+        if (t == "Emissive" && !n["emission"]) rd.fail(n, "Emissive shader needs 'emission'");
+    } else if (t == "Lambert") {
+        rd.checkKeys(n, "Lambert shader", {"type", "emission", "two sided", "reflectance", "colour", "texture"});
+        p.model = kModelLambert;
+        if (n["reflectance"]) p.reflectance = float(rd.number(n["reflectance"], "reflectance", 0.0, 1.0));
+        if (n["colour"] && n["texture"]) rd.fail(n["texture"], "Lambert takes colour or texture, not both");
+        if (n["colour"]) p.colour = rd.vec<3>(n["colour"], "colour", 0.0, 1.0);
+        if (n["texture"]) {
+            s.texture = readTexture(rd, n["texture"], dir, scene);
+            p.flags |= kShaderTextured;
+        }
+    } else {
+        rd.fail(n["type"], "unknown shader type '" + t + "' (Null, Lambert or Emissive)");
+    }
+    if (n["emission"]) p.emission = rd.vec<3>(n["emission"], "emission", 0.0, 1e30);
+    if (n["two sided"] && rd.boolean(n["two sided"], "two sided")) p.flags |= kShaderTwoSided;
+    scene.shaders.push_back(s);
+}
+
+struct PendingObject {
+    YAML::Node node;
+    int shader;
+    int line;
+};
+
+void readObject(const Reader& rd, const YAML::Node& n, const fs::path& dir, Scene& scene,
+                std::vector<PendingObject>& pending) {
+    rd.checkKeys(n, "object", {"type", "filename", "translation", "rotation", "scale", "shader"});
+    std::string t = n["type"] ? rd.string(n["type"], "object type") : "Polygon";
+    if (t != "Polygon") rd.fail(n["type"], "unknown object type '" + t + "' (Polygon)");
+    if (!n["filename"]) rd.fail(n, "object needs a filename (an OBJ file)");
+    fs::path p = dir / rd.string(n["filename"], "object filename");
+    if (!fs::is_regular_file(p)) rd.fail(n["filename"], "object file '" + p.string() + "' does not exist");
+    int shader = n["shader"] ? int(rd.integer(n["shader"], "object shader", 0, 1 << 30)) : 0;
+    mat4 xf = readTransform(rd, n, "object", true);
+    Mesh mesh = loadObjMesh(p.string(), xf, rd.file(), n["filename"].Mark().line + 1);
+    mesh.shader = shader;
+    scene.meshes.push_back(std::move(mesh));
+    pending.push_back({n, shader, n.Mark().line + 1});
+}
+
+// A quad light becomes two triangles (appended to lightMeshes) and an emissive Null shader of
+// its own (returned); both go after the scene's objects and shaders once the file is read.
+Shader readLight(const Reader& rd, const YAML::Node& n, std::vector<Mesh>& lightMeshes) {
+    if (!n.IsMap() || !n["type"]) rd.fail(n, "light needs a type (Quad)");
+    std::string t = rd.string(n["type"], "light type");
+    if (t == "Point" || t == "Environment") rd.fail(n["type"], "light type '" + t + "' is not supported yet");
+    if (t != "Quad") rd.fail(n["type"], "unknown light type '" + t + "' (Quad)");
+    rd.checkKeys(n, "Quad light", {"type", "translation", "rotation", "scale", "intensity", "colour"});
+    vec2 size(1.0f);
+    if (n["scale"]) size = rd.vec<2>(n["scale"], "light scale", 1e-30, 1e30);
+    float intensity = n["intensity"] ? float(rd.number(n["intensity"], "light intensity", 0.0, 1e30)) : 1.0f;
+    vec3 colour = n["colour"] ? rd.vec<3>(n["colour"], "light colour", 0.0, 1e30) : vec3(1.0f);
+    mat4 xf = readTransform(rd, n, "light", false);
+
+    Mesh m;
+    m.name = "quad light " + std::to_string(lightMeshes.size());
+    for (vec2 c : {vec2(-0.5f, -0.5f), vec2(0.5f, -0.5f), vec2(0.5f, 0.5f), vec2(-0.5f, 0.5f)})
+        m.positions.push_back(vec3(xf * vec4(c.x * size.x, c.y * size.y, 0.0f, 1.0f)));
+    m.triangles = {uvec3(0, 1, 2), uvec3(0, 2, 3)};
+    Shader s;
+    s.typeName = "Quad light";
+    s.line = n.Mark().line + 1;
+    s.params.model = kModelNull;
+    s.params.emission = intensity * colour;
+    lightMeshes.push_back(std::move(m));
+    return s;
+}
+
+} // namespace
+
+float Camera::tanHalfFovX() const {
+    if (fovDegrees) return std::tan(glm::radians(*fovDegrees) * 0.5f);
+    return 0.5f * filmWidth / focalLength;
+}
+
+bool Scene::usesTextures() const {
+    for (const Shader& s : shaders)
+        if (s.texture >= 0) return true;
+    return false;
+}
+
+Scene loadScene(const std::string& path) {
+    Scene scene;
+    scene.file = path;
+    Reader rd(path);
+    YAML::Node root;
+    try {
+        root = YAML::LoadFile(path);
+    } catch (const YAML::BadFile&) {
+        throw SceneError(path, 0, "cannot open the scene file");
+    } catch (const YAML::ParserException& e) {
+        throw SceneError(path, e.mark.line + 1, "YAML syntax error: " + e.msg);
+    }
+    if (root.IsNull()) return scene; // an empty file is an empty scene: black
+    if (!root.IsMap()) rd.fail(root, "a scene is a map of entries (image, camera, object, ...)");
+    fs::path dir = fs::path(path).parent_path();
+
+    std::vector<PendingObject> pending;
+    std::vector<Mesh> lightMeshes;
+    std::vector<Shader> lightShaders;
+    std::set<std::string> seenOnce;
+    try {
+        for (auto it = root.begin(); it != root.end(); ++it) {
+            std::string key = it->first.as<std::string>();
+            const YAML::Node& v = it->second;
+            bool single = key == "image" || key == "settings" || key == "camera" || key == "filter" ||
+                          key == "sampler";
+            if (single && !seenOnce.insert(key).second)
+                rd.fail(it->first, "'" + key + "' may appear only once");
+            auto each = [&](const std::function<void(const YAML::Node&)>& fn) {
+                if (v.IsSequence()) {
+                    for (const YAML::Node& e : v) fn(e);
+                } else {
+                    fn(v);
+                }
+            };
+            if (key == "image") readImage(rd, v, scene.image);
+            else if (key == "settings") readSettings(rd, v, scene.settings);
+            else if (key == "camera") readCamera(rd, v, scene.camera);
+            else if (key == "filter") readFilter(rd, v, scene.filter);
+            else if (key == "sampler") scene.sampler = readSampler(rd, v);
+            else if (key == "object" || key == "objects") {
+                if (key == "objects" && !v.IsSequence()) rd.fail(v, "'objects' must be a list");
+                each([&](const YAML::Node& e) { readObject(rd, e, dir, scene, pending); });
+            } else if (key == "shader" || key == "shaders") {
+                if (key == "shaders" && !v.IsSequence()) rd.fail(v, "'shaders' must be a list");
+                each([&](const YAML::Node& e) { readShader(rd, e, dir, scene); });
+            } else if (key == "light" || key == "lights") {
+                if (key == "lights" && !v.IsSequence()) rd.fail(v, "'lights' must be a list");
+                each([&](const YAML::Node& e) { lightShaders.push_back(readLight(rd, e, lightMeshes)); });
+            } else {
+                rd.fail(it->first, "unknown entry '" + key +
+                                       "' (image, settings, camera, filter, sampler, object, shader, light)");
+            }
+        }
+    } catch (const YAML::Exception& e) {
+        throw SceneError(path, e.mark.line + 1, e.msg);
+    }
+
+    const int sceneShaders = int(scene.shaders.size());
+    for (const PendingObject& o : pending)
+        if (o.shader >= sceneShaders)
+            rd.fail(o.line, "object uses shader " + std::to_string(o.shader) + " but the scene has " +
+                                std::to_string(sceneShaders) + " shader" + (sceneShaders == 1 ? "" : "s"));
+    scene.objectCount = int(scene.meshes.size());
+    scene.quadLightCount = int(lightMeshes.size());
+    for (size_t i = 0; i < lightMeshes.size(); ++i) {
+        lightMeshes[i].shader = int(scene.shaders.size());
+        scene.shaders.push_back(lightShaders[i]);
+        scene.meshes.push_back(std::move(lightMeshes[i]));
+    }
+    const ImageSettings& img = scene.image;
+    if ((unsigned long long)img.width * img.height * img.samplesPerIteration() > 0xFFFFFFFFull)
+        rd.fail(1, "width x height x sample base^2 exceeds 2^32 samples per iteration; lower the sample "
+                   "base and raise iterations");
+    return scene;
+}
+
+} // namespace spw

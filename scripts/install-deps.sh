@@ -1,0 +1,31 @@
+#!/usr/bin/env bash
+# Installs every Spillway dependency from Debian 12 packages. Idempotent: packages already
+# present are left alone, so a second run costs one dpkg query.
+set -euo pipefail
+
+packages=(
+  build-essential cmake pkg-config ninja-build
+  libembree-dev libtbb-dev                 # ray traversal (Embree 3) and its task scheduler
+  libopenimageio-dev openimageio-tools     # textures (lazy, mipmapped) and image output
+  libopenexr-dev                           # float EXR through OpenImageIO
+  libyaml-cpp-dev                          # the scene format
+  libglm-dev                               # vector math shared by C++ and GLSL
+  nlohmann-json3-dev                       # --stats JSON and reading it back in tests
+  libtinyobjloader-dev                     # OBJ meshes
+  libglfw3-dev                             # window for interactive preview (later)
+  libgtest-dev                             # the test suite
+  libvulkan-dev mesa-vulkan-drivers vulkan-validationlayers glslc glslang-tools
+  python3 python3-numpy python3-matplotlib # convergence plots
+)
+
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q 'install ok installed' || missing+=("$p")
+done
+if ((${#missing[@]})); then
+  echo "install-deps: installing ${missing[*]}" >&2
+  sudo=""; [ "$(id -u)" -eq 0 ] || sudo="sudo"
+  export DEBIAN_FRONTEND=noninteractive
+  $sudo apt-get update -qq
+  $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+fi

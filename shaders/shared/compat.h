@@ -1,0 +1,75 @@
+// The only code both compilers see lives in shaders/shared/. It is written in the common subset
+// of GLSL 4.60 and C++17 over glm, so that the BSDFs, light sampling, MIS and the random numbers
+// exist once and every backend (reference, cpu, and the Vulkan compute shaders) runs the same
+// source. We chose "GLSL-compatible headers compiled as C++ over glm" over generating one language
+// from the other: no code generator to maintain, and a compile error on either side points at the
+// one true line.
+//
+// Rules for code in this folder:
+//   * float literals carry an `f` suffix (GLSL accepts it; C++ glm refuses float*double);
+//   * unsigned literals carry `u`;
+//   * no references, pointers, templates or constructors: parameters are `in`, `OUT(T)` or
+//     `INOUT(T)`, and structs are filled field by field;
+//   * functions are declared `SHARED_FN` (inline in C++, nothing in GLSL);
+//   * buffer reads go through the accessor macros of the file that declares the buffer.
+#ifndef SPILLWAY_SHARED_COMPAT_H
+#define SPILLWAY_SHARED_COMPAT_H
+
+#ifdef __cplusplus
+#include <cstdint>
+#include <glm/glm.hpp>
+#include <glm/gtc/packing.hpp>
+
+namespace spw {
+using glm::bvec3;
+using glm::ivec2;
+using glm::mat3;
+using glm::mat4;
+using glm::uvec2;
+using glm::uvec3;
+using glm::uvec4;
+using glm::vec2;
+using glm::vec3;
+using glm::vec4;
+using uint = std::uint32_t;
+using glm::abs;
+using glm::clamp;
+using glm::cross;
+using glm::dot;
+using glm::floatBitsToUint;
+using glm::inversesqrt;
+using glm::length;
+using glm::max;
+using glm::min;
+using glm::mix;
+using glm::normalize;
+using glm::sign;
+using glm::uintBitsToFloat;
+using std::sqrt;
+using std::cos;
+using std::sin;
+using std::atan;
+using std::exp;
+using std::floor;
+} // namespace spw
+
+#define SHARED_FN inline
+#define OUT(T) T&
+#define INOUT(T) T&
+#define SHARED_BEGIN namespace spw {
+#define SHARED_END }
+#else
+#define SHARED_FN
+#define OUT(T) out T
+#define INOUT(T) inout T
+#define SHARED_BEGIN
+#define SHARED_END
+#endif
+
+SHARED_BEGIN
+const float kPi = 3.14159265358979323846f;
+const float kInvPi = 0.31830988618379067154f;
+const float kOneMinusEpsilon = 0.99999994f; // largest float below 1
+SHARED_END
+
+#endif

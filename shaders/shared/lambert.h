@@ -1,0 +1,35 @@
+// Lambert: the ideal diffuse reflector.
+//   parameters: reflectance (1), colour [r, g, b] ([1, 1, 1]) or texture; albedo = reflectance x
+//   colour. f = albedo / pi; sampled by the cosine-weighted hemisphere, pdf = cos / pi, so the
+//   sample weight is exactly the albedo. Reflection only: wi on the side of ng that wo is on.
+#ifndef SPILLWAY_SHARED_LAMBERT_H
+#define SPILLWAY_SHARED_LAMBERT_H
+#include "sampling.h"
+
+SHARED_BEGIN
+
+SHARED_FN vec3 lambertEval(vec3 albedo, vec3 ng, vec3 ns, vec3 wo, vec3 wi, OUT(float) pdf) {
+    pdf = 0.0f;
+    if (dot(ng, wo) * dot(ng, wi) <= 0.0f) return vec3(0.0f);
+    vec3 n = facingShadingNormal(ns, ng, wo);
+    float c = dot(n, wi);
+    if (c <= 0.0f) return vec3(0.0f);
+    pdf = c * kInvPi;
+    return albedo * (c * kInvPi);
+}
+
+SHARED_FN bool lambertSample(vec3 albedo, vec3 ng, vec3 ns, vec3 wo, vec2 u, OUT(vec3) wi,
+                             OUT(vec3) weight, OUT(float) pdf) {
+    vec3 n = facingShadingNormal(ns, ng, wo);
+    vec3 local = sampleCosineHemisphere(u);
+    wi = normalize(toWorld(local, n));
+    // With a shading normal the sample can fall below the geometric surface: absorb it, as the
+    // eval above gives 0 there, so sampling and evaluation stay consistent.
+    if (dot(ng, wo) * dot(ng, wi) <= 0.0f || local.z <= 0.0f) return false;
+    pdf = local.z * kInvPi;
+    weight = albedo;
+    return true;
+}
+
+SHARED_END
+#endif

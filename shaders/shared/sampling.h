@@ -1,0 +1,88 @@
+// Sampling primitives shared by every backend: orthonormal frames, warps from the unit square,
+// and the multiple-importance-sampling weight.
+#ifndef SPILLWAY_SHARED_SAMPLING_H
+#define SPILLWAY_SHARED_SAMPLING_H
+#include "compat.h"
+
+SHARED_BEGIN
+
+// Orthonormal basis around a unit vector n (Duff et al. 2017, "Building an Orthonormal Basis,
+// Revisited"): branch-free and continuous except at n.z = -0 / +0.
+SHARED_FN void makeFrame(vec3 n, OUT(vec3) t, OUT(vec3) b) {
+    float s = n.z >= 0.0f ? 1.0f : -1.0f;
+    float a = -1.0f / (s + n.z);
+    float c = n.x * n.y * a;
+    t = vec3(1.0f + s * n.x * n.x * a, s * c, -s * n.x);
+    b = vec3(c, s + n.y * n.y * a, -n.y);
+}
+
+SHARED_FN vec3 toWorld(vec3 local, vec3 n) {
+    vec3 t;
+    vec3 b;
+    makeFrame(n, t, b);
+    return local.x * t + local.y * b + local.z * n;
+}
+
+// Cosine-weighted hemisphere around +Z through the concentric disk map (Shirley & Chiu 1997).
+SHARED_FN vec3 sampleCosineHemisphere(vec2 u) {
+    vec2 d = 2.0f * u - vec2(1.0f, 1.0f);
+    float r;
+    float phi;
+    if (d.x == 0.0f && d.y == 0.0f) {
+        r = 0.0f;
+        phi = 0.0f;
+    } else if (abs(d.x) > abs(d.y)) {
+        r = d.x;
+        phi = (kPi / 4.0f) * (d.y / d.x);
+    } else {
+        r = d.y;
+        phi = (kPi / 2.0f) - (kPi / 4.0f) * (d.x / d.y);
+    }
+    float x = r * cos(phi);
+    float y = r * sin(phi);
+    return vec3(x, y, sqrt(max(0.0f, 1.0f - x * x - y * y)));
+}
+
+SHARED_FN vec2 sampleConcentricDisk(vec2 u) {
+    vec3 h = sampleCosineHemisphere(u);
+    return vec2(h.x, h.y);
+}
+
+// Uniform barycentrics on a triangle (Heitz 2019's square-root-free fold would do too; the
+// square root form is the classic Turk 1990 map and keeps strata contiguous).
+SHARED_FN vec2 sampleTriangle(vec2 u) {
+    float su = sqrt(u.x);
+    return vec2(1.0f - su, u.y * su);
+}
+
+// Power heuristic with beta = 2 (Veach 1997, ch. 9), written to stay finite for any pair of
+// non-negative pdfs, including infinite ones.
+SHARED_FN float powerHeuristic(float pdfThis, float pdfOther) {
+    if (pdfThis <= 0.0f) return 0.0f;
+    float r = pdfOther / pdfThis;
+    return 1.0f / (1.0f + r * r);
+}
+
+// The BSDF pdf that MIS compares with the light pdf travels inside the 32-byte compact ray as a
+// bfloat16 (the top 16 bits of the float). Quantising it the same way on *both* sides of the
+// MIS pair (light sampling and BSDF sampling) keeps the weights an exact partition of unity, so
+// the quantisation changes which strategy gets credit, never the expected value.
+SHARED_FN float quantizePdf(float pdf) {
+    return uintBitsToFloat(floatBitsToUint(pdf) & 0xFFFF0000u);
+}
+
+// The shading normal turned to the side of the geometric normal that wo is on.
+SHARED_FN vec3 facingShadingNormal(vec3 ns, vec3 ng, vec3 wo) {
+    float side = dot(ng, wo) >= 0.0f ? 1.0f : -1.0f;
+    vec3 n = ns * side;
+    // A shading normal on the far side of the geometric one (bad vertex normals) is replaced by
+    // the geometric normal, so cosines stay non-negative.
+    return dot(n, ng * side) > 0.0f ? n : ng * side;
+}
+
+SHARED_FN float maxComponent(vec3 v) { return max(v.x, max(v.y, v.z)); }
+
+SHARED_FN float luminance(vec3 c) { return dot(c, vec3(0.2126f, 0.7152f, 0.0722f)); }
+
+SHARED_END
+#endif

@@ -1,0 +1,28 @@
+// How shared code reads scene-wide arrays (shaders, emitters, the emitter CDF). In C++ they are
+// spans passed as the first argument of every function that needs them; in GLSL they are
+// storage buffers declared by the kernel before it includes the shared headers, and the
+// SCENE_PARAM / SCENE_ARG macros vanish.
+#ifndef SPILLWAY_SHARED_SCENE_ACCESS_H
+#define SPILLWAY_SHARED_SCENE_ACCESS_H
+#include "types.h"
+
+#ifdef __cplusplus
+namespace spw {
+struct SceneView {
+    const ShaderParams* shaders = nullptr;
+    const Emitter* emitters = nullptr;
+    const float* emitterCdf = nullptr; // inclusive prefix sums of pickPdf, last entry 1
+    uint emitterCount = 0;
+};
+} // namespace spw
+#define SCENE_PARAM const SceneView &scene,
+#define SCENE_ARG scene,
+#define SHADER(i) scene.shaders[i]
+#define EMITTER(i) scene.emitters[i]
+#define EMITTER_CDF(i) scene.emitterCdf[i]
+#else
+#define SCENE_PARAM
+#define SCENE_ARG
+#endif
+
+#endif

@@ -1,0 +1,101 @@
+// Structs that every backend's shading step reads and writes. Declared once, here; the C++
+// side checks their layout in host/shared_layout.cpp so that a GLSL scalar-block-layout view of
+// the same bytes stays in step.
+#ifndef SPILLWAY_SHARED_TYPES_H
+#define SPILLWAY_SHARED_TYPES_H
+#include "compat.h"
+
+SHARED_BEGIN
+
+// Surface models. The registry (host/surface_models.h) maps each to its name and code.
+const uint kModelNull = 0u;
+const uint kModelLambert = 1u;
+const uint kModelCount = 2u;
+
+const uint kShaderTwoSided = 1u; // emits from both faces
+const uint kShaderTextured = 2u; // albedo comes from a texture tree, resolved on the host
+
+struct ShaderParams {
+    vec3 emission;     // radiance leaving the front face (both with kShaderTwoSided)
+    uint model;        // kModel*
+    vec3 colour;       // constant albedo colour when not textured
+    float reflectance; // albedo scale
+    uint flags;        // kShader*
+    float ior;         // Dielectric (not built yet)
+    float alpha;       // GGX width (not built yet)
+    uint pad0;
+};
+
+// One emitting triangle (quad lights are two). Sampled uniformly by area; picked with
+// probability pickPdf, proportional to its power.
+struct Emitter {
+    vec3 p0;
+    float area;
+    vec3 e1; // v1 - v0
+    float pickPdf;
+    vec3 e2; // v2 - v0
+    uint twoSided;
+    vec3 normal; // unit, cross(e1, e2) direction: the front face
+    float pad0;
+    vec3 radiance;
+    float pad1;
+};
+
+// What the shading step needs to know about a hit, already in world space.
+struct SurfaceHit {
+    vec3 p;       // position, interpolated from the triangle's vertices (not o + t d)
+    float t;      // distance along the unit ray direction
+    vec3 ng;      // unit geometric normal, cross(v1 - v0, v2 - v0)
+    uint shader;  // index into the scene's shaders
+    vec3 ns;      // unit shading normal (interpolated vertex normals, or ng)
+    uint emitter; // index of the emitting triangle hit, or kNoEmitter
+    vec3 albedo;  // reflectance x texture, resolved on the host in hit-sorted order
+    uint pad0;
+};
+const uint kNoEmitter = 0xFFFFFFFFu;
+
+// A path between bounces.
+const uint kPathSpecular = 1u; // the last bounce sampled a delta lobe: no MIS on emitter hits
+
+struct PathState {
+    vec3 beta;     // throughput
+    float prevPdf; // solid-angle pdf of the BSDF sample that made this ray (bfloat16-quantised)
+    uint pathId;   // pixel * samplesPerIteration + sample within the iteration
+    uint bounce;   // 0 for camera rays
+    uint flags;    // kPath*
+    uint pad0;
+};
+
+const uint kStrategyMis = 0u;   // light and BSDF sampling, power heuristic
+const uint kStrategyLight = 1u; // next-event estimation only (emitter hits after bounce 0 ignored)
+const uint kStrategyBsdf = 2u;  // BSDF sampling only (no shadow rays)
+
+struct RenderParams {
+    uint seed;
+    uint iteration;
+    uint samplesPerIteration;
+    uint minDepth;
+    uint maxDepth;
+    float threshold;
+    uint strategy;
+    uint emitterCount;
+};
+
+const uint kShadeEmitted = 1u;
+const uint kShadeShadow = 2u;
+const uint kShadeContinue = 4u;
+
+struct ShadeResult {
+    uint flags;             // kShade*
+    vec3 emitted;           // beta * Le * MIS weight, for the film now
+    vec3 shadowOrigin;
+    float shadowTmax;
+    vec3 shadowDir;
+    vec3 shadowContribution; // added to the film if the shadow ray is unoccluded
+    vec3 nextOrigin;
+    vec3 nextDir;
+    PathState next;
+};
+
+SHARED_END
+#endif

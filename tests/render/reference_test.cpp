@@ -1,0 +1,208 @@
+// The reference backend against closed forms: every assertion compares with an analytic value
+// within a standard error computed from the render's own samples.
+#include "host/camera.h"
+#include "test_util.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+
+namespace spw::test {
+namespace {
+
+// Per-pixel statistics over iterations: each iteration is an independent estimate.
+struct PixelStats {
+    std::vector<double> sum, sum2;
+    int n = 0;
+    void add(const std::vector<float>& img) {
+        if (sum.empty()) sum.assign(img.size() / 3, 0.0), sum2.assign(img.size() / 3, 0.0);
+        for (size_t i = 0; i < sum.size(); ++i) {
+            double v = (double(img[3 * i]) + img[3 * i + 1] + img[3 * i + 2]) / 3.0;
+            sum[i] += v;
+            sum2[i] += v * v;
+        }
+        ++n;
+    }
+    double mean(size_t i) const { return sum[i] / n; }
+    double variance(size_t i) const { return std::max(0.0, (sum2[i] - n * mean(i) * mean(i)) / (n - 1)); }
+    double stderror(size_t i) const { return std::sqrt(variance(i) / n); }
+    double meanVariance() const {
+        double v = 0;
+        for (size_t i = 0; i < sum.size(); ++i) v += variance(i);
+        return v / double(sum.size());
+    }
+    // Image mean and its standard error (pixels independent).
+    MeanError imageMean() const {
+        double m = 0, var = 0;
+        for (size_t i = 0; i < sum.size(); ++i) m += mean(i), var += variance(i) / n;
+        const double p = double(sum.size());
+        return {m / p, std::sqrt(var) / p};
+    }
+};
+
+std::unique_ptr<RenderResult> renderWithStats(const Scene& scene, const RenderConfig& cfg, PixelStats* stats) {
+    return render(scene, cfg, [&](int, int, const Film& film) {
+        if (stats) stats->add(film.lastIterationImage());
+    });
+}
+
+std::string enclosureScene(TempDir& dir, double albedo, int maxDepth) {
+    dir.write("cube.obj", insideCubeObj());
+    char buf[1024];
+    std::snprintf(buf, sizeof buf,
+                  "image: {width: 24, height: 24, sample base: 2, iterations: 8}\n"
+                  "settings: {max depth: %d, min depth: 3, threshold: 0.1}\n"
+                  "camera: {look at: {eye: [0, 0, 0], target: [0.3, 0.2, -1]}, fov: 100}\n"
+                  "object: {type: Polygon, filename: cube.obj, shader: 0}\n"
+                  "shader: {type: Lambert, reflectance: %.17g, emission: [1, 1, 1]}\n",
+                  maxDepth, albedo);
+    return dir.write("enclosure.yaml", buf);
+}
+
+class ClosedEnclosure : public ::testing::TestWithParam<double> {};
+
+// Inside a closed cube whose every face is Lambert with albedo a and emission Le, the radiance
+// everywhere is Le / (1 - a) (a geometric series over bounces).
+TEST_P(ClosedEnclosure, MeanMatchesLeOverOneMinusAlbedo) {
+    const double a = GetParam();
+    TempDir dir;
+    Scene scene = loadScene(enclosureScene(dir, a, 400));
+    auto result = render(scene, RenderConfig{});
+    MeanError m = meanAndError(result->film->image());
+    const double expected = 1.0 / (1.0 - a);
+    std::printf("albedo %.3f: mean %.5f, expected %.5f, standard error %.5f\n", a, m.mean, expected, m.stderror);
+    EXPECT_GT(m.stderror, 0.0);
+    EXPECT_NEAR(m.mean, expected, 4.0 * m.stderror) << "standard error " << m.stderror;
+    EXPECT_EQ(result->stats.nonFiniteSamples, 0u);
+}
+
+INSTANTIATE_TEST_SUITE_P(Albedo, ClosedEnclosure, ::testing::Values(0.5, 0.9));
+
+// Irradiance at x from a uniformly emitting polygon (Lambert's formula): E = L/2 sum_i theta_i
+// (n . unit(v_i x v_{i+1})), v_i the corners relative to x.
+double polygonIrradiance(vec3 x, vec3 n, const std::vector<vec3>& corners, double L) {
+    double sum = 0;
+    for (size_t i = 0; i < corners.size(); ++i) {
+        glm::dvec3 a = glm::normalize(glm::dvec3(corners[i] - x));
+        glm::dvec3 b = glm::normalize(glm::dvec3(corners[(i + 1) % corners.size()] - x));
+        double theta = std::acos(std::clamp(glm::dot(a, b), -1.0, 1.0));
+        glm::dvec3 g = glm::normalize(glm::cross(a, b));
+        sum += theta * glm::dot(glm::dvec3(n), g);
+    }
+    return 0.5 * L * std::fabs(sum);
+}
+
+// A Lambert floor under one quad light, direct light only: every pixel is albedo/pi * E(x).
+TEST(QuadLight, PixelsMatchPolygonIrradiance) {
+    TempDir dir;
+    dir.write("floor.obj", floorObj(4.0f));
+    const std::string path = dir.write("quad.yaml",
+                                       "image: {width: 16, height: 16, sample base: 1, iterations: 256}\n"
+                                       "settings: {max depth: 1}\n"
+                                       "camera: {look at: {eye: [0.2, 0.6, 0.1], target: [0.2, 0, 0.1], up: [0, 0, -1]}, fov: 90}\n"
+                                       "sampler: {type: Grid}\n"
+                                       "object: {filename: floor.obj, shader: 0}\n"
+                                       "shader: {type: Lambert, reflectance: 0.5}\n"
+                                       "light: {type: Quad, translation: [0, 1, 0], rotation: [90, 0, 0], scale: [1, 0.5], intensity: 3}\n");
+    Scene scene = loadScene(path);
+    PixelStats ps;
+    auto result = renderWithStats(scene, RenderConfig{}, &ps);
+    const std::vector<vec3> corners = {{-0.5f, 1, -0.25f}, {0.5f, 1, -0.25f}, {0.5f, 1, 0.25f}, {-0.5f, 1, 0.25f}};
+    CameraModel cam(scene, 1);
+    double worstZ = 0, sumZ = 0;
+    for (int y = 0; y < 16; ++y)
+        for (int x = 0; x < 16; ++x) {
+            CameraRay r = cam.generate(uint(x), uint(y), 0, 0, 0); // Grid: the pixel centre
+            vec3 p = r.origin + r.dir * (-r.origin.y / r.dir.y);
+            double expected = 0.5 / kPi * polygonIrradiance(p, vec3(0, 1, 0), corners, 3.0);
+            size_t i = size_t(y * 16 + x);
+            double z = (ps.mean(i) - expected) / std::max(ps.stderror(i), 1e-12);
+            worstZ = std::max(worstZ, std::fabs(z));
+            sumZ += z;
+        }
+    std::printf("worst |z| %.2f, mean z %.3f\n", worstZ, sumZ / 256.0);
+    // 256 pixels: |z| < 5 for each, and their mean z within 4 / sqrt(256) of 0.
+    EXPECT_LT(worstZ, 5.0);
+    EXPECT_LT(std::fabs(sumZ / 256.0), 4.0 / 16.0);
+}
+
+// Direct light on a floor from a tiny bright light and a large dim wall emitter standing on it:
+// light sampling is best for the former, BSDF sampling for the parts of the floor next to the
+// wall; MIS must agree with both and beat both.
+TEST(Mis, StrategiesAgreeAndMisHasLowestVariance) {
+    TempDir dir;
+    dir.write("floor.obj", floorObj(1.0f));
+    const std::string path = dir.write("mis.yaml",
+                                       "image: {width: 16, height: 16, sample base: 1, iterations: 200}\n"
+                                       "settings: {max depth: 1}\n"
+                                       "camera: {look at: {eye: [0, 0.8, -0.2], target: [0, 0, -0.2], up: [0, 0, -1]}, fov: 100}\n"
+                                       "object: {filename: floor.obj, shader: 0}\n"
+                                       "shader: {type: Lambert, reflectance: 0.8}\n"
+                                       "lights:\n"
+                                       "  - {type: Quad, translation: [0, 1, 0], rotation: [90, 0, 0], scale: [0.04, 0.04], intensity: 600}\n"
+                                       "  - {type: Quad, translation: [0, 1, -1], scale: [2, 2], intensity: 0.4}\n");
+    Scene scene = loadScene(path);
+    PixelStats stats[3];
+    for (uint s : {kStrategyMis, kStrategyLight, kStrategyBsdf}) {
+        RenderConfig cfg;
+        cfg.strategy = s;
+        renderWithStats(scene, cfg, &stats[s]);
+    }
+    for (uint s : {kStrategyMis, kStrategyLight, kStrategyBsdf})
+        std::printf("strategy %u: mean %.5f +- %.5f, mean pixel variance %.5f\n", s, stats[s].imageMean().mean,
+                    stats[s].imageMean().stderror, stats[s].meanVariance());
+    MeanError mis = stats[kStrategyMis].imageMean();
+    for (uint s : {kStrategyLight, kStrategyBsdf}) {
+        MeanError other = stats[s].imageMean();
+        double se = std::hypot(mis.stderror, other.stderror);
+        EXPECT_NEAR(mis.mean, other.mean, 4.0 * se) << "strategy " << s;
+        EXPECT_LT(stats[kStrategyMis].meanVariance(), stats[s].meanVariance()) << "strategy " << s;
+    }
+}
+
+std::vector<float> renderCornell(int threads) {
+    Scene scene = loadScene(sourceDir() + "/scenes/cornell-box.yaml");
+    scene.image.width = scene.image.height = 48;
+    RenderConfig cfg;
+    cfg.threads = threads;
+    cfg.spp = 8;
+    return render(scene, cfg)->film->image();
+}
+
+TEST(Determinism, SameImageBitForBitWithOneAndTwoThreads) {
+    std::vector<float> one = renderCornell(1), two = renderCornell(2);
+    ASSERT_EQ(one.size(), two.size());
+    EXPECT_EQ(std::memcmp(one.data(), two.data(), one.size() * sizeof(float)), 0);
+    EXPECT_GT(mean(one), 0.01);
+}
+
+// max depth 0: only emitters seen directly; the floor under a light stays black.
+TEST(MaxDepth, ZeroShowsOnlyEmitters) {
+    TempDir dir;
+    dir.write("floor.obj", floorObj(4.0f));
+    Scene scene = loadScene(dir.write("d0.yaml",
+                                      "image: {width: 8, height: 8}\n"
+                                      "settings: {max depth: 0}\n"
+                                      "camera: {look at: {eye: [0, 2, 0], target: [0, 0, 0], up: [0, 0, -1]}, fov: 60}\n"
+                                      "object: {filename: floor.obj, shader: 0}\n"
+                                      "shader: {type: Lambert}\n"
+                                      "light: {type: Quad, translation: [0, 3, 0], rotation: [90, 0, 0], intensity: 5}\n"));
+    EXPECT_EQ(mean(render(scene, RenderConfig{})->film->image()), 0.0);
+    // The same floor emitting itself is seen at exactly its radiance.
+    Scene lit = loadScene(dir.write("d0e.yaml",
+                                    "image: {width: 8, height: 8}\n"
+                                    "settings: {max depth: 0}\n"
+                                    "camera: {look at: {eye: [0, 2, 0], target: [0, 0, 0], up: [0, 0, -1]}, fov: 60}\n"
+                                    "object: {filename: floor.obj, shader: 0}\n"
+                                    "shader: {type: Emissive, emission: [0.25, 0.5, 2]}\n"));
+    std::vector<float> img = render(lit, RenderConfig{})->film->image();
+    for (size_t i = 0; i < img.size(); i += 3) {
+        ASSERT_FLOAT_EQ(img[i], 0.25f);
+        ASSERT_FLOAT_EQ(img[i + 1], 0.5f);
+        ASSERT_FLOAT_EQ(img[i + 2], 2.0f);
+    }
+}
+
+} // namespace
+} // namespace spw::test

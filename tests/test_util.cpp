@@ -1,0 +1,90 @@
+#include "test_util.h"
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <sys/wait.h>
+
+namespace spw::test {
+
+TempDir::TempDir() {
+    std::random_device rd;
+    for (int tries = 0; tries < 100; ++tries) {
+        auto p = std::filesystem::temp_directory_path() / ("spillway-test-" + std::to_string(rd()));
+        if (std::filesystem::create_directory(p)) {
+            path_ = p.string();
+            return;
+        }
+    }
+    throw std::runtime_error("cannot create a temporary folder");
+}
+
+TempDir::~TempDir() {
+    std::error_code ec;
+    std::filesystem::remove_all(path_, ec);
+}
+
+std::string TempDir::write(const std::string& name, const std::string& text) const {
+    std::string p = file(name);
+    std::filesystem::create_directories(std::filesystem::path(p).parent_path());
+    std::ofstream(p) << text;
+    return p;
+}
+
+std::string sourceDir() { return SPILLWAY_SOURCE_DIR; }
+std::string binary() { return SPILLWAY_BINARY; }
+
+CommandResult runSpillway(const std::string& args) {
+    std::string cmd = binary() + " " + args + " 2>&1";
+    FILE* p = popen(cmd.c_str(), "r");
+    if (!p) return {-1, "popen failed"};
+    std::string out;
+    char buf[4096];
+    size_t n;
+    while ((n = fread(buf, 1, sizeof buf, p)) > 0) out.append(buf, n);
+    int st = pclose(p);
+    return {WIFEXITED(st) ? WEXITSTATUS(st) : -1, out};
+}
+
+double mean(const std::vector<float>& rgb) {
+    double s = 0;
+    for (float v : rgb) s += v;
+    return rgb.empty() ? 0.0 : s / double(rgb.size());
+}
+
+MeanError meanAndError(const std::vector<float>& rgb) {
+    const size_t n = rgb.size() / 3;
+    double s = 0, s2 = 0;
+    for (size_t i = 0; i < n; ++i) {
+        double v = (double(rgb[3 * i]) + rgb[3 * i + 1] + rgb[3 * i + 2]) / 3.0;
+        s += v;
+        s2 += v * v;
+    }
+    double m = s / double(n);
+    double var = (s2 - double(n) * m * m) / double(n - 1);
+    return {m, std::sqrt(std::max(0.0, var) / double(n))};
+}
+
+std::string insideCubeObj() {
+    // 8 corners; faces wound so that cross(v1 - v0, v2 - v0) points into the cube.
+    return "v -1 -1 -1\nv 1 -1 -1\nv 1 1 -1\nv -1 1 -1\n"
+           "v -1 -1 1\nv 1 -1 1\nv 1 1 1\nv -1 1 1\n"
+           "f 1 2 3 4\n"  // z = -1, normal +z
+           "f 5 8 7 6\n"  // z = +1, normal -z
+           "f 1 4 8 5\n"  // x = -1, normal +x
+           "f 2 6 7 3\n"  // x = +1, normal -x
+           "f 1 5 6 2\n"  // y = -1, normal +y
+           "f 4 3 7 8\n"; // y = +1, normal -y
+}
+
+std::string floorObj(float h) {
+    char buf[256];
+    std::snprintf(buf, sizeof buf, "v %g 0 %g\nv %g 0 %g\nv %g 0 %g\nv %g 0 %g\nf 1 2 3 4\n", -h, -h, -h, h, h,
+                  h, h, -h);
+    return buf;
+}
+
+} // namespace spw::test

@@ -1,0 +1,53 @@
+// Helpers shared by the test suites: scratch folders, scene files written on the fly, running
+// the spillway binary, and statistics over images.
+#pragma once
+
+#include "host/render.h"
+#include "host/scene.h"
+
+#include <string>
+#include <vector>
+
+namespace spw::test {
+
+// A fresh folder under the system temp dir, removed with everything in it on destruction.
+class TempDir {
+  public:
+    TempDir();
+    ~TempDir();
+    TempDir(const TempDir&) = delete;
+    TempDir& operator=(const TempDir&) = delete;
+    const std::string& path() const { return path_; }
+    std::string file(const std::string& name) const { return path_ + "/" + name; }
+    // Writes `text` to `name` inside the folder and returns its path.
+    std::string write(const std::string& name, const std::string& text) const;
+
+  private:
+    std::string path_;
+};
+
+std::string sourceDir();
+std::string binary();
+
+struct CommandResult {
+    int status;         // exit status, or -1 when killed by a signal
+    std::string output; // stdout and stderr together
+};
+CommandResult runSpillway(const std::string& args);
+
+// Mean of the channel average over all pixels.
+double mean(const std::vector<float>& rgb);
+// Mean and standard error of the mean of a per-pixel quantity (channel average), treating
+// pixels as independent samples.
+struct MeanError {
+    double mean;
+    double stderror;
+};
+MeanError meanAndError(const std::vector<float>& rgb);
+
+// An axis-aligned box [-1,1]^3 whose faces point inward, as OBJ text.
+std::string insideCubeObj();
+// A square [-h,h]^2 at y = 0 facing +Y, as OBJ text.
+std::string floorObj(float halfSize);
+
+} // namespace spw::test
