@@ -2,7 +2,9 @@
 
 #include <tiny_obj_loader.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <fstream>
 #include <map>
 #include <sstream>
@@ -23,6 +25,37 @@ int lineOfVertex(const std::string& path, size_t vertexIndex) {
     return 0;
 }
 
+// tinyobjloader reads a number it cannot parse ("nan", "inf", "1x") as 0 without a word: check
+// every coordinate of the v, vn and vt statements first, naming the OBJ file and line.
+void checkCoordinates(const std::string& path, const std::string& text) {
+    auto blank = [](char c) { return c == ' ' || c == '\t' || c == '\r'; };
+    const char* p = text.c_str();
+    const char* const end = p + text.size();
+    for (int lineNo = 1; p < end; ++lineNo) {
+        const char* eol = std::find(p, end, '\n');
+        const char* stop = std::find(p, eol, '#');
+        while (p < stop && blank(*p)) ++p;
+        const char* word = p;
+        while (p < stop && !blank(*p)) ++p;
+        const std::string statement(word, p);
+        if (statement == "v" || statement == "vn" || statement == "vt") {
+            while (true) {
+                while (p < stop && blank(*p)) ++p;
+                if (p == stop) break;
+                const char* start = p;
+                while (p < stop && !blank(*p)) ++p;
+                const std::string token(start, p);
+                char* parsed = nullptr;
+                const double v = std::strtod(token.c_str(), &parsed);
+                if (parsed != token.c_str() + token.size() || !std::isfinite(v))
+                    throw SceneError(path, lineNo, "'" + statement + "' coordinate '" + token +
+                                                       "' is not a finite number");
+            }
+        }
+        p = eol + (eol < end ? 1 : 0);
+    }
+}
+
 } // namespace
 
 Mesh loadObjMesh(const std::string& path, const mat4& objectToWorld, const std::string& sceneFile,
@@ -36,6 +69,7 @@ Mesh loadObjMesh(const std::string& path, const mat4& objectToWorld, const std::
     std::ifstream file(path);
     std::stringstream text;
     text << file.rdbuf();
+    if (file) checkCoordinates(path, text.str());
     if (!file || !reader.ParseFromString(text.str(), "", cfg)) {
         std::string why = reader.Error();
         while (!why.empty() && (why.back() == '\n' || why.back() == '\r')) why.pop_back();

@@ -302,7 +302,8 @@ void readObject(const Reader& rd, const YAML::Node& n, const fs::path& dir, Scen
     Mesh mesh = loadObjMesh(p.string(), xf, rd.file(), n["filename"].Mark().line + 1);
     mesh.shader = shader;
     scene.meshes.push_back(std::move(mesh));
-    pending.push_back({n, shader, n.Mark().line + 1});
+    // A bad index is reported at the `shader:` value, or at the object when it has none.
+    pending.push_back({n, shader, (n["shader"] ? n["shader"] : n).Mark().line + 1});
 }
 
 // A quad light becomes two triangles (appended to lightMeshes) and an emissive Null shader of

@@ -1,0 +1,188 @@
+// The spillway command line: usage and version, exit status 2 for every kind of bad usage, the
+// Cornell box rendered to both output formats, the --stats JSON, and --seed reproducibility.
+#include "host/image_io.h"
+#include "test_util.h"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+
+namespace spw::test {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string cornellBox() { return sourceDir() + "/scenes/cornell-box.yaml"; }
+
+bool contains(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
+
+TEST(Cli, HelpPrintsUsage) {
+    CommandResult r = runSpillway("--help");
+    EXPECT_EQ(r.status, 0) << r.output;
+    EXPECT_TRUE(contains(r.output, "usage")) << r.output;
+    EXPECT_TRUE(contains(r.output, "render")) << r.output;
+}
+
+TEST(Cli, VersionExitsZero) {
+    CommandResult r = runSpillway("--version");
+    EXPECT_EQ(r.status, 0) << r.output;
+    EXPECT_TRUE(contains(r.output, "spillway")) << r.output;
+}
+
+TEST(Cli, NoArgumentsIsAUsageError) {
+    CommandResult r = runSpillway("");
+    EXPECT_EQ(r.status, 2) << r.output;
+    EXPECT_TRUE(contains(r.output, "usage")) << r.output;
+}
+
+TEST(Cli, UnknownCommandIsAUsageError) {
+    CommandResult r = runSpillway("paint " + cornellBox());
+    EXPECT_EQ(r.status, 2) << r.output;
+    EXPECT_TRUE(contains(r.output, "paint")) << r.output;
+}
+
+// A bad render command line: its arguments after "render" ({scene}, {out} and {dir} are
+// replaced) and a word the message must contain.
+struct BadUsage {
+    const char* name;
+    const char* args;
+    const char* mention;
+};
+
+void PrintTo(const BadUsage& c, std::ostream* os) { *os << c.name; }
+
+std::string expand(std::string s, const std::string& key, const std::string& value) {
+    for (size_t at; (at = s.find(key)) != std::string::npos;) s.replace(at, key.size(), value);
+    return s;
+}
+
+class CliBadUsage : public ::testing::TestWithParam<BadUsage> {};
+
+// Each exits 2 before rendering and writes no file.
+TEST_P(CliBadUsage, ExitsTwoAndWritesNothing) {
+    const BadUsage& c = GetParam();
+    TempDir dir;
+    std::string args = expand(expand(expand(c.args, "{scene}", cornellBox()), "{out}", dir.file("out.exr")),
+                              "{dir}", dir.path());
+    CommandResult r = runSpillway("render " + args);
+    EXPECT_EQ(r.status, 2) << args << "\n" << r.output;
+    EXPECT_TRUE(contains(r.output, c.mention)) << args << "\n" << r.output;
+    EXPECT_TRUE(fs::is_empty(dir.path())) << "a failed command wrote a file";
+}
+
+const BadUsage kBadUsages[] = {
+    {"UnknownOption", "{scene} -o {out} --quiet --frobnicate", "--frobnicate"},
+    {"MissingValueAtEnd", "{scene} --quiet -o {out} --spp", "--spp"},
+    {"MissingOutputValue", "{scene} --quiet --spp 1 -o", "-o"},
+    {"SppNotAnInteger", "{scene} -o {out} --quiet --spp abc", "abc"},
+    {"SppZero", "{scene} -o {out} --quiet --spp 0", "--spp"},
+    {"SppNegative", "{scene} -o {out} --quiet --spp -3", "--spp"},
+    {"SppTrailingGarbage", "{scene} -o {out} --quiet --spp 4x", "4x"},
+    {"ThreadsZero", "{scene} -o {out} --quiet --threads 0", "--threads"},
+    {"SeedNegative", "{scene} -o {out} --quiet --seed -1", "--seed"},
+    {"UnknownBackend", "{scene} -o {out} --quiet --backend nonsense", "nonsense"},
+    {"NoScene", "-o {out} --quiet", "scene"},
+    {"TwoScenes", "{scene} {scene} -o {out} --quiet", "more than one"},
+    {"JpgOutput", "{scene} -o {dir}/out.jpg --quiet --spp 1", "out.jpg"},
+    {"OutputWithoutExtension", "{scene} -o {dir}/out --quiet --spp 1", ".exr"},
+};
+
+INSTANTIATE_TEST_SUITE_P(Cli, CliBadUsage, ::testing::ValuesIn(kBadUsages),
+                         [](const ::testing::TestParamInfo<BadUsage>& info) { return std::string(info.param.name); });
+
+TEST(Cli, MissingSceneFileExitsTwo) {
+    TempDir dir;
+    const std::string scene = dir.file("absent.yaml");
+    CommandResult r = runSpillway("render " + scene + " -o " + dir.file("out.exr") + " --quiet");
+    EXPECT_EQ(r.status, 2) << r.output;
+    EXPECT_EQ(r.output.rfind(scene + ":", 0), 0u) << r.output;
+    EXPECT_FALSE(fs::exists(dir.file("out.exr")));
+}
+
+void expectCornellImage(const std::string& path) {
+    ASSERT_TRUE(fs::exists(path)) << path;
+    ImageRGB img = readImage(path);
+    EXPECT_EQ(img.width, 256);
+    EXPECT_EQ(img.height, 256);
+    ASSERT_EQ(img.rgb.size(), 256u * 256u * 3u);
+    for (float v : img.rgb) ASSERT_TRUE(std::isfinite(v)) << path;
+    EXPECT_GT(mean(img.rgb), 0.0) << path << " is black";
+}
+
+TEST(Cli, RendersCornellBoxToExr) {
+    TempDir dir;
+    const std::string out = dir.file("cornell.exr");
+    CommandResult r = runSpillway("render " + cornellBox() + " --spp 1 --quiet -o " + out);
+    ASSERT_EQ(r.status, 0) << r.output;
+    expectCornellImage(out);
+}
+
+TEST(Cli, RendersCornellBoxToPng) {
+    TempDir dir;
+    const std::string out = dir.file("cornell.png");
+    CommandResult r = runSpillway("render " + cornellBox() + " --spp 1 --quiet --output " + out);
+    ASSERT_EQ(r.status, 0) << r.output;
+    expectCornellImage(out);
+}
+
+TEST(Cli, StatsFileIsJsonWithTheDocumentedKeys) {
+    TempDir dir;
+    const std::string stats = dir.file("stats.json");
+    CommandResult r = runSpillway("render " + cornellBox() + " --spp 1 --quiet -o " + dir.file("c.exr") +
+                                  " --stats " + stats);
+    ASSERT_EQ(r.status, 0) << r.output;
+    std::ifstream in(stats);
+    ASSERT_TRUE(in) << "no stats file";
+    nlohmann::json j = nlohmann::json::parse(in); // throws (fails the test) on malformed JSON
+    for (const char* key : {"backend", "device", "width", "height", "spp", "wall_seconds", "rays", "stage_seconds"})
+        EXPECT_TRUE(j.contains(key)) << "missing key " << key << " in " << j.dump(2);
+    ASSERT_TRUE(j["backend"].is_string());
+    EXPECT_FALSE(j["backend"].get<std::string>().empty());
+    ASSERT_TRUE(j["device"].is_string());
+    EXPECT_FALSE(j["device"].get<std::string>().empty());
+    EXPECT_EQ(j["width"], 256);
+    EXPECT_EQ(j["height"], 256);
+    EXPECT_EQ(j["spp"], 1);
+    EXPECT_TRUE(j["wall_seconds"].is_number());
+    EXPECT_GT(j["wall_seconds"].get<double>(), 0.0);
+    ASSERT_TRUE(j["rays"].is_object());
+    for (const char* key : {"camera", "bounce", "shadow"}) {
+        ASSERT_TRUE(j["rays"].contains(key)) << "missing rays." << key;
+        EXPECT_TRUE(j["rays"][key].is_number_unsigned()) << key;
+    }
+    EXPECT_EQ(j["rays"]["camera"], 256 * 256);
+    EXPECT_GT(j["rays"]["bounce"].get<double>(), 0.0);
+    EXPECT_GT(j["rays"]["shadow"].get<double>(), 0.0);
+    ASSERT_TRUE(j["stage_seconds"].is_object());
+    EXPECT_FALSE(j["stage_seconds"].empty());
+    for (const auto& [stage, seconds] : j["stage_seconds"].items()) {
+        EXPECT_TRUE(seconds.is_number()) << stage;
+        EXPECT_GE(seconds.get<double>(), 0.0) << stage;
+    }
+}
+
+std::vector<float> renderWithSeed(const TempDir& dir, const std::string& name, const std::string& seed) {
+    const std::string out = dir.file(name);
+    CommandResult r = runSpillway("render " + cornellBox() + " --spp 1 --quiet --seed " + seed + " -o " + out);
+    EXPECT_EQ(r.status, 0) << r.output;
+    return readImage(out).rgb;
+}
+
+TEST(Cli, SameSeedReproducesTheImageBitForBit) {
+    TempDir dir;
+    std::vector<float> a = renderWithSeed(dir, "a.exr", "7");
+    std::vector<float> b = renderWithSeed(dir, "b.exr", "7");
+    std::vector<float> c = renderWithSeed(dir, "c.exr", "8");
+    ASSERT_EQ(a.size(), 256u * 256u * 3u);
+    ASSERT_EQ(b.size(), a.size());
+    ASSERT_EQ(c.size(), a.size());
+    EXPECT_EQ(std::memcmp(a.data(), b.data(), a.size() * sizeof(float)), 0) << "seed 7 twice gave different images";
+    EXPECT_NE(std::memcmp(a.data(), c.data(), a.size() * sizeof(float)), 0) << "seeds 7 and 8 gave the same image";
+}
+
+} // namespace
+} // namespace spw::test

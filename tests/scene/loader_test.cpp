@@ -1,0 +1,405 @@
+// The scene loader against SCENE_FORMAT.md: the thesis' Appendix B example loads as written,
+// every class of bad input stops the program with "file:line:" and exit status 2 before anything
+// is rendered, a scene without entries takes the documented defaults, and transforms compose as
+// specified (scale, then R = Rz*Ry*Rx, then translation).
+#include "test_util.h"
+
+#include <OpenImageIO/imageio.h>
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+
+namespace spw::test {
+namespace {
+
+namespace fs = std::filesystem;
+
+// A 4x4 RGB float image; OpenImageIO writes a ".tx" path as TIFF.
+void writeTexture(const std::string& path, float value) {
+    fs::create_directories(fs::path(path).parent_path());
+    auto out = OIIO::ImageOutput::create(path);
+    ASSERT_TRUE(out) << OIIO::geterror();
+    OIIO::ImageSpec spec(4, 4, 3, OIIO::TypeDesc::FLOAT);
+    std::vector<float> pixels(4 * 4 * 3, value);
+    ASSERT_TRUE(out->open(path, spec)) << out->geterror();
+    ASSERT_TRUE(out->write_image(OIIO::TypeDesc::FLOAT, pixels.data())) << out->geterror();
+    ASSERT_TRUE(out->close()) << out->geterror();
+}
+
+// One triangle with corners on the three axes, wound so that its normal is (1, 1, 1).
+const char* kTriangleObj = "v 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 2 3\n";
+
+// A unit square in the XZ plane facing +Y, with texture coordinates.
+const char* kModelObj = "v -1 0 -1\nv -1 0 1\nv 1 0 1\nv 1 0 -1\n"
+                        "vt 0 0\nvt 0 1\nvt 1 1\nvt 1 0\n"
+                        "f 1/1 2/2 3/3\nf 1/1 3/3 4/4\n";
+
+// Appendix B of the thesis, verbatim but for the object's rotation, which the text extraction
+// turned into LaTeX. Note the two top-level `light:` keys.
+const char* kAppendixB = R"(image:
+  width: 1024
+  height: 429
+  sample base: 1
+settings:
+  min depth: 2
+  max depth: 5
+  threshold: 0.1
+  bucket size: 32
+  shading size: 4096
+  bin exponent: 15
+camera:
+  type: PinHole
+  translation: [ 0, 120, 1000 ]
+  rotation: [0, 90, -3]
+  focal length: 150
+filter:
+  type: Tent
+sampler:
+  type: Stratified
+object:
+  type: Polygon
+  filename: objects/model.obj
+  translation: [15, 0, 25]
+  rotation: [0, 45, 0]
+  scale: [10, 10, 10]
+  shader: 0
+shader:
+  type: Lambert
+  reflectance: 0.3
+  texture:
+    type: Layered
+    upper:
+      type: Standard
+      string: textures/texture_one.tx
+    lower:
+      type: Standard
+      string: textures/texture_two.tx
+    mask:
+      type: Constant
+      colour: [0.5, 0.5, 0.5]
+light:
+  type: Quad
+  translation: [ 100, 100, 35 ]
+  rotation: [0, 135, -25]
+  scale: [ 50, 50 ]
+  intensity: 25
+light:
+  type: Quad
+  translation: [-120, 120, 50]
+  rotation: [0, 45, -25]
+  scale: [ 100, 100 ]
+  intensity: 1
+)";
+
+vec3 centroid(const Mesh& m) {
+    vec3 c(0.0f);
+    for (vec3 p : m.positions) c += p;
+    return c / float(m.positions.size());
+}
+
+void expectNear(vec3 actual, vec3 expected, float tolerance, const std::string& what) {
+    for (int i = 0; i < 3; ++i)
+        EXPECT_NEAR(actual[i], expected[i], tolerance) << what << ", component " << i;
+}
+
+bool endsWith(const std::string& s, const std::string& suffix) {
+    return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
+}
+
+TEST(Loader, AppendixBExampleLoads) {
+    TempDir dir;
+    dir.write("objects/model.obj", kModelObj);
+    writeTexture(dir.file("textures/texture_one.tx"), 0.8f);
+    writeTexture(dir.file("textures/texture_two.tx"), 0.2f);
+    Scene scene = loadScene(dir.write("appendix_b.yaml", kAppendixB));
+
+    EXPECT_EQ(scene.image.width, 1024);
+    EXPECT_EQ(scene.image.height, 429);
+    EXPECT_EQ(scene.image.sampleBase, 1);
+    EXPECT_EQ(scene.settings.minDepth, 2);
+    EXPECT_EQ(scene.settings.maxDepth, 5);
+    EXPECT_FLOAT_EQ(scene.settings.threshold, 0.1f);
+    EXPECT_EQ(scene.settings.bucketSize, 32);
+    EXPECT_EQ(scene.settings.shadingSize, 4096);
+    EXPECT_EQ(scene.settings.binExponent, 15);
+    EXPECT_EQ(scene.camera.type, CameraType::PinHole);
+    EXPECT_FLOAT_EQ(scene.camera.focalLength, 150.0f);
+    expectNear(vec3(scene.camera.cameraToWorld[3]), vec3(0, 120, 1000), 1e-4f, "camera position");
+    EXPECT_EQ(scene.filter.type, FilterType::Tent);
+    EXPECT_EQ(scene.sampler, SamplerType::Stratified);
+
+    // One object, one scene shader, and both `light:` entries, in file order.
+    ASSERT_EQ(scene.objectCount, 1);
+    ASSERT_EQ(scene.quadLightCount, 2);
+    ASSERT_EQ(scene.meshes.size(), 3u);
+    ASSERT_EQ(scene.shaders.size(), 3u); // the Lambert, then one emissive Null per quad light
+    EXPECT_EQ(scene.meshes[0].triangles.size(), 2u);
+    EXPECT_EQ(scene.meshes[0].uvs.size(), scene.meshes[0].positions.size());
+    EXPECT_EQ(scene.meshes[0].shader, 0);
+    expectNear(centroid(scene.meshes[1]), vec3(100, 100, 35), 1e-3f, "first light");
+    expectNear(centroid(scene.meshes[2]), vec3(-120, 120, 50), 1e-3f, "second light");
+    expectNear(scene.shaders[size_t(scene.meshes[1].shader)].params.emission, vec3(25.0f), 0.0f,
+               "first light emission");
+    expectNear(scene.shaders[size_t(scene.meshes[2].shader)].params.emission, vec3(1.0f), 0.0f,
+               "second light emission");
+
+    const Shader& lambert = scene.shaders[0];
+    EXPECT_EQ(lambert.typeName, "Lambert");
+    EXPECT_FLOAT_EQ(lambert.params.reflectance, 0.3f);
+    ASSERT_EQ(scene.textures.size(), 4u);
+    ASSERT_GE(lambert.texture, 0);
+    const Texture& root = scene.textures[size_t(lambert.texture)];
+    ASSERT_EQ(root.type, TextureType::Layered);
+    const Texture& upper = scene.textures[size_t(root.upper)];
+    const Texture& lower = scene.textures[size_t(root.lower)];
+    const Texture& mask = scene.textures[size_t(root.mask)];
+    EXPECT_EQ(upper.type, TextureType::Standard);
+    EXPECT_TRUE(endsWith(upper.path, "textures/texture_one.tx")) << upper.path;
+    EXPECT_EQ(lower.type, TextureType::Standard);
+    EXPECT_TRUE(endsWith(lower.path, "textures/texture_two.tx")) << lower.path;
+    EXPECT_EQ(mask.type, TextureType::Constant);
+    expectNear(mask.colour, vec3(0.5f), 0.0f, "mask colour");
+    EXPECT_TRUE(scene.usesTextures());
+
+    // And it renders: a small film, one sample a pixel, nothing but finite values.
+    scene.image.width = 32;
+    scene.image.height = 16;
+    RenderConfig config;
+    config.spp = 1;
+    auto result = render(scene, config);
+    std::vector<float> image = result->film->image();
+    ASSERT_EQ(image.size(), 32u * 16u * 3u);
+    for (float v : image) ASSERT_TRUE(std::isfinite(v));
+    EXPECT_EQ(result->stats.nonFiniteSamples, 0u);
+}
+
+TEST(Loader, EmptyFileTakesTheDocumentedDefaults) {
+    TempDir dir;
+    Scene scene = loadScene(dir.write("empty.yaml", ""));
+    EXPECT_EQ(scene.image.width, 512);
+    EXPECT_EQ(scene.image.height, 512);
+    EXPECT_EQ(scene.image.sampleBase, 1);
+    EXPECT_EQ(scene.image.iterations, 1);
+    EXPECT_EQ(scene.settings.minDepth, 3);
+    EXPECT_EQ(scene.settings.maxDepth, 16);
+    EXPECT_FLOAT_EQ(scene.settings.threshold, 0.1f);
+    EXPECT_EQ(scene.settings.bucketSize, 32);
+    EXPECT_EQ(scene.settings.shadingSize, 4096);
+    EXPECT_EQ(scene.settings.binExponent, 15);
+    EXPECT_DOUBLE_EQ(scene.settings.memoryBudgetMiB, 512.0);
+    EXPECT_EQ(scene.settings.seed, 0u);
+    EXPECT_EQ(scene.camera.type, CameraType::PinHole);
+    EXPECT_FLOAT_EQ(scene.camera.focalLength, 35.0f);
+    EXPECT_FLOAT_EQ(scene.camera.filmWidth, 35.0f);
+    EXPECT_FALSE(scene.camera.fovDegrees.has_value());
+    EXPECT_EQ(scene.filter.type, FilterType::Box);
+    EXPECT_EQ(scene.sampler, SamplerType::Independent);
+    EXPECT_TRUE(scene.meshes.empty());
+    EXPECT_TRUE(scene.shaders.empty());
+    EXPECT_EQ(scene.objectCount, 0);
+    EXPECT_EQ(scene.quadLightCount, 0);
+
+    scene.image.width = 16;
+    scene.image.height = 16;
+    RenderConfig config;
+    config.spp = 1;
+    auto result = render(scene, config);
+    std::vector<float> image = result->film->image();
+    ASSERT_EQ(image.size(), 16u * 16u * 3u);
+    for (float v : image) ASSERT_EQ(v, 0.0f);
+}
+
+TEST(Loader, CommentOnlyFileIsAnEmptyScene) {
+    TempDir dir;
+    Scene scene = loadScene(dir.write("comment.yaml", "# nothing here yet\n"));
+    EXPECT_EQ(scene.image.width, 512);
+    EXPECT_TRUE(scene.meshes.empty());
+}
+
+TEST(Loader, PluralAndSingularKeysLoadInFileOrder) {
+    TempDir dir;
+    dir.write("tri.obj", kTriangleObj);
+    const char* text = R"(shaders:
+  - {type: Lambert, reflectance: 0.1}
+  - {type: Lambert, reflectance: 0.2}
+shader: {type: Lambert, reflectance: 0.3}
+objects:
+  - {filename: tri.obj, shader: 2}
+object: {filename: tri.obj, shader: 0, translation: [0, 5, 0]}
+lights:
+  - {type: Quad, intensity: 2}
+light: {type: Quad, intensity: 3}
+shaders:
+  - {type: Emissive, emission: [4, 4, 4]}
+objects:
+  - {filename: tri.obj, shader: 3, translation: [0, 9, 0]}
+lights:
+  - {type: Quad, intensity: 5}
+)";
+    Scene scene = loadScene(dir.write("mixed.yaml", text));
+    ASSERT_EQ(scene.objectCount, 3);
+    ASSERT_EQ(scene.quadLightCount, 3);
+    ASSERT_EQ(scene.shaders.size(), 4u + 3u);
+    EXPECT_FLOAT_EQ(scene.shaders[0].params.reflectance, 0.1f);
+    EXPECT_FLOAT_EQ(scene.shaders[1].params.reflectance, 0.2f);
+    EXPECT_FLOAT_EQ(scene.shaders[2].params.reflectance, 0.3f);
+    EXPECT_EQ(scene.shaders[3].typeName, "Emissive");
+    expectNear(scene.shaders[3].params.emission, vec3(4.0f), 0.0f, "Emissive shader");
+
+    EXPECT_EQ(scene.meshes[0].shader, 2);
+    EXPECT_EQ(scene.meshes[1].shader, 0);
+    EXPECT_EQ(scene.meshes[2].shader, 3);
+    EXPECT_NEAR(centroid(scene.meshes[0]).y, 1.0f / 3.0f, 1e-5f);
+    EXPECT_NEAR(centroid(scene.meshes[1]).y, 5.0f + 1.0f / 3.0f, 1e-5f);
+    EXPECT_NEAR(centroid(scene.meshes[2]).y, 9.0f + 1.0f / 3.0f, 1e-5f);
+
+    const float intensities[] = {2.0f, 3.0f, 5.0f};
+    for (int i = 0; i < 3; ++i) {
+        const Mesh& light = scene.meshes[size_t(scene.objectCount + i)];
+        ASSERT_GE(light.shader, 4) << "light " << i << " must use a shader after the scene's";
+        expectNear(scene.shaders[size_t(light.shader)].params.emission, vec3(intensities[i]), 0.0f,
+                   "light " + std::to_string(i));
+    }
+}
+
+// scale [2, 3, 4], rotation [90, 90, 90] (R = Rz*Ry*Rx), translation [1, 2, 3], worked by hand:
+//   (1,0,0) -> scale (2,0,0) -> Rx (2,0,0)  -> Ry (0,0,-2) -> Rz (0,0,-2) -> (1,2,1)
+//   (0,1,0) -> scale (0,3,0) -> Rx (0,0,3)  -> Ry (3,0,0)  -> Rz (0,3,0)  -> (1,5,3)
+//   (0,0,1) -> scale (0,0,4) -> Rx (0,-4,0) -> Ry (0,-4,0) -> Rz (4,0,0)  -> (5,2,3)
+// Rx*Ry*Rz would send the first corner to (1,2,5); rotating before scaling, to (1,2,-1).
+TEST(Loader, ObjectTransformScalesThenRotatesZYXThenTranslates) {
+    TempDir dir;
+    dir.write("tri.obj", kTriangleObj);
+    Scene scene = loadScene(dir.write(
+        "xf.yaml", "shader: {type: Lambert}\n"
+                   "object: {filename: tri.obj, scale: [2, 3, 4], rotation: [90, 90, 90], translation: [1, 2, 3]}\n"));
+    ASSERT_EQ(scene.objectCount, 1);
+    const Mesh& m = scene.meshes[0];
+    ASSERT_EQ(m.triangles.size(), 1u);
+    const uvec3 t = m.triangles[0];
+    expectNear(m.positions[t.x], vec3(1, 2, 1), 1e-5f, "corner (1,0,0)");
+    expectNear(m.positions[t.y], vec3(1, 5, 3), 1e-5f, "corner (0,1,0)");
+    expectNear(m.positions[t.z], vec3(5, 2, 3), 1e-5f, "corner (0,0,1)");
+}
+
+TEST(Loader, UniformScaleIsANumber) {
+    TempDir dir;
+    dir.write("tri.obj", kTriangleObj);
+    Scene scene = loadScene(dir.write(
+        "xf.yaml", "shader: {type: Lambert}\nobject: {filename: tri.obj, scale: 3, translation: [0, 0, -1]}\n"));
+    const Mesh& m = scene.meshes[0];
+    const uvec3 t = m.triangles[0];
+    expectNear(m.positions[t.x], vec3(3, 0, -1), 1e-5f, "corner (1,0,0)");
+    expectNear(m.positions[t.y], vec3(0, 3, -1), 1e-5f, "corner (0,1,0)");
+    expectNear(m.positions[t.z], vec3(0, 0, 2), 1e-5f, "corner (0,0,1)");
+}
+
+// The unit square in local XY, scaled by [4, 2], turned by 90 degrees about X: it lies in the
+// plane y = 5, spans 4 in X and 2 in Z, and its front (local +Z) faces -Y.
+TEST(Loader, QuadLightRotatedNinetyAboutXFacesDown) {
+    TempDir dir;
+    Scene scene = loadScene(
+        dir.write("light.yaml", "light: {type: Quad, translation: [1, 5, -3], rotation: [90, 0, 0], scale: [4, 2]}\n"));
+    ASSERT_EQ(scene.quadLightCount, 1);
+    const Mesh& m = scene.meshes[size_t(scene.objectCount)];
+    ASSERT_EQ(m.triangles.size(), 2u);
+    for (const uvec3& t : m.triangles) {
+        vec3 n = glm::cross(m.positions[t.y] - m.positions[t.x], m.positions[t.z] - m.positions[t.x]);
+        expectNear(glm::normalize(n), vec3(0, -1, 0), 1e-5f, "triangle normal");
+    }
+    vec3 lo(HUGE_VALF), hi(-HUGE_VALF);
+    for (vec3 p : m.positions) lo = glm::min(lo, p), hi = glm::max(hi, p);
+    expectNear(lo, vec3(-1, 5, -4), 1e-5f, "lower corner");
+    expectNear(hi, vec3(3, 5, -2), 1e-5f, "upper corner");
+}
+
+// ---- errors, through the real binary ----------------------------------------------------------
+
+struct ErrorCase {
+    const char* name;
+    const char* scene;   // written to scene.yaml next to tri.obj and bad.obj
+    int line;            // the line the message must name
+    const char* message; // a part of the message; with inObj, the OBJ file the error must name
+    bool inObj = false;  // the error is in an OBJ file, not in the scene file
+};
+
+void PrintTo(const ErrorCase& c, std::ostream* os) { *os << c.name; }
+
+class LoaderError : public ::testing::TestWithParam<ErrorCase> {};
+
+TEST_P(LoaderError, ExitsTwoNamingFileAndLine) {
+    const ErrorCase& c = GetParam();
+    TempDir dir;
+    dir.write("tri.obj", kTriangleObj);
+    dir.write("bad.obj", "# one vertex is not a number\nv 0 0 0\nv 1 0 0\nv nan 0 0\nf 1 2 3\n");
+    dir.write("bad_inf.obj", "v 0 0 0\nv 0 inf 0\nv 1 0 0\nf 1 2 3\n");
+    writeTexture(dir.file("textures/ok.tx"), 0.5f);
+    const std::string scenePath = dir.write("scene.yaml", c.scene);
+    const std::string output = dir.file("out.exr");
+    CommandResult r = runSpillway("render " + scenePath + " -o " + output + " --quiet");
+
+    EXPECT_EQ(r.status, 2) << r.output;
+    const std::string file = c.inObj ? dir.file(c.message) : scenePath;
+    const std::string where = file + ":" + std::to_string(c.line) + ":";
+    EXPECT_EQ(r.output.rfind(where, 0), 0u) << "expected output to start with '" << where << "', got: " << r.output;
+    if (!c.inObj) {
+        EXPECT_NE(r.output.find(c.message, where.size()), std::string::npos) << r.output;
+    }
+    EXPECT_FALSE(fs::exists(output)) << "an image was written despite the error";
+}
+
+const ErrorCase kErrorCases[] = {
+    {"UnknownTopLevelKey", "image: {width: 8, height: 8}\nmaterials: {type: Lambert}\n", 2, "materials"},
+    {"UnknownCameraKey", "camera:\n  type: PinHole\n  zoom: 3\n", 3, "zoom"},
+    {"UnknownKeyInObject", "shader: {type: Lambert}\nobject:\n  filename: tri.obj\n  colour: [1, 0, 0]\n", 4,
+     "colour"},
+    {"WidthNotAnInteger", "image:\n  height: 8\n  width: abc\n", 3, "width"},
+    {"WidthNotWhole", "image:\n  width: 8.5\n", 2, "width"},
+    {"StringWhereListExpected", "camera:\n  type: PinHole\n  translation: far away\n", 3, "translation"},
+    {"ListWithTooFewNumbers", "light:\n  type: Quad\n  colour: [1, 1]\n", 3, "colour"},
+    {"MapWhereNumberExpected", "shader:\n  type: Lambert\n  reflectance: {a: 1}\n", 3, "reflectance"},
+    {"NegativeWidth", "settings: {max depth: 4}\nimage:\n  width: -5\n", 3, "width"},
+    {"ZeroHeight", "image: {width: 8,\n  height: 0}\n", 2, "height"},
+    {"NegativeLightScale", "light:\n  type: Quad\n  scale: [1, -2]\n", 3, "scale"},
+    {"NegativeLightIntensity", "light:\n  type: Quad\n  intensity: -1\n", 3, "intensity"},
+    {"ReflectanceAboveOne", "shader:\n  type: Lambert\n  reflectance: 1.5\n", 3, "reflectance"},
+    {"NegativeMaxDepth", "settings:\n  min depth: 2\n  max depth: -1\n", 3, "max depth"},
+    {"NanIntensity", "light:\n  type: Quad\n  intensity: .nan\n", 3, "intensity"},
+    {"InfTranslation", "camera:\n  translation: [0, .inf, 0]\n", 2, "translation"},
+    {"NegativeInfFocalLength", "camera:\n  focal length: -.inf\n", 2, "focal length"},
+    {"NanInObjectScale", "shader: {type: Lambert}\nobject:\n  filename: tri.obj\n  scale: [1, .NaN, 1]\n", 4,
+     "scale"},
+    {"ShaderIndexMissingFlow",
+     "shader: {type: Lambert}\nobject: {type: Polygon, filename: tri.obj, shader: 1}\n", 2, "shader 1"},
+    {"ShaderIndexMissingBlock",
+     "shader: {type: Lambert}\nobject:\n  type: Polygon\n  filename: tri.obj\n  shader: 3\n", 5, "shader 3"},
+    {"NoShadersAtAll", "object: {type: Polygon, filename: tri.obj}\n", 1, "shader 0"},
+    {"MissingObjFile", "shader: {type: Lambert}\nobject:\n  type: Polygon\n  filename: nowhere.obj\n", 4,
+     "nowhere.obj"},
+    {"MissingTextureFile",
+     "shader:\n  type: Lambert\n  texture:\n    type: Layered\n    upper: {type: Standard, string: textures/ok.tx}\n"
+     "    lower:\n      type: Standard\n      string: textures/none.tx\n    mask: {type: Constant}\n",
+     8, "none.tx"},
+    {"ConductorNotSupported", "image: {width: 4, height: 4}\nshader:\n  type: Conductor\n  alpha: 0.1\n", 3,
+     "not supported yet"},
+    {"DielectricNotSupported", "shaders:\n  - {type: Lambert}\n  - {type: Dielectric, ior: 1.5}\n", 3,
+     "not supported yet"},
+    {"PointLightNotSupported", "light: {type: Quad}\nlight:\n  type: Point\n  position: [0, 1, 0]\n", 3,
+     "not supported yet"},
+    {"EnvironmentLightNotSupported", "lights:\n  - {type: Environment, colour: [1, 1, 1]}\n", 2,
+     "not supported yet"},
+    {"UnknownShaderType", "shader:\n  type: Phong\n", 2, "Phong"},
+    {"YamlSyntaxError", "image:\n  width: 8\n  height: 8: 9\n", 3, "YAML"},
+    {"ImageTwice", "image: {width: 8}\ncamera: {fov: 40}\nimage: {height: 8}\n", 3, "image"},
+    {"ObjectsNotAList", "shader: {type: Lambert}\nobjects: {filename: tri.obj}\n", 2, "list"},
+    {"ObjNanVertex", "shader: {type: Lambert}\nobject: {filename: bad.obj}\n", 4, "bad.obj", true},
+    {"ObjInfVertex", "shader: {type: Lambert}\nobject: {filename: bad_inf.obj}\n", 2, "bad_inf.obj", true},
+};
+
+INSTANTIATE_TEST_SUITE_P(Loader, LoaderError, ::testing::ValuesIn(kErrorCases),
+                         [](const ::testing::TestParamInfo<ErrorCase>& info) { return std::string(info.param.name); });
+
+} // namespace
+} // namespace spw::test
