@@ -71,14 +71,15 @@ void ReferenceRenderer::renderIteration(uint iteration, Film& film) {
                                                                               rh.hit.u, rh.hit.v));
                             ShadeResult res;
                             shadeSurface(view, rp, hit, dir, st, res);
-                            const uint key = st.pathId * 64u + st.bounce;
-                            if (res.flags & kShadeEmitted) film.splat(cr.filmPos, res.emitted, key);
+                            if (res.flags & kShadeEmitted)
+                                film.splat(cr.filmPos, res.emitted, filmKey(st.pathId, st.bounce, false));
                             if (res.flags & kShadeShadow) {
                                 ++shadow;
                                 RTCRay sr = makeRay(res.shadowOrigin, res.shadowDir, res.shadowTmax).ray;
                                 rtcInitIntersectContext(&ictx);
                                 rtcOccluded1(embree.handle(), &ictx, &sr);
-                                if (sr.tfar >= 0.0f) film.splat(cr.filmPos, res.shadowContribution, key ^ 0x80000000u);
+                                if (sr.tfar >= 0.0f)
+                                    film.splat(cr.filmPos, res.shadowContribution, filmKey(st.pathId, st.bounce, true));
                             }
                             if (!(res.flags & kShadeContinue)) break;
                             ++bounce;

@@ -19,6 +19,12 @@
 
 namespace spw {
 
+// The stochastic-rounding key of a contribution: every backend uses the same one, so that
+// backends tracing the same paths produce the same film bit for bit.
+inline uint filmKey(uint pathId, uint bounce, bool shadow) {
+    return (pathId * 64u + bounce) ^ (shadow ? 0x80000000u : 0u);
+}
+
 class Film {
   public:
     Film(int width, int height, const Filter& filter, float brightestRadiance);

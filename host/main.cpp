@@ -1,10 +1,13 @@
 // The spillway command line. Exit status: 0 success, 1 runtime failure (disk, device),
 // 2 bad input (usage or scene error).
+#include "host/compare.h"
 #include "host/image_io.h"
 #include "host/progress.h"
 #include "host/render.h"
 #include "host/scene.h"
 
+#include <cmath>
+#include <csignal>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -24,6 +27,7 @@ const char* kUsage = R"(Spillway: a breadth-first, sorted-deferred-shading path 
 
 usage:
   spillway render SCENE [options]   render a scene file (see SCENE_FORMAT.md)
+  spillway compare A B [options]    error metrics of image A against reference B
   spillway --help                   this text
   spillway --version                the version
 
@@ -31,11 +35,20 @@ render options:
   -o, --output FILE     image to write: .exr (linear float) or .png (8-bit sRGB);
                         default: the scene's name with .exr, in the current folder
   --spp N               total samples per pixel (overrides sample base x iterations)
-  --backend NAME        reference (a depth-first path tracer on Embree)
+  --backend NAME        cpu (default: the sorted deferred pipeline, shading in C++) or
+                        reference (a plain depth-first path tracer on Embree)
   --threads N           worker threads (default: every core)
   --seed S              random seed (overrides settings: seed)
   --stats FILE.json     write render statistics (rays, stage seconds, ...) as JSON
   --quiet               no progress bar
+
+sorted pipeline options (cpu backend):
+  --bin-exponent E      a directional bin becomes a batch at 2^E rays (settings: bin exponent)
+  --memory-budget MiB   RAM for queued batches; the rest spills to disk (settings: memory budget)
+  --spill-dir DIR       where spilled batches go (default: the system temp folder)
+  --ray-sort MODE       auto (sort only where it measures faster), morton, median or off
+  --hit-sort on|off     sort hits by (shader, object, primitive) before shading
+  --ray-format F        compact (32-byte rays, default) or full (48 bytes, every bit kept)
 
 exit status: 0 done, 1 runtime failure, 2 bad usage or scene error
 )";
@@ -58,6 +71,28 @@ long long parseInteger(const std::string& flag, const std::string& v, long long 
     return n;
 }
 
+double parseNumber(const std::string& flag, const std::string& v, double lo, double hi) {
+    size_t used = 0;
+    double x = 0;
+    try {
+        x = std::stod(v, &used);
+    } catch (const std::exception&) {
+        used = 0;
+    }
+    if (used != v.size() || v.empty() || !std::isfinite(x)) throw UsageError(flag + " takes a number, not '" + v + "'");
+    if (x < lo || x > hi) throw UsageError(flag + " must be in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
+    return x;
+}
+
+// Parses a named choice with the library's parser, turning its error into a usage error.
+template <class Parse> auto choice(const std::string& flag, const std::string& v, Parse parse) {
+    try {
+        return parse(v);
+    } catch (const std::invalid_argument& e) {
+        throw UsageError(flag + ": " + e.what());
+    }
+}
+
 int renderCommand(const std::vector<std::string>& args) {
     std::string scenePath, output, statsPath;
     bool quiet = false;
@@ -75,13 +110,23 @@ int renderCommand(const std::vector<std::string>& args) {
         else if (a == "--seed") config.seed = std::uint32_t(parseInteger(a, value(), 0, 0xFFFFFFFFLL));
         else if (a == "--stats") statsPath = value();
         else if (a == "--quiet") quiet = true;
+        else if (a == "--bin-exponent") config.pipeline.binExponent = int(parseInteger(a, value(), 4, 24));
+        else if (a == "--memory-budget") config.pipeline.memoryBudgetMiB = parseNumber(a, value(), 1.0 / 1024, 1 << 20);
+        else if (a == "--spill-dir") config.pipeline.spillDir = value();
+        else if (a == "--ray-sort") config.pipeline.raySort = choice(a, value(), spw::parseRaySortMode);
+        else if (a == "--ray-format") config.pipeline.rayFormat = choice(a, value(), spw::parseRayFormat);
+        else if (a == "--hit-sort") {
+            std::string v = value();
+            if (v != "on" && v != "off") throw UsageError("--hit-sort takes on or off, not '" + v + "'");
+            config.pipeline.hitSort = v == "on";
+        }
         else if (!a.empty() && a[0] == '-') throw UsageError("unknown option '" + a + "'");
         else if (scenePath.empty()) scenePath = a;
         else throw UsageError("more than one scene given ('" + scenePath + "', '" + a + "')");
     }
     if (scenePath.empty()) throw UsageError("render needs a scene file");
-    if (config.backend != "reference")
-        throw UsageError("unknown backend '" + config.backend + "' (reference)");
+    if (config.backend != "reference" && config.backend != "cpu")
+        throw UsageError("unknown backend '" + config.backend + "' (cpu or reference)");
     if (output.empty()) output = std::filesystem::path(scenePath).stem().string() + ".exr";
     if (!spw::isSupportedOutput(output)) throw UsageError("output '" + output + "' must end in .exr or .png");
 
@@ -117,6 +162,8 @@ int renderCommand(const std::vector<std::string>& args) {
 } // namespace
 
 int main(int argc, char** argv) {
+    // A file-size limit must surface as a write error (EFBIG) with a message, not kill us.
+    std::signal(SIGXFSZ, SIG_IGN);
     std::vector<std::string> args(argv + 1, argv + argc);
     try {
         if (args.empty()) {
@@ -132,6 +179,7 @@ int main(int argc, char** argv) {
             return 0;
         }
         if (args[0] == "render") return renderCommand({args.begin() + 1, args.end()});
+        if (args[0] == "compare") return spw::compareCommand({args.begin() + 1, args.end()});
         throw UsageError("unknown command '" + args[0] + "' (try spillway --help)");
     } catch (const UsageError& e) {
         std::fprintf(stderr, "spillway: %s\n", e.what());

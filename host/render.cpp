@@ -4,6 +4,7 @@
 #include "embree_backend/reference_renderer.h"
 #include "host/backend.h"
 #include "host/camera.h"
+#include "host/pipeline/sorted_renderer.h"
 #include "host/textures.h"
 
 #include <tbb/global_control.h>
@@ -39,8 +40,11 @@ SamplingPlan planSampling(const ImageSettings& image, std::optional<int> spp) {
 
 std::unique_ptr<RenderResult> render(const Scene& scene, const RenderConfig& config,
                                      const IterationCallback& onIteration) {
-    if (config.backend != "reference")
-        throw std::invalid_argument("unknown backend '" + config.backend + "' (reference)");
+    if (config.backend != "reference" && config.backend != "cpu")
+        throw std::invalid_argument("unknown backend '" + config.backend + "' (reference or cpu)");
+    if (config.pipeline.rayFormat == RayFormat::Compact && scene.settings.maxDepth > int(kMaxCompactBounce))
+        throw std::invalid_argument("max depth " + std::to_string(scene.settings.maxDepth) +
+                                    " exceeds the compact ray's " + std::to_string(kMaxCompactBounce) + " bounces");
     const auto start = std::chrono::steady_clock::now();
     const int threads = config.threads > 0 ? config.threads : tbb::info::default_concurrency();
     tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
@@ -76,7 +80,9 @@ std::unique_ptr<RenderResult> render(const Scene& scene, const RenderConfig& con
     RenderContext ctx{scene, config, *embree, textures, camera, params, threads, stats};
     result->film = std::make_unique<Film>(scene.image.width, scene.image.height, scene.filter,
                                           embree->brightestEmission());
-    std::unique_ptr<Backend> backend = std::make_unique<ReferenceRenderer>(ctx);
+    std::unique_ptr<Backend> backend;
+    if (config.backend == "reference") backend = std::make_unique<ReferenceRenderer>(ctx);
+    else backend = std::make_unique<SortedRenderer>(ctx, config.pipeline, makeCpuShading(ctx));
     for (int it = 0; it < plan.iterations; ++it) {
         backend->renderIteration(uint(it), *result->film);
         {

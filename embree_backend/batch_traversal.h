@@ -1,0 +1,26 @@
+// Embree traversal of whole batches for the sorted backends: closest hits for a batch of rays,
+// and occlusion for a batch of shadow rays. Both split the batch into groups traced with
+// rtcIntersect1M / rtcOccluded1M, with the coherent context flag only when the batch was sorted
+// (Embree's coherent mode halves throughput on incoherent rays).
+#pragma once
+
+#include "embree_backend/embree_scene.h"
+#include "host/ray_record.h"
+
+#include <vector>
+
+namespace spw {
+
+void intersectBatch(const EmbreeScene& scene, const std::vector<RayState>& rays, bool coherent,
+                    std::vector<RTCRayHit>& hits);
+
+struct ShadowRay {
+    vec3 origin;
+    vec3 dir;
+    float tmax;
+};
+// occluded[i] = 1 when something blocks ray i before its tmax.
+void occludedBatch(const EmbreeScene& scene, const std::vector<ShadowRay>& rays, bool coherent,
+                   std::vector<std::uint8_t>& occluded);
+
+} // namespace spw

@@ -1,0 +1,229 @@
+#include "host/pipeline/batch_queue.h"
+
+#include <cerrno>
+#include <cstring>
+#include <fcntl.h>
+#include <stdexcept>
+#include <unistd.h>
+
+namespace spw {
+
+// ---------------------------------------------------------------------------- SpillFile
+
+SpillFile::SpillFile(const std::string& dir) : dir_(dir) {
+#ifdef O_TMPFILE
+    fd_ = ::open(dir.c_str(), O_TMPFILE | O_RDWR | O_CLOEXEC, 0600);
+#endif
+    if (fd_ < 0) {
+        // No O_TMPFILE here: make a named file and unlink it before anything else happens.
+        std::string templ = dir + "/spillway-spill-XXXXXX";
+        std::vector<char> name(templ.begin(), templ.end());
+        name.push_back('\0');
+        fd_ = ::mkostemp(name.data(), O_CLOEXEC);
+        if (fd_ >= 0) ::unlink(name.data());
+    }
+    if (fd_ < 0)
+        throw std::runtime_error("cannot create a spill file in '" + dir + "': " + std::strerror(errno));
+}
+
+SpillFile::~SpillFile() {
+    if (fd_ >= 0) ::close(fd_);
+}
+
+std::uint64_t SpillFile::write(const std::vector<std::uint8_t>& bytes) {
+    const std::uint64_t offset = end_;
+    size_t done = 0;
+    while (done < bytes.size()) {
+        ssize_t n = ::pwrite(fd_, bytes.data() + done, bytes.size() - done, off_t(offset + done));
+        if (n < 0 && errno == EINTR) continue;
+        if (n <= 0)
+            throw std::runtime_error("cannot write ray batch to the spill file in '" + dir_ +
+                                     "': " + (n < 0 ? std::strerror(errno) : "no space left"));
+        done += size_t(n);
+    }
+    end_ += bytes.size();
+    return offset;
+}
+
+void SpillFile::read(std::uint64_t offset, std::vector<std::uint8_t>& bytes) {
+    size_t done = 0;
+    while (done < bytes.size()) {
+        ssize_t n = ::pread(fd_, bytes.data() + done, bytes.size() - done, off_t(offset + done));
+        if (n < 0 && errno == EINTR) continue;
+        if (n <= 0)
+            throw std::runtime_error("cannot read ray batch back from the spill file in '" + dir_ +
+                                     "': " + (n < 0 ? std::strerror(errno) : "file ended early"));
+        done += size_t(n);
+    }
+}
+
+void SpillFile::release(std::uint64_t offset, std::uint64_t size) {
+    // Best effort: a file system without hole punching keeps the space until the file closes.
+    (void)::fallocate(fd_, FALLOC_FL_PUNCH_HOLE | FALLOC_FL_KEEP_SIZE, off_t(offset), off_t(size));
+}
+
+// ---------------------------------------------------------------------------- BatchQueue
+
+BatchQueue::BatchQueue(std::uint64_t budgetBytes, std::string spillDir)
+    : budget_(budgetBytes), spillDir_(std::move(spillDir)) {}
+
+BatchQueue::~BatchQueue() {
+    if (prefetch_.valid()) prefetch_.wait();
+}
+
+SpillFile& BatchQueue::spill() {
+    if (!spill_) spill_ = std::make_unique<SpillFile>(spillDir_);
+    return *spill_;
+}
+
+void BatchQueue::push(RayBatch&& batch) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    Entry e;
+    e.size = batch.bytes.size();
+    ++counters_.batchesQueued;
+    if (ramBytes_ + e.size <= budget_) {
+        ramBytes_ += e.size;
+        e.batch = std::move(batch);
+    } else {
+        e.offset = spill().write(batch.bytes);
+        e.spilled = true;
+        counters_.bytesWritten += e.size;
+        ++counters_.batchesSpilled;
+        batch.bytes.clear();
+        batch.bytes.shrink_to_fit();
+        e.batch = std::move(batch);
+    }
+    counters_.peakRamBytes = std::max<std::uint64_t>(counters_.peakRamBytes, ramBytes_ + std::uint64_t(std::max<std::int64_t>(0, outsideBytes_)));
+    entries_.push_back(std::move(e));
+    if (entries_.size() == 1) startPrefetch();
+}
+
+void BatchQueue::startPrefetch() {
+    // Called with the mutex held; reads the front entry's bytes on another thread.
+    if (entries_.empty() || !entries_.front().spilled || prefetch_.valid()) return;
+    const Entry& e = entries_.front();
+    SpillFile* file = &spill();
+    std::uint64_t offset = e.offset, size = e.size;
+    prefetch_ = std::async(std::launch::async, [file, offset, size] {
+        std::vector<std::uint8_t> bytes(size);
+        file->read(offset, bytes);
+        file->release(offset, size);
+        return bytes;
+    });
+}
+
+std::optional<RayBatch> BatchQueue::pop(StageTimes& times) {
+    std::unique_lock<std::mutex> lock(mutex_);
+    if (entries_.empty()) return std::nullopt;
+    Entry e = std::move(entries_.front());
+    entries_.pop_front();
+    if (e.spilled) {
+        // The front entry, when spilled, always has its prefetch in flight (startPrefetch runs
+        // whenever an entry becomes the front), so this waits only if the disk is slower than
+        // the processing of the previous batch.
+        StageTimer t(times, "load");
+        lock.unlock();
+        e.batch.bytes = prefetch_.get(); // rethrows a read error
+        lock.lock();
+        counters_.bytesRead += e.size;
+    } else {
+        ramBytes_ -= e.size;
+    }
+    startPrefetch();
+    return std::move(e.batch);
+}
+
+bool BatchQueue::empty() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return entries_.empty();
+}
+
+void BatchQueue::noteOutsideBytes(std::int64_t delta) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    outsideBytes_ += delta;
+    counters_.peakRamBytes = std::max<std::uint64_t>(counters_.peakRamBytes, ramBytes_ + std::uint64_t(std::max<std::int64_t>(0, outsideBytes_)));
+}
+
+QueueCounters BatchQueue::counters() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return counters_;
+}
+
+// ---------------------------------------------------------------------------- DirectionalBins
+
+DirectionalBins::DirectionalBins(RayFormat format, uint binExponent, BatchQueue& queue)
+    : format_(format), recordBytes_(rayRecordBytes(format)), batchRays_(size_t(1) << binExponent),
+      queue_(queue) {}
+
+void DirectionalBins::add(RayBuffer& buffer) {
+    const size_t batchBytes = batchRays_ * recordBytes_;
+    for (uint b = 0; b < 6; ++b) {
+        std::vector<std::uint8_t>& src = buffer.perBin[b];
+        if (src.empty()) continue;
+        std::vector<RayBatch> full;
+        std::int64_t delta = 0;
+        {
+            std::lock_guard<std::mutex> lock(bins_[b].mutex);
+            std::vector<std::uint8_t>& bin = bins_[b].bytes;
+            delta += std::int64_t(src.size());
+            bin.insert(bin.end(), src.begin(), src.end());
+            size_t start = 0;
+            while (bin.size() - start >= batchBytes) {
+                RayBatch batch;
+                batch.format = format_;
+                batch.count = batchRays_;
+                batch.bin = b;
+                batch.bytes.assign(bin.begin() + std::ptrdiff_t(start),
+                                   bin.begin() + std::ptrdiff_t(start + batchBytes));
+                full.push_back(std::move(batch));
+                start += batchBytes;
+                delta -= std::int64_t(batchBytes);
+            }
+            if (start > 0) bin.erase(bin.begin(), bin.begin() + std::ptrdiff_t(start));
+        }
+        src.clear();
+        queue_.noteOutsideBytes(delta);
+        for (RayBatch& batch : full) queue_.push(std::move(batch));
+    }
+    buffer.count = 0;
+}
+
+bool DirectionalBins::flushLargest() {
+    int best = -1;
+    size_t bestSize = 0;
+    for (int b = 0; b < 6; ++b) {
+        std::lock_guard<std::mutex> lock(bins_[b].mutex);
+        if (bins_[b].bytes.size() > bestSize) best = b, bestSize = bins_[b].bytes.size();
+    }
+    if (best < 0) return false;
+    RayBatch batch;
+    {
+        std::lock_guard<std::mutex> lock(bins_[best].mutex);
+        batch.bytes.swap(bins_[best].bytes);
+    }
+    batch.format = format_;
+    batch.count = batch.bytes.size() / recordBytes_;
+    batch.bin = uint(best);
+    queue_.noteOutsideBytes(-std::int64_t(batch.bytes.size()));
+    queue_.push(std::move(batch));
+    return true;
+}
+
+size_t DirectionalBins::raysWaiting() {
+    size_t n = 0;
+    for (Bin& b : bins_) {
+        std::lock_guard<std::mutex> lock(b.mutex);
+        n += b.bytes.size();
+    }
+    return n / recordBytes_;
+}
+
+void RayBuffer::push(const RayState& ray, RayFormat format, uvec4 rounding) {
+    std::vector<std::uint8_t>& dst = perBin[cardinalBin(ray.dir)];
+    const size_t at = dst.size();
+    dst.resize(at + rayRecordBytes(format));
+    encodeRay(ray, format, rounding, dst.data() + at);
+    ++count;
+}
+
+} // namespace spw

@@ -1,0 +1,122 @@
+// Ray batches and where they wait: six directional bins, then a FIFO queue of batches that
+// holds at most `memory budget` bytes in RAM and spills the rest to disk.
+//
+// Spilling: all spilled batches share one file in the spill folder, opened with O_TMPFILE (or
+// created and unlinked at once where the file system lacks it), so it has no name from the
+// start: whatever way the process ends, normal exit, exception, SIGINT, SIGTERM or SIGKILL, the
+// kernel frees it and no file is left behind. Each batch is one large sequential pwrite at the
+// file's end and one pread back; the space of a batch read back is returned with
+// fallocate(PUNCH_HOLE) so the file's disk use stays at what is still queued.
+#pragma once
+
+#include "host/ray_record.h"
+#include "host/stats.h"
+
+#include <cstdint>
+#include <deque>
+#include <future>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace spw {
+
+struct RayBatch {
+    RayFormat format = RayFormat::Compact;
+    size_t count = 0;
+    std::vector<std::uint8_t> bytes; // count * record size
+    uint bin = 0;                    // cardinal bin the rays came from
+};
+
+// Traffic counters for --stats.
+struct QueueCounters {
+    std::uint64_t batchesQueued = 0, batchesSpilled = 0, bytesWritten = 0, bytesRead = 0;
+    std::uint64_t peakRamBytes = 0; // queued batches in RAM + rays waiting in bins
+};
+
+class SpillFile {
+  public:
+    // Throws std::runtime_error naming `dir` when no file can be made there.
+    explicit SpillFile(const std::string& dir);
+    ~SpillFile();
+    SpillFile(const SpillFile&) = delete;
+    SpillFile& operator=(const SpillFile&) = delete;
+    // Appends; returns the offset. Throws naming the folder on any write error (a full disk).
+    std::uint64_t write(const std::vector<std::uint8_t>& bytes);
+    void read(std::uint64_t offset, std::vector<std::uint8_t>& bytes);
+    void release(std::uint64_t offset, std::uint64_t size);
+    const std::string& dir() const { return dir_; }
+
+  private:
+    std::string dir_;
+    int fd_ = -1;
+    std::uint64_t end_ = 0;
+};
+
+class BatchQueue {
+  public:
+    BatchQueue(std::uint64_t budgetBytes, std::string spillDir);
+    ~BatchQueue();
+
+    // Thread-safe. Keeps the batch in RAM if it fits the budget, else spills it.
+    void push(RayBatch&& batch);
+    // Not thread-safe with itself (one consumer). The next batch, loaded; prefetches the one
+    // after it when that one is on disk.
+    std::optional<RayBatch> pop(StageTimes& times);
+    bool empty() const;
+    // Bytes of rays waiting outside the queue (bins), for the peak-RAM statistic.
+    void noteOutsideBytes(std::int64_t delta);
+    QueueCounters counters() const;
+
+  private:
+    struct Entry {
+        RayBatch batch;          // bytes empty when spilled
+        bool spilled = false;
+        std::uint64_t offset = 0, size = 0;
+    };
+    void startPrefetch();
+    SpillFile& spill();
+
+    mutable std::mutex mutex_;
+    std::deque<Entry> entries_;
+    std::uint64_t budget_, ramBytes_ = 0;
+    std::int64_t outsideBytes_ = 0;
+    std::string spillDir_;
+    std::unique_ptr<SpillFile> spill_;
+    std::future<std::vector<std::uint8_t>> prefetch_; // bytes of entries_.front() when spilled
+    QueueCounters counters_;
+};
+
+// A thread-local buffer of encoded rays, already split by cardinal bin.
+struct RayBuffer {
+    std::vector<std::uint8_t> perBin[6];
+    size_t count = 0;
+    void push(const RayState& ray, RayFormat format, uvec4 rounding);
+};
+
+// Six cardinal-direction bins. Rays arrive in thread-local buffers; a bin holding 2^e rays
+// becomes a batch of exactly 2^e rays in the queue (a buffer larger than a batch simply makes
+// several). When the queue runs dry the largest bin is flushed whatever its size.
+class DirectionalBins {
+  public:
+    DirectionalBins(RayFormat format, uint binExponent, BatchQueue& queue);
+    // Thread-safe. Takes the buffer's rays (leaving it empty, capacity kept).
+    void add(RayBuffer& buffer);
+    // Moves the fullest bin into the queue; false when every bin is empty.
+    bool flushLargest();
+    size_t raysWaiting();
+
+  private:
+    struct Bin {
+        std::mutex mutex;
+        std::vector<std::uint8_t> bytes;
+    };
+    RayFormat format_;
+    size_t recordBytes_;
+    size_t batchRays_;
+    BatchQueue& queue_;
+    Bin bins_[6];
+};
+
+} // namespace spw

@@ -1,0 +1,160 @@
+#include "host/pipeline/ray_sort.h"
+
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_invoke.h>
+#include <tbb/parallel_reduce.h>
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace spw {
+namespace {
+
+// Spreads the low 15 bits of v three apart (bit i -> bit 3i).
+std::uint64_t spread3(std::uint64_t v) {
+    v &= 0x7FFF;
+    v = (v | v << 32) & 0x001F00000000FFFFull;
+    v = (v | v << 16) & 0x001F0000FF0000FFull;
+    v = (v | v << 8) & 0x100F00F00F00F00Full;
+    v = (v | v << 4) & 0x10C30C30C30C30C3ull;
+    v = (v | v << 2) & 0x1249249249249249ull;
+    return v;
+}
+
+struct Bounds {
+    vec3 lo{HUGE_VALF}, hi{-HUGE_VALF};
+    void add(vec3 p) {
+        lo = glm::min(lo, p);
+        hi = glm::max(hi, p);
+    }
+    void add(const Bounds& b) {
+        lo = glm::min(lo, b.lo);
+        hi = glm::max(hi, b.hi);
+    }
+    int longestAxis() const {
+        vec3 e = hi - lo;
+        return e.x >= e.y && e.x >= e.z ? 0 : (e.y >= e.z ? 1 : 2);
+    }
+};
+
+Bounds originBounds(const RayState* r, size_t n) {
+    return tbb::parallel_reduce(
+        tbb::blocked_range<size_t>(0, n, 1 << 14), Bounds(),
+        [&](const tbb::blocked_range<size_t>& range, Bounds b) {
+            for (size_t i = range.begin(); i < range.end(); ++i) b.add(r[i].origin);
+            return b;
+        },
+        [](Bounds a, const Bounds& b) {
+            a.add(b);
+            return a;
+        });
+}
+
+template <class Get> void medianSplit(RayState* r, size_t n, size_t leaf, Get get) {
+    if (n <= leaf) return;
+    Bounds b;
+    for (size_t i = 0; i < n; ++i) b.add(get(r[i]));
+    const int axis = b.longestAxis();
+    if (b.hi[axis] <= b.lo[axis]) return; // all equal along every axis: nothing to split
+    const size_t mid = n / 2;
+    std::nth_element(r, r + mid, r + n, [&](const RayState& a, const RayState& c) { return get(a)[axis] < get(c)[axis]; });
+    auto left = [&] { medianSplit(r, mid, leaf, get); };
+    auto right = [&] { medianSplit(r + mid, n - mid, leaf, get); };
+    if (n > 8192) tbb::parallel_invoke(left, right);
+    else left(), right();
+}
+
+void medianByOrigin(RayState* r, size_t n) {
+    if (n <= 4096) {
+        // Leaf of the origin split: now order by direction down to groups of 64.
+        medianSplit(r, n, 64, [](const RayState& s) { return s.dir; });
+        return;
+    }
+    Bounds b;
+    for (size_t i = 0; i < n; ++i) b.add(r[i].origin);
+    const int axis = b.longestAxis();
+    const size_t mid = n / 2;
+    std::nth_element(r, r + mid, r + n, [&](const RayState& a, const RayState& c) { return a.origin[axis] < c.origin[axis]; });
+    tbb::parallel_invoke([&] { medianByOrigin(r, mid); }, [&] { medianByOrigin(r + mid, n - mid); });
+}
+
+} // namespace
+
+RaySortMode parseRaySortMode(const std::string& name) {
+    if (name == "auto") return RaySortMode::Auto;
+    if (name == "morton") return RaySortMode::Morton;
+    if (name == "median") return RaySortMode::Median;
+    if (name == "off") return RaySortMode::Off;
+    throw std::invalid_argument("unknown ray sort '" + name + "' (auto, morton, median or off)");
+}
+
+const char* raySortName(RaySortMode mode) {
+    switch (mode) {
+    case RaySortMode::Auto: return "auto";
+    case RaySortMode::Morton: return "morton";
+    case RaySortMode::Median: return "median";
+    case RaySortMode::Off: return "off";
+    }
+    return "?";
+}
+
+void sortRaysMorton(std::vector<RayState>& rays, std::vector<KeyIndex>& keys, std::vector<KeyIndex>& scratch,
+                    std::vector<RayState>& tmp) {
+    const size_t n = rays.size();
+    if (n < 2) return;
+    const Bounds b = originBounds(rays.data(), n);
+    const vec3 extent = b.hi - b.lo;
+    const vec3 scale(extent.x > 0 ? 32767.0f / extent.x : 0.0f, extent.y > 0 ? 32767.0f / extent.y : 0.0f,
+                     extent.z > 0 ? 32767.0f / extent.z : 0.0f);
+    keys.resize(n);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 4096), [&](const tbb::blocked_range<size_t>& range) {
+        for (size_t i = range.begin(); i < range.end(); ++i) {
+            const RayState& r = rays[i];
+            vec3 q = glm::clamp((r.origin - b.lo) * scale, vec3(0.0f), vec3(32767.0f));
+            std::uint64_t morton = spread3(std::uint64_t(q.x)) | spread3(std::uint64_t(q.y)) << 1 |
+                                   spread3(std::uint64_t(q.z)) << 2;
+            // 8+8-bit octahedral direction.
+            vec3 d = r.dir / (std::fabs(r.dir.x) + std::fabs(r.dir.y) + std::fabs(r.dir.z));
+            vec2 o = d.z >= 0 ? vec2(d.x, d.y)
+                              : vec2((1 - std::fabs(d.y)) * (d.x >= 0 ? 1 : -1), (1 - std::fabs(d.x)) * (d.y >= 0 ? 1 : -1));
+            std::uint64_t du = std::uint64_t(std::clamp((o.x * 0.5f + 0.5f) * 255.0f, 0.0f, 255.0f));
+            std::uint64_t dv = std::uint64_t(std::clamp((o.y * 0.5f + 0.5f) * 255.0f, 0.0f, 255.0f));
+            keys[i] = {std::uint64_t(cardinalBin(r.dir)) << 61 | morton << 16 | du << 8 | dv, std::uint32_t(i)};
+        }
+    });
+    radixSort(keys, scratch);
+    tmp.resize(n);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 4096), [&](const tbb::blocked_range<size_t>& range) {
+        for (size_t i = range.begin(); i < range.end(); ++i) tmp[i] = rays[keys[i].index];
+    });
+    rays.swap(tmp);
+}
+
+void sortRaysMedian(std::vector<RayState>& rays) { medianByOrigin(rays.data(), rays.size()); }
+
+RaySortMode RaySortPolicy::choose(double cameraFraction) {
+    if (mode_ != RaySortMode::Auto) return mode_;
+    if (cameraFraction > 0.5) return RaySortMode::Off;
+    ++decisions_;
+    bool sort;
+    if (samples_[0] == 0) sort = false;
+    else if (samples_[1] == 0) sort = true;
+    else {
+        sort = cost_[1] < cost_[0];
+        if (decisions_ % 16 == 0) sort = !sort; // keep the other estimate fresh
+    }
+    return sort ? RaySortMode::Morton : RaySortMode::Off;
+}
+
+void RaySortPolicy::record(bool sorted, double seconds, size_t rays) {
+    if (rays == 0) return;
+    (sorted ? sortedBatches_ : unsortedBatches_)++;
+    const int k = sorted ? 1 : 0;
+    const double perRay = seconds / double(rays);
+    // Running mean that forgets: the last ~8 batches dominate.
+    cost_[k] = samples_[k] == 0 ? perRay : 0.875 * cost_[k] + 0.125 * perRay;
+    ++samples_[k];
+}
+
+} // namespace spw

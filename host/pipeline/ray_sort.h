@@ -1,0 +1,50 @@
+// Ordering a batch for coherent traversal, two ways:
+//  * morton: a parallel radix sort on (cardinal bin, 45-bit Morton code of the origin in the
+//    batch's bounds, 8+8-bit octahedral direction);
+//  * median: the thesis's recursive median split of the origins along the longest axis down to
+//    4096 rays, then of the directions down to 64.
+// and the rule that decides whether sorting a batch pays at all (RaySortPolicy).
+#pragma once
+
+#include "host/pipeline/radix_sort.h"
+#include "host/pipeline/ray_sort_mode.h"
+#include "host/ray_record.h"
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace spw {
+
+
+void sortRaysMorton(std::vector<RayState>& rays, std::vector<KeyIndex>& keys, std::vector<KeyIndex>& scratch,
+                    std::vector<RayState>& tmp);
+void sortRaysMedian(std::vector<RayState>& rays);
+
+// The `auto` rule. Sorting costs a fixed time per ray and saves traversal time only when
+// traversal is expensive and the rays arrive incoherent, so the rule measures instead of
+// guessing:
+//  * a batch that is mostly camera rays is never sorted: they arrive in tile order, already
+//    coherent, and sorting them is a net loss;
+//  * for other batches it keeps a running mean of the cost per ray with sorting (sort +
+//    traverse) and without (traverse), measures each way once, then takes the cheaper way,
+//    re-measuring the other every 16th batch so a change of workload is noticed.
+class RaySortPolicy {
+  public:
+    explicit RaySortPolicy(RaySortMode mode) : mode_(mode) {}
+    // The sort to use for a batch with `cameraFraction` of camera rays.
+    RaySortMode choose(double cameraFraction);
+    // Reports what a non-camera batch cost (sorted or not).
+    void record(bool sorted, double seconds, size_t rays);
+    size_t sortedBatches() const { return sortedBatches_; }
+    size_t unsortedBatches() const { return unsortedBatches_; }
+
+  private:
+    RaySortMode mode_;
+    double cost_[2] = {0, 0}; // seconds per ray: [unsorted, sorted]
+    int samples_[2] = {0, 0};
+    size_t decisions_ = 0;
+    size_t sortedBatches_ = 0, unsortedBatches_ = 0;
+};
+
+} // namespace spw

@@ -1,0 +1,289 @@
+#include "host/pipeline/sorted_renderer.h"
+
+#include "embree_backend/batch_traversal.h"
+#include "host/pipeline/radix_sort.h"
+#include "shared/path.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/combinable.h>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+
+#include <chrono>
+#include <filesystem>
+
+namespace spw {
+
+struct SortedRenderer::Scratch {
+    std::vector<RayState> rays, rayTmp;
+    std::vector<KeyIndex> keys, keyTmp;
+    std::vector<RTCRayHit> hits;
+    std::vector<ShadeInput> inputs;
+    std::vector<ShadeResult> results;
+    std::vector<ShadowRay> shadows;
+    std::vector<std::uint32_t> shadowOwner;
+    std::vector<std::uint8_t> occluded;
+};
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+
+constexpr std::uint64_t kMissKey = ~0ull;
+
+class CpuShading : public ShadingEngine {
+  public:
+    CpuShading(SceneView view, RenderParams params, size_t chunk) : view_(view), params_(params), chunk_(chunk) {}
+    void beginIteration(uint iteration) override { params_.iteration = iteration; }
+    void shade(uint /*model*/, const ShadeInput* in, size_t count, ShadeResult* out) override {
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, count, chunk_), [&](const tbb::blocked_range<size_t>& r) {
+            for (size_t i = r.begin(); i < r.end(); ++i) shadeSurface(view_, params_, in[i].hit, in[i].rayDir, in[i].path, out[i]);
+        });
+    }
+  private:
+    SceneView view_;
+    RenderParams params_;
+    size_t chunk_;
+};
+
+} // namespace
+
+std::unique_ptr<ShadingEngine> makeCpuShading(const RenderContext& ctx) {
+    return std::make_unique<CpuShading>(ctx.embree.view(), ctx.params, size_t(ctx.scene.settings.shadingSize));
+}
+
+SortedRenderer::SortedRenderer(const RenderContext& ctx, const PipelineConfig& config,
+                               std::unique_ptr<ShadingEngine> shading)
+    : ctx_(ctx), config_(config), shading_(std::move(shading)), policy_(config.raySort),
+      scratch_(std::make_unique<Scratch>()) {
+    const double budgetMiB = config.memoryBudgetMiB.value_or(ctx.scene.settings.memoryBudgetMiB);
+    const uint exponent = uint(config.binExponent.value_or(ctx.scene.settings.binExponent));
+    std::string dir = config.spillDir.empty() ? std::filesystem::temp_directory_path().string() : config.spillDir;
+    queue_ = std::make_unique<BatchQueue>(std::uint64_t(budgetMiB * 1024.0 * 1024.0), dir);
+    bins_ = std::make_unique<DirectionalBins>(config.rayFormat, exponent, *queue_);
+}
+
+SortedRenderer::~SortedRenderer() = default;
+
+vec2 SortedRenderer::filmPosition(uint pathId, uint iteration) const {
+    const uint spi = ctx_.params.samplesPerIteration;
+    const uint pixel = pathId / spi, s = pathId % spi;
+    const uint width = uint(ctx_.scene.image.width);
+    return ctx_.camera.filmPosition(pixel % width, pixel / width, s, iteration * spi + s, ctx_.params.seed);
+}
+
+uvec4 SortedRenderer::roundingBits(const PathState& path, uint iteration) const {
+    const uint spi = ctx_.params.samplesPerIteration;
+    return pcg4d(uvec4(path.pathId / spi, iteration * spi + path.pathId % spi, (path.bounce << 8u) | kDimRounding,
+                       ctx_.params.seed));
+}
+
+void SortedRenderer::generate(uint iteration, Film& film) {
+    StageTimer timer(ctx_.stats.stages, "generate");
+    const Scene& scene = ctx_.scene;
+    const int width = scene.image.width, height = scene.image.height, tile = scene.settings.bucketSize;
+    const uint spi = ctx_.params.samplesPerIteration;
+    const int tilesX = (width + tile - 1) / tile, tilesY = (height + tile - 1) / tile;
+    tbb::parallel_for(0, tilesX * tilesY, [&](int t) {
+        const int x0 = (t % tilesX) * tile, y0 = (t / tilesX) * tile;
+        RayBuffer buffer; // the tile's thread-local buffer, handed to the bins whole
+        for (int y = y0; y < std::min(height, y0 + tile); ++y)
+            for (int x = x0; x < std::min(width, x0 + tile); ++x)
+                for (uint s = 0; s < spi; ++s) {
+                    CameraRay cr = ctx_.camera.generate(uint(x), uint(y), s, iteration * spi + s, ctx_.params.seed);
+                    film.addSample(cr.filmPos);
+                    RayState r;
+                    r.origin = cr.origin;
+                    r.dir = cr.dir;
+                    r.path = PathState{};
+                    r.path.beta = vec3(1.0f);
+                    r.path.pathId = uint(y * width + x) * spi + s;
+                    buffer.push(r, config_.rayFormat, roundingBits(r.path, iteration));
+                }
+        ctx_.stats.cameraRays += buffer.count;
+        bins_->add(buffer);
+    });
+}
+
+void SortedRenderer::renderIteration(uint iteration, Film& film) {
+    shading_->beginIteration(iteration);
+    generate(iteration, film);
+    for (;;) {
+        std::optional<RayBatch> batch = queue_->pop(ctx_.stats.stages);
+        if (!batch) {
+            if (!bins_->flushLargest()) break; // queue and bins empty: the iteration is done
+            continue;
+        }
+        processBatch(*batch, iteration, film);
+    }
+    publishStats();
+}
+
+void SortedRenderer::processBatch(RayBatch& batch, uint iteration, Film& film) {
+    Scratch& s = *scratch_;
+    StageTimes& times = ctx_.stats.stages;
+    const size_t n = batch.count;
+    const size_t recordBytes = rayRecordBytes(batch.format);
+    ++batchesProcessed_;
+
+    // decompress
+    size_t cameraRays = 0;
+    {
+        StageTimer t(times, "decompress");
+        s.rays.resize(n);
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 4096), [&](const tbb::blocked_range<size_t>& r) {
+            for (size_t i = r.begin(); i < r.end(); ++i) decodeRay(&batch.bytes[i * recordBytes], batch.format, s.rays[i]);
+        });
+        for (size_t i = 0; i < n; ++i) cameraRays += s.rays[i].path.bounce == 0 ? 1 : 0;
+        std::vector<std::uint8_t>().swap(batch.bytes);
+    }
+
+    // sort rays + traverse
+    const RaySortMode mode = policy_.choose(double(cameraRays) / double(std::max<size_t>(n, 1)));
+    const auto sortStart = Clock::now();
+    if (mode == RaySortMode::Morton || mode == RaySortMode::Median) {
+        StageTimer t(times, "sort rays");
+        if (mode == RaySortMode::Morton) sortRaysMorton(s.rays, s.keys, s.keyTmp, s.rayTmp);
+        else sortRaysMedian(s.rays);
+    }
+    const bool sorted = mode != RaySortMode::Off;
+    {
+        StageTimer t(times, "traverse");
+        intersectBatch(ctx_.embree, s.rays, sorted, s.hits);
+    }
+    if (cameraRays * 2 < n) policy_.record(sorted, since(sortStart), n);
+    ctx_.stats.bounceRays += n - cameraRays;
+
+    // sort hits by (shader, object, primitive); misses go last and are dropped
+    size_t hitCount = 0;
+    {
+        StageTimer t(times, "sort hits");
+        s.keys.resize(n);
+        for (size_t i = 0; i < n; ++i) {
+            const RTCHit& h = s.hits[i].hit;
+            std::uint64_t key = kMissKey;
+            if (h.geomID != RTC_INVALID_GEOMETRY_ID) {
+                const std::uint64_t shader = std::uint64_t(ctx_.scene.meshes[h.geomID].shader);
+                key = config_.hitSort ? (shader << 52 | std::uint64_t(h.geomID) << 32 | h.primID) : 0;
+                ++hitCount;
+            }
+            s.keys[i] = {key, std::uint32_t(i)};
+        }
+        if (config_.hitSort) {
+            radixSort(s.keys, s.keyTmp);
+        } else {
+            // No sort: keep traversal order, just move the misses out.
+            std::stable_partition(s.keys.begin(), s.keys.end(), [](const KeyIndex& k) { return k.key != kMissKey; });
+        }
+    }
+
+    // texture: hit setup and texture lookups in sorted order
+    {
+        StageTimer t(times, "texture");
+        s.inputs.resize(hitCount);
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, hitCount, 1024), [&](const tbb::blocked_range<size_t>& r) {
+            for (size_t i = r.begin(); i < r.end(); ++i) {
+                const std::uint32_t k = s.keys[i].index;
+                const RTCRayHit& rh = s.hits[k];
+                ShadeInput& in = s.inputs[i];
+                ctx_.embree.surfaceHit(rh.hit.geomID, rh.hit.primID, rh.hit.u, rh.hit.v, rh.ray.tfar, in.hit);
+                in.hit.albedo = ctx_.textures.albedo(ctx_.scene.shaders[in.hit.shader],
+                                                     ctx_.embree.uvAt(rh.hit.geomID, rh.hit.primID, rh.hit.u, rh.hit.v));
+                in.path = s.rays[k].path;
+                in.rayDir = s.rays[k].dir;
+                in.pad0 = 0.0f;
+            }
+        });
+    }
+
+    // shade: one call per contiguous shader range (the whole list when hits are unsorted)
+    {
+        StageTimer t(times, "shade");
+        s.results.resize(hitCount);
+        size_t begin = 0;
+        while (begin < hitCount) {
+            size_t end = begin + 1;
+            const uint shader = s.inputs[begin].hit.shader;
+            if (config_.hitSort)
+                while (end < hitCount && s.inputs[end].hit.shader == shader) ++end;
+            else
+                end = hitCount;
+            shading_->shade(ctx_.scene.shaders[shader].params.model, &s.inputs[begin], end - begin, &s.results[begin]);
+            begin = end;
+        }
+    }
+
+    // shadow rays
+    {
+        StageTimer t(times, "shadow");
+        s.shadows.clear();
+        s.shadowOwner.clear();
+        for (size_t i = 0; i < hitCount; ++i)
+            if (s.results[i].flags & kShadeShadow) {
+                s.shadows.push_back({s.results[i].shadowOrigin, s.results[i].shadowDir, s.results[i].shadowTmax});
+                s.shadowOwner.push_back(std::uint32_t(i));
+            }
+        occludedBatch(ctx_.embree, s.shadows, false, s.occluded);
+        ctx_.stats.shadowRays += s.shadows.size();
+    }
+
+    // accumulate
+    {
+        StageTimer t(times, "accumulate");
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, hitCount, 1024), [&](const tbb::blocked_range<size_t>& r) {
+            for (size_t i = r.begin(); i < r.end(); ++i)
+                if (s.results[i].flags & kShadeEmitted) {
+                    const PathState& p = s.inputs[i].path;
+                    film.splat(filmPosition(p.pathId, iteration), s.results[i].emitted, filmKey(p.pathId, p.bounce, false));
+                }
+        });
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, s.shadows.size(), 1024), [&](const tbb::blocked_range<size_t>& r) {
+            for (size_t j = r.begin(); j < r.end(); ++j)
+                if (!s.occluded[j]) {
+                    const size_t i = s.shadowOwner[j];
+                    const PathState& p = s.inputs[i].path;
+                    film.splat(filmPosition(p.pathId, iteration), s.results[i].shadowContribution,
+                               filmKey(p.pathId, p.bounce, true));
+                }
+        });
+    }
+
+    // bin the continuation rays through thread-local buffers
+    {
+        StageTimer t(times, "bin");
+        const size_t chunk = size_t(ctx_.scene.settings.shadingSize);
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, hitCount, chunk), [&](const tbb::blocked_range<size_t>& r) {
+            RayBuffer buffer;
+            for (size_t i = r.begin(); i < r.end(); ++i) {
+                const ShadeResult& res = s.results[i];
+                if (!(res.flags & kShadeContinue)) continue;
+                RayState ray;
+                ray.origin = res.nextOrigin;
+                ray.dir = res.nextDir;
+                ray.path = res.next;
+                buffer.push(ray, config_.rayFormat, roundingBits(ray.path, iteration));
+            }
+            bins_->add(buffer);
+        });
+    }
+}
+
+void SortedRenderer::publishStats() {
+    const QueueCounters c = queue_->counters();
+    nlohmann::json& x = ctx_.stats.extra;
+    x["batches_processed"] = batchesProcessed_;
+    x["batches_queued"] = c.batchesQueued;
+    x["batches_spilled"] = c.batchesSpilled;
+    x["bytes_spilled_written"] = c.bytesWritten;
+    x["bytes_spilled_read"] = c.bytesRead;
+    x["peak_ray_bytes_in_ram"] = c.peakRamBytes;
+    x["ray_format"] = config_.rayFormat == RayFormat::Compact ? "compact" : "full";
+    x["ray_record_bytes"] = rayRecordBytes(config_.rayFormat);
+    x["ray_sort"] = raySortName(config_.raySort);
+    x["hit_sort"] = config_.hitSort;
+    x["batches_ray_sorted"] = policy_.sortedBatches();
+    x["batches_ray_unsorted_measured"] = policy_.unsortedBatches();
+}
+
+} // namespace spw

@@ -1,0 +1,131 @@
+#include "host/ray_record.h"
+
+#include <cmath>
+#include <cstring>
+#include <stdexcept>
+
+namespace spw {
+namespace {
+
+constexpr double kOctScale = double((1u << 24) - 1);
+
+void put24(std::uint8_t* p, uint v) {
+    p[0] = std::uint8_t(v);
+    p[1] = std::uint8_t(v >> 8);
+    p[2] = std::uint8_t(v >> 16);
+}
+uint get24(const std::uint8_t* p) { return uint(p[0]) | uint(p[1]) << 8 | uint(p[2]) << 16; }
+
+// Octahedral map of a unit vector to [-1, 1]^2, in double so the 24-bit grid is the only rounding.
+void octEncode(vec3 d, uint& u, uint& v) {
+    double x = d.x, y = d.y, z = d.z;
+    double n = std::fabs(x) + std::fabs(y) + std::fabs(z);
+    x /= n;
+    y /= n;
+    if (z < 0) {
+        double ox = (1.0 - std::fabs(y)) * (x >= 0 ? 1.0 : -1.0);
+        double oy = (1.0 - std::fabs(x)) * (y >= 0 ? 1.0 : -1.0);
+        x = ox;
+        y = oy;
+    }
+    u = uint(std::lround((x * 0.5 + 0.5) * kOctScale));
+    v = uint(std::lround((y * 0.5 + 0.5) * kOctScale));
+}
+
+vec3 octDecode(uint u, uint v) {
+    double x = double(u) / kOctScale * 2.0 - 1.0, y = double(v) / kOctScale * 2.0 - 1.0;
+    double z = 1.0 - std::fabs(x) - std::fabs(y);
+    if (z < 0) {
+        double ox = (1.0 - std::fabs(y)) * (x >= 0 ? 1.0 : -1.0);
+        double oy = (1.0 - std::fabs(x)) * (y >= 0 ? 1.0 : -1.0);
+        x = ox;
+        y = oy;
+    }
+    double len = std::sqrt(x * x + y * y + z * z);
+    return vec3(float(x / len), float(y / len), float(z / len));
+}
+
+// bfloat16 with stochastic rounding: round the magnitude up with probability (dropped bits / 2^16).
+std::uint16_t toBfloat16(float f, uint random) {
+    std::uint32_t bits;
+    std::memcpy(&bits, &f, 4);
+    std::uint32_t hi = bits >> 16, lo = bits & 0xFFFFu;
+    if ((random & 0xFFFFu) < lo && (hi & 0x7F80u) != 0x7F80u) ++hi; // never round into Inf/NaN
+    return std::uint16_t(hi);
+}
+float fromBfloat16(std::uint16_t h) {
+    std::uint32_t bits = std::uint32_t(h) << 16;
+    float f;
+    std::memcpy(&f, &bits, 4);
+    return f;
+}
+
+template <class T> void put(std::uint8_t*& p, T v) {
+    std::memcpy(p, &v, sizeof(T));
+    p += sizeof(T);
+}
+template <class T> T get(const std::uint8_t*& p) {
+    T v;
+    std::memcpy(&v, p, sizeof(T));
+    p += sizeof(T);
+    return v;
+}
+
+} // namespace
+
+RayFormat parseRayFormat(const std::string& name) {
+    if (name == "compact") return RayFormat::Compact;
+    if (name == "full") return RayFormat::Full;
+    throw std::invalid_argument("unknown ray format '" + name + "' (compact or full)");
+}
+
+void encodeRay(const RayState& r, RayFormat format, uvec4 rounding, std::uint8_t* out) {
+    std::uint8_t* p = out;
+    for (int i = 0; i < 3; ++i) put<float>(p, r.origin[i]);
+    put<std::uint32_t>(p, r.path.pathId);
+    if (format == RayFormat::Full) {
+        for (int i = 0; i < 3; ++i) put<float>(p, r.dir[i]);
+        for (int i = 0; i < 3; ++i) put<float>(p, r.path.beta[i]);
+        put<float>(p, r.path.prevPdf);
+        put<std::uint32_t>(p, r.path.bounce | r.path.flags << 16);
+        return;
+    }
+    uint u, v;
+    octEncode(r.dir, u, v);
+    put24(p, u);
+    put24(p + 3, v);
+    p += 6;
+    put<std::uint16_t>(p, toBfloat16(r.path.beta.x, rounding.x));
+    put<std::uint16_t>(p, toBfloat16(r.path.beta.y, rounding.y));
+    put<std::uint16_t>(p, toBfloat16(r.path.beta.z, rounding.z));
+    put<std::uint16_t>(p, std::uint16_t(floatBitsToUint(r.path.prevPdf) >> 16));
+    put<std::uint16_t>(p, std::uint16_t(std::min(r.path.bounce, kMaxCompactBounce) |
+                                        ((r.path.flags & kPathSpecular) ? 0x8000u : 0u)));
+}
+
+void decodeRay(const std::uint8_t* in, RayFormat format, RayState& r) {
+    const std::uint8_t* p = in;
+    for (int i = 0; i < 3; ++i) r.origin[i] = get<float>(p);
+    r.path.pathId = get<std::uint32_t>(p);
+    r.path.pad0 = 0;
+    if (format == RayFormat::Full) {
+        for (int i = 0; i < 3; ++i) r.dir[i] = get<float>(p);
+        for (int i = 0; i < 3; ++i) r.path.beta[i] = get<float>(p);
+        r.path.prevPdf = get<float>(p);
+        std::uint32_t bf = get<std::uint32_t>(p);
+        r.path.bounce = bf & 0xFFFFu;
+        r.path.flags = bf >> 16;
+        return;
+    }
+    r.dir = octDecode(get24(p), get24(p + 3));
+    p += 6;
+    r.path.beta.x = fromBfloat16(get<std::uint16_t>(p));
+    r.path.beta.y = fromBfloat16(get<std::uint16_t>(p));
+    r.path.beta.z = fromBfloat16(get<std::uint16_t>(p));
+    r.path.prevPdf = fromBfloat16(get<std::uint16_t>(p));
+    std::uint16_t bf = get<std::uint16_t>(p);
+    r.path.bounce = bf & 0x7FFFu;
+    r.path.flags = (bf & 0x8000u) ? kPathSpecular : 0u;
+}
+
+} // namespace spw

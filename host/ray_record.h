@@ -1,0 +1,61 @@
+// Rays between bounces, as they wait in bins, batches and spill files.
+//
+// RayState is the working form (56 bytes). On the way into a bin it is encoded into one of two
+// records; `compact` is the default, `full` keeps every bit and exists to prove that compaction
+// does not change the image (a test renders both).
+//
+// Compact record, 32 bytes:
+//   origin      3 x float32  12 B  exact: the origin decides self-intersection, so it keeps
+//                                  every bit.
+//   pathId      uint32        4 B  exact: pixel * samples per iteration + sample. The iteration
+//                                  is global to all rays in flight, so it is not stored.
+//   direction   2 x 24 bits   6 B  octahedral map (Cigolle et al. 2014) on a 2^24 grid: 1.2e-7
+//                                  rad worst case, the precision of a float32 unit vector itself.
+//                                  The direction traced is the decoded one; its error is below
+//                                  the rounding every float renderer has in its own directions.
+//   throughput  3 x bfloat16  6 B  stochastically rounded with the path's own random number
+//                                  (dimension kDimRounding): E[stored] = exact, so the estimator
+//                                  stays unbiased; the added noise is < 2^-8 relative.
+//   prevPdf     bfloat16      2 B  exact: shadeSurface() already quantises it, and MIS uses the
+//                                  same quantised value on both sides (shared/sampling.h).
+//   bounce      15 bits      2 B  exact up to 32767 bounces; the top bit is the specular flag.
+//
+// Full record, 48 bytes: float32 origin, direction, throughput, prevPdf; uint32 pathId and
+// bounce | flags << 16.
+#pragma once
+
+#include "shared/types.h"
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+
+namespace spw {
+
+struct RayState {
+    vec3 origin;
+    vec3 dir; // unit
+    PathState path;
+};
+
+enum class RayFormat { Compact, Full };
+constexpr size_t kCompactRayBytes = 32;
+constexpr size_t kFullRayBytes = 48;
+constexpr uint kMaxCompactBounce = 0x7FFF;
+
+inline size_t rayRecordBytes(RayFormat f) { return f == RayFormat::Compact ? kCompactRayBytes : kFullRayBytes; }
+RayFormat parseRayFormat(const std::string& name); // "compact" | "full"; throws invalid_argument
+
+// `rounding`: four uniform 32-bit words for the stochastic rounding (compact only).
+void encodeRay(const RayState& ray, RayFormat format, uvec4 rounding, std::uint8_t* out);
+void decodeRay(const std::uint8_t* in, RayFormat format, RayState& ray);
+
+// The cardinal direction bin of a direction: 0..5 for +X, -X, +Y, -Y, +Z, -Z (dominant axis).
+inline uint cardinalBin(vec3 d) {
+    vec3 a = glm::abs(d);
+    if (a.x >= a.y && a.x >= a.z) return d.x >= 0.0f ? 0u : 1u;
+    if (a.y >= a.z) return d.y >= 0.0f ? 2u : 3u;
+    return d.z >= 0.0f ? 4u : 5u;
+}
+
+} // namespace spw

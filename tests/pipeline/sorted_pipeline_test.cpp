@@ -1,0 +1,325 @@
+// The sorted deferred pipeline (--backend cpu): it must render the reference's image, whatever
+// its batching, sorting, memory budget and thread count, and it must clean up after itself.
+#include "test_util.h"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <csignal>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <thread>
+#include <unistd.h>
+
+namespace spw::test {
+namespace {
+
+Scene smallCornell(int size) {
+    Scene scene = loadScene(sourceDir() + "/scenes/cornell-box.yaml");
+    scene.image.width = scene.image.height = size;
+    return scene;
+}
+
+std::vector<float> renderImage(const Scene& scene, RenderConfig cfg) { return render(scene, cfg)->film->image(); }
+
+bool sameBits(const std::vector<float>& a, const std::vector<float>& b) {
+    return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(float)) == 0;
+}
+
+// With full-precision rays the sorted pipeline traces exactly the reference's paths with the
+// same random numbers, and the fixed-point film makes the sums order-independent: the images
+// are identical, not merely close.
+TEST(SortedPipeline, FullPrecisionRaysGiveTheReferenceImageBitForBit) {
+    Scene scene = smallCornell(40);
+    RenderConfig ref;
+    ref.backend = "reference";
+    ref.spp = 8;
+    RenderConfig cpu = ref;
+    cpu.backend = "cpu";
+    cpu.pipeline.rayFormat = RayFormat::Full;
+    cpu.pipeline.binExponent = 10;
+    EXPECT_TRUE(sameBits(renderImage(scene, ref), renderImage(scene, cpu)));
+}
+
+// Per-pixel means and standard errors over iterations.
+struct Accumulated {
+    std::vector<double> sum, sum2;
+    int n = 0;
+    void add(const std::vector<float>& img) {
+        if (sum.empty()) sum.assign(img.size(), 0.0), sum2.assign(img.size(), 0.0);
+        for (size_t i = 0; i < img.size(); ++i) sum[i] += img[i], sum2[i] += double(img[i]) * img[i];
+        ++n;
+    }
+    double mean(size_t i) const { return sum[i] / n; }
+    double var(size_t i) const { return std::max(0.0, (sum2[i] - n * mean(i) * mean(i)) / (n - 1)); }
+};
+
+Accumulated renderAccumulated(const Scene& scene, const RenderConfig& cfg) {
+    Accumulated acc;
+    render(scene, cfg, [&](int, int, const Film& f) { acc.add(f.lastIterationImage()); });
+    return acc;
+}
+
+// Compact rays (32 bytes: octahedral direction, stochastically rounded bfloat16 throughput)
+// against the reference: the image means agree within 4 standard errors, and per pixel the
+// share of |difference| > 4 standard errors is what noise allows.
+void expectAgreesWithReference(const Scene& scene, int iterations) {
+    RenderConfig ref;
+    ref.backend = "reference";
+    ref.spp = iterations * scene.image.samplesPerIteration();
+    RenderConfig cpu = ref;
+    cpu.backend = "cpu";
+    cpu.pipeline.binExponent = 10;
+    Accumulated a = renderAccumulated(scene, ref), b = renderAccumulated(scene, cpu);
+    double ma = 0, mb = 0, var = 0;
+    size_t outliers = 0;
+    const size_t m = a.sum.size();
+    for (size_t i = 0; i < m; ++i) {
+        ma += a.mean(i);
+        mb += b.mean(i);
+        // The two renders share random numbers, so their difference is far smaller than either
+        // one's noise; the bound below uses the (larger) independent-sample error and is
+        // therefore conservative in the direction of passing only agreeing images.
+        double se = std::sqrt((a.var(i) + b.var(i)) / a.n);
+        var += (a.var(i) + b.var(i)) / a.n;
+        if (std::fabs(a.mean(i) - b.mean(i)) > 4.0 * se + 1e-7) ++outliers;
+    }
+    const double se = std::sqrt(var) / double(m);
+    std::printf("reference mean %.6f, cpu mean %.6f, standard error %.6f, outlier pixels %zu of %zu\n", ma / m,
+                mb / m, se, outliers, m);
+    EXPECT_NEAR(ma / m, mb / m, 4.0 * se);
+    EXPECT_LE(double(outliers), 0.001 * double(m));
+}
+
+TEST(SortedPipeline, CompactRaysAgreeWithReferenceOnCornellBox) {
+    Scene scene = smallCornell(32);
+    scene.image.sampleBase = 1;
+    expectAgreesWithReference(scene, 32);
+}
+
+TEST(SortedPipeline, CompactRaysAgreeWithReferenceOnClosedEnclosure) {
+    TempDir dir;
+    dir.write("cube.obj", insideCubeObj());
+    Scene scene = loadScene(dir.write("e.yaml",
+                                      "image: {width: 16, height: 16, sample base: 1, iterations: 1}\n"
+                                      "settings: {max depth: 300}\n"
+                                      "camera: {look at: {eye: [0, 0, 0], target: [0.3, 0.2, -1]}, fov: 100}\n"
+                                      "object: {filename: cube.obj, shader: 0}\n"
+                                      "shader: {type: Lambert, reflectance: 0.8, emission: [1, 1, 1]}\n"));
+    expectAgreesWithReference(scene, 32);
+    // And the cpu backend alone against the closed form Le / (1 - a) = 5.
+    RenderConfig cpu;
+    cpu.spp = 64;
+    MeanError m = meanAndError(renderImage(scene, cpu));
+    EXPECT_NEAR(m.mean, 5.0, 4.0 * m.stderror);
+}
+
+// The film must not depend on how rays were batched, sorted, spilled or scheduled.
+TEST(SortedPipeline, ImageIsIndependentOfBatchingSortingBudgetAndThreads) {
+    Scene scene = smallCornell(40);
+    RenderConfig base;
+    base.spp = 8;
+    base.threads = 1;
+    base.pipeline.binExponent = 12;
+    const std::vector<float> expected = renderImage(scene, base);
+    auto variant = [&](const char* what, auto change) {
+        RenderConfig cfg = base;
+        change(cfg);
+        EXPECT_TRUE(sameBits(expected, renderImage(scene, cfg))) << what;
+    };
+    variant("bin exponent 8", [](RenderConfig& c) { c.pipeline.binExponent = 8; });
+    variant("bin exponent 16", [](RenderConfig& c) { c.pipeline.binExponent = 16; });
+    variant("2 threads", [](RenderConfig& c) { c.threads = 2; });
+    variant("1 MiB budget", [](RenderConfig& c) { c.pipeline.memoryBudgetMiB = 1.0; });
+    variant("1 GiB budget", [](RenderConfig& c) { c.pipeline.memoryBudgetMiB = 1024.0; });
+    variant("1 MiB budget, 2 threads, exponent 8", [](RenderConfig& c) {
+        c.pipeline.memoryBudgetMiB = 1.0;
+        c.threads = 2;
+        c.pipeline.binExponent = 8;
+    });
+    variant("morton ray sort", [](RenderConfig& c) { c.pipeline.raySort = RaySortMode::Morton; });
+    variant("median ray sort", [](RenderConfig& c) { c.pipeline.raySort = RaySortMode::Median; });
+    variant("no ray sort", [](RenderConfig& c) { c.pipeline.raySort = RaySortMode::Off; });
+    variant("no hit sort", [](RenderConfig& c) { c.pipeline.hitSort = false; });
+}
+
+// The thesis's known crash: a tile's buffer (64 x 64 pixels x 64 samples = 262144 rays) far
+// larger than a batch (2^8 rays). It must simply become many batches.
+TEST(SortedPipeline, ThreadBufferLargerThanABatch) {
+    Scene scene = smallCornell(64);
+    scene.settings.bucketSize = 64;
+    scene.image.sampleBase = 8;
+    scene.image.iterations = 1;
+    scene.settings.maxDepth = 2;
+    RenderConfig small;
+    small.pipeline.binExponent = 8;
+    auto result = render(scene, small);
+    RenderConfig large;
+    large.pipeline.binExponent = 16;
+    EXPECT_TRUE(sameBits(result->film->image(), renderImage(scene, large)));
+    EXPECT_GE(result->stats.extra["batches_processed"].get<int>(), 64 * 64 * 64 / 256);
+}
+
+// Runs the binary with its output discarded; returns the exit status (-signal if killed) and
+// the child's peak resident set in KiB.
+struct ChildResult {
+    int status;
+    long maxRssKiB;
+    std::string output;
+};
+
+ChildResult runChild(const std::vector<std::string>& args, const std::function<void(pid_t)>& whileRunning = {}) {
+    std::string log = std::filesystem::temp_directory_path() / ("spillway-child-" + std::to_string(getpid()) + ".log");
+    pid_t pid = fork();
+    if (pid == 0) {
+        FILE* f = std::freopen(log.c_str(), "w", stderr);
+        (void)f;
+        dup2(2, 1);
+        std::vector<char*> argv;
+        std::string bin = binary();
+        argv.push_back(bin.data());
+        std::vector<std::string> copy = args;
+        for (std::string& a : copy) argv.push_back(a.data());
+        argv.push_back(nullptr);
+        execv(bin.c_str(), argv.data());
+        _exit(127);
+    }
+    if (whileRunning) whileRunning(pid);
+    int st = 0;
+    struct rusage ru {};
+    wait4(pid, &st, 0, &ru);
+    std::ifstream in(log);
+    std::string out((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    std::filesystem::remove(log);
+    return {WIFEXITED(st) ? WEXITSTATUS(st) : -WTERMSIG(st), ru.ru_maxrss, out};
+}
+
+size_t filesIn(const std::string& dir) {
+    size_t n = 0;
+    for ([[maybe_unused]] const auto& e : std::filesystem::directory_iterator(dir)) ++n;
+    return n;
+}
+
+// A scene whose single iteration holds 256 x 256 x 64 = 4M camera rays, 128 MiB as compact
+// records: far more than a 1 MiB budget. max depth 0 keeps the test fast (no shading work).
+std::string heavyScene(const TempDir& dir) {
+    const std::string box = sourceDir() + "/scenes/cornell-box/";
+    return dir.write("heavy.yaml",
+                     "image: {width: 256, height: 256, sample base: 8, iterations: 1}\n"
+                     "settings: {max depth: 0, bin exponent: 12}\n"
+                     "camera: {look at: {eye: [278, 273, -800], target: [278, 273, 0]}, fov: 39.3}\n"
+                     "shader: {type: Lambert}\n"
+                     "object: {filename: " + box + "white.obj, shader: 0}\n"
+                     "object: {filename: " + box + "blocks.obj, shader: 0}\n"
+                     "light: {type: Quad, translation: [278, 548.7, 279.5], rotation: [90, 0, 0], scale: [130, 105], intensity: 10}\n");
+}
+
+TEST(Spill, SmallBudgetSpillsReadsBackAndBoundsMemory) {
+    TempDir dir, spill;
+    const std::string scene = heavyScene(dir);
+    auto run = [&](const char* budget, const std::string& stats) {
+        return runChild({"render", scene, "-o", dir.file("o.exr"), "--quiet", "--memory-budget", budget, "--spill-dir",
+                         spill.path(), "--stats", stats});
+    };
+    // The process's own baseline (libraries, Embree and TBB start-up): an 8 x 8 pixel render.
+    ChildResult tiny = runChild({"render", dir.write("tiny.yaml", "image: {width: 8, height: 8}\n"), "-o",
+                                 dir.file("t.exr"), "--quiet"});
+    ASSERT_EQ(tiny.status, 0) << tiny.output;
+    ChildResult big = run("1024", dir.file("big.json"));
+    ChildResult small = run("1", dir.file("small.json"));
+    ASSERT_EQ(big.status, 0) << big.output;
+    ASSERT_EQ(small.status, 0) << small.output;
+    nlohmann::json s = nlohmann::json::parse(std::ifstream(dir.file("small.json")));
+    nlohmann::json b = nlohmann::json::parse(std::ifstream(dir.file("big.json")));
+    EXPECT_GT(s["batches_spilled"].get<long>(), 0);
+    EXPECT_GE(s["bytes_spilled_written"].get<long>(), 120L << 20);
+    EXPECT_EQ(s["bytes_spilled_read"], s["bytes_spilled_written"]);
+    EXPECT_EQ(b["batches_spilled"].get<long>(), 0);
+    // Queued rays in RAM stay within the budget plus the six bins (6 x 2^12 x 32 bytes).
+    EXPECT_LE(s["peak_ray_bytes_in_ram"].get<long>(), (1L << 20) + 6L * 4096 * 32);
+    std::printf("peak RSS: baseline %ld MiB, %ld MiB with a 1 MiB budget, %ld MiB with 1 GiB\n",
+                tiny.maxRssKiB / 1024, small.maxRssKiB / 1024, big.maxRssKiB / 1024);
+    // The stated bound: with a 1 MiB budget, peak RSS stays within baseline + budget + 32 MiB
+    // (bins, one batch in flight with its hits and shading records, the prefetched batch, the
+    // film), while the 1 GiB run holds the whole 128 MiB iteration in RAM.
+    EXPECT_LE(small.maxRssKiB, tiny.maxRssKiB + 1024 + 32 * 1024);
+    EXPECT_GE(big.maxRssKiB - small.maxRssKiB, 64 * 1024);
+    EXPECT_EQ(filesIn(spill.path()), 0u);
+}
+
+TEST(Spill, NoFileLeftAfterNormalRunErrorOrSigint) {
+    TempDir dir, spill;
+    const std::string scene = heavyScene(dir);
+    std::vector<std::string> args = {"render", scene, "--quiet", "--memory-budget", "1", "--spill-dir", spill.path()};
+
+    std::vector<std::string> ok = args;
+    ok.insert(ok.end(), {"-o", dir.file("ok.exr")});
+    EXPECT_EQ(runChild(ok).status, 0);
+    EXPECT_EQ(filesIn(spill.path()), 0u);
+
+    // An error after spilling: the output folder does not exist, found when the image is written.
+    std::vector<std::string> bad = args;
+    bad.insert(bad.end(), {"-o", dir.file("missing/folder/x.exr")});
+    ChildResult err = runChild(bad);
+    EXPECT_EQ(err.status, 1) << err.output;
+    EXPECT_NE(err.output.find("missing/folder/x.exr"), std::string::npos) << err.output;
+    EXPECT_EQ(filesIn(spill.path()), 0u);
+
+    // SIGINT while batches are on disk: wait until the process holds an open spill file.
+    std::vector<std::string> slow = args;
+    slow.insert(slow.end(), {"-o", dir.file("slow.exr"), "--spp", "1024"});
+    bool sawSpill = false, sawName = false;
+    ChildResult sig = runChild(slow, [&](pid_t pid) {
+        for (int i = 0; i < 400 && !sawSpill; ++i) {
+            std::error_code ec;
+            for (const auto& e : std::filesystem::directory_iterator("/proc/" + std::to_string(pid) + "/fd", ec)) {
+                std::string target = std::filesystem::read_symlink(e.path(), ec).string();
+                if (target.rfind(spill.path(), 0) == 0) sawSpill = true;
+            }
+            sawName = sawName || filesIn(spill.path()) > 0;
+            if (!sawSpill) std::this_thread::sleep_for(std::chrono::milliseconds(25));
+        }
+        sawName = sawName || filesIn(spill.path()) > 0;
+        kill(pid, SIGINT);
+    });
+    EXPECT_TRUE(sawSpill) << "the render never opened a spill file";
+    EXPECT_FALSE(sawName) << "a spill file was visible by name in the spill folder";
+    EXPECT_EQ(sig.status, -SIGINT);
+    EXPECT_EQ(filesIn(spill.path()), 0u);
+}
+
+TEST(Spill, UnwritableSpillFolderExitsOneNamingIt) {
+    TempDir dir;
+    const std::string scene = heavyScene(dir);
+    const std::string missing = dir.file("no-such-folder");
+    ChildResult r = runChild({"render", scene, "--quiet", "--memory-budget", "1", "--spill-dir", missing, "-o",
+                              dir.file("x.exr")});
+    EXPECT_EQ(r.status, 1) << r.output;
+    EXPECT_NE(r.output.find(missing), std::string::npos) << r.output;
+    EXPECT_FALSE(std::filesystem::exists(dir.file("x.exr")));
+}
+
+// A full disk, simulated with a file-size limit (RLIMIT_FSIZE): writes fail with EFBIG.
+TEST(Spill, FullDiskExitsOneNamingTheFolder) {
+    TempDir dir, spill;
+    const std::string scene = heavyScene(dir);
+    std::string cmd = "bash -c 'ulimit -f 4096; exec " + binary() + " render " + scene + " --quiet --memory-budget 1 --spill-dir " +
+                      spill.path() + " -o " + dir.file("x.exr") + "' 2>&1";
+    FILE* p = popen(cmd.c_str(), "r");
+    ASSERT_NE(p, nullptr);
+    std::string out;
+    char buf[512];
+    size_t n;
+    while ((n = fread(buf, 1, sizeof buf, p)) > 0) out.append(buf, n);
+    int st = pclose(p);
+    EXPECT_TRUE(WIFEXITED(st) && WEXITSTATUS(st) == 1) << out;
+    EXPECT_NE(out.find(spill.path()), std::string::npos) << out;
+    EXPECT_EQ(filesIn(spill.path()), 0u);
+}
+
+} // namespace
+} // namespace spw::test
