@@ -18,12 +18,18 @@ float filterWeight1D(FilterType type, float d, float radius) {
     return std::exp(k * d * d) - std::exp(k * radius * radius);
 }
 
+// The stochastic rounding's key: the caller's (path and bounce within the iteration) mixed with
+// the render-wide sample index, so that every iteration rounds with fresh random numbers. Without
+// the sample index a pixel whose value repeats each iteration (a tiny light seen through the
+// Grid sampler) would be rounded the same way every time: a bias of up to one fixed-point step.
+uint roundingKey(uint key, uint sampleIndex) { return pcg4d(uvec4(key, sampleIndex, 0xF11Du, 0x2545F491u)).x; }
+
 } // namespace
 
 Film::Film(int width, int height, const Filter& filter, float brightestRadiance)
     : width_(width), height_(height), filter_(filter),
-      acc_(new std::atomic<std::int64_t>[size_t(width) * height * 4]),
-      sum_(size_t(width) * height * 4, 0.0), lastIteration_(size_t(width) * height * 3, 0.0f) {
+      acc_(new std::atomic<std::int64_t>[size_t(width) * height * 8]),
+      sum_(size_t(width) * height * 8, 0.0), lastIteration_(size_t(width) * height * 3, 0.0f) {
     int e = brightestRadiance > 0.0f ? int(std::ceil(std::log2(brightestRadiance))) : 0;
     e = std::max(-60, std::min(60, e));
     scale_ = std::ldexp(1.0, 40 - e);
@@ -32,11 +38,11 @@ Film::Film(int width, int height, const Filter& filter, float brightestRadiance)
 }
 
 void Film::beginIteration() {
-    for (size_t i = 0; i < size_t(width_) * height_ * 4; ++i) acc_[i].store(0, std::memory_order_relaxed);
+    for (size_t i = 0; i < size_t(width_) * height_ * 8; ++i) acc_[i].store(0, std::memory_order_relaxed);
 }
 
-void Film::add(int px, int py, vec3 value, float weight, uint key) {
-    std::atomic<std::int64_t>* a = &acc_[(size_t(py) * width_ + px) * 4];
+void Film::add(int px, int py, int half, vec3 value, float weight, uint key) {
+    std::atomic<std::int64_t>* a = &acc_[(size_t(py) * width_ + px) * 8 + size_t(half) * 4];
     uvec4 h = pcg4d(uvec4(key, uint(py * width_ + px), 0x5157u, 0x9E3779B9u));
     const double in[4] = {value.x * scale_, value.y * scale_, value.z * scale_, weight * weightScale_};
     const uint rnd[4] = {h.x, h.y, h.z, h.w};
@@ -53,21 +59,23 @@ void Film::add(int px, int py, vec3 value, float weight, uint key) {
     }
 }
 
-void Film::splat(vec2 filmPos, vec3 radiance, uint key) {
+void Film::splat(vec2 filmPos, uint sampleIndex, vec3 radiance, uint key) {
     if (!std::isfinite(radiance.x) || !std::isfinite(radiance.y) || !std::isfinite(radiance.z)) {
         nonFinite_.fetch_add(1, std::memory_order_relaxed);
         return;
     }
     if (radiance.x == 0.0f && radiance.y == 0.0f && radiance.z == 0.0f) return;
-    filtered(filmPos, radiance, 0.0f, key);
+    filtered(filmPos, int(sampleIndex & 1u), radiance, 0.0f, roundingKey(key, sampleIndex));
 }
 
-void Film::addSample(vec2 filmPos) { filtered(filmPos, vec3(0.0f), 1.0f, 0u); }
+void Film::addSample(vec2 filmPos, uint sampleIndex) {
+    filtered(filmPos, int(sampleIndex & 1u), vec3(0.0f), 1.0f, roundingKey(0u, sampleIndex));
+}
 
-void Film::filtered(vec2 filmPos, vec3 radiance, float weight, uint key) {
+void Film::filtered(vec2 filmPos, int half, vec3 radiance, float weight, uint key) {
     if (filter_.type == FilterType::Box) {
         int px = std::min(int(filmPos.x), width_ - 1), py = std::min(int(filmPos.y), height_ - 1);
-        add(px, py, radiance, weight, key);
+        add(px, py, half, radiance, weight, key);
         return;
     }
     float r = filter_.radius;
@@ -80,7 +88,7 @@ void Film::filtered(vec2 filmPos, vec3 radiance, float weight, uint key) {
         if (wy <= 0.0f) continue;
         for (int x = x0; x <= x1; ++x) {
             float w = wy * filterWeight1D(filter_.type, float(x) + 0.5f - filmPos.x, r);
-            if (w > 0.0f) add(x, y, radiance * w, weight * w, key);
+            if (w > 0.0f) add(x, y, half, radiance * w, weight * w, key);
         }
     }
 }
@@ -88,14 +96,18 @@ void Film::filtered(vec2 filmPos, vec3 radiance, float weight, uint key) {
 void Film::endIteration() {
     const size_t n = size_t(width_) * height_;
     for (size_t i = 0; i < n; ++i) {
-        double v[4];
-        for (int c = 0; c < 4; ++c) v[c] = double(acc_[i * 4 + c].load(std::memory_order_relaxed));
-        v[0] /= scale_;
-        v[1] /= scale_;
-        v[2] /= scale_;
-        v[3] /= weightScale_;
-        for (int c = 0; c < 4; ++c) sum_[i * 4 + c] += v[c];
-        for (int c = 0; c < 3; ++c) lastIteration_[i * 3 + c] = v[3] > 0 ? float(v[c] / v[3]) : 0.0f;
+        double it[4] = {0, 0, 0, 0};
+        for (int h = 0; h < 2; ++h) {
+            double v[4];
+            for (int c = 0; c < 4; ++c)
+                v[c] = double(acc_[i * 8 + size_t(h) * 4 + size_t(c)].load(std::memory_order_relaxed)) /
+                       (c < 3 ? scale_ : weightScale_);
+            for (int c = 0; c < 4; ++c) {
+                sum_[i * 8 + size_t(h) * 4 + size_t(c)] += v[c];
+                it[c] += v[c];
+            }
+        }
+        for (int c = 0; c < 3; ++c) lastIteration_[i * 3 + c] = it[3] > 0 ? float(it[c] / it[3]) : 0.0f;
     }
     beginIteration();
 }
@@ -104,11 +116,39 @@ std::vector<float> Film::image() const {
     const size_t n = size_t(width_) * height_;
     std::vector<float> out(n * 3, 0.0f);
     for (size_t i = 0; i < n; ++i) {
-        double w = sum_[i * 4 + 3];
+        const double* s = &sum_[i * 8];
+        double w = s[3] + s[7];
         if (w > 0)
-            for (int c = 0; c < 3; ++c) out[i * 3 + c] = float(sum_[i * 4 + c] / w);
+            for (int c = 0; c < 3; ++c) out[i * 3 + c] = float((s[c] + s[4 + c]) / w);
     }
     return out;
+}
+
+std::vector<float> Film::halfImage(int half) const {
+    const size_t n = size_t(width_) * height_;
+    std::vector<float> out(n * 3, 0.0f);
+    for (size_t i = 0; i < n; ++i) {
+        const double* s = &sum_[i * 8 + size_t(half) * 4];
+        if (s[3] > 0)
+            for (int c = 0; c < 3; ++c) out[i * 3 + c] = float(s[c] / s[3]);
+    }
+    return out;
+}
+
+double Film::halfBufferRelMse() const {
+    const size_t n = size_t(width_) * height_;
+    double total = 0;
+    size_t count = 0;
+    for (size_t i = 0; i < n; ++i) {
+        const double* s = &sum_[i * 8];
+        if (!(s[3] > 0 && s[7] > 0)) continue;
+        for (int c = 0; c < 3; ++c) {
+            double a = s[c] / s[3], b = s[4 + c] / s[7], m = (s[c] + s[4 + c]) / (s[3] + s[7]);
+            total += (a - b) * (a - b) / 4.0 / (m * m + 0.01);
+            ++count;
+        }
+    }
+    return count ? total / double(count) : 0.0;
 }
 
 } // namespace spw

@@ -8,6 +8,9 @@
 // The fixed-point scale is picked from the scene's brightest emitter so that one sample of it
 // sits at 2^40: that leaves 2^23 such samples per pixel and iteration before saturation and
 // resolves 2^-40 of it. Non-finite samples are counted and dropped, never added.
+//
+// Even and odd samples (by render-wide sample index) accumulate apart, in two half buffers:
+// their difference estimates the image's own error without a reference (halfBufferRelMse).
 #pragma once
 
 #include "host/scene.h"
@@ -34,14 +37,19 @@ class Film {
 
     void beginIteration();
     // Thread-safe. Once per camera sample: adds the sample's filter weight.
-    void addSample(vec2 filmPos);
+    void addSample(vec2 filmPos, uint sampleIndex);
     // Thread-safe. Any number of times per sample: adds radiance it carried to the camera.
-    // `key` makes the stochastic rounding deterministic (mix the path id and bounce into it).
-    void splat(vec2 filmPos, vec3 radiance, uint key);
+    // `key` makes the stochastic rounding deterministic (filmKey()).
+    void splat(vec2 filmPos, uint sampleIndex, vec3 radiance, uint key);
     void endIteration();
 
     // The render so far: sum of weighted radiance / sum of weights, RGB, row-major.
     std::vector<float> image() const;
+    // The render of the even (half 0) or odd (half 1) samples alone.
+    std::vector<float> halfImage(int half) const;
+    // relMSE of image() estimated from the halves: per value (A - B)^2 / 4 / (m^2 + 0.01),
+    // averaged; (A - B)^2 / 4 is an unbiased estimate of the variance of m = (A + B) / 2.
+    double halfBufferRelMse() const;
     // The last completed iteration alone (for per-iteration statistics).
     std::vector<float> lastIterationImage() const { return lastIteration_; }
 
@@ -50,15 +58,15 @@ class Film {
     double fixedPointScale() const { return scale_; }
 
   private:
-    void filtered(vec2 filmPos, vec3 radiance, float weight, uint key);
-    void add(int px, int py, vec3 value, float weight, uint key);
+    void filtered(vec2 filmPos, int half, vec3 radiance, float weight, uint key);
+    void add(int px, int py, int half, vec3 value, float weight, uint key);
 
     int width_, height_;
     Filter filter_;
     double scale_;       // radiance units -> fixed-point units
     double weightScale_; // filter weight -> fixed-point units
-    std::unique_ptr<std::atomic<std::int64_t>[]> acc_; // 4 per pixel: r, g, b, weight
-    std::vector<double> sum_;                          // 4 per pixel, whole render
+    std::unique_ptr<std::atomic<std::int64_t>[]> acc_; // 8 per pixel: (r, g, b, weight) x 2 halves
+    std::vector<double> sum_;                          // 8 per pixel, whole render
     std::vector<float> lastIteration_;
     std::atomic<std::uint64_t> nonFinite_{0}, saturated_{0};
 };

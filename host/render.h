@@ -20,6 +20,13 @@ struct RenderResult {
 // Called after every iteration with (iterations done, iterations in all, the film).
 using IterationCallback = std::function<void(int, int, const Film&)>;
 
+struct IterationInfo {
+    int done = 0, total = 0; // iterations
+    int spp = 0;             // samples per pixel so far
+    double renderSeconds = 0; // time in the iterations so far, callbacks excluded
+};
+using ProgressCallback = std::function<void(const IterationInfo&, const Film&)>;
+
 // The effective sampling after --spp: samples per pixel and iteration, and iterations.
 struct SamplingPlan {
     int sampleBase;
@@ -31,5 +38,8 @@ SamplingPlan planSampling(const ImageSettings& image, std::optional<int> spp);
 // std::runtime_error for a failure while rendering.
 std::unique_ptr<RenderResult> render(const Scene& scene, const RenderConfig& config,
                                      const IterationCallback& onIteration = {});
+// The same, reporting render time too; stops early at config.timeLimitSeconds.
+std::unique_ptr<RenderResult> renderWithProgress(const Scene& scene, const RenderConfig& config,
+                                                 const ProgressCallback& onIteration);
 
 } // namespace spw

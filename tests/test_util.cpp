@@ -35,6 +35,8 @@ std::string TempDir::write(const std::string& name, const std::string& text) con
 }
 
 std::string sourceDir() { return SPILLWAY_SOURCE_DIR; }
+
+std::vector<std::string> backendsUnderTest() { return {"reference", "cpu", "vulkan"}; }
 std::string binary() { return SPILLWAY_BINARY; }
 
 CommandResult runSpillway(const std::string& args) {

@@ -26,6 +26,9 @@ class TempDir {
     std::string path_;
 };
 
+// Every backend the suites must hold for. Vulkan runs on lavapipe in CI (always installed).
+std::vector<std::string> backendsUnderTest();
+
 std::string sourceDir();
 std::string binary();
 

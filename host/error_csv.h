@@ -1,0 +1,28 @@
+// Error against time while rendering (--error-csv): a CSV row after every iteration with the
+// render seconds so far (start-up, output and this bookkeeping excluded), the spp, the relMSE
+// estimated from the film's two half buffers, and, given a reference image, the metrics of
+// `spillway compare` against it.
+#pragma once
+
+#include "host/compare.h"
+#include "host/film.h"
+
+#include <fstream>
+#include <optional>
+#include <string>
+
+namespace spw {
+
+class ErrorCsv {
+  public:
+    // Throws std::runtime_error naming the path when it cannot be written.
+    ErrorCsv(const std::string& path, std::optional<ImageRGB> reference);
+    void addRow(int iteration, int spp, double seconds, const Film& film);
+
+  private:
+    std::string path_;
+    std::ofstream out_;
+    std::optional<ImageRGB> reference_;
+};
+
+} // namespace spw
