@@ -1,5 +1,6 @@
 #include "embree_backend/embree_scene.h"
 
+#include "shared/offset.h"
 #include "shared/sampling.h"
 
 #include <stdexcept>
@@ -114,7 +115,7 @@ void EmbreeScene::surfaceHit(uint geomID, uint primID, float u, float v, float t
     int base = emitterBase_[geomID];
     hit.emitter = base >= 0 ? uint(base) + primID : kNoEmitter;
     hit.albedo = vec3(0.0f);
-    hit.pad0 = 0;
+    hit.offset = surfaceOffset(hit.p, p0, p1, p2, hit.ng);
 }
 
 } // namespace spw

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <sstream>
 #include <tuple>
@@ -102,7 +103,13 @@ Mesh loadObjMesh(const std::string& path, const mat4& objectToWorld, const std::
                 if (inserted) {
                     vec3 p(a.vertices[3 * ix.vertex_index], a.vertices[3 * ix.vertex_index + 1],
                            a.vertices[3 * ix.vertex_index + 2]);
-                    mesh.positions.push_back(vec3(objectToWorld * vec4(p, 1.0f)));
+                    const vec3 world = vec3(objectToWorld * vec4(p, 1.0f));
+                    // Finite in the file but not after the object's transform.
+                    if (!std::isfinite(world.x) || !std::isfinite(world.y) || !std::isfinite(world.z))
+                        throw SceneError(path, lineOfVertex(path, size_t(ix.vertex_index)),
+                                         "vertex is not a finite number after the object's transform (scene " +
+                                             sceneFile + ":" + std::to_string(sceneLine) + ")");
+                    mesh.positions.push_back(world);
                     if (hasNormals) {
                         vec3 n(0.0f);
                         if (ix.normal_index >= 0)
@@ -121,10 +128,16 @@ Mesh loadObjMesh(const std::string& path, const mat4& objectToWorld, const std::
                 }
                 tri[k] = it->second;
             }
+            // Zero area as the renderer sees it: it normalises cross(e1, e2) in float, so |c|^2 must
+            // be a normal float (not 0, not a denormal that flush-to-zero turns into 0).
             vec3 e1 = mesh.positions[tri.y] - mesh.positions[tri.x];
             vec3 e2 = mesh.positions[tri.z] - mesh.positions[tri.x];
             vec3 c = glm::cross(e1, e2);
-            if (!(glm::dot(c, c) > 0.0f) || !std::isfinite(glm::dot(c, c))) {
+            const float c2 = glm::dot(c, c);
+            if (std::isinf(c2) || std::isnan(c2))
+                throw SceneError(sceneFile, sceneLine, "OBJ file '" + path + "' has a triangle too large for float "
+                                                       "(its normal overflows): edges must stay below about 1e9");
+            if (!(c2 >= std::numeric_limits<float>::min())) {
                 ++mesh.droppedTriangles;
                 continue;
             }

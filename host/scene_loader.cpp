@@ -139,6 +139,12 @@ void readImage(const Reader& rd, const YAML::Node& n, ImageSettings& img) {
     if ((long long)img.width * img.height > kMaxPixels)
         rd.fail(n, "image of " + std::to_string(img.width) + "x" + std::to_string(img.height) +
                        " pixels is larger than the " + std::to_string(kMaxPixels) + " pixels Spillway renders");
+    // Render-wide sample indices are 32-bit (they key the random numbers): refuse more samples
+    // per pixel than that holds instead of silently repeating random numbers.
+    if ((long long)img.samplesPerIteration() * img.iterations > 0xFFFFFFFFLL)
+        rd.fail(n, "sample base^2 x iterations = " +
+                       std::to_string((long long)img.samplesPerIteration() * img.iterations) +
+                       " samples per pixel exceeds 2^32");
 }
 
 void readSettings(const Reader& rd, const YAML::Node& n, Settings& s) {
@@ -250,7 +256,8 @@ int readTexture(const Reader& rd, const YAML::Node& n, const fs::path& dir, Scen
 }
 
 void readShader(const Reader& rd, const YAML::Node& n, const fs::path& dir, Scene& scene) {
-    if (!n.IsMap() || !n["type"]) rd.fail(n, "shader needs a type (Null, Lambert or Emissive)");
+    const char* kTypes = "(Null, Lambert, Emissive, Conductor or Dielectric)";
+    if (!n.IsMap() || !n["type"]) rd.fail(n, std::string("shader needs a type ") + kTypes);
     std::string t = rd.string(n["type"], "shader type");
     Shader s;
     s.typeName = t;
@@ -260,8 +267,8 @@ void readShader(const Reader& rd, const YAML::Node& n, const fs::path& dir, Scen
     p.colour = vec3(1.0f);
     p.reflectance = 1.0f;
     p.emission = vec3(0.0f);
-    if (t == "Conductor" || t == "Dielectric")
-        rd.fail(n["type"], "shader type '" + t + "' is not supported yet");
+    p.ior = 1.5f;
+    p.alpha = 0.0f;
     if (t == "Null" || t == "Emissive") {
         rd.checkKeys(n, t + " shader", {"type", "emission", "two sided"});
         if (t == "Emissive" && !n["emission"]) rd.fail(n, "Emissive shader needs 'emission'");
@@ -275,8 +282,20 @@ void readShader(const Reader& rd, const YAML::Node& n, const fs::path& dir, Scen
             s.texture = readTexture(rd, n["texture"], dir, scene);
             p.flags |= kShaderTextured;
         }
+    } else if (t == "Conductor") {
+        // colour is F0 (Schlick); alpha the GGX width, 0 a mirror (shared/conductor.h).
+        rd.checkKeys(n, "Conductor shader", {"type", "emission", "two sided", "colour", "alpha"});
+        p.model = kModelConductor;
+        if (n["colour"]) p.colour = rd.vec<3>(n["colour"], "colour", 0.0, 1.0);
+        if (n["alpha"]) p.alpha = float(rd.number(n["alpha"], "alpha", 0.0, 1.0));
+    } else if (t == "Dielectric") {
+        // ior behind the surface, vacuum in front; alpha 0 is smooth glass (shared/dielectric.h).
+        rd.checkKeys(n, "Dielectric shader", {"type", "emission", "two sided", "ior", "alpha"});
+        p.model = kModelDielectric;
+        if (n["ior"]) p.ior = float(rd.number(n["ior"], "ior", 1.01, 10.0));
+        if (n["alpha"]) p.alpha = float(rd.number(n["alpha"], "alpha", 0.0, 1.0));
     } else {
-        rd.fail(n["type"], "unknown shader type '" + t + "' (Null, Lambert or Emissive)");
+        rd.fail(n["type"], "unknown shader type '" + t + "' " + kTypes);
     }
     if (n["emission"]) p.emission = rd.vec<3>(n["emission"], "emission", 0.0, 1e30);
     if (n["two sided"] && rd.boolean(n["two sided"], "two sided")) p.flags |= kShaderTwoSided;
@@ -325,6 +344,13 @@ Shader readLight(const Reader& rd, const YAML::Node& n, std::vector<Mesh>& light
     for (vec2 c : {vec2(-0.5f, -0.5f), vec2(0.5f, -0.5f), vec2(0.5f, 0.5f), vec2(-0.5f, 0.5f)})
         m.positions.push_back(vec3(xf * vec4(c.x * size.x, c.y * size.y, 0.0f, 1.0f)));
     m.triangles = {uvec3(0, 1, 2), uvec3(0, 2, 3)};
+    // A light too small (or too far out) for float to span: refuse it rather than divide by its area.
+    for (const uvec3& tri : m.triangles) {
+        vec3 c = glm::cross(m.positions[tri.y] - m.positions[tri.x], m.positions[tri.z] - m.positions[tri.x]);
+        float a2 = glm::dot(c, c);
+        if (!(a2 >= std::numeric_limits<float>::min()) || !std::isfinite(a2))
+            rd.fail(n, "quad light has no area in float after its scale and transform");
+    }
     Shader s;
     s.typeName = "Quad light";
     s.line = n.Mark().line + 1;

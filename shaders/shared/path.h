@@ -8,25 +8,10 @@
 #define SPILLWAY_SHARED_PATH_H
 #include "bsdf.h"
 #include "lights.h"
+#include "offset.h"
 #include "rng.h"
 
 SHARED_BEGIN
-
-// How far a new ray's origin moves off a surface: proportional to the floating-point magnitude
-// of the hit point (its coordinates' ulp), never a scene-unit epsilon. The hit point comes from
-// barycentric interpolation of the vertices, whose rounding error is a few ulps of the largest
-// coordinate; 2^-20 relative gives an 8-ulp margin. The tiny absolute term keeps a point at the
-// exact origin movable.
-SHARED_FN float originOffset(vec3 p) {
-    vec3 a = abs(p);
-    return max(a.x, max(a.y, a.z)) * (1.0f / 1048576.0f) + 1e-30f;
-}
-
-// p moved off its surface to the side of ng that `dir` leaves towards.
-SHARED_FN vec3 offsetOrigin(vec3 p, vec3 ng, vec3 dir) {
-    float side = dot(ng, dir) >= 0.0f ? 1.0f : -1.0f;
-    return p + ng * (side * originOffset(p));
-}
 
 // The pixel and the render-wide sample index of a path.
 SHARED_FN uint pathPixel(RenderParams rp, uint pathId) { return pathId / rp.samplesPerIteration; }
@@ -72,8 +57,9 @@ SHARED_FN void shadeSurface(SCENE_PARAM RenderParams rp, SurfaceHit hit, vec3 ra
 
     vec4 uLight = rand4(rp.seed, pixel, sampleIndex, st.bounce, kDimLight);
 
-    // 2. Next-event estimation: one emitter picked by power, one point on it by area.
-    if (rp.emitterCount > 0u && rp.strategy != kStrategyBsdf) {
+    // 2. Next-event estimation: one emitter picked by power, one point on it by area. A BSDF of
+    //    delta lobes only can never reach the sampled point: no shadow ray.
+    if (rp.emitterCount > 0u && rp.strategy != kStrategyBsdf && !bsdfIsDelta(sh)) {
         uint ei = pickEmitter(SCENE_ARG rp.emitterCount, uLight.x);
         Emitter e = EMITTER(ei);
         vec3 q = emitterPoint(e, vec2(uLight.y, uLight.z));
@@ -84,14 +70,14 @@ SHARED_FN void shadeSurface(SCENE_PARAM RenderParams rp, SurfaceHit hit, vec3 ra
             float cosLight = emitterCosine(e, -wi);
             float lightPdf = emitterSolidAnglePdf(e, dist, cosLight);
             float bsdfPdf;
-            vec3 fcos = bsdfEval(sh.model, hit.albedo, hit.ng, hit.ns, wo, wi, bsdfPdf);
+            vec3 fcos = bsdfEval(sh, hit.albedo, hit.ng, hit.ns, wo, wi, bsdfPdf);
             if (lightPdf > 0.0f && maxComponent(fcos) > 0.0f) {
                 float w = rp.strategy == kStrategyMis ? powerHeuristic(lightPdf, quantizePdf(bsdfPdf)) : 1.0f;
-                vec3 origin = offsetOrigin(hit.p, hit.ng, wi);
-                r.shadowOrigin = origin;
+                r.shadowOrigin = offsetOrigin(hit.p, hit.ng, hit.offset, wi);
                 r.shadowDir = wi;
-                // Stop short of the emitter by its own offset so its surface never occludes.
-                r.shadowTmax = dist - originOffset(q) - originOffset(hit.p) * 2.0f;
+                // Stop short of the emitter's own surface, whatever the scene's scale.
+                float offsetQ = surfaceOffset(q, e.p0, e.p0 + e.e1, e.p0 + e.e2, e.normal);
+                r.shadowTmax = shadowRayTmax(dist, hit.offset, offsetQ, cosLight);
                 r.shadowContribution = st.beta * fcos * e.radiance * (w / lightPdf);
                 if (r.shadowTmax > 0.0f) r.flags |= kShadeShadow;
             }
@@ -104,8 +90,8 @@ SHARED_FN void shadeSurface(SCENE_PARAM RenderParams rp, SurfaceHit hit, vec3 ra
     vec3 weight;
     float pdf;
     bool specular;
-    if (!bsdfSample(sh.model, hit.albedo, hit.ng, hit.ns, wo, vec3(uBsdf.x, uBsdf.y, uBsdf.z), wi,
-                    weight, pdf, specular))
+    if (!bsdfSample(sh, hit.albedo, hit.ng, hit.ns, wo, vec3(uBsdf.x, uBsdf.y, uBsdf.z), wi, weight, pdf,
+                    specular))
         return;
     vec3 beta = st.beta * weight;
     if (st.bounce >= rp.minDepth) {
@@ -115,7 +101,7 @@ SHARED_FN void shadeSurface(SCENE_PARAM RenderParams rp, SurfaceHit hit, vec3 ra
         beta = beta / q;
     }
     if (!(maxComponent(beta) > 0.0f)) return;
-    r.nextOrigin = offsetOrigin(hit.p, hit.ng, wi);
+    r.nextOrigin = offsetOrigin(hit.p, hit.ng, hit.offset, wi);
     r.nextDir = wi;
     r.next.beta = beta;
     r.next.prevPdf = quantizePdf(pdf);

@@ -10,7 +10,9 @@ SHARED_BEGIN
 // Surface models. The registry (host/surface_models.h) maps each to its name and code.
 const uint kModelNull = 0u;
 const uint kModelLambert = 1u;
-const uint kModelCount = 2u;
+const uint kModelConductor = 2u;
+const uint kModelDielectric = 3u;
+const uint kModelCount = 4u;
 
 const uint kShaderTwoSided = 1u; // emits from both faces
 const uint kShaderTextured = 2u; // albedo comes from a texture tree, resolved on the host
@@ -18,11 +20,11 @@ const uint kShaderTextured = 2u; // albedo comes from a texture tree, resolved o
 struct ShaderParams {
     vec3 emission;     // radiance leaving the front face (both with kShaderTwoSided)
     uint model;        // kModel*
-    vec3 colour;       // constant albedo colour when not textured
+    vec3 colour;       // constant albedo colour when not textured (Conductor: F0)
     float reflectance; // albedo scale
     uint flags;        // kShader*
-    float ior;         // Dielectric (not built yet)
-    float alpha;       // GGX width (not built yet)
+    float ior;         // Dielectric: index of refraction of the back (inside) of the surface
+    float alpha;       // Conductor, Dielectric: GGX width; below kGgxSmoothAlpha a delta lobe
     uint pad0;
 };
 
@@ -50,7 +52,7 @@ struct SurfaceHit {
     vec3 ns;      // unit shading normal (interpolated vertex normals, or ng)
     uint emitter; // index of the emitting triangle hit, or kNoEmitter
     vec3 albedo;  // reflectance x texture, resolved on the host in hit-sorted order
-    uint pad0;
+    float offset; // how far rays leaving p start off the surface (shared/offset.h), set with p
 };
 const uint kNoEmitter = 0xFFFFFFFFu;
 

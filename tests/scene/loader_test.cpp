@@ -296,6 +296,64 @@ TEST(Loader, UniformScaleIsANumber) {
     expectNear(m.positions[t.z], vec3(0, 0, 2), 1e-5f, "corner (0,0,1)");
 }
 
+// Conductor and Dielectric: their keys, defaults (colour 1, alpha 0; ior 1.5, alpha 0) and
+// the models they select.
+TEST(Loader, ConductorAndDielectricTakeTheirKeysAndDefaults) {
+    TempDir dir;
+    Scene scene = loadScene(dir.write("metal.yaml", "shaders:\n"
+                                                    "  - {type: Conductor}\n"
+                                                    "  - {type: Conductor, colour: [0.9, 0.6, 0.2], alpha: 0.3, two sided: true}\n"
+                                                    "  - {type: Dielectric}\n"
+                                                    "  - {type: Dielectric, ior: 2.4, alpha: 0.05, emission: [1, 2, 3]}\n"));
+    ASSERT_EQ(scene.shaders.size(), 4u);
+    const ShaderParams& c0 = scene.shaders[0].params;
+    EXPECT_EQ(c0.model, kModelConductor);
+    expectNear(c0.colour, vec3(1.0f), 0.0f, "default F0");
+    EXPECT_EQ(c0.alpha, 0.0f);
+    const ShaderParams& c1 = scene.shaders[1].params;
+    expectNear(c1.colour, vec3(0.9f, 0.6f, 0.2f), 0.0f, "F0");
+    EXPECT_FLOAT_EQ(c1.alpha, 0.3f);
+    EXPECT_TRUE(c1.flags & kShaderTwoSided);
+    const ShaderParams& d0 = scene.shaders[2].params;
+    EXPECT_EQ(d0.model, kModelDielectric);
+    EXPECT_FLOAT_EQ(d0.ior, 1.5f);
+    EXPECT_EQ(d0.alpha, 0.0f);
+    const ShaderParams& d1 = scene.shaders[3].params;
+    EXPECT_FLOAT_EQ(d1.ior, 2.4f);
+    EXPECT_FLOAT_EQ(d1.alpha, 0.05f);
+    expectNear(d1.emission, vec3(1, 2, 3), 0.0f, "emission");
+}
+
+// Zero-area triangles are dropped, and the CLI says so once per file, naming it and the count.
+TEST(Loader, DegenerateTrianglesAreDroppedWithOneWarning) {
+    TempDir dir;
+    const std::string obj = dir.write("degenerate.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 2 0 0\n"
+                                                        "f 1 2 3\nf 1 2 4\nf 1 1 3\n");
+    Scene scene = loadScene(dir.write("d.yaml", "shader: {type: Lambert}\nobject: {filename: degenerate.obj}\n"));
+    ASSERT_EQ(scene.meshes.size(), 1u);
+    EXPECT_EQ(scene.meshes[0].triangles.size(), 1u);
+    EXPECT_EQ(scene.meshes[0].droppedTriangles, 2);
+    CommandResult r = runSpillway("render " + dir.file("d.yaml") + " -o " + dir.file("d.exr") +
+                                  " --quiet --spp 1 --backend reference");
+    EXPECT_EQ(r.status, 0) << r.output;
+    const std::string warning = "degenerate.obj: dropped 2 zero-area triangles";
+    const size_t at = r.output.find(warning);
+    EXPECT_NE(at, std::string::npos) << r.output;
+    EXPECT_EQ(r.output.find(warning, at + 1), std::string::npos) << "warned twice: " << r.output;
+    EXPECT_NE(r.output.find(obj), std::string::npos) << "the warning must name the file: " << r.output;
+}
+
+// Absurd --spp values are refused before anything is loaded or allocated.
+TEST(Loader, AbsurdSppIsAUsageError) {
+    TempDir dir;
+    const std::string scene = dir.write("s.yaml", "image: {width: 4, height: 4}\n");
+    for (const char* spp : {"0", "-3", "100000000000", "1e9"}) {
+        CommandResult r = runSpillway("render " + scene + " -o " + dir.file("s.exr") + " --quiet --spp " + spp);
+        EXPECT_EQ(r.status, 2) << spp << ": " << r.output;
+        EXPECT_NE(r.output.find("--spp"), std::string::npos) << r.output;
+    }
+}
+
 // The unit square in local XY, scaled by [4, 2], turned by 90 degrees about X: it lies in the
 // plane y = 5, spans 4 in X and 2 in Z, and its front (local +Z) faces -Y.
 TEST(Loader, QuadLightRotatedNinetyAboutXFacesDown) {
@@ -335,6 +393,7 @@ TEST_P(LoaderError, ExitsTwoNamingFileAndLine) {
     dir.write("tri.obj", kTriangleObj);
     dir.write("bad.obj", "# one vertex is not a number\nv 0 0 0\nv 1 0 0\nv nan 0 0\nf 1 2 3\n");
     dir.write("bad_inf.obj", "v 0 0 0\nv 0 inf 0\nv 1 0 0\nf 1 2 3\n");
+    dir.write("big.obj", "v 0 0 0\nv 1e15 0 0\nv 0 1e15 0\nf 1 2 3\n");
     writeTexture(dir.file("textures/ok.tx"), 0.5f);
     const std::string scenePath = dir.write("scene.yaml", c.scene);
     const std::string output = dir.file("out.exr");
@@ -382,10 +441,13 @@ const ErrorCase kErrorCases[] = {
      "shader:\n  type: Lambert\n  texture:\n    type: Layered\n    upper: {type: Standard, string: textures/ok.tx}\n"
      "    lower:\n      type: Standard\n      string: textures/none.tx\n    mask: {type: Constant}\n",
      8, "none.tx"},
-    {"ConductorNotSupported", "image: {width: 4, height: 4}\nshader:\n  type: Conductor\n  alpha: 0.1\n", 3,
-     "not supported yet"},
-    {"DielectricNotSupported", "shaders:\n  - {type: Lambert}\n  - {type: Dielectric, ior: 1.5}\n", 3,
-     "not supported yet"},
+    {"ConductorAlphaAboveOne", "image: {width: 4, height: 4}\nshader:\n  type: Conductor\n  alpha: 1.5\n", 4,
+     "alpha"},
+    {"ConductorColourAboveOne", "shader:\n  type: Conductor\n  colour: [1, 1.2, 1]\n", 3, "colour"},
+    {"ConductorTakesNoIor", "shader:\n  type: Conductor\n  ior: 1.5\n", 3, "ior"},
+    {"DielectricIorBelowOne", "shaders:\n  - {type: Lambert}\n  - {type: Dielectric, ior: 0.8}\n", 3, "ior"},
+    {"DielectricNegativeAlpha", "shader:\n  type: Dielectric\n  alpha: -0.1\n", 3, "alpha"},
+    {"DielectricTakesNoColour", "shader:\n  type: Dielectric\n  colour: [1, 1, 1]\n", 3, "colour"},
     {"PointLightNotSupported", "light: {type: Quad}\nlight:\n  type: Point\n  position: [0, 1, 0]\n", 3,
      "not supported yet"},
     {"EnvironmentLightNotSupported", "lights:\n  - {type: Environment, colour: [1, 1, 1]}\n", 2,
@@ -396,6 +458,13 @@ const ErrorCase kErrorCases[] = {
     {"ObjectsNotAList", "shader: {type: Lambert}\nobjects: {filename: tri.obj}\n", 2, "list"},
     {"ObjNanVertex", "shader: {type: Lambert}\nobject: {filename: bad.obj}\n", 4, "bad.obj", true},
     {"ObjInfVertex", "shader: {type: Lambert}\nobject: {filename: bad_inf.obj}\n", 2, "bad_inf.obj", true},
+    {"ObjVertexInfiniteAfterTransform", "shader: {type: Lambert}\nobject: {filename: big.obj, scale: 1e30}\n", 2,
+     "big.obj", true},
+    {"ObjTriangleTooLargeForFloat", "shader: {type: Lambert}\nobject:\n  filename: big.obj\n", 3, "too large"},
+    {"QuadLightWithoutAreaInFloat", "light:\n  type: Quad\n  scale: [1e-30, 1e-30]\n", 2, "no area"},
+    {"MoreSamplesPerPixelThan2To32", "image:\n  sample base: 256\n  iterations: 16777216\n", 2, "2^32"},
+    {"AbsurdImageSize", "image:\n  width: 32768\n  height: 32768\n", 2, "larger than"},
+    {"AbsurdWidth", "image:\n  width: 1000000000\n", 2, "width"},
 };
 
 INSTANTIATE_TEST_SUITE_P(Loader, LoaderError, ::testing::ValuesIn(kErrorCases),
