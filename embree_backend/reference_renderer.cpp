@@ -53,7 +53,7 @@ void ReferenceRenderer::renderIteration(uint iteration, Film& film) {
                         const uint pixel = uint(y * width + x);
                         const uint sampleIndex = iteration * spi + s;
                         CameraRay cr = ctx_.camera.generate(uint(x), uint(y), s, sampleIndex, rp.seed);
-                        film.addSample(cr.filmPos);
+                        film.addSample(cr.filmPos, sampleIndex);
                         PathState st{};
                         st.beta = vec3(1.0f);
                         st.pathId = pixel * spi + s;
@@ -72,14 +72,14 @@ void ReferenceRenderer::renderIteration(uint iteration, Film& film) {
                             ShadeResult res;
                             shadeSurface(view, rp, hit, dir, st, res);
                             if (res.flags & kShadeEmitted)
-                                film.splat(cr.filmPos, res.emitted, filmKey(st.pathId, st.bounce, false));
+                                film.splat(cr.filmPos, sampleIndex, res.emitted, filmKey(st.pathId, st.bounce, false));
                             if (res.flags & kShadeShadow) {
                                 ++shadow;
                                 RTCRay sr = makeRay(res.shadowOrigin, res.shadowDir, res.shadowTmax).ray;
                                 rtcInitIntersectContext(&ictx);
                                 rtcOccluded1(embree.handle(), &ictx, &sr);
                                 if (sr.tfar >= 0.0f)
-                                    film.splat(cr.filmPos, res.shadowContribution, filmKey(st.pathId, st.bounce, true));
+                                    film.splat(cr.filmPos, sampleIndex, res.shadowContribution, filmKey(st.pathId, st.bounce, true));
                             }
                             if (!(res.flags & kShadeContinue)) break;
                             ++bounce;

@@ -1,10 +1,12 @@
 // The spillway command line. Exit status: 0 success, 1 runtime failure (disk, device),
 // 2 bad input (usage or scene error).
 #include "host/compare.h"
+#include "host/error_csv.h"
 #include "host/image_io.h"
 #include "host/progress.h"
 #include "host/render.h"
 #include "host/scene.h"
+#include "host/vk/context.h"
 
 #include <cmath>
 #include <csignal>
@@ -28,6 +30,7 @@ const char* kUsage = R"(Spillway: a breadth-first, sorted-deferred-shading path 
 usage:
   spillway render SCENE [options]   render a scene file (see SCENE_FORMAT.md)
   spillway compare A B [options]    error metrics of image A against reference B
+  spillway devices                  the Vulkan devices, their drivers, and which are usable
   spillway --help                   this text
   spillway --version                the version
 
@@ -35,19 +38,28 @@ render options:
   -o, --output FILE     image to write: .exr (linear float) or .png (8-bit sRGB);
                         default: the scene's name with .exr, in the current folder
   --spp N               total samples per pixel (overrides sample base x iterations)
-  --backend NAME        cpu (default: the sorted deferred pipeline, shading in C++) or
-                        reference (a plain depth-first path tracer on Embree)
+  --backend NAME        auto (default: vulkan where a device exists, else cpu), vulkan (the
+                        sorted deferred pipeline, shading as Vulkan compute), cpu (the same,
+                        shading in C++) or reference (a plain depth-first path tracer on Embree)
+  --device N|NAME       the Vulkan device: its index in `spillway devices` or part of its
+                        name (default: the first usable one)
   --threads N           worker threads (default: every core)
   --seed S              random seed (overrides settings: seed)
   --stats FILE.json     write render statistics (rays, stage seconds, ...) as JSON
   --quiet               no progress bar
+  --error-csv FILE.csv  after every iteration, a row: seconds, spp, relMSE estimated from
+                        two half buffers, and with --reference the compare metrics
+  --reference REF.exr   the reference image for --error-csv
+  --time-limit SECONDS  stop after the iteration that crosses this render time
 
-sorted pipeline options (cpu backend):
+sorted pipeline options (cpu and vulkan backends):
   --bin-exponent E      a directional bin becomes a batch at 2^E rays (settings: bin exponent)
   --memory-budget MiB   RAM for queued batches; the rest spills to disk (settings: memory budget)
   --spill-dir DIR       where spilled batches go (default: the system temp folder)
   --ray-sort MODE       auto (sort only where it measures faster), morton, median or off
   --hit-sort on|off     sort hits by (shader, object, primitive) before shading
+  --shading MODE        sorted (default: one dispatch per shader range, one kernel per surface
+                        model) or megakernel (unsorted hits, one uber-shader switching per hit)
   --ray-format F        compact (32-byte rays, default) or full (48 bytes, every bit kept)
 
 exit status: 0 done, 1 runtime failure, 2 bad usage or scene error
@@ -93,10 +105,30 @@ template <class Parse> auto choice(const std::string& flag, const std::string& v
     }
 }
 
+int devicesCommand(const std::vector<std::string>& args) {
+    if (!args.empty()) throw UsageError("devices takes no arguments");
+    std::vector<spw::vk::DeviceInfo> devices;
+    try {
+        devices = spw::vk::listDevices();
+    } catch (const spw::vk::NoDeviceError& e) {
+        std::fprintf(stderr, "spillway: no Vulkan device: %s\n", e.what());
+        return 1;
+    }
+    if (devices.empty()) {
+        std::fprintf(stderr, "spillway: no Vulkan device (the loader found drivers but no device)\n");
+        return 1;
+    }
+    for (const spw::vk::DeviceInfo& d : devices)
+        std::printf("%u: %s\n   type: %s, Vulkan %s, driver: %s\n   %s\n", d.index, d.name.c_str(), d.type.c_str(),
+                    d.api.c_str(), d.driver.c_str(), d.usable ? "usable" : ("unusable: " + d.whyNot).c_str());
+    return 0;
+}
+
 int renderCommand(const std::vector<std::string>& args) {
-    std::string scenePath, output, statsPath;
+    std::string scenePath, output, statsPath, errorCsvPath, referencePath;
     bool quiet = false;
     spw::RenderConfig config;
+    config.backend = "auto";
     for (size_t i = 0; i < args.size(); ++i) {
         const std::string& a = args[i];
         auto value = [&]() -> std::string {
@@ -106,10 +138,15 @@ int renderCommand(const std::vector<std::string>& args) {
         if (a == "-o" || a == "--output") output = value();
         else if (a == "--spp") config.spp = int(parseInteger(a, value(), 1, 1 << 24));
         else if (a == "--backend") config.backend = value();
+        else if (a == "--device") config.vulkan.device = value();
+        else if (a == "--shading") config.pipeline.shading = choice(a, value(), spw::parseShadingMode);
         else if (a == "--threads") config.threads = int(parseInteger(a, value(), 1, 1024));
         else if (a == "--seed") config.seed = std::uint32_t(parseInteger(a, value(), 0, 0xFFFFFFFFLL));
         else if (a == "--stats") statsPath = value();
         else if (a == "--quiet") quiet = true;
+        else if (a == "--error-csv") errorCsvPath = value();
+        else if (a == "--reference") referencePath = value();
+        else if (a == "--time-limit") config.timeLimitSeconds = parseNumber(a, value(), 1e-3, 1e9);
         else if (a == "--bin-exponent") config.pipeline.binExponent = int(parseInteger(a, value(), 4, 24));
         else if (a == "--memory-budget") config.pipeline.memoryBudgetMiB = parseNumber(a, value(), 1.0 / 1024, 1 << 20);
         else if (a == "--spill-dir") config.pipeline.spillDir = value();
@@ -125,8 +162,8 @@ int renderCommand(const std::vector<std::string>& args) {
         else throw UsageError("more than one scene given ('" + scenePath + "', '" + a + "')");
     }
     if (scenePath.empty()) throw UsageError("render needs a scene file");
-    if (config.backend != "reference" && config.backend != "cpu")
-        throw UsageError("unknown backend '" + config.backend + "' (cpu or reference)");
+    if (config.backend != "reference" && config.backend != "cpu" && config.backend != "vulkan" && config.backend != "auto")
+        throw UsageError("unknown backend '" + config.backend + "' (auto, vulkan, cpu or reference)");
     if (output.empty()) output = std::filesystem::path(scenePath).stem().string() + ".exr";
     if (!spw::isSupportedOutput(output)) throw UsageError("output '" + output + "' must end in .exr or .png");
 
@@ -136,11 +173,28 @@ int renderCommand(const std::vector<std::string>& args) {
             std::fprintf(stderr, "spillway: warning: %s: dropped %d zero-area triangle%s\n", m.name.c_str(),
                          m.droppedTriangles, m.droppedTriangles == 1 ? "" : "s");
 
+    if (!referencePath.empty() && errorCsvPath.empty()) throw UsageError("--reference goes with --error-csv");
+    std::optional<spw::ImageRGB> reference;
+    if (!referencePath.empty()) {
+        try {
+            reference = spw::readImage(referencePath);
+        } catch (const std::exception& e) {
+            throw UsageError(e.what());
+        }
+        if (reference->width != scene.image.width || reference->height != scene.image.height)
+            throw UsageError("reference '" + referencePath + "' is " + std::to_string(reference->width) + "x" +
+                             std::to_string(reference->height) + ", the scene renders " +
+                             std::to_string(scene.image.width) + "x" + std::to_string(scene.image.height));
+    }
+    std::unique_ptr<spw::ErrorCsv> errorCsv;
+    if (!errorCsvPath.empty()) errorCsv = std::make_unique<spw::ErrorCsv>(errorCsvPath, std::move(reference));
+
     spw::ProgressBar progress(!quiet && isatty(STDERR_FILENO));
     const spw::SamplingPlan plan = spw::planSampling(scene.image, config.spp);
     const int sppPerIteration = plan.sampleBase * plan.sampleBase;
-    auto result = spw::render(scene, config, [&](int done, int total, const spw::Film&) {
-        progress.update(done, total, done * sppPerIteration, total * sppPerIteration);
+    auto result = spw::renderWithProgress(scene, config, [&](const spw::IterationInfo& info, const spw::Film& film) {
+        if (errorCsv) errorCsv->addRow(info.done, info.spp, info.renderSeconds, film);
+        progress.update(info.done, info.total, info.spp, info.total * sppPerIteration);
     });
     progress.finish();
 
@@ -180,6 +234,7 @@ int main(int argc, char** argv) {
         }
         if (args[0] == "render") return renderCommand({args.begin() + 1, args.end()});
         if (args[0] == "compare") return spw::compareCommand({args.begin() + 1, args.end()});
+        if (args[0] == "devices") return devicesCommand({args.begin() + 1, args.end()});
         throw UsageError("unknown command '" + args[0] + "' (try spillway --help)");
     } catch (const UsageError& e) {
         std::fprintf(stderr, "spillway: %s\n", e.what());

@@ -6,11 +6,14 @@
 #include "host/camera.h"
 #include "host/pipeline/sorted_renderer.h"
 #include "host/textures.h"
+#include "host/vk/context.h"
+#include "host/vk/vulkan_shading.h"
 
 #include <tbb/global_control.h>
 #include <tbb/info.h>
 
 #include <chrono>
+#include <cstdio>
 #include <fstream>
 #include <stdexcept>
 
@@ -40,8 +43,15 @@ SamplingPlan planSampling(const ImageSettings& image, std::optional<int> spp) {
 
 std::unique_ptr<RenderResult> render(const Scene& scene, const RenderConfig& config,
                                      const IterationCallback& onIteration) {
-    if (config.backend != "reference" && config.backend != "cpu")
-        throw std::invalid_argument("unknown backend '" + config.backend + "' (reference or cpu)");
+    return renderWithProgress(scene, config, [&](const IterationInfo& info, const Film& film) {
+        if (onIteration) onIteration(info.done, info.total, film);
+    });
+}
+
+std::unique_ptr<RenderResult> renderWithProgress(const Scene& scene, const RenderConfig& config,
+                                                 const ProgressCallback& onIteration) {
+    if (config.backend != "reference" && config.backend != "cpu" && config.backend != "vulkan" && config.backend != "auto")
+        throw std::invalid_argument("unknown backend '" + config.backend + "' (reference, cpu, vulkan or auto)");
     if (config.pipeline.rayFormat == RayFormat::Compact && scene.settings.maxDepth > int(kMaxCompactBounce))
         throw std::invalid_argument("max depth " + std::to_string(scene.settings.maxDepth) +
                                     " exceeds the compact ray's " + std::to_string(kMaxCompactBounce) + " bounces");
@@ -54,6 +64,23 @@ std::unique_ptr<RenderResult> render(const Scene& scene, const RenderConfig& con
     const SamplingPlan plan = planSampling(scene.image, config.spp);
     stats.backend = config.backend;
     stats.device = cpuName();
+
+    // Vulkan only when asked for (vulkan, or auto): never for cpu or reference. `auto` takes the
+    // first usable device and falls back to cpu, saying so on stderr, when there is none.
+    std::unique_ptr<vk::Context> vulkan;
+    if (config.backend == "vulkan" || config.backend == "auto") {
+        StageTimer t(stats.stages, "vulkan init");
+        try {
+            vulkan = std::make_unique<vk::Context>(config.vulkan);
+            stats.backend = "vulkan";
+            stats.device = vulkan->info().name;
+        } catch (const vk::NoDeviceError& e) {
+            if (config.backend == "vulkan") throw std::runtime_error(std::string("--backend vulkan: ") + e.what());
+            std::fprintf(stderr, "spillway: no Vulkan device; rendering on cpu\n");
+            stats.backend = "cpu";
+            stats.extra["backend_fallback"] = e.what();
+        }
+    }
     stats.width = scene.image.width;
     stats.height = scene.image.height;
     stats.spp = plan.sampleBase * plan.sampleBase * plan.iterations;
@@ -82,16 +109,27 @@ std::unique_ptr<RenderResult> render(const Scene& scene, const RenderConfig& con
                                           embree->brightestEmission());
     std::unique_ptr<Backend> backend;
     if (config.backend == "reference") backend = std::make_unique<ReferenceRenderer>(ctx);
+    else if (vulkan) backend = std::make_unique<SortedRenderer>(ctx, config.pipeline, makeVulkanShading(ctx, config.pipeline, *vulkan));
     else backend = std::make_unique<SortedRenderer>(ctx, config.pipeline, makeCpuShading(ctx));
-    for (int it = 0; it < plan.iterations; ++it) {
-        backend->renderIteration(uint(it), *result->film);
+    double renderSeconds = 0;
+    int done = 0;
+    while (done < plan.iterations) {
+        const auto iterationStart = std::chrono::steady_clock::now();
+        backend->renderIteration(uint(done), *result->film);
         {
             StageTimer t(stats.stages, "accumulate");
             result->film->endIteration();
         }
         embree->checkError("tracing");
-        if (onIteration) onIteration(it + 1, plan.iterations, *result->film);
+        renderSeconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - iterationStart).count();
+        ++done;
+        const int sppDone = done * plan.sampleBase * plan.sampleBase;
+        if (onIteration) onIteration({done, plan.iterations, sppDone, renderSeconds}, *result->film);
+        if (config.timeLimitSeconds && renderSeconds >= *config.timeLimitSeconds) break;
     }
+    stats.iterations = done;
+    stats.spp = done * plan.sampleBase * plan.sampleBase;
+    stats.extra["render_seconds"] = renderSeconds;
     stats.nonFiniteSamples = result->film->nonFiniteSamples();
     stats.saturatedSamples = result->film->saturatedSamples();
     stats.wallSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -160,29 +160,30 @@ void DirectionalBins::add(RayBuffer& buffer) {
     for (uint b = 0; b < 6; ++b) {
         std::vector<std::uint8_t>& src = buffer.perBin[b];
         if (src.empty()) continue;
+        // Each bin fills its batch in place; a full batch leaves for the queue (outside the
+        // lock) and the next one starts. A buffer of any size simply makes several batches.
         std::vector<RayBatch> full;
-        std::int64_t delta = 0;
+        size_t at = 0;
         {
             std::lock_guard<std::mutex> lock(bins_[b].mutex);
             std::vector<std::uint8_t>& bin = bins_[b].bytes;
-            delta += std::int64_t(src.size());
-            bin.insert(bin.end(), src.begin(), src.end());
-            size_t start = 0;
-            while (bin.size() - start >= batchBytes) {
-                RayBatch batch;
-                batch.format = format_;
-                batch.count = batchRays_;
-                batch.bin = b;
-                batch.bytes.assign(bin.begin() + std::ptrdiff_t(start),
-                                   bin.begin() + std::ptrdiff_t(start + batchBytes));
-                full.push_back(std::move(batch));
-                start += batchBytes;
-                delta -= std::int64_t(batchBytes);
+            while (at < src.size()) {
+                if (bin.capacity() < batchBytes) bin.reserve(batchBytes);
+                const size_t take = std::min(src.size() - at, batchBytes - bin.size());
+                bin.insert(bin.end(), src.begin() + std::ptrdiff_t(at), src.begin() + std::ptrdiff_t(at + take));
+                at += take;
+                if (bin.size() == batchBytes) {
+                    RayBatch batch;
+                    batch.format = format_;
+                    batch.count = batchRays_;
+                    batch.bin = b;
+                    batch.bytes.swap(bin);
+                    full.push_back(std::move(batch));
+                }
             }
-            if (start > 0) bin.erase(bin.begin(), bin.begin() + std::ptrdiff_t(start));
         }
+        queue_.noteOutsideBytes(std::int64_t(src.size()) - std::int64_t(full.size() * batchBytes));
         src.clear();
-        queue_.noteOutsideBytes(delta);
         for (RayBatch& batch : full) queue_.push(std::move(batch));
     }
     buffer.count = 0;

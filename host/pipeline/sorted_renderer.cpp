@@ -18,8 +18,15 @@ struct SortedRenderer::Scratch {
     std::vector<RayState> rays, rayTmp;
     std::vector<KeyIndex> keys, keyTmp;
     std::vector<RTCRayHit> hits;
-    std::vector<ShadeInput> inputs;
-    std::vector<ShadeResult> results;
+    std::vector<ShadeRange> ranges;
+    // A batch between its shading submit and its accumulation, one per engine slot.
+    struct InFlight {
+        size_t hitCount = 0;
+        ShadeSlot shading;
+        std::vector<uvec2> paths; // (pathId, bounce) per hit: the film needs them, and the
+                                  // inputs may sit in write-combined device memory
+    };
+    InFlight inFlight[2];
     std::vector<ShadowRay> shadows;
     std::vector<std::uint32_t> shadowOwner;
     std::vector<std::uint8_t> occluded;
@@ -32,22 +39,46 @@ double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::
 
 constexpr std::uint64_t kMissKey = ~0ull;
 
+// The same shadeSurface() the kernels run, as C++: shaded at submit, one slot (TBB already
+// keeps every core busy, so there is nothing to overlap).
 class CpuShading : public ShadingEngine {
   public:
     CpuShading(SceneView view, RenderParams params, size_t chunk) : view_(view), params_(params), chunk_(chunk) {}
     void beginIteration(uint iteration) override { params_.iteration = iteration; }
-    void shade(uint /*model*/, const ShadeInput* in, size_t count, ShadeResult* out) override {
-        tbb::parallel_for(tbb::blocked_range<size_t>(0, count, chunk_), [&](const tbb::blocked_range<size_t>& r) {
-            for (size_t i = r.begin(); i < r.end(); ++i) shadeSurface(view_, params_, in[i].hit, in[i].rayDir, in[i].path, out[i]);
-        });
+    ShadeSlot reserve(int /*slot*/, size_t count) override {
+        inputs_.resize(count);
+        results_.resize(count);
+        return {inputs_.data(), results_.data()};
     }
+    void submit(int /*slot*/, const std::vector<ShadeRange>& ranges) override {
+        for (const ShadeRange& range : ranges) {
+            const ShadeInput* in = &inputs_[range.begin];
+            ShadeResult* out = &results_[range.begin];
+            tbb::parallel_for(tbb::blocked_range<size_t>(0, range.count, chunk_), [&](const tbb::blocked_range<size_t>& r) {
+                for (size_t i = r.begin(); i < r.end(); ++i)
+                    shadeSurface(view_, params_, in[i].hit, in[i].rayDir, in[i].path, out[i]);
+            });
+        }
+    }
+    void finish(int /*slot*/) override {}
+
   private:
     SceneView view_;
     RenderParams params_;
     size_t chunk_;
+    std::vector<ShadeInput> inputs_;
+    std::vector<ShadeResult> results_;
 };
 
 } // namespace
+
+ShadingMode parseShadingMode(const std::string& name) {
+    if (name == "sorted") return ShadingMode::Sorted;
+    if (name == "megakernel") return ShadingMode::Megakernel;
+    throw std::invalid_argument("unknown shading '" + name + "' (sorted or megakernel)");
+}
+
+const char* shadingModeName(ShadingMode mode) { return mode == ShadingMode::Sorted ? "sorted" : "megakernel"; }
 
 std::unique_ptr<ShadingEngine> makeCpuShading(const RenderContext& ctx) {
     return std::make_unique<CpuShading>(ctx.embree.view(), ctx.params, size_t(ctx.scene.settings.shadingSize));
@@ -73,6 +104,11 @@ vec2 SortedRenderer::filmPosition(uint pathId, uint iteration) const {
     return ctx_.camera.filmPosition(pixel % width, pixel / width, s, iteration * spi + s, ctx_.params.seed);
 }
 
+uint SortedRenderer::sampleOf(uint pathId, uint iteration) const {
+    const uint spi = ctx_.params.samplesPerIteration;
+    return iteration * spi + pathId % spi;
+}
+
 uvec4 SortedRenderer::roundingBits(const PathState& path, uint iteration) const {
     const uint spi = ctx_.params.samplesPerIteration;
     return pcg4d(uvec4(path.pathId / spi, iteration * spi + path.pathId % spi, (path.bounce << 8u) | kDimRounding,
@@ -92,7 +128,7 @@ void SortedRenderer::generate(uint iteration, Film& film) {
             for (int x = x0; x < std::min(width, x0 + tile); ++x)
                 for (uint s = 0; s < spi; ++s) {
                     CameraRay cr = ctx_.camera.generate(uint(x), uint(y), s, iteration * spi + s, ctx_.params.seed);
-                    film.addSample(cr.filmPos);
+                    film.addSample(cr.filmPos, iteration * spi + s);
                     RayState r;
                     r.origin = cr.origin;
                     r.dir = cr.dir;
@@ -109,19 +145,38 @@ void SortedRenderer::generate(uint iteration, Film& film) {
 void SortedRenderer::renderIteration(uint iteration, Film& film) {
     shading_->beginIteration(iteration);
     generate(iteration, film);
+    // With two engine slots, batch k's shading runs while batch k+1 is loaded, traversed and set
+    // up; batch k is then finished (its continuation rays binned) before k+2 starts. Batches may
+    // be finished in any order: the film and the random numbers do not depend on it.
+    const bool overlap = shading_->slots() > 1;
+    int pending = -1; // the slot whose batch is being shaded
+    int next = 0;
     for (;;) {
         std::optional<RayBatch> batch = queue_->pop(ctx_.stats.stages);
         if (!batch) {
+            if (pending >= 0) { // its continuation rays may refill the queue
+                finishBatch(pending, iteration, film);
+                pending = -1;
+                continue;
+            }
             if (!bins_->flushLargest()) break; // queue and bins empty: the iteration is done
             continue;
         }
-        processBatch(*batch, iteration, film);
+        startBatch(*batch, next);
+        if (pending >= 0) finishBatch(pending, iteration, film);
+        if (overlap) {
+            pending = next;
+            next ^= 1;
+        } else {
+            finishBatch(next, iteration, film);
+        }
     }
     publishStats();
 }
 
-void SortedRenderer::processBatch(RayBatch& batch, uint iteration, Film& film) {
+void SortedRenderer::startBatch(RayBatch& batch, int slot) {
     Scratch& s = *scratch_;
+    Scratch::InFlight& flight = s.inFlight[slot];
     StageTimes& times = ctx_.stats.stages;
     const size_t n = batch.count;
     const size_t recordBytes = rayRecordBytes(batch.format);
@@ -165,12 +220,12 @@ void SortedRenderer::processBatch(RayBatch& batch, uint iteration, Film& film) {
             std::uint64_t key = kMissKey;
             if (h.geomID != RTC_INVALID_GEOMETRY_ID) {
                 const std::uint64_t shader = std::uint64_t(ctx_.scene.meshes[h.geomID].shader);
-                key = config_.hitSort ? (shader << 52 | std::uint64_t(h.geomID) << 32 | h.primID) : 0;
+                key = config_.sortsHits() ? (shader << 52 | std::uint64_t(h.geomID) << 32 | h.primID) : 0;
                 ++hitCount;
             }
             s.keys[i] = {key, std::uint32_t(i)};
         }
-        if (config_.hitSort) {
+        if (config_.sortsHits()) {
             radixSort(s.keys, s.keyTmp);
         } else {
             // No sort: keep traversal order, just move the misses out.
@@ -181,37 +236,58 @@ void SortedRenderer::processBatch(RayBatch& batch, uint iteration, Film& film) {
     // texture: hit setup and texture lookups in sorted order
     {
         StageTimer t(times, "texture");
-        s.inputs.resize(hitCount);
+        flight.hitCount = hitCount;
+        flight.shading = shading_->reserve(slot, hitCount);
+        flight.paths.resize(hitCount);
+        ShadeInput* inputs = flight.shading.inputs;
         tbb::parallel_for(tbb::blocked_range<size_t>(0, hitCount, 1024), [&](const tbb::blocked_range<size_t>& r) {
             for (size_t i = r.begin(); i < r.end(); ++i) {
                 const std::uint32_t k = s.keys[i].index;
                 const RTCRayHit& rh = s.hits[k];
-                ShadeInput& in = s.inputs[i];
+                ShadeInput in; // assembled here, stored whole: one sequential write into the slot
                 ctx_.embree.surfaceHit(rh.hit.geomID, rh.hit.primID, rh.hit.u, rh.hit.v, rh.ray.tfar, in.hit);
                 in.hit.albedo = ctx_.textures.albedo(ctx_.scene.shaders[in.hit.shader],
                                                      ctx_.embree.uvAt(rh.hit.geomID, rh.hit.primID, rh.hit.u, rh.hit.v));
                 in.path = s.rays[k].path;
                 in.rayDir = s.rays[k].dir;
                 in.pad0 = 0.0f;
+                inputs[i] = in;
+                flight.paths[i] = uvec2(in.path.pathId, in.path.bounce);
             }
         });
     }
 
-    // shade: one call per contiguous shader range (the whole list when hits are unsorted)
+    // shade: one range per contiguous shader range (the whole list when hits are unsorted),
+    // found from the sort keys, which carry the shader in their top bits
     {
         StageTimer t(times, "shade");
-        s.results.resize(hitCount);
+        s.ranges.clear();
         size_t begin = 0;
         while (begin < hitCount) {
-            size_t end = begin + 1;
-            const uint shader = s.inputs[begin].hit.shader;
-            if (config_.hitSort)
-                while (end < hitCount && s.inputs[end].hit.shader == shader) ++end;
-            else
-                end = hitCount;
-            shading_->shade(ctx_.scene.shaders[shader].params.model, &s.inputs[begin], end - begin, &s.results[begin]);
+            size_t end = hitCount;
+            uint model = kMixedModels;
+            if (config_.sortsHits()) {
+                const std::uint64_t shader = s.keys[begin].key >> 52;
+                end = begin + 1;
+                while (end < hitCount && s.keys[end].key >> 52 == shader) ++end;
+                model = ctx_.scene.shaders[size_t(shader)].params.model;
+            }
+            s.ranges.push_back({model, begin, end - begin});
             begin = end;
         }
+        shading_->submit(slot, s.ranges);
+    }
+}
+
+void SortedRenderer::finishBatch(int slot, uint iteration, Film& film) {
+    Scratch& s = *scratch_;
+    StageTimes& times = ctx_.stats.stages;
+    const Scratch::InFlight& flight = s.inFlight[slot];
+    const size_t hitCount = flight.hitCount;
+    const ShadeResult* results = flight.shading.results;
+    {
+        StageTimer t(times, "shade");
+        shading_->finish(slot);
     }
 
     // shadow rays
@@ -220,8 +296,8 @@ void SortedRenderer::processBatch(RayBatch& batch, uint iteration, Film& film) {
         s.shadows.clear();
         s.shadowOwner.clear();
         for (size_t i = 0; i < hitCount; ++i)
-            if (s.results[i].flags & kShadeShadow) {
-                s.shadows.push_back({s.results[i].shadowOrigin, s.results[i].shadowDir, s.results[i].shadowTmax});
+            if (results[i].flags & kShadeShadow) {
+                s.shadows.push_back({results[i].shadowOrigin, results[i].shadowDir, results[i].shadowTmax});
                 s.shadowOwner.push_back(std::uint32_t(i));
             }
         occludedBatch(ctx_.embree, s.shadows, false, s.occluded);
@@ -233,18 +309,19 @@ void SortedRenderer::processBatch(RayBatch& batch, uint iteration, Film& film) {
         StageTimer t(times, "accumulate");
         tbb::parallel_for(tbb::blocked_range<size_t>(0, hitCount, 1024), [&](const tbb::blocked_range<size_t>& r) {
             for (size_t i = r.begin(); i < r.end(); ++i)
-                if (s.results[i].flags & kShadeEmitted) {
-                    const PathState& p = s.inputs[i].path;
-                    film.splat(filmPosition(p.pathId, iteration), s.results[i].emitted, filmKey(p.pathId, p.bounce, false));
+                if (results[i].flags & kShadeEmitted) {
+                    const uvec2 p = flight.paths[i]; // (pathId, bounce)
+                    film.splat(filmPosition(p.x, iteration), sampleOf(p.x, iteration), results[i].emitted,
+                               filmKey(p.x, p.y, false));
                 }
         });
         tbb::parallel_for(tbb::blocked_range<size_t>(0, s.shadows.size(), 1024), [&](const tbb::blocked_range<size_t>& r) {
             for (size_t j = r.begin(); j < r.end(); ++j)
                 if (!s.occluded[j]) {
                     const size_t i = s.shadowOwner[j];
-                    const PathState& p = s.inputs[i].path;
-                    film.splat(filmPosition(p.pathId, iteration), s.results[i].shadowContribution,
-                               filmKey(p.pathId, p.bounce, true));
+                    const uvec2 p = flight.paths[i]; // (pathId, bounce)
+                    film.splat(filmPosition(p.x, iteration), sampleOf(p.x, iteration),
+                               results[i].shadowContribution, filmKey(p.x, p.y, true));
                 }
         });
     }
@@ -256,7 +333,7 @@ void SortedRenderer::processBatch(RayBatch& batch, uint iteration, Film& film) {
         tbb::parallel_for(tbb::blocked_range<size_t>(0, hitCount, chunk), [&](const tbb::blocked_range<size_t>& r) {
             RayBuffer buffer;
             for (size_t i = r.begin(); i < r.end(); ++i) {
-                const ShadeResult& res = s.results[i];
+                const ShadeResult& res = results[i];
                 if (!(res.flags & kShadeContinue)) continue;
                 RayState ray;
                 ray.origin = res.nextOrigin;
@@ -281,9 +358,11 @@ void SortedRenderer::publishStats() {
     x["ray_format"] = config_.rayFormat == RayFormat::Compact ? "compact" : "full";
     x["ray_record_bytes"] = rayRecordBytes(config_.rayFormat);
     x["ray_sort"] = raySortName(config_.raySort);
-    x["hit_sort"] = config_.hitSort;
+    x["hit_sort"] = config_.sortsHits();
+    x["shading"] = shadingModeName(config_.sortsHits() ? ShadingMode::Sorted : ShadingMode::Megakernel);
     x["batches_ray_sorted"] = policy_.sortedBatches();
     x["batches_ray_unsorted_measured"] = policy_.unsortedBatches();
+    shading_->publishStats(ctx_.stats);
 }
 
 } // namespace spw

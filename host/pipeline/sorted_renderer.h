@@ -8,7 +8,8 @@
 //   traverse   Embree closest hits for the whole batch
 //   sort hits  radix sort by (shader, object, primitive): one contiguous range per shader
 //   texture    hit setup and texture lookups in that sorted order
-//   shade      one pass per shader range (ShadingEngine: C++ here, Vulkan compute later)
+//   shade      one pass per shader range (ShadingEngine: C++, or Vulkan compute in host/vk/),
+//              overlapping the next batch's traversal where the engine has two slots
 //   shadow     next-event rays traced with Embree's occlusion call
 //   accumulate emitted and unoccluded contributions into the film
 //   bin        continuation rays -> thread-local buffers -> bins
@@ -17,27 +18,48 @@
 #include "host/backend.h"
 #include "host/pipeline/batch_queue.h"
 #include "host/pipeline/ray_sort.h"
+#include "shared/shade_io.h"
 
 #include <memory>
 
 namespace spw {
 
 
-// One shader's contiguous range of hits, as the shading stage receives it.
-struct ShadeInput {
-    SurfaceHit hit;
-    PathState path;
-    vec3 rayDir;
-    float pad0;
+// A contiguous range of a batch's hits that one dispatch shades: all of one shader, so of one
+// surface model, or (hits unsorted) every hit, of any model: kMixedModels.
+struct ShadeRange {
+    uint model; // kModel*, or kMixedModels
+    size_t begin, count;
+};
+constexpr uint kMixedModels = 0xFFFFFFFFu;
+
+// Where one batch's hits are shaded. The texture stage writes `inputs` in place (for the Vulkan
+// engine that is the mapped device buffer itself: no copy); `results` hold the shadow rays, their
+// pending contributions and the continuation rays once ShadingEngine::finish() returns.
+struct ShadeSlot {
+    ShadeInput* inputs = nullptr;
+    const ShadeResult* results = nullptr;
 };
 
-// Shades ranges of hits that share one surface model. The CPU engine runs shared/path.h's
-// shadeSurface() in TBB tasks of `shading size` hits.
+// Shades a batch's hits, one pass per range, with shared/path.h's shadeSurface(): as C++ in TBB
+// tasks of `shading size` hits (makeCpuShading), or as Vulkan compute dispatches
+// (host/vk/vulkan_shading.h).
 class ShadingEngine {
   public:
     virtual ~ShadingEngine() = default;
     virtual void beginIteration(uint iteration) = 0;
-    virtual void shade(uint model, const ShadeInput* in, size_t count, ShadeResult* out) = 0;
+    // Batches that may be in flight at once. With 2 the renderer traverses and sets up batch k+1
+    // while batch k is being shaded (double buffering); with 1 each batch is shaded in turn.
+    virtual int slots() const { return 1; }
+    // Storage for `count` hits in `slot` (0 <= slot < slots()); the slot's previous batch must be
+    // finished. Valid until the slot's next reserve().
+    virtual ShadeSlot reserve(int slot, size_t count) = 0;
+    // Starts shading the slot's ranges (in order, each over inputs[begin, begin + count)).
+    virtual void submit(int slot, const std::vector<ShadeRange>& ranges) = 0;
+    // Returns once the slot's results are complete.
+    virtual void finish(int slot) = 0;
+    // Adds the engine's own counters to the stats (called at the end of every iteration).
+    virtual void publishStats(RenderStats& /*stats*/) {}
 };
 
 class SortedRenderer : public Backend {
@@ -50,8 +72,13 @@ class SortedRenderer : public Backend {
   private:
     struct Scratch;
     void generate(uint iteration, Film& film);
-    void processBatch(RayBatch& batch, uint iteration, Film& film);
+    // One batch in two halves, so that a batch's shading can overlap the next one's traversal:
+    // decompress .. texture, then submit its shading to `slot`; then wait for it, trace its
+    // shadow rays, accumulate and bin its continuation rays.
+    void startBatch(RayBatch& batch, int slot);
+    void finishBatch(int slot, uint iteration, Film& film);
     vec2 filmPosition(uint pathId, uint iteration) const;
+    uint sampleOf(uint pathId, uint iteration) const; // render-wide sample index
     uvec4 roundingBits(const PathState& path, uint iteration) const;
     void publishStats();
 
