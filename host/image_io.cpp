@@ -22,8 +22,6 @@ std::uint8_t linearToSrgb8(float v) {
     return std::uint8_t(std::lround(std::clamp(s, 0.0f, 1.0f) * 255.0f));
 }
 
-float srgbToLinear(float c) { return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f); }
-
 } // namespace
 
 bool isSupportedOutput(const std::string& path) {

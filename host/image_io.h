@@ -1,6 +1,7 @@
 // Images in and out through OpenImageIO: linear float EXR, or 8-bit sRGB PNG, by extension.
 #pragma once
 
+#include <cmath>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -11,6 +12,11 @@ struct ImageRGB {
     int width = 0, height = 0;
     std::vector<float> rgb; // linear, row-major, 3 floats a pixel
 };
+
+// The sRGB transfer function, decoded: 8-bit images and textures are linearised with it.
+inline float srgbToLinear(float c) {
+    return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f);
+}
 
 // True for the extensions writeImage understands (.exr, .png; any case).
 bool isSupportedOutput(const std::string& path);

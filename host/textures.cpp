@@ -1,5 +1,7 @@
 #include "host/textures.h"
 
+#include "host/image_io.h"
+
 #include <OpenImageIO/texture.h>
 
 #include <cmath>
@@ -19,12 +21,6 @@ struct TextureResolver::Impl {
         if (system) OIIO::TextureSystem::destroy(system);
     }
 };
-
-namespace {
-float srgbToLinear(float c) {
-    return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f);
-}
-} // namespace
 
 TextureResolver::TextureResolver(const Scene& scene) : scene_(scene) {
     bool any = false;
