@@ -28,8 +28,8 @@ void octEncode(vec3 d, uint& u, uint& v) {
         x = ox;
         y = oy;
     }
-    u = uint(std::lround((x * 0.5 + 0.5) * kOctScale));
-    v = uint(std::lround((y * 0.5 + 0.5) * kOctScale));
+    u = uint((x * 0.5 + 0.5) * kOctScale + 0.5); // round to nearest (the value is >= 0)
+    v = uint((y * 0.5 + 0.5) * kOctScale + 0.5);
 }
 
 vec3 octDecode(uint u, uint v) {

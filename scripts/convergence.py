@@ -1,4 +1,4 @@
-#!/usr/bin/env python3
+#!/usr/bin/python3
 """Error against run time for every backend: the convergence report.
 
 Renders a reference once at high spp (or takes --reference), then renders the scene on each
@@ -12,6 +12,9 @@ better; for an unbiased estimator it stays roughly constant along the curve).
                          [--reference-spp 4096 | --reference REF.exr] [--out out/convergence]
 
 A backend that cannot run here (vulkan without a Vulkan device) is reported and skipped.
+--replot redraws OUT/convergence.png from OUT/convergence.csv without rendering. The plot needs
+Debian's python3-matplotlib, hence /usr/bin/python3 rather than whatever python3 is first on
+the PATH.
 """
 import argparse
 import csv
@@ -31,12 +34,21 @@ def main():
     ap.add_argument("--reference")
     ap.add_argument("--out", default=os.path.join(ROOT, "out", "convergence"))
     ap.add_argument("--spillway", default=os.path.join(ROOT, "build", "spillway"))
+    ap.add_argument("--replot", action="store_true")
     a = ap.parse_args()
     os.makedirs(a.out, exist_ok=True)
+    out_csv = os.path.join(a.out, "convergence.csv")
+    if a.replot:
+        with open(out_csv) as f:
+            rows = [{"backend": r["backend"], "iteration": int(r["iteration"]), "spp": int(r["spp"]),
+                     "seconds": float(r["seconds"]), "relmse": float(r["relmse"]),
+                     "relmse_estimate": float(r["relmse_estimate"])} for r in csv.DictReader(f)]
+        report(a, rows)
+        return
 
     ref = a.reference
     if not ref:
-        ref = os.path.join(a.out, "reference.exr")
+        ref = os.path.join(a.out, "ground-truth.exr")  # not <backend>.exr: the reference backend writes that
         print("rendering the reference: %d spp on the reference backend (seed 1000003)" % a.reference_spp)
         subprocess.check_call([a.spillway, "render", a.scene, "--backend", "reference", "--spp", str(a.reference_spp),
                                "--seed", "1000003", "--quiet", "-o", ref])
@@ -58,17 +70,21 @@ def main():
     if not rows:
         sys.exit("no backend rendered")
 
-    out_csv = os.path.join(a.out, "convergence.csv")
     with open(out_csv, "w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=["backend", "iteration", "spp", "seconds", "relmse", "relmse_estimate"])
         w.writeheader()
         w.writerows(rows)
+    report(a, rows)
 
+
+def report(a, rows):
+    """Prints each backend's last point and efficiency, and draws the log-log plot."""
+    out_csv = os.path.join(a.out, "convergence.csv")
     backends = [b for b in a.backends.split(",") if any(r["backend"] == b for r in rows)]
     print("\n%-10s %6s %10s %12s %14s" % ("backend", "spp", "seconds", "relMSE", "efficiency"))
     for b in backends:
         last = [r for r in rows if r["backend"] == b][-1]
-        print("%-10s %6d %10.3f %12.6f %14.1f" % (b, last["spp"], last["seconds"], last["relmse"],
+        print("%-10s %6d %10.3f %12.4g %14.4g" % (b, last["spp"], last["seconds"], last["relmse"],
                                                   1.0 / (last["relmse"] * last["seconds"])))
 
     import matplotlib

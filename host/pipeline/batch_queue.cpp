@@ -222,6 +222,7 @@ size_t DirectionalBins::raysWaiting() {
 void RayBuffer::push(const RayState& ray, RayFormat format, uvec4 rounding) {
     std::vector<std::uint8_t>& dst = perBin[cardinalBin(ray.dir)];
     const size_t at = dst.size();
+    if (dst.capacity() == at) dst.reserve(std::max<size_t>(at * 2, 256 * kFullRayBytes));
     dst.resize(at + rayRecordBytes(format));
     encodeRay(ray, format, rounding, dst.data() + at);
     ++count;

@@ -1,6 +1,7 @@
 #include "host/pipeline/sorted_renderer.h"
 
 #include "embree_backend/batch_traversal.h"
+#include "host/pipeline/parallel.h"
 #include "host/pipeline/radix_sort.h"
 #include "shared/path.h"
 
@@ -101,7 +102,10 @@ vec2 SortedRenderer::filmPosition(uint pathId, uint iteration) const {
     const uint spi = ctx_.params.samplesPerIteration;
     const uint pixel = pathId / spi, s = pathId % spi;
     const uint width = uint(ctx_.scene.image.width);
-    return ctx_.camera.filmPosition(pixel % width, pixel / width, s, iteration * spi + s, ctx_.params.seed);
+    const uint x = pixel % width, y = pixel / width;
+    // The Box filter needs only the pixel: skip re-deriving the sample's position in it.
+    if (ctx_.scene.filter.type == FilterType::Box) return vec2(float(x) + 0.5f, float(y) + 0.5f);
+    return ctx_.camera.filmPosition(x, y, s, iteration * spi + s, ctx_.params.seed);
 }
 
 uint SortedRenderer::sampleOf(uint pathId, uint iteration) const {
@@ -190,7 +194,7 @@ void SortedRenderer::startBatch(RayBatch& batch, int slot) {
         tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 4096), [&](const tbb::blocked_range<size_t>& r) {
             for (size_t i = r.begin(); i < r.end(); ++i) decodeRay(&batch.bytes[i * recordBytes], batch.format, s.rays[i]);
         });
-        for (size_t i = 0; i < n; ++i) cameraRays += s.rays[i].path.bounce == 0 ? 1 : 0;
+        cameraRays = parallelCount(n, [&](size_t i) { return s.rays[i].path.bounce == 0; });
         std::vector<std::uint8_t>().swap(batch.bytes);
     }
 
@@ -215,16 +219,19 @@ void SortedRenderer::startBatch(RayBatch& batch, int slot) {
     {
         StageTimer t(times, "sort hits");
         s.keys.resize(n);
-        for (size_t i = 0; i < n; ++i) {
-            const RTCHit& h = s.hits[i].hit;
-            std::uint64_t key = kMissKey;
-            if (h.geomID != RTC_INVALID_GEOMETRY_ID) {
-                const std::uint64_t shader = std::uint64_t(ctx_.scene.meshes[h.geomID].shader);
-                key = config_.sortsHits() ? (shader << 52 | std::uint64_t(h.geomID) << 32 | h.primID) : 0;
-                ++hitCount;
+        const bool sortHits = config_.sortsHits();
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, n, kParallelGrain), [&](const tbb::blocked_range<size_t>& r) {
+            for (size_t i = r.begin(); i < r.end(); ++i) {
+                const RTCHit& h = s.hits[i].hit;
+                std::uint64_t key = kMissKey;
+                if (h.geomID != RTC_INVALID_GEOMETRY_ID) {
+                    const std::uint64_t shader = std::uint64_t(ctx_.scene.meshes[h.geomID].shader);
+                    key = sortHits ? (shader << 52 | std::uint64_t(h.geomID) << 32 | h.primID) : 0;
+                }
+                s.keys[i] = {key, std::uint32_t(i)};
             }
-            s.keys[i] = {key, std::uint32_t(i)};
-        }
+        });
+        hitCount = parallelCount(n, [&](size_t i) { return s.keys[i].key != kMissKey; });
         if (config_.sortsHits()) {
             radixSort(s.keys, s.keyTmp);
         } else {
@@ -293,13 +300,15 @@ void SortedRenderer::finishBatch(int slot, uint iteration, Film& film) {
     // shadow rays
     {
         StageTimer t(times, "shadow");
-        s.shadows.clear();
-        s.shadowOwner.clear();
-        for (size_t i = 0; i < hitCount; ++i)
-            if (results[i].flags & kShadeShadow) {
-                s.shadows.push_back({results[i].shadowOrigin, results[i].shadowDir, results[i].shadowTmax});
-                s.shadowOwner.push_back(std::uint32_t(i));
-            }
+        parallelSelect(hitCount, [&](size_t i) { return (results[i].flags & kShadeShadow) != 0; }, s.shadowOwner);
+        s.shadows.resize(s.shadowOwner.size());
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, s.shadows.size(), kParallelGrain),
+                          [&](const tbb::blocked_range<size_t>& r) {
+                              for (size_t j = r.begin(); j < r.end(); ++j) {
+                                  const ShadeResult& res = results[s.shadowOwner[j]];
+                                  s.shadows[j] = {res.shadowOrigin, res.shadowDir, res.shadowTmax};
+                              }
+                          });
         occludedBatch(ctx_.embree, s.shadows, false, s.occluded);
         ctx_.stats.shadowRays += s.shadows.size();
     }
