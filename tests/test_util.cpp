@@ -70,6 +70,35 @@ MeanError meanAndError(const std::vector<float>& rgb) {
     return {m, std::sqrt(std::max(0.0, var) / double(n))};
 }
 
+void PixelStats::add(const std::vector<float>& img) {
+    if (sum.empty()) sum.assign(img.size() / 3, 0.0), sum2.assign(img.size() / 3, 0.0);
+    for (size_t i = 0; i < sum.size(); ++i) {
+        const double v = (double(img[3 * i]) + img[3 * i + 1] + img[3 * i + 2]) / 3.0;
+        sum[i] += v;
+        sum2[i] += v * v;
+    }
+    ++n;
+}
+
+double PixelStats::variance(size_t i) const {
+    return std::max(0.0, (sum2[i] - n * mean(i) * mean(i)) / (n - 1));
+}
+
+double PixelStats::stderror(size_t i) const { return std::sqrt(meanVariance(i)); }
+
+double PixelStats::averageVariance() const {
+    double v = 0;
+    for (size_t i = 0; i < pixels(); ++i) v += variance(i);
+    return v / double(pixels());
+}
+
+MeanError PixelStats::imageMean() const {
+    double m = 0, var = 0;
+    for (size_t i = 0; i < pixels(); ++i) m += mean(i), var += meanVariance(i);
+    const double p = double(pixels());
+    return {m / p, std::sqrt(var) / p};
+}
+
 std::string insideCubeObj() {
     // 8 corners; faces wound so that cross(v1 - v0, v2 - v0) points into the cube.
     return "v -1 -1 -1\nv 1 -1 -1\nv 1 1 -1\nv -1 1 -1\n"

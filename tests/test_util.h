@@ -48,6 +48,25 @@ struct MeanError {
 };
 MeanError meanAndError(const std::vector<float>& rgb);
 
+// Per-pixel statistics of the channel average over iterations, each iteration an independent
+// estimate (feed it Film::lastIterationImage() from a render callback).
+struct PixelStats {
+    std::vector<double> sum, sum2;
+    int n = 0;
+    void add(const std::vector<float>& img);
+    size_t pixels() const { return sum.size(); }
+    double mean(size_t i) const { return sum[i] / n; }
+    // Sample variance of pixel i's per-iteration values.
+    double variance(size_t i) const;
+    // Variance and standard error of pixel i's mean.
+    double meanVariance(size_t i) const { return variance(i) / n; }
+    double stderror(size_t i) const;
+    // The per-iteration variance averaged over pixels: how noisy a strategy is.
+    double averageVariance() const;
+    // The image mean and its standard error (pixels independent).
+    MeanError imageMean() const;
+};
+
 // An axis-aligned box [-1,1]^3 whose faces point inward, as OBJ text.
 std::string insideCubeObj();
 // A square [-h,h]^2 at y = 0 facing +Y, as OBJ text.

@@ -32,33 +32,6 @@ std::vector<std::string> extremeBackends() { return backendsUnderTest(); }
 
 // ---- statistics -------------------------------------------------------------------------
 
-// Per-pixel mean and variance over iterations, each iteration an independent estimate.
-struct PixelStats {
-    std::vector<double> sum, sum2;
-    int n = 0;
-    void add(const std::vector<float>& img) {
-        if (sum.empty()) sum.assign(img.size() / 3, 0.0), sum2.assign(img.size() / 3, 0.0);
-        for (size_t i = 0; i < sum.size(); ++i) {
-            const double v = (double(img[3 * i]) + img[3 * i + 1] + img[3 * i + 2]) / 3.0;
-            sum[i] += v;
-            sum2[i] += v * v;
-        }
-        ++n;
-    }
-    size_t pixels() const { return sum.size(); }
-    double mean(size_t i) const { return sum[i] / n; }
-    // Variance of the mean of pixel i.
-    double meanVariance(size_t i) const {
-        return std::max(0.0, (sum2[i] - n * mean(i) * mean(i)) / (n - 1)) / n;
-    }
-    MeanError imageMean() const {
-        double m = 0, var = 0;
-        for (size_t i = 0; i < pixels(); ++i) m += mean(i), var += meanVariance(i);
-        const double p = double(pixels());
-        return {m / p, std::sqrt(var) / p};
-    }
-};
-
 // What a test reads of RenderStats (which holds atomics and cannot be copied).
 struct Counters {
     std::uint64_t cameraRays = 0, bounceRays = 0, nonFiniteSamples = 0, saturatedSamples = 0;

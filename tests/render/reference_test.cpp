@@ -11,36 +11,6 @@
 namespace spw::test {
 namespace {
 
-// Per-pixel statistics over iterations: each iteration is an independent estimate.
-struct PixelStats {
-    std::vector<double> sum, sum2;
-    int n = 0;
-    void add(const std::vector<float>& img) {
-        if (sum.empty()) sum.assign(img.size() / 3, 0.0), sum2.assign(img.size() / 3, 0.0);
-        for (size_t i = 0; i < sum.size(); ++i) {
-            double v = (double(img[3 * i]) + img[3 * i + 1] + img[3 * i + 2]) / 3.0;
-            sum[i] += v;
-            sum2[i] += v * v;
-        }
-        ++n;
-    }
-    double mean(size_t i) const { return sum[i] / n; }
-    double variance(size_t i) const { return std::max(0.0, (sum2[i] - n * mean(i) * mean(i)) / (n - 1)); }
-    double stderror(size_t i) const { return std::sqrt(variance(i) / n); }
-    double meanVariance() const {
-        double v = 0;
-        for (size_t i = 0; i < sum.size(); ++i) v += variance(i);
-        return v / double(sum.size());
-    }
-    // Image mean and its standard error (pixels independent).
-    MeanError imageMean() const {
-        double m = 0, var = 0;
-        for (size_t i = 0; i < sum.size(); ++i) m += mean(i), var += variance(i) / n;
-        const double p = double(sum.size());
-        return {m / p, std::sqrt(var) / p};
-    }
-};
-
 std::unique_ptr<RenderResult> renderWithStats(const Scene& scene, const RenderConfig& cfg, PixelStats* stats) {
     return render(scene, cfg, [&](int, int, const Film& film) {
         if (stats) stats->add(film.lastIterationImage());
@@ -151,13 +121,13 @@ TEST(Mis, StrategiesAgreeAndMisHasLowestVariance) {
     }
     for (uint s : {kStrategyMis, kStrategyLight, kStrategyBsdf})
         std::printf("strategy %u: mean %.5f +- %.5f, mean pixel variance %.5f\n", s, stats[s].imageMean().mean,
-                    stats[s].imageMean().stderror, stats[s].meanVariance());
+                    stats[s].imageMean().stderror, stats[s].averageVariance());
     MeanError mis = stats[kStrategyMis].imageMean();
     for (uint s : {kStrategyLight, kStrategyBsdf}) {
         MeanError other = stats[s].imageMean();
         double se = std::hypot(mis.stderror, other.stderror);
         EXPECT_NEAR(mis.mean, other.mean, 4.0 * se) << "strategy " << s;
-        EXPECT_LT(stats[kStrategyMis].meanVariance(), stats[s].meanVariance()) << "strategy " << s;
+        EXPECT_LT(stats[kStrategyMis].averageVariance(), stats[s].averageVariance()) << "strategy " << s;
     }
 }
 
