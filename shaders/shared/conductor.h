@@ -25,12 +25,9 @@ SHARED_FN vec3 conductorEval(vec3 f0, float alpha, vec3 ng, vec3 ns, vec3 wo, ve
     pdf = 0.0f;
     if (ggxIsSmooth(alpha)) return vec3(0.0f);
     if (dot(ng, wo) * dot(ng, wi) <= 0.0f) return vec3(0.0f);
-    vec3 n = facingShadingNormal(ns, ng, wo);
-    vec3 t;
-    vec3 b;
-    makeFrame(n, t, b);
-    vec3 lo = toLocal(wo, t, b, n);
-    vec3 li = toLocal(wi, t, b, n);
+    Frame f = shadingFrame(ns, ng, wo);
+    vec3 lo = frameToLocal(f, wo);
+    vec3 li = frameToLocal(f, wi);
     if (lo.z <= 0.0f || li.z <= 0.0f) return vec3(0.0f);
     vec3 h = lo + li;
     float len2 = dot(h, h);
@@ -46,14 +43,11 @@ SHARED_FN vec3 conductorEval(vec3 f0, float alpha, vec3 ng, vec3 ns, vec3 wo, ve
 
 SHARED_FN bool conductorSample(vec3 f0, float alpha, vec3 ng, vec3 ns, vec3 wo, vec2 u, OUT(vec3) wi,
                                OUT(vec3) weight, OUT(float) pdf, OUT(bool) specular) {
-    vec3 n = facingShadingNormal(ns, ng, wo);
-    vec3 t;
-    vec3 b;
-    makeFrame(n, t, b);
-    vec3 lo = toLocal(wo, t, b, n);
+    Frame f = shadingFrame(ns, ng, wo);
+    vec3 lo = frameToLocal(f, wo);
     if (lo.z <= 0.0f) return false;
     if (ggxIsSmooth(alpha)) {
-        wi = normalize(2.0f * lo.z * n - wo);
+        wi = normalize(2.0f * lo.z * f.n - wo);
         if (dot(ng, wo) * dot(ng, wi) <= 0.0f) return false;
         specular = true;
         pdf = 0.0f;
@@ -64,7 +58,7 @@ SHARED_FN bool conductorSample(vec3 f0, float alpha, vec3 ng, vec3 ns, vec3 wo, 
     float oh = dot(lo, h);
     vec3 li = 2.0f * oh * h - lo;
     if (oh <= 0.0f || li.z <= 0.0f) return false; // reflected below the surface: absorbed
-    wi = fromLocal(li, t, b, n);
+    wi = frameToWorld(f, li);
     if (dot(ng, wo) * dot(ng, wi) <= 0.0f) return false;
     float ao = ggxA(lo, alpha);
     float denom = ggxG2Denominator(lo, li, alpha);

@@ -48,12 +48,9 @@ SHARED_FN vec3 dielectricEval(float ior, float alpha, vec3 ng, vec3 ns, vec3 wo,
     if (go == 0.0f || gi == 0.0f) return vec3(0.0f);
     bool isReflection = go * gi > 0.0f;
     float eta = dielectricEta(ior, ng, wo);
-    vec3 n = facingShadingNormal(ns, ng, wo);
-    vec3 t;
-    vec3 b;
-    makeFrame(n, t, b);
-    vec3 lo = toLocal(wo, t, b, n);
-    vec3 li = toLocal(wi, t, b, n);
+    Frame f = shadingFrame(ns, ng, wo);
+    vec3 lo = frameToLocal(f, wo);
+    vec3 li = frameToLocal(f, wi);
     // The shading frame must agree with the geometric sides, as sampling requires.
     if (lo.z <= 0.0f || (li.z > 0.0f) != isReflection || li.z == 0.0f) return vec3(0.0f);
     // The (generalised) half vector, on the side of wo.
@@ -91,11 +88,8 @@ SHARED_FN bool dielectricSample(float ior, float alpha, vec3 ng, vec3 ns, vec3 w
     float go = dot(ng, wo);
     if (go == 0.0f) return false;
     float eta = dielectricEta(ior, ng, wo);
-    vec3 n = facingShadingNormal(ns, ng, wo);
-    vec3 t;
-    vec3 b;
-    makeFrame(n, t, b);
-    vec3 lo = toLocal(wo, t, b, n);
+    Frame f = shadingFrame(ns, ng, wo);
+    vec3 lo = frameToLocal(f, wo);
     if (lo.z <= 0.0f) return false;
     bool isSmooth = ggxIsSmooth(alpha);
     // The facet: the shading normal itself, or a visible microfacet normal.
@@ -107,7 +101,7 @@ SHARED_FN bool dielectricSample(float ior, float alpha, vec3 ng, vec3 ns, vec3 w
     bool isReflection = u.z < F;
     vec3 li = isReflection ? 2.0f * oh * h - lo : (oh / eta - cosT) * h - lo / eta;
     if (isReflection ? li.z <= 0.0f : li.z >= 0.0f) return false; // wrong side of the macro surface
-    wi = fromLocal(li, t, b, n);
+    wi = frameToWorld(f, li);
     if ((go * dot(ng, wi) > 0.0f) != isReflection) return false; // the geometric side disagrees
     float etaScale = isReflection ? 1.0f : 1.0f / (eta * eta);
     if (isSmooth) {

@@ -84,5 +84,21 @@ SHARED_FN vec3 ggxSampleVisibleNormal(vec3 wo, float alpha, vec2 u) {
 SHARED_FN vec3 toLocal(vec3 w, vec3 t, vec3 b, vec3 n) { return vec3(dot(w, t), dot(w, b), dot(w, n)); }
 SHARED_FN vec3 fromLocal(vec3 l, vec3 t, vec3 b, vec3 n) { return normalize(l.x * t + l.y * b + l.z * n); }
 
+// The frame the microfacet models work in: the shading normal turned to wo's side, and two
+// tangents. Built once per eval or sample.
+struct Frame {
+    vec3 t;
+    vec3 b;
+    vec3 n;
+};
+SHARED_FN Frame shadingFrame(vec3 ns, vec3 ng, vec3 wo) {
+    Frame f;
+    f.n = facingShadingNormal(ns, ng, wo);
+    makeFrame(f.n, f.t, f.b);
+    return f;
+}
+SHARED_FN vec3 frameToLocal(Frame f, vec3 w) { return toLocal(w, f.t, f.b, f.n); }
+SHARED_FN vec3 frameToWorld(Frame f, vec3 l) { return fromLocal(l, f.t, f.b, f.n); }
+
 SHARED_END
 #endif
