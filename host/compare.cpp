@@ -476,26 +476,13 @@ HeatmapInfo writeHeatmap(const std::string& path, const ImageRGB& a, const Image
         label(0.0, "0", true);
     }
 
-    auto out = OIIO::ImageOutput::create(path);
-    if (!out) throw std::runtime_error("cannot write '" + path + "': " + OIIO::geterror());
-    OIIO::ImageSpec spec(canvas.width(), canvas.height(), 3, OIIO::TypeDesc::UINT8);
-    spec.attribute("oiio:ColorSpace", "sRGB");
-    spec.attribute("Software", "Spillway compare");
     char desc[320];
     std::snprintf(desc, sizeof desc,
                   "Spillway compare heatmap: per-pixel relative error, channel mean of "
                   "(a-b)^2/(b^2+0.01); viridis on a log10 scale from %.6g to %.6g; "
                   "red = non-finite pixel",
                   info.low, info.high);
-    spec.attribute("ImageDescription", desc);
-    bool ok = out->open(path, spec) && out->write_image(OIIO::TypeDesc::UINT8, canvas.data());
-    std::string err2 = ok ? "" : out->geterror();
-    if (!out->close() && ok) err2 = out->geterror(), ok = false;
-    if (!ok) {
-        std::error_code ec;
-        std::filesystem::remove(path, ec);
-        throw std::runtime_error("cannot write '" + path + "': " + err2);
-    }
+    writeImage8(path, canvas.width(), canvas.height(), canvas.data(), "Spillway compare", desc);
     info.width = canvas.width();
     info.height = canvas.height();
     return info;

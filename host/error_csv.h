@@ -7,7 +7,8 @@
 #include "host/compare.h"
 #include "host/film.h"
 
-#include <fstream>
+#include "host/output_file.h"
+
 #include <optional>
 #include <string>
 
@@ -15,13 +16,15 @@ namespace spw {
 
 class ErrorCsv {
   public:
-    // Throws std::runtime_error naming the path when it cannot be written.
+    // Throws std::runtime_error naming the path when it cannot be written. The rows go to an
+    // anonymous file as they come; the CSV appears under its name at commit(), not before.
     ErrorCsv(const std::string& path, std::optional<ImageRGB> reference);
     void addRow(int iteration, int spp, double seconds, const Film& film);
+    void flush() { out_.flush(); }
+    void commit() { out_.commit(); }
 
   private:
-    std::string path_;
-    std::ofstream out_;
+    OutputFile out_;
     std::optional<ImageRGB> reference_;
 };
 

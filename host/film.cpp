@@ -30,8 +30,9 @@ Film::Film(int width, int height, const Filter& filter, float brightestRadiance)
     : width_(width), height_(height), filter_(filter),
       acc_(new std::atomic<std::int64_t>[size_t(width) * height * 8]),
       sum_(size_t(width) * height * 8, 0.0), lastIteration_(size_t(width) * height * 3, 0.0f) {
-    int e = brightestRadiance > 0.0f ? int(std::ceil(std::log2(brightestRadiance))) : 0;
-    e = std::max(-60, std::min(60, e));
+    // No clamp on e: the scale is a double, and every emission the loader accepts (up to
+    // kMaxRadiance, down to the smallest float) keeps its brightest sample at 2^40.
+    const int e = brightestRadiance > 0.0f ? int(std::ceil(std::log2(double(brightestRadiance)))) : 0;
     scale_ = std::ldexp(1.0, 40 - e);
     weightScale_ = std::ldexp(1.0, 40);
     beginIteration();

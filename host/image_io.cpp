@@ -1,5 +1,8 @@
 #include "host/image_io.h"
 
+#include "host/output_file.h"
+
+#include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
 
 #include <algorithm>
@@ -29,30 +32,52 @@ bool isSupportedOutput(const std::string& path) {
     return e == ".exr" || e == ".png";
 }
 
-void writeImage(const std::string& path, const ImageRGB& image) {
-    if (!isSupportedOutput(path)) throw std::runtime_error("cannot write '" + path + "': use .exr or .png");
-    auto out = OIIO::ImageOutput::create(path);
+namespace {
+
+// Encodes through OpenImageIO into memory (the format by the path's extension): OpenImageIO
+// never touches the destination, so a failure leaves no file.
+std::vector<unsigned char> encode(const std::string& path, const OIIO::ImageSpec& spec, OIIO::TypeDesc format,
+                                  const void* data) {
+    std::vector<unsigned char> bytes;
+    OIIO::Filesystem::IOVecOutput proxy(bytes);
+    auto out = OIIO::ImageOutput::create(path, &proxy);
     if (!out) throw std::runtime_error("cannot write '" + path + "': " + OIIO::geterror());
+    bool ok = out->open(path, spec) && out->write_image(format, data);
+    std::string err = ok ? "" : out->geterror();
+    if (!out->close() && ok) err = out->geterror(), ok = false;
+    if (!ok) throw std::runtime_error("cannot write '" + path + "': " + err);
+    return bytes;
+}
+
+} // namespace
+
+std::vector<unsigned char> encodeImage(const std::string& path, const ImageRGB& image) {
+    if (!isSupportedOutput(path)) throw std::runtime_error("cannot write '" + path + "': use .exr or .png");
     const bool png = extension(path) == ".png";
     OIIO::ImageSpec spec(image.width, image.height, 3, png ? OIIO::TypeDesc::UINT8 : OIIO::TypeDesc::FLOAT);
     spec.attribute("oiio:ColorSpace", png ? "sRGB" : "Linear");
     spec.attribute("Software", "Spillway");
-    if (!out->open(path, spec)) throw std::runtime_error("cannot write '" + path + "': " + out->geterror());
-    bool ok;
     if (png) {
         std::vector<std::uint8_t> bytes(image.rgb.size());
         std::transform(image.rgb.begin(), image.rgb.end(), bytes.begin(), linearToSrgb8);
-        ok = out->write_image(OIIO::TypeDesc::UINT8, bytes.data());
-    } else {
-        ok = out->write_image(OIIO::TypeDesc::FLOAT, image.rgb.data());
+        return encode(path, spec, OIIO::TypeDesc::UINT8, bytes.data());
     }
-    std::string err = ok ? "" : out->geterror();
-    if (!out->close() && ok) err = out->geterror(), ok = false;
-    if (!ok) {
-        std::error_code ec;
-        std::filesystem::remove(path, ec);
-        throw std::runtime_error("cannot write '" + path + "': " + err);
-    }
+    return encode(path, spec, OIIO::TypeDesc::FLOAT, image.rgb.data());
+}
+
+void writeImage(const std::string& path, const ImageRGB& image) {
+    const std::vector<unsigned char> bytes = encodeImage(path, image);
+    writeFileAtomically(path, bytes.data(), bytes.size());
+}
+
+void writeImage8(const std::string& path, int width, int height, const unsigned char* rgb,
+                 const std::string& software, const std::string& description) {
+    OIIO::ImageSpec spec(width, height, 3, OIIO::TypeDesc::UINT8);
+    spec.attribute("oiio:ColorSpace", "sRGB");
+    spec.attribute("Software", software);
+    spec.attribute("ImageDescription", description);
+    const std::vector<unsigned char> bytes = encode(path, spec, OIIO::TypeDesc::UINT8, rgb);
+    writeFileAtomically(path, bytes.data(), bytes.size());
 }
 
 ImageRGB readImage(const std::string& path) {

@@ -20,8 +20,14 @@ inline float srgbToLinear(float c) {
 
 // True for the extensions writeImage understands (.exr, .png; any case).
 bool isSupportedOutput(const std::string& path);
-// Throws std::runtime_error naming the path when the file cannot be written.
+// The file's bytes, in the format the path's extension names (.exr float, .png 8-bit sRGB).
+std::vector<unsigned char> encodeImage(const std::string& path, const ImageRGB& image);
+// Writes the image whole or not at all (host/output_file.h). Throws std::runtime_error naming
+// the path when the file cannot be written.
 void writeImage(const std::string& path, const ImageRGB& image);
+// An 8-bit sRGB RGB image (compare's heatmap) with a description in its metadata, written the same way.
+void writeImage8(const std::string& path, int width, int height, const unsigned char* rgb,
+                 const std::string& software, const std::string& description);
 // Reads any image OpenImageIO reads; 8-bit sRGB data are linearised. Throws on failure.
 ImageRGB readImage(const std::string& path);
 

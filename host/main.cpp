@@ -3,6 +3,7 @@
 #include "host/compare.h"
 #include "host/error_csv.h"
 #include "host/image_io.h"
+#include "host/output_file.h"
 #include "host/progress.h"
 #include "host/render.h"
 #include "host/scene.h"
@@ -13,7 +14,6 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <iostream>
 #include <string>
 #include <unistd.h>
@@ -54,7 +54,9 @@ render options:
 
 sorted pipeline options (cpu and vulkan backends):
   --bin-exponent E      a directional bin becomes a batch at 2^E rays (settings: bin exponent)
-  --memory-budget MiB   RAM for queued batches; the rest spills to disk (settings: memory budget)
+  --memory-budget MiB   RAM for rays waiting in bins and queued batches; the rest spills to
+                        disk (settings: memory budget). Peak rays in RAM stay within the
+                        budget, or within six batches (2^E rays each) if that is larger
   --spill-dir DIR       where spilled batches go (default: the system temp folder)
   --ray-sort MODE       auto (sort only where it measures faster), morton, median or off
   --hit-sort on|off     sort hits by (shader, object, primitive) before shading
@@ -62,7 +64,9 @@ sorted pipeline options (cpu and vulkan backends):
                         model) or megakernel (unsorted hits, one uber-shader switching per hit)
   --ray-format F        compact (32-byte rays, default) or full (48 bytes, every bit kept)
 
-exit status: 0 done, 1 runtime failure, 2 bad usage or scene error
+exit status: 0 done; 1 runtime failure (disk, device, an output that cannot be written);
+2 bad usage or scene error (printed as FILE:LINE: message). On any failure no output file
+is written or changed, and no temporary file is left.
 )";
 
 struct UsageError : std::runtime_error {
@@ -135,6 +139,10 @@ int renderCommand(const std::vector<std::string>& args) {
             if (i + 1 >= args.size()) throw UsageError(a + " needs a value");
             return args[++i];
         };
+        if (a == "-h" || a == "--help") {
+            std::fputs(kUsage, stdout);
+            return 0;
+        }
         if (a == "-o" || a == "--output") output = value();
         else if (a == "--spp") config.spp = int(parseInteger(a, value(), 1, 1 << 24));
         else if (a == "--backend") config.backend = value();
@@ -166,6 +174,10 @@ int renderCommand(const std::vector<std::string>& args) {
         throw UsageError("unknown backend '" + config.backend + "' (auto, vulkan, cpu or reference)");
     if (output.empty()) output = std::filesystem::path(scenePath).stem().string() + ".exr";
     if (!spw::isSupportedOutput(output)) throw UsageError("output '" + output + "' must end in .exr or .png");
+    if (!referencePath.empty() && errorCsvPath.empty()) throw UsageError("--reference goes with --error-csv");
+    // Every output path is checked before any work, so that a typo costs no render.
+    for (const std::string* path : {&output, &statsPath, &errorCsvPath})
+        if (!path->empty()) spw::checkWritable(*path);
 
     spw::Scene scene = spw::loadScene(scenePath);
     for (const spw::Mesh& m : scene.meshes)
@@ -173,7 +185,6 @@ int renderCommand(const std::vector<std::string>& args) {
             std::fprintf(stderr, "spillway: warning: %s: dropped %d zero-area triangle%s\n", m.name.c_str(),
                          m.droppedTriangles, m.droppedTriangles == 1 ? "" : "s");
 
-    if (!referencePath.empty() && errorCsvPath.empty()) throw UsageError("--reference goes with --error-csv");
     std::optional<spw::ImageRGB> reference;
     if (!referencePath.empty()) {
         try {
@@ -198,18 +209,34 @@ int renderCommand(const std::vector<std::string>& args) {
     });
     progress.finish();
 
+    // Every output is written whole, and flushed, before any is given its name: a failure in
+    // any of them leaves none (host/output_file.h).
+    spw::OutputFile image(output);
     {
         spw::StageTimer t(result->stats.stages, "write image");
-        spw::writeImage(output, {scene.image.width, scene.image.height, result->film->image()});
+        const std::vector<unsigned char> bytes =
+            spw::encodeImage(output, {scene.image.width, scene.image.height, result->film->image()});
+        image.write(bytes.data(), bytes.size());
+        image.flush();
     }
+    std::unique_ptr<spw::OutputFile> stats;
+    if (!statsPath.empty()) {
+        stats = std::make_unique<spw::OutputFile>(statsPath);
+        stats->write(result->stats.toJson().dump(2) + "\n");
+        stats->flush();
+    }
+    if (errorCsv) errorCsv->flush();
     if (result->stats.nonFiniteSamples > 0)
         std::fprintf(stderr, "spillway: warning: %llu non-finite samples were dropped\n",
                      (unsigned long long)result->stats.nonFiniteSamples);
-    if (!statsPath.empty()) {
-        std::ofstream out(statsPath);
-        out << result->stats.toJson().dump(2) << "\n";
-        if (!out) throw std::runtime_error("cannot write stats file '" + statsPath + "'");
-    }
+    if (result->stats.saturatedSamples > 0)
+        std::fprintf(stderr,
+                     "spillway: warning: %llu sample values exceeded the film's range (2^22 times the brightest "
+                     "emitter) and were clamped: the image is darker than it should be where they landed\n",
+                     (unsigned long long)result->stats.saturatedSamples);
+    image.commit();
+    if (stats) stats->commit();
+    if (errorCsv) errorCsv->commit();
     return 0;
 }
 

@@ -2,9 +2,15 @@
 
 #include <tiny_obj_loader.h>
 
+#include <glm/mat3x3.hpp>
+#include <glm/matrix.hpp>
+
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <fstream>
 #include <limits>
 #include <map>
@@ -14,81 +20,224 @@
 namespace spw {
 namespace {
 
-// tinyobjloader does not report line numbers: find the line of the n-th vertex statement.
-int lineOfVertex(const std::string& path, size_t vertexIndex) {
-    std::ifstream in(path);
-    std::string line;
-    size_t seen = 0;
-    for (int lineNo = 1; std::getline(in, line); ++lineNo) {
-        size_t i = line.find_first_not_of(" \t");
-        if (i != std::string::npos && line.compare(i, 2, "v ") == 0 && seen++ == vertexIndex) return lineNo;
+// Every statement of the OBJ format (Wavefront's specification, appendix B1), geometry and
+// free-form alike. tinyobjloader reads v, vt, vn, f, l, p, g, o, s, mtllib and usemtl and
+// skips the rest, as Spillway does; a word outside this list is not OBJ.
+const char* const kStatements[] = {
+    "v", "vt", "vn", "vp", "f", "l", "p", "g", "o", "s", "mtllib", "usemtl", "maplib", "usemap",
+    "cstype", "deg", "bmat", "step", "curv", "curv2", "surf", "parm", "trim", "hole", "scrv", "sp", "end",
+    "con", "mg", "bevel", "c_interp", "d_interp", "lod", "shadow_obj", "trace_obj", "ctech", "stech",
+    "call", "csh"};
+
+bool isBlank(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f'; }
+
+// A decimal number as tinyobjloader parses one: sign, digits with an optional point, exponent.
+// strtod alone would also take hex floats, "inf" and "nan", which tinyobjloader reads otherwise.
+bool isDecimal(const std::string& s) {
+    size_t i = 0, n = s.size();
+    if (i < n && (s[i] == '+' || s[i] == '-')) ++i;
+    size_t digits = 0;
+    while (i < n && std::isdigit((unsigned char)s[i])) ++i, ++digits;
+    if (i < n && s[i] == '.') {
+        ++i;
+        while (i < n && std::isdigit((unsigned char)s[i])) ++i, ++digits;
     }
-    return 0;
+    if (digits == 0) return false;
+    if (i < n && (s[i] == 'e' || s[i] == 'E')) {
+        ++i;
+        if (i < n && (s[i] == '+' || s[i] == '-')) ++i;
+        size_t exp = 0;
+        while (i < n && std::isdigit((unsigned char)s[i])) ++i, ++exp;
+        if (exp == 0) return false;
+    }
+    return i == n;
 }
 
-// tinyobjloader reads a number it cannot parse ("nan", "inf", "1x") as 0 without a word: check
-// every coordinate of the v, vn and vt statements first, naming the OBJ file and line.
-void checkCoordinates(const std::string& path, const std::string& text) {
-    auto blank = [](char c) { return c == ' ' || c == '\t' || c == '\r'; };
-    const char* p = text.c_str();
-    const char* const end = p + text.size();
-    for (int lineNo = 1; p < end; ++lineNo) {
-        const char* eol = std::find(p, end, '\n');
-        const char* stop = std::find(p, eol, '#');
-        while (p < stop && blank(*p)) ++p;
-        const char* word = p;
-        while (p < stop && !blank(*p)) ++p;
-        const std::string statement(word, p);
-        if (statement == "v" || statement == "vn" || statement == "vt") {
-            while (true) {
-                while (p < stop && blank(*p)) ++p;
-                if (p == stop) break;
-                const char* start = p;
-                while (p < stop && !blank(*p)) ++p;
-                const std::string token(start, p);
-                char* parsed = nullptr;
-                const double v = std::strtod(token.c_str(), &parsed);
-                if (parsed != token.c_str() + token.size() || !std::isfinite(v))
-                    throw SceneError(path, lineNo, "'" + statement + "' coordinate '" + token +
-                                                       "' is not a finite number");
+// What the checking pass keeps: positions in double with their lines, and the element counts.
+struct ObjText {
+    std::string clean; // the text with comments blanked out: what tinyobjloader parses
+    std::vector<glm::dvec3> positions;
+    std::vector<int> positionLines;
+    size_t normals = 0, uvs = 0, faces = 0;
+};
+
+class ObjChecker {
+  public:
+    ObjChecker(const std::string& path, ObjText& out) : path_(path), out_(out) {}
+
+    void check(const std::string& text) {
+        out_.clean = text;
+        std::string& t = out_.clean;
+        for (size_t i = 0; i < t.size(); ++i) {
+            const unsigned char c = (unsigned char)t[i];
+            if ((c < 0x20 && c != '\n' && !isBlank(char(c))) || c == 0x7F) {
+                const int line = int(std::count(t.begin(), t.begin() + std::ptrdiff_t(i), '\n')) + 1;
+                char hex[8];
+                std::snprintf(hex, sizeof hex, "0x%02X", c);
+                fail(line, std::string("byte ") + hex + " is not text: this is not an OBJ file");
             }
         }
-        p = eol + (eol < end ? 1 : 0);
+        size_t at = 0;
+        for (int line = 1; at < t.size(); ++line) {
+            size_t eol = t.find('\n', at);
+            if (eol == std::string::npos) eol = t.size();
+            const size_t hash = t.find('#', at);
+            if (hash < eol) std::fill(t.begin() + std::ptrdiff_t(hash), t.begin() + std::ptrdiff_t(eol), ' ');
+            statement(line, tokens(t, at, eol));
+            at = eol + 1;
+        }
+        // Positive indices may name elements defined later in the file: check them at the end.
+        for (int k = 0; k < 3; ++k)
+            if (maxIndex_[k] > (long long)count(k))
+                fail(maxIndexLine_[k], std::string("index ") + std::to_string(maxIndex_[k]) + " names no " +
+                                           kKindNames[k] + ": the file has " + std::to_string(count(k)));
     }
+
+  private:
+    static constexpr const char* kKindNames[3] = {"vertex ('v')", "texture coordinate ('vt')", "normal ('vn')"};
+
+    [[noreturn]] void fail(int line, const std::string& message) const { throw SceneError(path_, line, message); }
+
+    static std::vector<std::string> tokens(const std::string& t, size_t at, size_t eol) {
+        std::vector<std::string> words;
+        while (at < eol) {
+            while (at < eol && isBlank(t[at])) ++at;
+            const size_t start = at;
+            while (at < eol && !isBlank(t[at])) ++at;
+            if (at > start) words.emplace_back(t, start, at - start);
+        }
+        return words;
+    }
+
+    size_t count(int kind) const {
+        return kind == 0 ? out_.positions.size() : kind == 1 ? out_.uvs : out_.normals;
+    }
+
+    void numbers(int line, const std::vector<std::string>& w, size_t lo, size_t hi, double* values) const {
+        const size_t n = w.size() - 1;
+        if (n < lo || n > hi)
+            fail(line, "'" + w[0] + "' takes " + (lo == hi ? std::to_string(lo) : std::to_string(lo) + " to " + std::to_string(hi)) +
+                           " numbers, not " + std::to_string(n));
+        for (size_t i = 1; i < w.size(); ++i) {
+            const double v = std::strtod(w[i].c_str(), nullptr);
+            if (!isDecimal(w[i]) || !std::isfinite(v))
+                fail(line, "'" + w[0] + "' coordinate '" + w[i] + "' is not a finite number");
+            if (values && i <= 3) values[i - 1] = v;
+        }
+    }
+
+    // One index of a face, line or point: 1-based, or negative counting back from the last
+    // element defined so far; 0 and anything else naming no element is an error.
+    void index(int line, const std::string& text, int kind) {
+        errno = 0;
+        char* end = nullptr;
+        const long long v = std::strtoll(text.c_str(), &end, 10);
+        if (text.empty() || *end != '\0' || (!std::isdigit((unsigned char)text[0]) && text[0] != '-' && text[0] != '+'))
+            fail(line, "'" + text + "' is not an index");
+        const long long have = (long long)count(kind);
+        if (v == 0) fail(line, std::string("index 0 names no ") + kKindNames[kind] + ": indices start at 1");
+        if (errno == ERANGE || v < -have || v > std::numeric_limits<int>::max())
+            fail(line, std::string("index ") + text + " names no " + kKindNames[kind] + ": " +
+                           (v < 0 ? std::to_string(have) + " defined before this line" : "out of range"));
+        if (v > maxIndex_[kind]) maxIndex_[kind] = v, maxIndexLine_[kind] = line;
+    }
+
+    // "v", "v/vt", "v//vn" or "v/vt/vn" (faces); lines and points take "v" or "v/vt".
+    void reference(int line, const std::string& ref, bool face) {
+        std::string part[3];
+        int parts = 0;
+        size_t at = 0;
+        while (parts < 3) {
+            const size_t slash = ref.find('/', at);
+            part[parts++] = ref.substr(at, slash == std::string::npos ? std::string::npos : slash - at);
+            if (slash == std::string::npos) break;
+            at = slash + 1;
+            if (parts == 3) fail(line, "'" + ref + "' has more than three indices");
+        }
+        if (!face && parts == 3) fail(line, "'" + ref + "': a line or point takes no normal index");
+        index(line, part[0], 0);
+        if (parts >= 2 && !(parts == 3 && part[1].empty())) index(line, part[1], 1);
+        if (parts == 3) index(line, part[2], 2);
+    }
+
+    void statement(int line, const std::vector<std::string>& w) {
+        if (w.empty()) return;
+        const std::string& s = w[0];
+        if (s == "v") {
+            double p[3];
+            numbers(line, w, 3, 7, p); // x y z, then an optional w or a colour
+            out_.positions.emplace_back(p[0], p[1], p[2]);
+            out_.positionLines.push_back(line);
+        } else if (s == "vn") {
+            numbers(line, w, 3, 3, nullptr);
+            ++out_.normals;
+        } else if (s == "vt") {
+            numbers(line, w, 1, 3, nullptr);
+            ++out_.uvs;
+        } else if (s == "vp") {
+            numbers(line, w, 1, 3, nullptr);
+        } else if (s == "f") {
+            if (w.size() < 4)
+                fail(line, "a face needs at least 3 vertices, this one has " + std::to_string(w.size() - 1));
+            for (size_t i = 1; i < w.size(); ++i) reference(line, w[i], true);
+            ++out_.faces;
+        } else if (s == "l" || s == "p") {
+            if (w.size() < (s == "l" ? 3u : 2u)) fail(line, "'" + s + "' has too few vertices");
+            for (size_t i = 1; i < w.size(); ++i) reference(line, w[i], false);
+        } else if (std::find_if(std::begin(kStatements), std::end(kStatements),
+                                [&](const char* k) { return s == k; }) == std::end(kStatements)) {
+            fail(line, "'" + (s.size() > 40 ? s.substr(0, 40) + "..." : s) + "' is not an OBJ statement");
+        }
+    }
+
+    const std::string& path_;
+    ObjText& out_;
+    long long maxIndex_[3] = {0, 0, 0};
+    int maxIndexLine_[3] = {0, 0, 0};
+};
+
+std::string readFile(const std::string& path, const std::string& sceneFile, int sceneLine) {
+    std::ifstream file(path, std::ios::binary);
+    std::stringstream text;
+    if (file) text << file.rdbuf();
+    if (!file || file.bad())
+        throw SceneError(sceneFile, sceneLine, "cannot read OBJ file '" + path + "': " + std::strerror(errno));
+    return text.str();
 }
 
 } // namespace
 
-Mesh loadObjMesh(const std::string& path, const mat4& objectToWorld, const std::string& sceneFile,
-                 int sceneLine) {
+Mesh loadObjMesh(const std::string& path, const glm::dmat4& objectToWorld, const glm::dvec3& origin,
+                 const std::string& sceneFile, int sceneLine) {
+    ObjText obj;
+    ObjChecker(path, obj).check(readFile(path, sceneFile, sceneLine));
+    if (obj.faces == 0)
+        throw SceneError(sceneFile, sceneLine, "OBJ file '" + path + "' has no face ('f' statement): nothing to render");
+
     tinyobj::ObjReaderConfig cfg;
     cfg.triangulate = true;
     cfg.vertex_color = false;
     cfg.mtl_search_path = "";
     tinyobj::ObjReader reader;
     // Materials are ignored (shaders come from the scene): parse the geometry only.
-    std::ifstream file(path);
-    std::stringstream text;
-    text << file.rdbuf();
-    if (file) checkCoordinates(path, text.str());
-    if (!file || !reader.ParseFromString(text.str(), "", cfg)) {
+    if (!reader.ParseFromString(obj.clean, "", cfg)) {
         std::string why = reader.Error();
         while (!why.empty() && (why.back() == '\n' || why.back() == '\r')) why.pop_back();
         throw SceneError(sceneFile, sceneLine, "cannot read OBJ file '" + path + "': " + why);
     }
     const tinyobj::attrib_t& a = reader.GetAttrib();
-    for (size_t i = 0; i < a.vertices.size(); ++i)
-        if (!std::isfinite(a.vertices[i]))
-            throw SceneError(path, lineOfVertex(path, i / 3), "vertex coordinate is not a finite number");
-    for (size_t i = 0; i < a.normals.size(); ++i)
-        if (!std::isfinite(a.normals[i]))
-            throw SceneError(sceneFile, sceneLine, "OBJ file '" + path + "' has a non-finite normal");
+    // The checking pass and tinyobjloader must agree on every element, or an index could read
+    // out of bounds: refuse the file rather than trust either alone.
+    if (a.vertices.size() != 3 * obj.positions.size() || a.normals.size() != 3 * obj.normals ||
+        a.texcoords.size() != 2 * obj.uvs)
+        throw SceneError(sceneFile, sceneLine, "OBJ file '" + path + "': tinyobjloader read a different number of "
+                                                "vertices, normals or texture coordinates than the file holds");
+    const long long nv = (long long)obj.positions.size(), nn = (long long)obj.normals, nt = (long long)obj.uvs;
 
     Mesh mesh;
     mesh.name = path;
-    const mat3 normalXf = glm::transpose(glm::inverse(mat3(objectToWorld)));
-    bool hasNormals = !a.normals.empty();
-    bool hasUvs = !a.texcoords.empty();
+    const glm::dmat3 normalXf = glm::transpose(glm::inverse(glm::dmat3(objectToWorld)));
+    const bool hasNormals = nn > 0, hasUvs = nt > 0;
     // One mesh vertex per distinct (position, normal, uv) triple of the OBJ.
     std::map<std::tuple<int, int, int>, uint> remap;
     for (const tinyobj::shape_t& shape : reader.GetShapes()) {
@@ -97,32 +246,40 @@ Mesh loadObjMesh(const std::string& path, const mat4& objectToWorld, const std::
             uvec3 tri;
             for (int k = 0; k < 3; ++k) {
                 const tinyobj::index_t& ix = idx[f + k];
+                if (ix.vertex_index < 0 || ix.vertex_index >= nv || ix.normal_index >= nn || ix.texcoord_index >= nt)
+                    throw SceneError(sceneFile, sceneLine, "OBJ file '" + path + "': a face index is out of range");
                 auto key = std::make_tuple(ix.vertex_index, hasNormals ? ix.normal_index : -1,
                                            hasUvs ? ix.texcoord_index : -1);
                 auto [it, inserted] = remap.try_emplace(key, uint(mesh.positions.size()));
                 if (inserted) {
-                    vec3 p(a.vertices[3 * ix.vertex_index], a.vertices[3 * ix.vertex_index + 1],
-                           a.vertices[3 * ix.vertex_index + 2]);
-                    const vec3 world = vec3(objectToWorld * vec4(p, 1.0f));
-                    // Finite in the file but not after the object's transform.
-                    if (!std::isfinite(world.x) || !std::isfinite(world.y) || !std::isfinite(world.z))
-                        throw SceneError(path, lineOfVertex(path, size_t(ix.vertex_index)),
-                                         "vertex is not a finite number after the object's transform (scene " +
-                                             sceneFile + ":" + std::to_string(sceneLine) + ")");
-                    mesh.positions.push_back(world);
+                    // In double until here: the object's transform and the shift to the camera
+                    // round once, to float, at the end.
+                    const size_t vi = size_t(ix.vertex_index);
+                    const glm::dvec3 world = glm::dvec3(objectToWorld * glm::dvec4(obj.positions[vi], 1.0)) - origin;
+                    const double far = std::max({std::fabs(world.x), std::fabs(world.y), std::fabs(world.z)});
+                    if (!(far <= kMaxDistance)) {
+                        char where[64];
+                        std::snprintf(where, sizeof where, "%.3g", far);
+                        throw SceneError(path, obj.positionLines[vi],
+                                         std::string("vertex lies ") + where + " units from the camera after the "
+                                         "object's transform (scene " + sceneFile + ":" + std::to_string(sceneLine) +
+                                         "); Spillway renders within " + kMaxDistanceText + " units of it");
+                    }
+                    mesh.positions.push_back(vec3(world));
                     if (hasNormals) {
-                        vec3 n(0.0f);
+                        glm::dvec3 n(0.0);
                         if (ix.normal_index >= 0)
-                            n = vec3(a.normals[3 * ix.normal_index], a.normals[3 * ix.normal_index + 1],
-                                     a.normals[3 * ix.normal_index + 2]);
-                        n = normalXf * n;
-                        float len = glm::length(n);
-                        mesh.normals.push_back(len > 0.0f ? n / len : vec3(0.0f));
+                            n = normalXf * glm::dvec3(a.normals[3 * size_t(ix.normal_index)],
+                                                      a.normals[3 * size_t(ix.normal_index) + 1],
+                                                      a.normals[3 * size_t(ix.normal_index) + 2]);
+                        const double len = glm::length(n);
+                        mesh.normals.push_back(len > 0.0 && std::isfinite(len) ? vec3(n / len) : vec3(0.0f));
                     }
                     if (hasUvs) {
                         vec2 uv(0.0f);
                         if (ix.texcoord_index >= 0)
-                            uv = vec2(a.texcoords[2 * ix.texcoord_index], a.texcoords[2 * ix.texcoord_index + 1]);
+                            uv = vec2(a.texcoords[2 * size_t(ix.texcoord_index)],
+                                      a.texcoords[2 * size_t(ix.texcoord_index) + 1]);
                         mesh.uvs.push_back(uv);
                     }
                 }

@@ -1,10 +1,15 @@
 #include "host/ray_record.h"
 
+#include "host/scene.h"
+
 #include <cmath>
 #include <cstring>
 #include <stdexcept>
 
 namespace spw {
+
+static_assert(kMaxCompactBounce >= uint(kMaxDepth), "the loader accepts depths the compact ray cannot hold");
+
 namespace {
 
 constexpr double kOctScale = double((1u << 24) - 1);

@@ -121,6 +121,7 @@ std::unique_ptr<RenderResult> renderWithProgress(const Scene& scene, const Rende
             result->film->endIteration();
         }
         embree->checkError("tracing");
+        textures.checkErrors();
         renderSeconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - iterationStart).count();
         ++done;
         const int sppDone = done * plan.sampleBase * plan.sampleBase;

@@ -4,6 +4,8 @@
 
 #include "shared/types.h"
 
+#include <glm/vec3.hpp>
+
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -13,10 +15,12 @@ namespace spw {
 
 // A scene error: where in which file, and what is wrong. The CLI prints "file:line: message"
 // and exits 2.
+// A problem with the file as a whole (it cannot be opened, it is a folder) has no line: line 0,
+// printed "file: message".
 class SceneError : public std::runtime_error {
   public:
     SceneError(std::string file, int line, const std::string& message)
-        : std::runtime_error(file + ":" + std::to_string(line) + ": " + message),
+        : std::runtime_error(file + (line > 0 ? ":" + std::to_string(line) : std::string()) + ": " + message),
           file_(std::move(file)), line_(line) {}
     const std::string& file() const { return file_; }
     int line() const { return line_; }
@@ -25,6 +29,23 @@ class SceneError : public std::runtime_error {
     std::string file_;
     int line_;
 };
+
+// The ranges of the scene format that keep every ray Embree sees valid and every product of the
+// shading math finite in float (README, "Notes on the scene format").
+// Every position, after its transforms, lies within this many units of the camera: squared
+// distances stay below 1e31, far inside float, and ray origins far inside Embree's 1.8e18.
+constexpr double kMaxDistance = 1e15;
+constexpr const char* kMaxDistanceText = "1e15";
+// Emission (each channel) and a quad light's intensity x colour: products with BSDF values,
+// MIS weights and 1/pdf keep about 1e18 of headroom below float's 3.4e38.
+constexpr double kMaxRadiance = 1e20;
+constexpr const char* kMaxRadianceText = "1e20";
+// Bounces a path may take (settings: max depth): what the compact ray record's bounce field holds,
+// so that every backend renders every scene the loader accepts.
+constexpr int kMaxDepth = 0x7FFF;
+// Layered textures: levels from the root to a leaf, and textures in all (aliases shared).
+constexpr int kMaxTextureDepth = 64;
+constexpr int kMaxTextures = 1 << 16;
 
 struct ImageSettings {
     int width = 512;
@@ -49,7 +70,9 @@ enum class CameraType { PinHole, ThinLens };
 
 struct Camera {
     CameraType type = CameraType::PinHole;
-    mat4 cameraToWorld{1.0f}; // looks along local -Z, +Y up
+    // Looks along local -Z, +Y up. Its translation is always zero: the world is camera-relative
+    // (Scene::origin is where the camera stands in the scene file's coordinates).
+    mat4 cameraToWorld{1.0f};
     float focalLength = 35.0f; // mm
     float filmWidth = 35.0f;   // mm
     std::optional<float> fovDegrees; // horizontal; overrides the focal length
@@ -73,6 +96,7 @@ struct Texture {
     vec3 colour{1.0f};
     std::string path; // Standard: absolute path of the image
     int upper = -1, lower = -1, mask = -1; // Layered: indices into Scene::textures
+    int line = 0;                          // where the scene file defines it
 };
 
 struct Shader {
@@ -94,8 +118,12 @@ struct Mesh {
     int droppedTriangles = 0; // zero-area triangles left out when loading
 };
 
+// Rendering is camera-relative: the loader applies every transform in double and subtracts the
+// camera's position before rounding to float, so the float world has the camera at (0, 0, 0)
+// and the image does not depend on where the scene sits in the file's coordinates.
 struct Scene {
     std::string file;
+    glm::dvec3 origin{0.0}; // the camera's position in the scene file's coordinates
     ImageSettings image;
     Settings settings;
     Camera camera;

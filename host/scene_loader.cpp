@@ -3,15 +3,22 @@
 #include "host/obj_mesh.h"
 #include "host/scene.h"
 
+#include <OpenImageIO/imageio.h>
 #include <glm/gtc/matrix_transform.hpp>
+#include <yaml-cpp/depthguard.h>
 #include <yaml-cpp/yaml.h>
 
+#include <cerrno>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <functional>
 #include <initializer_list>
 #include <limits>
+#include <map>
 #include <set>
+#include <sstream>
 
 namespace fs = std::filesystem;
 
@@ -93,40 +100,71 @@ class Reader {
         return v;
     }
 
+    template <int N>
+    glm::vec<N, double> dvec(const YAML::Node& n, const std::string& what) const {
+        if (!n.IsSequence() || n.size() != N)
+            fail(n, what + " must be a list of " + std::to_string(N) + " numbers");
+        glm::vec<N, double> v;
+        for (int i = 0; i < N; ++i) v[i] = number(n[i], what);
+        return v;
+    }
+
     const std::string& file() const { return file_; }
 
-  private:
     static std::string fmt(double v) {
         if (std::isinf(v)) return v > 0 ? "inf" : "-inf";
         std::string s = std::to_string(v);
+        if (std::fabs(v) >= 1e7 || (v != 0 && std::fabs(v) < 1e-4)) {
+            // 1e+20 -> 1e20, 1e-05 -> 1e-5: as the format's ranges are written.
+            char buf[32];
+            std::snprintf(buf, sizeof buf, "%g", v);
+            std::string g = buf;
+            const size_t e = g.find('e');
+            if (e == std::string::npos) return g;
+            std::string mant = g.substr(0, e), exp = g.substr(e + 1);
+            const bool neg = exp[0] == '-';
+            exp.erase(0, exp.find_first_not_of("+-0"));
+            return mant + "e" + (neg ? "-" : "") + (exp.empty() ? "0" : exp);
+        }
         s.erase(s.find_last_not_of('0') + 1);
         if (!s.empty() && s.back() == '.') s.pop_back();
         return s;
     }
+
+  private:
     std::string file_;
 };
 
 // R = Rz * Ry * Rx, degrees.
-mat4 rotationXYZ(vec3 degrees) {
-    mat4 r(1.0f);
-    r = glm::rotate(r, glm::radians(degrees.z), vec3(0, 0, 1));
-    r = glm::rotate(r, glm::radians(degrees.y), vec3(0, 1, 0));
-    r = glm::rotate(r, glm::radians(degrees.x), vec3(1, 0, 0));
+glm::dmat4 rotationXYZ(glm::dvec3 degrees) {
+    glm::dmat4 r(1.0);
+    r = glm::rotate(r, glm::radians(degrees.z), glm::dvec3(0, 0, 1));
+    r = glm::rotate(r, glm::radians(degrees.y), glm::dvec3(0, 1, 0));
+    r = glm::rotate(r, glm::radians(degrees.x), glm::dvec3(1, 0, 0));
     return r;
 }
 
-// translation * rotation * scale, reading whichever of the three keys are present.
-mat4 readTransform(const Reader& rd, const YAML::Node& n, const std::string& what, bool scale3) {
-    mat4 m(1.0f);
-    if (n["translation"]) m = glm::translate(m, rd.vec<3>(n["translation"], what + " translation"));
-    if (n["rotation"]) m = m * rotationXYZ(rd.vec<3>(n["rotation"], what + " rotation"));
+// translation * rotation * scale, reading whichever of the three keys are present. In double:
+// the scene is moved to the camera before anything is rounded to float.
+glm::dmat4 readTransform(const Reader& rd, const YAML::Node& n, const std::string& what, bool scale3) {
+    glm::dmat4 m(1.0);
+    if (n["translation"]) m = glm::translate(m, rd.dvec<3>(n["translation"], what + " translation"));
+    if (n["rotation"]) m = m * rotationXYZ(rd.dvec<3>(n["rotation"], what + " rotation"));
     if (scale3 && n["scale"]) {
         const YAML::Node& s = n["scale"];
-        vec3 sc = s.IsScalar() ? vec3(float(rd.number(s, what + " scale"))) : rd.vec<3>(s, what + " scale");
+        glm::dvec3 sc = s.IsScalar() ? glm::dvec3(rd.number(s, what + " scale")) : rd.dvec<3>(s, what + " scale");
         if (sc.x == 0 || sc.y == 0 || sc.z == 0) rd.fail(s, what + " scale must not be zero");
         m = glm::scale(m, sc);
     }
     return m;
+}
+
+// A point `p` (relative to the camera) must lie within kMaxDistance of it.
+void checkDistance(const Reader& rd, const YAML::Node& at, const glm::dvec3& p, const std::string& what) {
+    const double far = std::max({std::fabs(p.x), std::fabs(p.y), std::fabs(p.z)});
+    if (!(far <= kMaxDistance))
+        rd.fail(at, what + " lies " + Reader::fmt(far) + " units from the camera; Spillway renders within " +
+                        kMaxDistanceText + " units of it");
 }
 
 void readImage(const Reader& rd, const YAML::Node& n, ImageSettings& img) {
@@ -150,8 +188,8 @@ void readImage(const Reader& rd, const YAML::Node& n, ImageSettings& img) {
 void readSettings(const Reader& rd, const YAML::Node& n, Settings& s) {
     rd.checkKeys(n, "settings", {"min depth", "max depth", "threshold", "bucket size", "shading size",
                                  "bin exponent", "memory budget", "seed"});
-    if (n["min depth"]) s.minDepth = int(rd.integer(n["min depth"], "min depth", 0, 1 << 16));
-    if (n["max depth"]) s.maxDepth = int(rd.integer(n["max depth"], "max depth", 0, 1 << 16));
+    if (n["min depth"]) s.minDepth = int(rd.integer(n["min depth"], "min depth", 0, kMaxDepth));
+    if (n["max depth"]) s.maxDepth = int(rd.integer(n["max depth"], "max depth", 0, kMaxDepth));
     if (n["threshold"]) s.threshold = float(rd.number(n["threshold"], "threshold", 0.0, 1e30));
     if (n["bucket size"]) s.bucketSize = int(rd.integer(n["bucket size"], "bucket size", 1, 4096));
     if (n["shading size"]) s.shadingSize = int(rd.integer(n["shading size"], "shading size", 1, 1 << 24));
@@ -161,9 +199,11 @@ void readSettings(const Reader& rd, const YAML::Node& n, Settings& s) {
     if (n["seed"]) s.seed = std::uint32_t(rd.integer(n["seed"], "seed", 0, 0xFFFFFFFFLL));
 }
 
-void readCamera(const Reader& rd, const YAML::Node& n, Camera& c) {
+// Reads the camera and returns its position in the file's coordinates: the scene's origin.
+glm::dvec3 readCamera(const Reader& rd, const YAML::Node& n, Camera& c) {
     rd.checkKeys(n, "camera", {"type", "translation", "rotation", "look at", "focal length", "fov",
                                "aperture radius", "focal distance", "film width"});
+    glm::dvec3 origin(0.0);
     if (n["type"]) {
         std::string t = rd.string(n["type"], "camera type");
         if (t == "PinHole") c.type = CameraType::PinHole;
@@ -176,28 +216,44 @@ void readCamera(const Reader& rd, const YAML::Node& n, Camera& c) {
             rd.fail(la, "camera takes either 'look at' or translation/rotation, not both");
         rd.checkKeys(la, "look at", {"eye", "target", "up"});
         if (!la["eye"] || !la["target"]) rd.fail(la, "look at needs eye and target");
-        vec3 eye = rd.vec<3>(la["eye"], "look at eye");
-        vec3 target = rd.vec<3>(la["target"], "look at target");
-        vec3 up = la["up"] ? rd.vec<3>(la["up"], "look at up") : vec3(0, 1, 0);
-        vec3 fwd = target - eye;
-        if (glm::length(fwd) == 0) rd.fail(la, "look at eye and target are the same point");
-        if (glm::length(glm::cross(glm::normalize(fwd), up)) < 1e-6f)
+        const glm::dvec3 eye = rd.dvec<3>(la["eye"], "look at eye");
+        const glm::dvec3 target = rd.dvec<3>(la["target"], "look at target");
+        const glm::dvec3 up = la["up"] ? rd.dvec<3>(la["up"], "look at up") : glm::dvec3(0, 1, 0);
+        // Relative to the eye, in double, and scaled to unit length before any product: an eye
+        // or target at 1e300 neither overflows nor reads as "parallel".
+        const glm::dvec3 d = target - eye;
+        const double span = std::max({std::fabs(d.x), std::fabs(d.y), std::fabs(d.z)});
+        if (span == 0) rd.fail(la, "look at eye and target are the same point");
+        if (!std::isfinite(span)) rd.fail(la, "look at eye and target are too far apart for double precision");
+        checkDistance(rd, la["target"], d, "look at target");
+        const double upSpan = std::max({std::fabs(up.x), std::fabs(up.y), std::fabs(up.z)});
+        if (upSpan == 0) rd.fail(la["up"], "look at up must not be zero");
+        const glm::dvec3 fwd = glm::normalize(d / span), upDir = glm::normalize(up / upSpan);
+        if (glm::length(glm::cross(fwd, upDir)) < 1e-6)
             rd.fail(la, "look at up is parallel to the viewing direction");
-        c.cameraToWorld = glm::inverse(glm::lookAt(eye, target, up));
+        glm::dmat4 m = glm::inverse(glm::lookAt(glm::dvec3(0.0), fwd, upDir));
+        m[3] = glm::dvec4(0, 0, 0, 1);
+        c.cameraToWorld = mat4(m);
+        origin = eye;
     } else {
-        c.cameraToWorld = readTransform(rd, n, "camera", false);
+        glm::dmat4 m = readTransform(rd, n, "camera", false);
+        origin = glm::dvec3(m[3]);
+        m[3] = glm::dvec4(0, 0, 0, 1);
+        c.cameraToWorld = mat4(m);
     }
     if (n["focal length"]) c.focalLength = float(rd.number(n["focal length"], "focal length", 1e-6, 1e9));
     if (n["film width"]) c.filmWidth = float(rd.number(n["film width"], "film width", 1e-6, 1e9));
     if (n["fov"]) {
         c.fovDegrees = float(rd.number(n["fov"], "fov", 1e-4, 179.9));
     }
+    // The lens and the focal plane lie within kMaxDistance of the camera like everything else.
     if (n["aperture radius"])
-        c.apertureRadius = float(rd.number(n["aperture radius"], "aperture radius", 0.0, 1e30));
+        c.apertureRadius = float(rd.number(n["aperture radius"], "aperture radius", 0.0, kMaxDistance));
     if (n["focal distance"])
-        c.focalDistance = float(rd.number(n["focal distance"], "focal distance", 1e-30, 1e30));
+        c.focalDistance = float(rd.number(n["focal distance"], "focal distance", 1e-30, kMaxDistance));
     if (c.type == CameraType::PinHole && (n["aperture radius"] || n["focal distance"]))
         rd.fail(n, "aperture radius and focal distance need camera type ThinLens");
+    return origin;
 }
 
 void readFilter(const Reader& rd, const YAML::Node& n, Filter& f) {
@@ -222,43 +278,103 @@ SamplerType readSampler(const Reader& rd, const YAML::Node& n) {
     rd.fail(n["type"], "unknown sampler type '" + t + "' (Independent, Grid or Stratified)");
 }
 
-int readTexture(const Reader& rd, const YAML::Node& n, const fs::path& dir, Scene& scene) {
-    rd.checkKeys(n, "texture", {"type", "colour", "string", "filename", "upper", "lower", "mask"});
-    if (!n["type"]) rd.fail(n, "texture needs a type (Constant, Standard or Layered)");
-    std::string t = rd.string(n["type"], "texture type");
-    Texture tex;
-    auto only = [&](std::initializer_list<const char*> keys) { rd.checkKeys(n, t + " texture", keys); };
-    if (t == "Constant") {
-        only({"type", "colour"});
-        tex.type = TextureType::Constant;
-        if (n["colour"]) tex.colour = rd.vec<3>(n["colour"], "texture colour", 0.0, 1.0);
-    } else if (t == "Standard") {
-        only({"type", "string", "filename"});
-        tex.type = TextureType::Standard;
-        YAML::Node f = n["string"] ? n["string"] : n["filename"];
-        if (!f) rd.fail(n, "Standard texture needs 'string' (or 'filename'): the image file");
-        fs::path p = dir / rd.string(f, "texture file");
-        if (!fs::is_regular_file(p)) rd.fail(f, "texture file '" + p.string() + "' does not exist");
-        tex.path = fs::absolute(p).lexically_normal().string();
-    } else if (t == "Layered") {
-        only({"type", "upper", "lower", "mask"});
-        tex.type = TextureType::Layered;
-        for (const char* k : {"upper", "lower", "mask"})
-            if (!n[k]) rd.fail(n, std::string("Layered texture needs '") + k + "'");
-        tex.upper = readTexture(rd, n["upper"], dir, scene);
-        tex.lower = readTexture(rd, n["lower"], dir, scene);
-        tex.mask = readTexture(rd, n["mask"], dir, scene);
-    } else {
-        rd.fail(n["type"], "unknown texture type '" + t + "' (Constant, Standard or Layered)");
-    }
-    scene.textures.push_back(tex);
-    return int(scene.textures.size()) - 1;
-}
+// Texture trees. A YAML anchor may be used many times and even inside itself: a node seen
+// before is shared (one Scene::textures entry, read once), a node used inside itself is a cycle,
+// and the tree's depth and size are bounded, so no file makes the loader recurse or multiply
+// without end.
+class TextureReader {
+  public:
+    TextureReader(const Reader& rd, const fs::path& dir, Scene& scene) : rd_(rd), dir_(dir), scene_(scene) {}
 
-void readShader(const Reader& rd, const YAML::Node& n, const fs::path& dir, Scene& scene) {
+    int read(const YAML::Node& n, int depth = 1) {
+        if (depth > kMaxTextureDepth)
+            rd_.fail(n, "textures nest deeper than " + std::to_string(kMaxTextureDepth) + " levels");
+        // yaml-cpp has no node identity but is(); nodes sharing a position in the file are the
+        // only candidates for being the same node.
+        std::vector<Seen>& atPos = seen_[n.Mark().pos];
+        for (const Seen& e : atPos)
+            if (e.node.is(n)) {
+                if (e.index < 0) rd_.fail(n, "texture contains itself (a YAML alias used inside its own anchor)");
+                return e.index;
+            }
+        atPos.push_back({n, -1});
+        const size_t slot = atPos.size() - 1;
+        const int index = readNode(n, depth);
+        seen_[n.Mark().pos][slot].index = index;
+        return index;
+    }
+
+  private:
+    struct Seen {
+        YAML::Node node;
+        int index; // -1 while its subtree is being read
+    };
+
+    int readNode(const YAML::Node& n, int depth) {
+        const Reader& rd = rd_;
+        rd.checkKeys(n, "texture", {"type", "colour", "string", "filename", "upper", "lower", "mask"});
+        if (!n["type"]) rd.fail(n, "texture needs a type (Constant, Standard or Layered)");
+        std::string t = rd.string(n["type"], "texture type");
+        Texture tex;
+        tex.line = n.Mark().line + 1;
+        auto only = [&](std::initializer_list<const char*> keys) { rd.checkKeys(n, t + " texture", keys); };
+        if (t == "Constant") {
+            only({"type", "colour"});
+            tex.type = TextureType::Constant;
+            if (n["colour"]) tex.colour = rd.vec<3>(n["colour"], "texture colour", 0.0, 1.0);
+        } else if (t == "Standard") {
+            only({"type", "string", "filename"});
+            tex.type = TextureType::Standard;
+            YAML::Node f = n["string"] ? n["string"] : n["filename"];
+            if (!f) rd.fail(n, "Standard texture needs 'string' (or 'filename'): the image file");
+            fs::path p = dir_ / rd.string(f, "texture file");
+            if (!fs::is_regular_file(p)) rd.fail(f, "texture file '" + p.string() + "' does not exist");
+            tex.path = fs::absolute(p).lexically_normal().string();
+            checkImage(f, tex.path);
+        } else if (t == "Layered") {
+            only({"type", "upper", "lower", "mask"});
+            tex.type = TextureType::Layered;
+            for (const char* k : {"upper", "lower", "mask"})
+                if (!n[k]) rd.fail(n, std::string("Layered texture needs '") + k + "'");
+            tex.upper = read(n["upper"], depth + 1);
+            tex.lower = read(n["lower"], depth + 1);
+            tex.mask = read(n["mask"], depth + 1);
+        } else {
+            rd.fail(n["type"], "unknown texture type '" + t + "' (Constant, Standard or Layered)");
+        }
+        if (scene_.textures.size() >= size_t(kMaxTextures))
+            rd.fail(n, "more than " + std::to_string(kMaxTextures) + " textures");
+        scene_.textures.push_back(tex);
+        return int(scene_.textures.size()) - 1;
+    }
+
+    // A file that is not an image is the scene's error, found now rather than mid-render. Only
+    // the header is read: the pixels stay lazy, for the texture system.
+    void checkImage(const YAML::Node& at, const std::string& path) const {
+        auto in = OIIO::ImageInput::open(path);
+        if (!in) {
+            std::string why = OIIO::geterror();
+            while (!why.empty() && (why.back() == '\n' || why.back() == '\r')) why.pop_back();
+            rd_.fail(at, "texture file '" + path + "' is not an image OpenImageIO can read: " + why);
+        }
+        const OIIO::ImageSpec& spec = in->spec();
+        if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0)
+            rd_.fail(at, "texture file '" + path + "' holds no pixels");
+        in->close();
+    }
+
+    const Reader& rd_;
+    const fs::path& dir_;
+    Scene& scene_;
+    std::map<std::size_t, std::vector<Seen>> seen_;
+};
+
+void readShader(const Reader& rd, const YAML::Node& n, TextureReader& textures, Scene& scene) {
     const char* kTypes = "(Null, Lambert, Emissive, Conductor or Dielectric)";
     if (!n.IsMap() || !n["type"]) rd.fail(n, std::string("shader needs a type ") + kTypes);
-    std::string t = rd.string(n["type"], "shader type");
+    // YAML reads a plain `Null` (like `null` and `~`) as the null value, not as a string: the
+    // format's shader type Null is written that way, so a null type means Null.
+    std::string t = n["type"].IsNull() ? "Null" : rd.string(n["type"], "shader type");
     Shader s;
     s.typeName = t;
     s.line = n.Mark().line + 1;
@@ -279,7 +395,7 @@ void readShader(const Reader& rd, const YAML::Node& n, const fs::path& dir, Scen
         if (n["colour"] && n["texture"]) rd.fail(n["texture"], "Lambert takes colour or texture, not both");
         if (n["colour"]) p.colour = rd.vec<3>(n["colour"], "colour", 0.0, 1.0);
         if (n["texture"]) {
-            s.texture = readTexture(rd, n["texture"], dir, scene);
+            s.texture = textures.read(n["texture"]);
             p.flags |= kShaderTextured;
         }
     } else if (t == "Conductor") {
@@ -297,7 +413,7 @@ void readShader(const Reader& rd, const YAML::Node& n, const fs::path& dir, Scen
     } else {
         rd.fail(n["type"], "unknown shader type '" + t + "' " + kTypes);
     }
-    if (n["emission"]) p.emission = rd.vec<3>(n["emission"], "emission", 0.0, 1e30);
+    if (n["emission"]) p.emission = rd.vec<3>(n["emission"], "emission", 0.0, kMaxRadiance);
     if (n["two sided"] && rd.boolean(n["two sided"], "two sided")) p.flags |= kShaderTwoSided;
     scene.shaders.push_back(s);
 }
@@ -310,6 +426,7 @@ struct PendingObject {
 
 void readObject(const Reader& rd, const YAML::Node& n, const fs::path& dir, Scene& scene,
                 std::vector<PendingObject>& pending) {
+    if (!n.IsMap()) rd.fail(n, "object must be a map of keys to values");
     rd.checkKeys(n, "object", {"type", "filename", "translation", "rotation", "scale", "shader"});
     std::string t = n["type"] ? rd.string(n["type"], "object type") : "Polygon";
     if (t != "Polygon") rd.fail(n["type"], "unknown object type '" + t + "' (Polygon)");
@@ -317,8 +434,8 @@ void readObject(const Reader& rd, const YAML::Node& n, const fs::path& dir, Scen
     fs::path p = dir / rd.string(n["filename"], "object filename");
     if (!fs::is_regular_file(p)) rd.fail(n["filename"], "object file '" + p.string() + "' does not exist");
     int shader = n["shader"] ? int(rd.integer(n["shader"], "object shader", 0, 1 << 30)) : 0;
-    mat4 xf = readTransform(rd, n, "object", true);
-    Mesh mesh = loadObjMesh(p.string(), xf, rd.file(), n["filename"].Mark().line + 1);
+    const glm::dmat4 xf = readTransform(rd, n, "object", true);
+    Mesh mesh = loadObjMesh(p.string(), xf, scene.origin, rd.file(), n["filename"].Mark().line + 1);
     mesh.shader = shader;
     scene.meshes.push_back(std::move(mesh));
     // A bad index is reported at the `shader:` value, or at the object when it has none.
@@ -327,22 +444,41 @@ void readObject(const Reader& rd, const YAML::Node& n, const fs::path& dir, Scen
 
 // A quad light becomes two triangles (appended to lightMeshes) and an emissive Null shader of
 // its own (returned); both go after the scene's objects and shaders once the file is read.
-Shader readLight(const Reader& rd, const YAML::Node& n, std::vector<Mesh>& lightMeshes) {
+Shader readLight(const Reader& rd, const YAML::Node& n, const glm::dvec3& origin, std::vector<Mesh>& lightMeshes) {
     if (!n.IsMap() || !n["type"]) rd.fail(n, "light needs a type (Quad)");
     std::string t = rd.string(n["type"], "light type");
     if (t == "Point" || t == "Environment") rd.fail(n["type"], "light type '" + t + "' is not supported yet");
     if (t != "Quad") rd.fail(n["type"], "unknown light type '" + t + "' (Quad)");
     rd.checkKeys(n, "Quad light", {"type", "translation", "rotation", "scale", "intensity", "colour"});
-    vec2 size(1.0f);
-    if (n["scale"]) size = rd.vec<2>(n["scale"], "light scale", 1e-30, 1e30);
-    float intensity = n["intensity"] ? float(rd.number(n["intensity"], "light intensity", 0.0, 1e30)) : 1.0f;
-    vec3 colour = n["colour"] ? rd.vec<3>(n["colour"], "light colour", 0.0, 1e30) : vec3(1.0f);
-    mat4 xf = readTransform(rd, n, "light", false);
+    glm::dvec2 size(1.0);
+    if (n["scale"]) {
+        size = rd.dvec<2>(n["scale"], "light scale");
+        for (int i = 0; i < 2; ++i)
+            if (!(size[i] >= 1e-30 && size[i] <= kMaxDistance))
+                rd.fail(n["scale"], "light scale must be in [1e-30, " + std::string(kMaxDistanceText) + "], not " +
+                                        Reader::fmt(size[i]));
+    }
+    const double intensity = n["intensity"] ? rd.number(n["intensity"], "light intensity", 0.0, kMaxRadiance) : 1.0;
+    const glm::dvec3 colour = n["colour"] ? rd.dvec<3>(n["colour"], "light colour") : glm::dvec3(1.0);
+    for (int i = 0; i < 3; ++i) {
+        if (!(colour[i] >= 0.0 && colour[i] <= kMaxRadiance))
+            rd.fail(n["colour"], "light colour must be in [0, " + std::string(kMaxRadianceText) + "], not " +
+                                     Reader::fmt(colour[i]));
+        // The product is the light's radiance: it must fit the same range as any emission.
+        if (intensity * colour[i] > kMaxRadiance)
+            rd.fail(n["colour"] ? n["colour"] : n["intensity"],
+                    "light intensity x colour = " + Reader::fmt(intensity * colour[i]) + " exceeds " +
+                        kMaxRadianceText + ", the brightest radiance Spillway renders");
+    }
+    const glm::dmat4 xf = readTransform(rd, n, "light", false);
 
     Mesh m;
     m.name = "quad light " + std::to_string(lightMeshes.size());
-    for (vec2 c : {vec2(-0.5f, -0.5f), vec2(0.5f, -0.5f), vec2(0.5f, 0.5f), vec2(-0.5f, 0.5f)})
-        m.positions.push_back(vec3(xf * vec4(c.x * size.x, c.y * size.y, 0.0f, 1.0f)));
+    for (glm::dvec2 c : {glm::dvec2(-0.5, -0.5), glm::dvec2(0.5, -0.5), glm::dvec2(0.5, 0.5), glm::dvec2(-0.5, 0.5)}) {
+        const glm::dvec3 p = glm::dvec3(xf * glm::dvec4(c.x * size.x, c.y * size.y, 0.0, 1.0)) - origin;
+        checkDistance(rd, n, p, "quad light corner");
+        m.positions.push_back(vec3(p));
+    }
     m.triangles = {uvec3(0, 1, 2), uvec3(0, 2, 3)};
     // A light too small (or too far out) for float to span: refuse it rather than divide by its area.
     for (const uvec3& tri : m.triangles) {
@@ -355,7 +491,7 @@ Shader readLight(const Reader& rd, const YAML::Node& n, std::vector<Mesh>& light
     s.typeName = "Quad light";
     s.line = n.Mark().line + 1;
     s.params.model = kModelNull;
-    s.params.emission = intensity * colour;
+    s.params.emission = vec3(intensity * colour);
     lightMeshes.push_back(std::move(m));
     return s;
 }
@@ -373,17 +509,38 @@ bool Scene::usesTextures() const {
     return false;
 }
 
+namespace {
+
+std::string readSceneText(const std::string& path) {
+    std::error_code ec;
+    const fs::file_status st = fs::status(path, ec);
+    if (ec) throw SceneError(path, 0, "cannot open the scene file: " + ec.message());
+    if (fs::is_directory(st)) throw SceneError(path, 0, "is a folder, not a scene file");
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw SceneError(path, 0, std::string("cannot open the scene file: ") + std::strerror(errno));
+    std::stringstream text;
+    text << in.rdbuf();
+    if (in.bad()) throw SceneError(path, 0, std::string("cannot read the scene file: ") + std::strerror(errno));
+    return text.str();
+}
+
+} // namespace
+
 Scene loadScene(const std::string& path) {
     Scene scene;
     scene.file = path;
     Reader rd(path);
     YAML::Node root;
+    const std::string text = readSceneText(path);
     try {
-        root = YAML::LoadFile(path);
-    } catch (const YAML::BadFile&) {
-        throw SceneError(path, 0, "cannot open the scene file");
+        root = YAML::Load(text);
+    } catch (const YAML::DeepRecursion& e) {
+        throw SceneError(path, e.mark.line + 1, "YAML nests deeper than yaml-cpp's limit of " +
+                                                    std::to_string(e.depth() - 1) + " levels");
     } catch (const YAML::ParserException& e) {
         throw SceneError(path, e.mark.line + 1, "YAML syntax error: " + e.msg);
+    } catch (const YAML::Exception& e) {
+        throw SceneError(path, e.mark.line + 1, "YAML error: " + e.msg);
     }
     if (root.IsNull()) return scene; // an empty file is an empty scene: black
     if (!root.IsMap()) rd.fail(root, "a scene is a map of entries (image, camera, object, ...)");
@@ -393,7 +550,14 @@ Scene loadScene(const std::string& path) {
     std::vector<Mesh> lightMeshes;
     std::vector<Shader> lightShaders;
     std::set<std::string> seenOnce;
+    TextureReader textures(rd, dir, scene);
     try {
+        // The camera first, wherever it stands in the file: everything else is placed relative to it.
+        for (auto it = root.begin(); it != root.end(); ++it)
+            if (it->first.IsScalar() && it->first.Scalar() == "camera") {
+                scene.origin = readCamera(rd, it->second, scene.camera);
+                break;
+            }
         for (auto it = root.begin(); it != root.end(); ++it) {
             std::string key = it->first.as<std::string>();
             const YAML::Node& v = it->second;
@@ -410,7 +574,7 @@ Scene loadScene(const std::string& path) {
             };
             if (key == "image") readImage(rd, v, scene.image);
             else if (key == "settings") readSettings(rd, v, scene.settings);
-            else if (key == "camera") readCamera(rd, v, scene.camera);
+            else if (key == "camera") continue; // read above
             else if (key == "filter") readFilter(rd, v, scene.filter);
             else if (key == "sampler") scene.sampler = readSampler(rd, v);
             else if (key == "object" || key == "objects") {
@@ -418,10 +582,10 @@ Scene loadScene(const std::string& path) {
                 each([&](const YAML::Node& e) { readObject(rd, e, dir, scene, pending); });
             } else if (key == "shader" || key == "shaders") {
                 if (key == "shaders" && !v.IsSequence()) rd.fail(v, "'shaders' must be a list");
-                each([&](const YAML::Node& e) { readShader(rd, e, dir, scene); });
+                each([&](const YAML::Node& e) { readShader(rd, e, textures, scene); });
             } else if (key == "light" || key == "lights") {
                 if (key == "lights" && !v.IsSequence()) rd.fail(v, "'lights' must be a list");
-                each([&](const YAML::Node& e) { lightShaders.push_back(readLight(rd, e, lightMeshes)); });
+                each([&](const YAML::Node& e) { lightShaders.push_back(readLight(rd, e, scene.origin, lightMeshes)); });
             } else {
                 rd.fail(it->first, "unknown entry '" + key +
                                        "' (image, settings, camera, filter, sampler, object, shader, light)");

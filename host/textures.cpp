@@ -4,7 +4,9 @@
 
 #include <OpenImageIO/texture.h>
 
+#include <atomic>
 #include <cmath>
+#include <mutex>
 #include <stdexcept>
 
 namespace spw {
@@ -17,12 +19,46 @@ struct TextureResolver::Impl {
         int channels = 3;
     };
     std::vector<Image> images; // parallel to Scene::textures (only Standard entries are used)
+    // The first failed lookup, reported after the iteration (a lookup cannot throw mid-batch).
+    std::atomic<bool> failed{false};
+    std::mutex errorMutex;
+    int failedTexture = -1;
+    std::string error;
     ~Impl() {
         if (system) OIIO::TextureSystem::destroy(system);
     }
 };
 
+namespace {
+
+// Children-first order of the nodes reachable from `root`, each once.
+void visit(const Scene& scene, int t, std::vector<int>& slotOf, std::vector<int>& order) {
+    if (slotOf[size_t(t)] >= 0) return;
+    const Texture& tex = scene.textures[size_t(t)];
+    if (tex.type == TextureType::Layered)
+        for (int child : {tex.upper, tex.lower, tex.mask}) visit(scene, child, slotOf, order);
+    slotOf[size_t(t)] = int(order.size());
+    order.push_back(t);
+}
+
+} // namespace
+
 TextureResolver::TextureResolver(const Scene& scene) : scene_(scene) {
+    programs_.resize(scene.textures.size());
+    for (const Shader& sh : scene.shaders) {
+        if (sh.texture < 0 || !programs_[size_t(sh.texture)].empty()) continue;
+        // The loader bounds the depth (kMaxTextureDepth), so this recursion is bounded too.
+        std::vector<int> slotOf(scene.textures.size(), -1), order;
+        visit(scene, sh.texture, slotOf, order);
+        std::vector<Op>& program = programs_[size_t(sh.texture)];
+        for (int t : order) {
+            const Texture& tex = scene.textures[size_t(t)];
+            Op op{tex.type, t, -1, -1, -1};
+            if (tex.type == TextureType::Layered)
+                op.upper = slotOf[size_t(tex.upper)], op.lower = slotOf[size_t(tex.lower)], op.mask = slotOf[size_t(tex.mask)];
+            program.push_back(op);
+        }
+    }
     bool any = false;
     for (const Texture& t : scene.textures) any = any || t.type == TextureType::Standard;
     if (!any) return;
@@ -47,37 +83,66 @@ TextureResolver::TextureResolver(const Scene& scene) : scene_(scene) {
 
 TextureResolver::~TextureResolver() = default;
 
-vec3 TextureResolver::eval(int index, vec2 uv) const {
-    const Texture& t = scene_.textures[size_t(index)];
-    switch (t.type) {
-    case TextureType::Constant:
-        return t.colour;
-    case TextureType::Layered: {
-        vec3 m = eval(t.mask, uv);
-        return m * eval(t.upper, uv) + (vec3(1.0f) - m) * eval(t.lower, uv);
+vec3 TextureResolver::lookup(int index, vec2 uv) const {
+    const Impl::Image& img = impl_->images[size_t(index)];
+    OIIO::TextureOpt opt;
+    opt.swrap = opt.twrap = OIIO::TextureOpt::WrapPeriodic;
+    opt.interpmode = OIIO::TextureOpt::InterpBilinear;
+    float rgb[4] = {0, 0, 0, 0};
+    int nc = std::min(img.channels, 3);
+    // OBJ's v grows upwards, image rows downwards. Zero derivatives: the finest MIP level.
+    if (!impl_->system->texture(img.handle, impl_->system->get_perthread_info(), opt, uv.x, 1.0f - uv.y, 0, 0, 0, 0,
+                                nc, rgb)) {
+        if (!impl_->failed.exchange(true)) {
+            std::lock_guard<std::mutex> lock(impl_->errorMutex);
+            impl_->failedTexture = index;
+            impl_->error = impl_->system->geterror();
+        }
+        return vec3(0.0f);
     }
-    case TextureType::Standard: {
-        const Impl::Image& img = impl_->images[size_t(index)];
-        OIIO::TextureOpt opt;
-        opt.swrap = opt.twrap = OIIO::TextureOpt::WrapPeriodic;
-        opt.interpmode = OIIO::TextureOpt::InterpBilinear;
-        float rgb[4] = {0, 0, 0, 0};
-        int nc = std::min(img.channels, 3);
-        // OBJ's v grows upwards, image rows downwards. Zero derivatives: the finest MIP level.
-        impl_->system->texture(img.handle, impl_->system->get_perthread_info(), opt, uv.x, 1.0f - uv.y,
-                               0, 0, 0, 0, nc, rgb);
-        vec3 c = nc == 1 ? vec3(rgb[0]) : vec3(rgb[0], rgb[1], rgb[2]);
-        if (img.srgb) c = vec3(srgbToLinear(c.x), srgbToLinear(c.y), srgbToLinear(c.z));
-        return c;
-    }
-    }
-    return vec3(0.0f);
+    vec3 c = nc == 1 ? vec3(rgb[0]) : vec3(rgb[0], rgb[1], rgb[2]);
+    if (img.srgb) c = vec3(srgbToLinear(c.x), srgbToLinear(c.y), srgbToLinear(c.z));
+    return c;
+}
+
+void TextureResolver::checkErrors() const {
+    if (!impl_ || !impl_->failed.load()) return;
+    std::lock_guard<std::mutex> lock(impl_->errorMutex);
+    const Texture& t = scene_.textures[size_t(impl_->failedTexture)];
+    std::string why = impl_->error;
+    while (!why.empty() && (why.back() == '\n' || why.back() == '\r')) why.pop_back();
+    throw SceneError(scene_.file, t.line, "texture file '" + t.path + "' cannot be read: " + why);
 }
 
 vec3 TextureResolver::albedo(const Shader& shader, vec2 uv) const {
     const ShaderParams& p = shader.params;
     if (shader.texture < 0) return p.colour * p.reflectance;
-    return eval(shader.texture, uv) * p.reflectance;
+    const std::vector<Op>& program = programs_[size_t(shader.texture)];
+    // Most trees have a handful of nodes: a fixed buffer, or a per-thread one for large DAGs.
+    vec3 small[16];
+    thread_local std::vector<vec3> large;
+    vec3* value = small;
+    if (program.size() > 16) {
+        if (large.size() < program.size()) large.resize(program.size());
+        value = large.data();
+    }
+    for (size_t i = 0; i < program.size(); ++i) {
+        const Op& op = program[i];
+        switch (op.type) {
+        case TextureType::Constant:
+            value[i] = scene_.textures[size_t(op.texture)].colour;
+            break;
+        case TextureType::Standard:
+            value[i] = lookup(op.texture, uv);
+            break;
+        case TextureType::Layered: {
+            const vec3 m = value[op.mask];
+            value[i] = m * value[op.upper] + (vec3(1.0f) - m) * value[op.lower];
+            break;
+        }
+        }
+    }
+    return value[program.size() - 1] * p.reflectance;
 }
 
 } // namespace spw

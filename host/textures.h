@@ -2,6 +2,10 @@
 // through OpenImageIO's TextureSystem, which opens files lazily and reads only the tiles and MIP
 // levels that lookups touch; the system is created only when a scene has a Standard texture.
 // 8-bit images are taken to be sRGB-encoded and linearised after the lookup.
+//
+// A texture tree may share subtrees (a YAML alias used several times): it is a DAG, and each
+// shader's is flattened once into a program that evaluates every node once per lookup, in
+// children-first order, so sharing never multiplies work.
 #pragma once
 
 #include "host/scene.h"
@@ -22,11 +26,21 @@ class TextureResolver {
     vec3 albedo(const Shader& shader, vec2 uv) const;
     // True when the scene has image textures (OpenImageIO is in use).
     bool active() const { return impl_ != nullptr; }
+    // Throws SceneError (the texture's file and scene line) if an image lookup failed since the
+    // scene loaded: a file that was readable when loaded but whose pixels are not.
+    void checkErrors() const;
 
   private:
-    vec3 eval(int texture, vec2 uv) const;
+    // One node of a flattened tree: its operands are slots of earlier nodes.
+    struct Op {
+        TextureType type;
+        int texture;             // index into Scene::textures
+        int upper, lower, mask;  // Layered: operand slots
+    };
+    vec3 lookup(int texture, vec2 uv) const;
     struct Impl;
     const Scene& scene_;
+    std::vector<std::vector<Op>> programs_; // per Scene::textures root used by a shader
     std::unique_ptr<Impl> impl_;
 };
 

@@ -18,6 +18,9 @@ packages=(
   python3 python3-numpy python3-matplotlib # convergence plots
 )
 
+# scripts/fuzz.sh: clang with libFuzzer and the sanitizer runtimes.
+if [ "${1:-}" = "--fuzz" ]; then packages+=(clang libclang-rt-dev); fi
+
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q 'install ok installed' || missing+=("$p")

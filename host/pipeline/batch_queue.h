@@ -56,6 +56,7 @@ class SpillFile {
 
 class BatchQueue {
   public:
+    // `budgetBytes`: queued batches held in RAM. `spillDir`: empty for the system temp folder.
     BatchQueue(std::uint64_t budgetBytes, std::string spillDir);
     ~BatchQueue();
 

@@ -91,8 +91,13 @@ SortedRenderer::SortedRenderer(const RenderContext& ctx, const PipelineConfig& c
       scratch_(std::make_unique<Scratch>()) {
     const double budgetMiB = config.memoryBudgetMiB.value_or(ctx.scene.settings.memoryBudgetMiB);
     const uint exponent = uint(config.binExponent.value_or(ctx.scene.settings.binExponent));
-    std::string dir = config.spillDir.empty() ? std::filesystem::temp_directory_path().string() : config.spillDir;
-    queue_ = std::make_unique<BatchQueue>(std::uint64_t(budgetMiB * 1024.0 * 1024.0), dir);
+    // The budget covers every ray waiting in RAM: the six bins fill up to one batch each, and
+    // the queue keeps the rest of the budget (none when six batches already exceed it, so that
+    // every batch spills). Peak rays in RAM <= max(budget, six batches), as --help states.
+    const std::uint64_t budget = std::uint64_t(budgetMiB * 1024.0 * 1024.0);
+    const std::uint64_t binBytes = 6 * (std::uint64_t(1) << exponent) * rayRecordBytes(config.rayFormat);
+    // The spill folder is resolved (and the file made) only when a batch first spills.
+    queue_ = std::make_unique<BatchQueue>(budget > binBytes ? budget - binBytes : 0, config.spillDir);
     bins_ = std::make_unique<DirectionalBins>(config.rayFormat, exponent, *queue_);
 }
 

@@ -15,6 +15,8 @@
 // Standard errors come from the renders' own samples: per pixel over iterations (PixelStats) or
 // over pixels when every pixel estimates the same value.
 #include "host/camera.h"
+#include "host/compare.h"
+#include "host/film.h"
 #include "test_util.h"
 
 #include <gtest/gtest.h>
@@ -197,6 +199,63 @@ TEST(Extreme, CornellBoxIsTheSameAtAnyScaleAndDistance) {
     }
 }
 
+// Camera-relative rendering: the whole scene, camera included, moved 1e5, 1e6 and 1e7 units
+// renders the same image as where it was authored, with the same seed: the loader applies every
+// transform in double and subtracts the camera's position before rounding to float, so the
+// floats the renderer sees barely change (a float at 1e6 is quantised to 1/16 unit: without the
+// shift the vertices themselves would move). relMSE against the untranslated render <= 1e-7.
+TEST(Extreme, ImageDoesNotDependOnWhereTheSceneSits) {
+    constexpr int kSize = 32;
+    TempDir dir;
+    for (const std::string& backend : extremeBackends()) {
+        const Scene original = loadScene(dir.write("o.yaml", cornellYaml(1.0, {0, 0, 0}, kSize, 2, 4)));
+        const Rendered ref = renderScene(original, backend);
+        for (double t : {1e5, 1e6, 1e7}) {
+            const Scene moved = loadScene(dir.write("m.yaml", cornellYaml(1.0, {t, -t, t}, kSize, 2, 4)));
+            EXPECT_NEAR(moved.origin.x - original.origin.x, t, 1e-9 * t);
+            const Rendered r = renderScene(moved, backend);
+            const double relMse =
+                compareImages({kSize, kSize, r.image}, {kSize, kSize, ref.image}).relMse;
+            std::printf("  %s, moved %g: relMSE %.3g against the untranslated render\n", backend.c_str(), t, relMse);
+            EXPECT_LE(relMse, 1e-7) << backend << " moved " << t;
+            EXPECT_GT(mean(r.image), 0.0);
+        }
+    }
+}
+
+// The film holds every radiance the loader accepts: the Cornell box's light at the format's
+// brightest (intensity x colour up to kMaxRadiance = 1e20) renders the same image, scaled, as at
+// its own radiance, with no sample saturating the fixed-point film, on every backend; and the
+// film places its brightest emitter's sample at 2^40 whatever the radiance.
+TEST(Extreme, LightAtTheBrightestAllowedRadianceRendersWithoutSaturation) {
+    constexpr int kSize = 32;
+    const double k = 5e18; // colour [17, 12, 4] x 5e18: 8.5e19 at most
+    TempDir dir;
+    const std::string base = cornellYaml(1.0, {0, 0, 0}, kSize, 2, 2);
+    std::string bright = base;
+    const size_t at = bright.find("intensity: 1,");
+    ASSERT_NE(at, std::string::npos) << base;
+    bright.replace(at, 13, "intensity: 5e18,");
+    for (const std::string& backend : extremeBackends()) {
+        const Rendered unit = renderScene(loadScene(dir.write("u.yaml", base)), backend);
+        const Rendered hot = renderScene(loadScene(dir.write("b.yaml", bright)), backend);
+        EXPECT_EQ(hot.counters.saturatedSamples, 0u) << backend;
+        EXPECT_EQ(hot.counters.nonFiniteSamples, 0u) << backend;
+        double worst = 0;
+        for (size_t i = 0; i < unit.image.size(); ++i)
+            worst = std::max(worst, std::fabs(hot.image[i] / k - unit.image[i]) / std::max(1e-3, double(unit.image[i])));
+        std::printf("  %s: worst relative difference %.3g between the image at 5e18 (scaled back) and at 1\n",
+                    backend.c_str(), worst);
+        EXPECT_LT(worst, 1e-4) << backend;
+    }
+    for (float brightest : {1e-30f, 17.0f, 8.5e19f, 1e20f}) {
+        const Film film(4, 4, Filter{}, brightest);
+        const double sample = film.fixedPointScale() * brightest;
+        EXPECT_GT(sample, std::ldexp(1.0, 39)) << brightest;
+        EXPECT_LE(sample, std::ldexp(1.0, 40)) << brightest;
+    }
+}
+
 // A huge tilted triangle through the origin, seen near the origin: the hit point's coordinates
 // are tiny but its error follows the vertices' magnitude (1e5); an offset scaled by |p| alone
 // leaves acne (shadow rays hitting their own surface). Compared with the same plane cut small.
@@ -310,7 +369,7 @@ TEST(Extreme, PinPointLightMatchesClosedFormAtEqualPower) {
             for (int y = 0; y < kSize; ++y)
                 for (int x = 0; x < kSize; ++x) {
                     const CameraRay cr = cam.generate(uint(x), uint(y), 0, 0, 0); // Grid: the pixel centre
-                    const glm::dvec3 o(cr.origin), dv(cr.dir);
+                    const glm::dvec3 o = scene.origin + glm::dvec3(cr.origin), dv(cr.dir); // camera-relative world
                     const glm::dvec3 p = o + dv * (-o.y / dv.y);
                     const double expected = 0.5 / M_PI * polygonIrradiance(p, {0, 1, 0}, corners, L);
                     const size_t i = size_t(y * kSize + x);

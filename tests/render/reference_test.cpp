@@ -84,7 +84,8 @@ TEST(QuadLight, PixelsMatchPolygonIrradiance) {
     for (int y = 0; y < 16; ++y)
         for (int x = 0; x < 16; ++x) {
             CameraRay r = cam.generate(uint(x), uint(y), 0, 0, 0); // Grid: the pixel centre
-            vec3 p = r.origin + r.dir * (-r.origin.y / r.dir.y);
+            const vec3 o = vec3(scene.origin) + r.origin; // the world is camera-relative
+            vec3 p = o + r.dir * (-o.y / r.dir.y);
             double expected = 0.5 / kPi * polygonIrradiance(p, vec3(0, 1, 0), corners, 3.0);
             size_t i = size_t(y * 16 + x);
             double z = (ps.mean(i) - expected) / std::max(ps.stderror(i), 1e-12);

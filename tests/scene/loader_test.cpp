@@ -126,7 +126,9 @@ TEST(Loader, AppendixBExampleLoads) {
     EXPECT_EQ(scene.settings.binExponent, 15);
     EXPECT_EQ(scene.camera.type, CameraType::PinHole);
     EXPECT_FLOAT_EQ(scene.camera.focalLength, 150.0f);
-    expectNear(vec3(scene.camera.cameraToWorld[3]), vec3(0, 120, 1000), 1e-4f, "camera position");
+    // The world is camera-relative: the camera's position is the scene's origin.
+    expectNear(vec3(scene.origin), vec3(0, 120, 1000), 1e-4f, "camera position");
+    expectNear(vec3(scene.camera.cameraToWorld[3]), vec3(0.0f), 0.0f, "camera position in the rendered world");
     EXPECT_EQ(scene.filter.type, FilterType::Tent);
     EXPECT_EQ(scene.sampler, SamplerType::Stratified);
 
@@ -138,8 +140,8 @@ TEST(Loader, AppendixBExampleLoads) {
     EXPECT_EQ(scene.meshes[0].triangles.size(), 2u);
     EXPECT_EQ(scene.meshes[0].uvs.size(), scene.meshes[0].positions.size());
     EXPECT_EQ(scene.meshes[0].shader, 0);
-    expectNear(centroid(scene.meshes[1]), vec3(100, 100, 35), 1e-3f, "first light");
-    expectNear(centroid(scene.meshes[2]), vec3(-120, 120, 50), 1e-3f, "second light");
+    expectNear(vec3(scene.origin) + centroid(scene.meshes[1]), vec3(100, 100, 35), 1e-3f, "first light");
+    expectNear(vec3(scene.origin) + centroid(scene.meshes[2]), vec3(-120, 120, 50), 1e-3f, "second light");
     expectNear(scene.shaders[size_t(scene.meshes[1].shader)].params.emission, vec3(25.0f), 0.0f,
                "first light emission");
     expectNear(scene.shaders[size_t(scene.meshes[2].shader)].params.emission, vec3(1.0f), 0.0f,
@@ -298,6 +300,33 @@ TEST(Loader, UniformScaleIsANumber) {
 
 // Conductor and Dielectric: their keys, defaults (colour 1, alpha 0; ior 1.5, alpha 0) and
 // the models they select.
+// YAML reads a plain `Null` as the null value: the format's Null shader must load all the same.
+TEST(Loader, NullShaderTypeIsReadAsTheNullShader) {
+    TempDir dir;
+    const Scene scene = loadScene(dir.write("n.yaml", "shaders:\n  - {type: Null, emission: [2, 2, 2]}\n  - type: Null\n"));
+    ASSERT_EQ(scene.shaders.size(), 2u);
+    for (const Shader& s : scene.shaders) EXPECT_EQ(s.params.model, kModelNull);
+    EXPECT_EQ(scene.shaders[0].params.emission, vec3(2.0f));
+}
+
+// A YAML anchor used many times is one texture, not a copy per use: 30 levels each using the
+// level below three times load as 31 textures (3^30 leaves if aliases were copied).
+TEST(Loader, TextureAliasesAreSharedNotCopied) {
+    TempDir dir;
+    std::string y = "shaders:\n  - {type: Lambert, texture: &a0 {type: Constant, colour: [0.5, 0.5, 0.5]}}\n";
+    for (int i = 1; i <= 30; ++i) {
+        const std::string prev = "*a" + std::to_string(i - 1);
+        y += "  - {type: Lambert, texture: &a" + std::to_string(i) + " {type: Layered, upper: " + prev + ", lower: " +
+             prev + ", mask: " + prev + "}}\n";
+    }
+    const Scene scene = loadScene(dir.write("bomb.yaml", y));
+    EXPECT_EQ(scene.textures.size(), 31u);
+    ASSERT_EQ(scene.shaders.size(), 31u);
+    const Texture& top = scene.textures[size_t(scene.shaders[30].texture)];
+    EXPECT_EQ(top.upper, top.lower);
+    EXPECT_EQ(top.upper, top.mask);
+}
+
 TEST(Loader, ConductorAndDielectricTakeTheirKeysAndDefaults) {
     TempDir dir;
     Scene scene = loadScene(dir.write("metal.yaml", "shaders:\n"
