@@ -26,6 +26,7 @@ EmbreeScene::EmbreeScene(const Scene& scene) : src_(scene) {
 
     emitterBase_.assign(scene.meshes.size(), -1);
     double totalPower = 0.0;
+    std::vector<double> powers; // per emitter, normalised into pickPdf below
     for (size_t m = 0; m < scene.meshes.size(); ++m) {
         const Mesh& mesh = scene.meshes[m];
         RTCGeometry g = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
@@ -57,17 +58,18 @@ EmbreeScene::EmbreeScene(const Scene& scene) : src_(scene) {
             e.twoSided = twoSided ? 1u : 0u;
             e.radiance = sp.emission;
             // Power = L * area * pi per emitting side.
-            double power = double(luminance(sp.emission)) * e.area * kPi * (twoSided ? 2.0 : 1.0);
-            e.pickPdf = float(power); // normalised below
+            // In double: radiance (up to 1e20) times area can pass float's range.
+            const double power = double(luminance(sp.emission)) * double(e.area) * kPi * (twoSided ? 2.0 : 1.0);
+            powers.push_back(power);
             totalPower += power;
             emitters_.push_back(e);
         }
     }
     if (totalPower > 0.0) {
         double running = 0.0;
-        for (Emitter& e : emitters_) {
-            running += e.pickPdf;
-            e.pickPdf = float(e.pickPdf / totalPower);
+        for (size_t i = 0; i < emitters_.size(); ++i) {
+            running += powers[i];
+            emitters_[i].pickPdf = float(powers[i] / totalPower);
             cdf_.push_back(float(running / totalPower));
         }
         cdf_.back() = 1.0f;

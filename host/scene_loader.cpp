@@ -253,6 +253,11 @@ glm::dvec3 readCamera(const Reader& rd, const YAML::Node& n, Camera& c) {
         c.focalDistance = float(rd.number(n["focal distance"], "focal distance", 1e-30, kMaxDistance));
     if (c.type == CameraType::PinHole && (n["aperture radius"] || n["focal distance"]))
         rd.fail(n, "aperture radius and focal distance need camera type ThinLens");
+    // fov is bounded by its range; focal length and film width must give no wider a view, or
+    // the camera's ray directions overflow float before they are normalised.
+    if (!c.fovDegrees && c.tanHalfFovX() > std::tan(glm::radians(179.9) / 2))
+        rd.fail(n["focal length"] ? n["focal length"] : n["film width"],
+                "film width / focal length gives a field of view wider than 179.9 degrees");
     return origin;
 }
 
@@ -560,7 +565,7 @@ Scene loadScene(const std::string& path) {
             }
         for (auto it = root.begin(); it != root.end(); ++it) {
             std::string key = it->first.as<std::string>();
-            const YAML::Node& v = it->second;
+            const YAML::Node v = it->second; // a handle: a reference would dangle (the iterator returns a proxy)
             bool single = key == "image" || key == "settings" || key == "camera" || key == "filter" ||
                           key == "sampler";
             if (single && !seenOnce.insert(key).second)
@@ -608,6 +613,17 @@ Scene loadScene(const std::string& path) {
         scene.meshes.push_back(std::move(lightMeshes[i]));
     }
     const ImageSettings& img = scene.image;
+    // A ThinLens ray aims at the focal plane: its farthest corner lies within kMaxDistance too.
+    if (scene.camera.type == CameraType::ThinLens) {
+        const double tx = scene.camera.tanHalfFovX(), ty = tx * img.height / img.width;
+        const double corner = scene.camera.focalDistance * std::sqrt(1.0 + tx * tx + ty * ty);
+        if (!(corner <= kMaxDistance)) {
+            const YAML::Node cam = static_cast<const YAML::Node&>(root)["camera"];
+            rd.fail(cam["focal distance"] ? cam["focal distance"] : cam,
+                    "the focal plane's corners lie " + Reader::fmt(corner) + " units from the camera; Spillway renders "
+                    "within " + kMaxDistanceText + " units of it");
+        }
+    }
     if ((unsigned long long)img.width * img.height * img.samplesPerIteration() > 0xFFFFFFFFull)
         rd.fail(1, "width x height x sample base^2 exceeds 2^32 samples per iteration; lower the sample "
                    "base and raise iterations");

@@ -1,8 +1,45 @@
 #!/usr/bin/env bash
-# Installs, builds, and runs every test (GoogleTest through ctest).
+# Installs, builds, and runs every test (GoogleTest through ctest), twice: the Release build in
+# build/, then the same suite built with clang under AddressSanitizer, UndefinedBehaviorSanitizer
+# and LeakSanitizer in build-asan/ (the fuzzing corpus's kept inputs are replayed in both).
+#   scripts/test.sh            both
+#   scripts/test.sh --release  the Release suite only (quicker, while working)
+#   scripts/test.sh --asan     the sanitized suite only
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
-"$root/scripts/build.sh"
+mode="${1:-all}"
 # Lavapipe: as many worker threads as cores (its default can oversubscribe small machines).
 export LP_NUM_THREADS="${LP_NUM_THREADS:-$(nproc)}"
-ctest --test-dir "$root/build" --output-on-failure --parallel "$(nproc)" --timeout 900
+
+if [ "$mode" = all ] || [ "$mode" = --release ]; then
+  "$root/scripts/build.sh"
+  ctest --test-dir "$root/build" --output-on-failure --parallel "$(nproc)" --timeout 900
+fi
+
+if [ "$mode" = all ] || [ "$mode" = --asan ]; then
+  "$root/scripts/install-deps.sh" --fuzz
+  CC=clang CXX=clang++ cmake -S "$root" -B "$root/build-asan" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+    -DSPILLWAY_SANITIZE=ON >/dev/null
+  cmake --build "$root/build-asan" --parallel "$(nproc)"
+  # Any sanitizer report fails the test it happens in (the process aborts). Two exceptions, both
+  # in libraries: OpenImageIO's TextureSystem::destroy frees with another size than it allocated
+  # (new_delete_type_mismatch), and LeakSanitizer ignores the libraries' own process-lifetime
+  # allocations (tests/fuzz/lsan.supp).
+  asan="abort_on_error=1:strict_string_checks=1:new_delete_type_mismatch=0"
+  export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
+  export LSAN_OPTIONS="suppressions=$root/tests/fuzz/lsan.supp:print_suppressions=0"
+  # Everything but the Vulkan* tests with LeakSanitizer on. The Vulkan* tests run the Khronos
+  # validation layer, which the loader unloads at vkDestroyInstance: LeakSanitizer then reports
+  # the layer's allocations from an "<unknown module>" that no suppression can name, so those
+  # tests run under ASan and UBSan with leak detection off (the other suites' vulkan-backend
+  # renders, without the layer, keep it on).
+  # Three statistical tests are left to the Release run: they repeat code paths the rest of the
+  # suite already runs under the sanitizers, for ten times the samples, and would take 10 of the
+  # sanitized run's 12 CPU-minutes (measured: 259, 251 and 123 s under ASan).
+  slow='^Convergence\.|StiffEnclosure\.ReachesLeOverOneMinusAlbedo/0\.999'
+  ASAN_OPTIONS="detect_leaks=1:$asan" ctest --test-dir "$root/build-asan" --output-on-failure \
+    --parallel "$(nproc)" --timeout 900 -E "^Vulkan|$slow"
+  ASAN_OPTIONS="detect_leaks=0:$asan" ctest --test-dir "$root/build-asan" --output-on-failure \
+    --parallel "$(nproc)" --timeout 900 -R '^Vulkan'
+
+fi

@@ -10,6 +10,20 @@
 
 namespace spw::test {
 
+// True in the sanitized build (scripts/test.sh's build-asan/): a process's RSS there includes
+// AddressSanitizer's shadow memory and quarantine, so bounds on RSS are not checked in it.
+#if defined(__SANITIZE_ADDRESS__)
+constexpr bool kAddressSanitizer = true;
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+constexpr bool kAddressSanitizer = true;
+#else
+constexpr bool kAddressSanitizer = false;
+#endif
+#else
+constexpr bool kAddressSanitizer = false;
+#endif
+
 // A fresh folder under the system temp dir, removed with everything in it on destruction.
 class TempDir {
   public:

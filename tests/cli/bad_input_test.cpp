@@ -151,6 +151,8 @@ TEST_P(BadInputs, NeverCrashHangOrLeaveAFile) {
         break;
     case Expect::Success:
         EXPECT_EQ(r.status, 0) << r.output;
+        // --quiet: a clean render prints nothing, not even a warning (non-finite samples).
+        EXPECT_EQ(r.output, "");
         break;
     }
     EXPECT_NE(r.output.find(c.mention), std::string::npos) << "expected '" << c.mention << "' in: " << r.output;
@@ -218,6 +220,14 @@ const BadInput kBadInputs[] = {
      Expect::SceneError, "scene.yaml:1", "aperture radius"},
     {"ThinLensFocalDistanceHuge", {}, "camera:\n  type: ThinLens\n  focal distance: 1e30\n" + kTri, "",
      Expect::SceneError, "scene.yaml:3", "focal distance"},
+    {"ThinLensFocalPlaneFar", {}, "camera:\n  type: ThinLens\n  fov: 179\n  focal distance: 1e13\n" + kTri, "",
+     Expect::SceneError, "scene.yaml:4", "focal plane"},
+    {"FilmWidthOverFocalLengthWiderThan180Degrees", {},
+     "camera:\n  focal length: 1e-6\n  film width: 1e9\n" + kTri, "", Expect::SceneError, "scene.yaml:2",
+     "wider than 179.9"},
+    {"QuadLightWithPowerBeyondFloat", {},
+     kTri + "light: {type: Quad, translation: [0, 0, 1e9], rotation: [180, 0, 0], scale: [3e9, 3e9], intensity: 1e20}\n",
+     "", Expect::Success, "", ""},
     {"QuadLightFar", {}, kTri + "light: {type: Quad, translation: [0, 0, -1e18]}\n", "", Expect::SceneError,
      "scene.yaml:4", "quad light corner"},
     // 6, 7. Radiance beyond float's headroom, or beyond the film.
