@@ -7,7 +7,6 @@
 namespace spw {
 namespace {
 
-constexpr double kMaxFixed = 4.6e18; // below 2^62: the sum of two saturated adds cannot wrap
 
 float filterWeight1D(FilterType type, float d, float radius) {
     d = std::fabs(d);
@@ -26,15 +25,20 @@ uint roundingKey(uint key, uint sampleIndex) { return pcg4d(uvec4(key, sampleInd
 
 } // namespace
 
-Film::Film(int width, int height, const Filter& filter, float brightestRadiance)
+Film::Film(int width, int height, const Filter& filter, float brightestRadiance, int samplesPerIteration)
     : width_(width), height_(height), filter_(filter),
       acc_(new std::atomic<std::int64_t>[size_t(width) * height * 8]),
       sum_(size_t(width) * height * 8, 0.0), lastIteration_(size_t(width) * height * 3, 0.0f) {
     // No clamp on e: the scale is a double, and every emission the loader accepts (up to
     // kMaxRadiance, down to the smallest float) keeps its brightest sample at 2^40.
     const int e = brightestRadiance > 0.0f ? int(std::ceil(std::log2(double(brightestRadiance)))) : 0;
-    scale_ = std::ldexp(1.0, 40 - e);
-    weightScale_ = std::ldexp(1.0, 40);
+    // N adds at most per accumulator and iteration: a sample reaches (floor(2r) + 1)^2 pixels.
+    const double reach = filter.type == FilterType::Box ? 1.0 : std::floor(2.0 * double(filter.radius)) + 1.0;
+    const int logAdds = int(std::ceil(std::log2(std::max(1.0, double(samplesPerIteration) * reach * reach))));
+    maxAdd_ = std::ldexp(1.0, 62 - logAdds);
+    const int top = std::min(40, 62 - logAdds - 16); // the brightest sample's exponent
+    scale_ = std::ldexp(1.0, top - e);
+    weightScale_ = std::ldexp(1.0, std::min(40, 62 - logAdds - 1));
     beginIteration();
 }
 
@@ -49,9 +53,9 @@ void Film::add(int px, int py, int half, vec3 value, float weight, uint key) {
     const uint rnd[4] = {h.x, h.y, h.z, h.w};
     for (int c = 0; c < 4; ++c) {
         double v = in[c];
-        if (std::fabs(v) > kMaxFixed) {
+        if (std::fabs(v) > maxAdd_) {
             saturated_.fetch_add(1, std::memory_order_relaxed);
-            v = std::copysign(kMaxFixed, v);
+            v = std::copysign(maxAdd_, v);
         }
         double fl = std::floor(v);
         // Round up with probability frac(v): E[rounded] = v exactly.

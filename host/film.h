@@ -5,9 +5,12 @@
 // the rounding is unbiased and still deterministic. At the end of an iteration the integer sums
 // are folded, pixel by pixel, into double-precision accumulators that hold the whole render.
 //
-// The fixed-point scale is picked from the scene's brightest emitter so that one sample of it
-// sits at 2^40: that leaves 2^23 such samples per pixel and iteration before saturation and
-// resolves 2^-40 of it. Non-finite samples are counted and dropped, never added.
+// No accumulator can wrap: at most N = (samples per pixel and iteration) x (pixels a filter
+// reaches) adds land in one in an iteration, and each add is clamped (and counted as saturated)
+// at 2^62 / N. The fixed-point scale puts one sample of the scene's brightest emitter at 2^40,
+// or lower where N needs it, keeping at least 2^16 of headroom below the clamp; the weights sit
+// at 2^40 or below the clamp likewise. For the usual N (up to 64) that is 2^40 and a clamp 2^20
+// times the brightest emitter. Non-finite samples are counted and dropped, never added.
 //
 // Even and odd samples (by render-wide sample index) accumulate apart, in two half buffers:
 // their difference estimates the image's own error without a reference (halfBufferRelMse).
@@ -30,7 +33,8 @@ inline uint filmKey(uint pathId, uint bounce, bool shadow) {
 
 class Film {
   public:
-    Film(int width, int height, const Filter& filter, float brightestRadiance);
+    // `samplesPerIteration`: camera samples per pixel in one iteration (sample base^2).
+    Film(int width, int height, const Filter& filter, float brightestRadiance, int samplesPerIteration = 1);
 
     int width() const { return width_; }
     int height() const { return height_; }
@@ -65,6 +69,7 @@ class Film {
     Filter filter_;
     double scale_;       // radiance units -> fixed-point units
     double weightScale_; // filter weight -> fixed-point units
+    double maxAdd_;      // the clamp of one add, in fixed-point units
     std::unique_ptr<std::atomic<std::int64_t>[]> acc_; // 8 per pixel: (r, g, b, weight) x 2 halves
     std::vector<double> sum_;                          // 8 per pixel, whole render
     std::vector<float> lastIteration_;

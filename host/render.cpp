@@ -106,7 +106,7 @@ std::unique_ptr<RenderResult> renderWithProgress(const Scene& scene, const Rende
 
     RenderContext ctx{scene, config, *embree, textures, camera, params, threads, stats};
     result->film = std::make_unique<Film>(scene.image.width, scene.image.height, scene.filter,
-                                          embree->brightestEmission());
+                                          embree->brightestEmission(), int(params.samplesPerIteration));
     std::unique_ptr<Backend> backend;
     if (config.backend == "reference") backend = std::make_unique<ReferenceRenderer>(ctx);
     else if (vulkan) backend = std::make_unique<SortedRenderer>(ctx, config.pipeline, makeVulkanShading(ctx, config.pipeline, *vulkan));

@@ -46,5 +46,33 @@ TEST(Film, RoundingIsUnbiasedAcrossIterations) {
     EXPECT_NEAR(mean, value, 4.0 * step * std::sqrt(0.21 / iterations)) << "step " << step;
 }
 
+// No accumulator wraps, whatever the samples per iteration and the filter's reach: the film
+// clamps each add at 2^62 / N (N = samples per iteration x pixels a sample reaches) and scales
+// so that samples up to 2^16 times the brightest emitter stay below the clamp. 2^22 samples
+// 8x the brightest emitter, through a Gaussian of radius 16 with 4096 samples per iteration,
+// summed 2^63.4 in each half buffer at a fixed scale of 2^40 (a wrap to garbage, as it was);
+// here they average exactly 8.
+TEST(Film, NoAccumulatorWrapsAtTheMostSamplesAFilterGathers) {
+    Film film(1, 1, Filter{FilterType::Gaussian, 16.0f}, 1.0f, 4096);
+    const int samples = 1 << 22;
+    for (int i = 0; i < samples; ++i) {
+        film.addSample(vec2(0.5f), uint(i));
+        film.splat(vec2(0.5f), uint(i), vec3(8.0f), uint(i));
+    }
+    film.endIteration();
+    EXPECT_EQ(film.saturatedSamples(), 0u);
+    const std::vector<float> img = film.image();
+    for (float v : img) EXPECT_NEAR(v, 8.0f, 8e-6f);
+}
+
+// The usual film keeps its brightest emitter's sample at 2^40 (a box filter, up to 64 samples
+// per iteration), so images do not change with the guard above.
+TEST(Film, UsualFilmsKeepTheBrightestSampleAt2To40) {
+    for (int spi : {1, 4, 16, 64}) {
+        const Film film(8, 8, Filter{}, 17.0f, spi);
+        EXPECT_EQ(film.fixedPointScale() * 32.0, std::ldexp(1.0, 40)) << spi; // 17 rounds up to 2^5
+    }
+}
+
 } // namespace
 } // namespace spw
