@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Builds the libFuzzer harnesses (tests/fuzz/) with clang, ASan and UBSan in build-fuzz/ and runs
-# each for SECONDS (default 60), one after the other, on one core each. The working corpus grows
+# each for SECONDS (default 60), both at once, on one core each. The working corpus grows
 # in build-fuzz/corpus/NAME (seeded from tests/fuzz/seeds/NAME); an input that crashes, hangs
 # (10 s) or leaks is written to tests/fuzz/crashers/NAME/, where the normal suite replays it.
 # Prints each run's executions, coverage and findings; exits 1 if any harness found something.
@@ -15,25 +15,32 @@ cmake --build "$build" --parallel "$(nproc)" --target scene_fuzzer obj_fuzzer
 # LeakSanitizer: oneTBB's and OpenImageIO's process-lifetime singletons are not leaks of ours.
 export ASAN_OPTIONS="${ASAN_OPTIONS:-detect_leaks=1:new_delete_type_mismatch=0}"
 export LSAN_OPTIONS="${LSAN_OPTIONS:-suppressions=$root/tests/fuzz/lsan.supp:print_suppressions=0}"
-found=0
+# Both harnesses at once, one core each (the machine's two), then their reports.
 for name in scene obj; do
   corpus="$build/corpus/$name"
   crashers="$root/tests/fuzz/crashers/$name"
   mkdir -p "$corpus" "$crashers"
-  log="$build/$name.log"
   echo "== $name: ${seconds} s" >&2
-  status=0
-  "$build/${name}_fuzzer" "$corpus" "$root/tests/fuzz/seeds/$name" -max_total_time="$seconds" \
-    -timeout=10 -rss_limit_mb=4096 -max_len=65536 -print_final_stats=1 -artifact_prefix="$crashers/" \
-    >"$log" 2>&1 || status=$?
-  grep -E '^#[0-9]+ +DONE' "$log" | tail -1 >&2 || true
-  grep -E '^stat::number_of_executed_units|^stat::average_exec_per_sec|^stat::peak_rss_mb' "$log" >&2 || true
+  ( status=0
+    "$build/${name}_fuzzer" "$corpus" "$root/tests/fuzz/seeds/$name" -max_total_time="$seconds" \
+      -timeout=10 -rss_limit_mb=4096 -max_len=65536 -print_final_stats=1 -artifact_prefix="$crashers/" \
+      >"$build/$name.log" 2>&1 || status=$?
+    echo "$status" >"$build/$name.status" ) &
+done
+wait
+found=0
+for name in scene obj; do
+  log="$build/$name.log"
+  status="$(cat "$build/$name.status")"
+  echo "== $name" >&2
+  grep -E '^#[0-9]+[[:space:]]+(INITED|DONE)' "$log" >&2 || true
+  grep -E '^stat::(number_of_executed_units|average_exec_per_sec|peak_rss_mb)' "$log" >&2 || true
   if [ "$status" -ne 0 ]; then
     found=1
-    echo "$name: FOUND a defect (exit $status); the input is in $crashers, the log in $log" >&2
+    echo "$name: FOUND a defect (exit $status); the input is in tests/fuzz/crashers/$name, the log in $log" >&2
     grep -E 'ERROR|SUMMARY|unexpected exception' "$log" | head -5 >&2 || true
   else
-    echo "$name: nothing found; corpus $(ls "$corpus" | wc -l) inputs" >&2
+    echo "$name: nothing found; corpus $(ls "$build/corpus/$name" | wc -l) inputs" >&2
   fi
 done
 exit "$found"

@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <fstream>
 #include <random>
+#include <sstream>
 #include <sys/wait.h>
 
 namespace spw::test {
@@ -35,6 +36,18 @@ std::string TempDir::write(const std::string& name, const std::string& text) con
 }
 
 std::string sourceDir() { return SPILLWAY_SOURCE_DIR; }
+
+std::string readFile(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    std::stringstream s;
+    s << in.rdbuf();
+    return s.str();
+}
+
+std::string replaceAll(std::string s, const std::string& key, const std::string& value) {
+    for (size_t at = 0; (at = s.find(key, at)) != std::string::npos; at += value.size()) s.replace(at, key.size(), value);
+    return s;
+}
 
 std::vector<std::string> backendsUnderTest() { return {"reference", "cpu", "vulkan"}; }
 std::string binary() { return SPILLWAY_BINARY; }

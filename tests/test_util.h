@@ -46,6 +46,11 @@ std::vector<std::string> backendsUnderTest();
 std::string sourceDir();
 std::string binary();
 
+// The whole file as bytes ("" when it cannot be read).
+std::string readFile(const std::string& path);
+// `s` with every `key` replaced by `value` (placeholders in command lines).
+std::string replaceAll(std::string s, const std::string& key, const std::string& value);
+
 struct CommandResult {
     int status;         // exit status, or -1 when killed by a signal
     std::string output; // stdout and stderr together

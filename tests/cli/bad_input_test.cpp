@@ -10,9 +10,7 @@
 
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <random>
-#include <sstream>
 #include <sys/wait.h>
 
 namespace spw::test {
@@ -46,13 +44,6 @@ Outcome runLimited(const std::string& args, int seconds = 120, const std::string
     if (code > 128) r.signalled = true, r.signal = code - 128;
     else r.status = code;
     return r;
-}
-
-std::string readText(const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    std::stringstream s;
-    s << in.rdbuf();
-    return s.str();
 }
 
 const char* const kTriangleObj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
@@ -112,11 +103,6 @@ struct BadInput {
 
 void PrintTo(const BadInput& c, std::ostream* os) { *os << c.name; }
 
-std::string expand(std::string s, const std::string& key, const std::string& value) {
-    for (size_t at; (at = s.find(key)) != std::string::npos;) s.replace(at, key.size(), value);
-    return s;
-}
-
 class BadInputs : public ::testing::TestWithParam<BadInput> {};
 
 TEST_P(BadInputs, NeverCrashHangOrLeaveAFile) {
@@ -130,14 +116,15 @@ TEST_P(BadInputs, NeverCrashHangOrLeaveAFile) {
     const std::string before = "not an image, and must stay so\n";
     dir.write("out/keep.exr", before);
     std::string args = c.args.empty() ? "{scene} -o {out} --quiet" : c.args;
-    args = expand(expand(expand(expand(args, "{scene}", scene), "{out}", dir.file("out/image.exr")), "{dir}", dir.path()),
-                  "{cornell}", sourceDir() + "/scenes/cornell-box.yaml");
-    const Outcome r = runLimited("render " + args, 120, expand(c.prefix, "{dir}", dir.path()));
+    args = replaceAll(replaceAll(replaceAll(replaceAll(args, "{scene}", scene), "{out}", dir.file("out/image.exr")),
+                                 "{dir}", dir.path()),
+                      "{cornell}", sourceDir() + "/scenes/cornell-box.yaml");
+    const Outcome r = runLimited("render " + args, 120, replaceAll(c.prefix, "{dir}", dir.path()));
 
     ASSERT_FALSE(r.signalled) << (r.signal == SIGKILL ? "hung (killed after 120 s)" : "killed by signal " +
                                                                                          std::to_string(r.signal))
                               << "\n" << r.output;
-    EXPECT_EQ(readText(dir.file("out/keep.exr")), before) << "an existing file was changed";
+    EXPECT_EQ(readFile(dir.file("out/keep.exr")), before) << "an existing file was changed";
     switch (c.expect) {
     case Expect::SceneError: {
         EXPECT_EQ(r.status, 2) << r.output;

@@ -55,18 +55,13 @@ struct BadUsage {
 
 void PrintTo(const BadUsage& c, std::ostream* os) { *os << c.name; }
 
-std::string expand(std::string s, const std::string& key, const std::string& value) {
-    for (size_t at; (at = s.find(key)) != std::string::npos;) s.replace(at, key.size(), value);
-    return s;
-}
-
 class CliBadUsage : public ::testing::TestWithParam<BadUsage> {};
 
 // Each exits 2 before rendering and writes no file.
 TEST_P(CliBadUsage, ExitsTwoAndWritesNothing) {
     const BadUsage& c = GetParam();
     TempDir dir;
-    std::string args = expand(expand(expand(c.args, "{scene}", cornellBox()), "{out}", dir.file("out.exr")),
+    std::string args = replaceAll(replaceAll(replaceAll(c.args, "{scene}", cornellBox()), "{out}", dir.file("out.exr")),
                               "{dir}", dir.path());
     CommandResult r = runSpillway("render " + args);
     EXPECT_EQ(r.status, 2) << args << "\n" << r.output;

@@ -7,8 +7,6 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 
 namespace spw::test {
 namespace {
@@ -24,17 +22,10 @@ std::vector<std::string> filesIn(const std::string& dir) {
     return out;
 }
 
-std::string bytesOf(const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    std::stringstream s;
-    s << in.rdbuf();
-    return s.str();
-}
-
 using Target = fuzz::Outcome (*)(const std::uint8_t*, std::size_t, std::string*);
 
 fuzz::Outcome replay(Target target, const std::string& path, std::string* detail) {
-    const std::string b = bytesOf(path);
+    const std::string b = readFile(path);
     return target(reinterpret_cast<const std::uint8_t*>(b.data()), b.size(), detail);
 }
 
