@@ -99,29 +99,34 @@ const char* raySortName(RaySortMode mode) {
     return "?";
 }
 
+MortonFrame MortonFrame::of(const std::vector<RayState>& rays) {
+    const Bounds b = originBounds(rays.data(), rays.size());
+    const vec3 extent = b.hi - b.lo;
+    return {b.lo, vec3(extent.x > 0 ? 32767.0f / extent.x : 0.0f, extent.y > 0 ? 32767.0f / extent.y : 0.0f,
+                       extent.z > 0 ? 32767.0f / extent.z : 0.0f)};
+}
+
+std::uint64_t MortonFrame::key(const RayState& r) const {
+    vec3 q = glm::clamp((r.origin - lo) * scale, vec3(0.0f), vec3(32767.0f));
+    std::uint64_t morton =
+        spread3(std::uint64_t(q.x)) | spread3(std::uint64_t(q.y)) << 1 | spread3(std::uint64_t(q.z)) << 2;
+    // 8+8-bit octahedral direction.
+    vec3 d = r.dir / (std::fabs(r.dir.x) + std::fabs(r.dir.y) + std::fabs(r.dir.z));
+    vec2 o = d.z >= 0 ? vec2(d.x, d.y)
+                      : vec2((1 - std::fabs(d.y)) * (d.x >= 0 ? 1 : -1), (1 - std::fabs(d.x)) * (d.y >= 0 ? 1 : -1));
+    std::uint64_t du = std::uint64_t(std::clamp((o.x * 0.5f + 0.5f) * 255.0f, 0.0f, 255.0f));
+    std::uint64_t dv = std::uint64_t(std::clamp((o.y * 0.5f + 0.5f) * 255.0f, 0.0f, 255.0f));
+    return std::uint64_t(cardinalBin(r.dir)) << 61 | morton << 16 | du << 8 | dv;
+}
+
 void sortRaysMorton(std::vector<RayState>& rays, std::vector<KeyIndex>& keys, std::vector<KeyIndex>& scratch,
                     std::vector<RayState>& tmp) {
     const size_t n = rays.size();
     if (n < 2) return;
-    const Bounds b = originBounds(rays.data(), n);
-    const vec3 extent = b.hi - b.lo;
-    const vec3 scale(extent.x > 0 ? 32767.0f / extent.x : 0.0f, extent.y > 0 ? 32767.0f / extent.y : 0.0f,
-                     extent.z > 0 ? 32767.0f / extent.z : 0.0f);
+    const MortonFrame frame = MortonFrame::of(rays);
     keys.resize(n);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 4096), [&](const tbb::blocked_range<size_t>& range) {
-        for (size_t i = range.begin(); i < range.end(); ++i) {
-            const RayState& r = rays[i];
-            vec3 q = glm::clamp((r.origin - b.lo) * scale, vec3(0.0f), vec3(32767.0f));
-            std::uint64_t morton = spread3(std::uint64_t(q.x)) | spread3(std::uint64_t(q.y)) << 1 |
-                                   spread3(std::uint64_t(q.z)) << 2;
-            // 8+8-bit octahedral direction.
-            vec3 d = r.dir / (std::fabs(r.dir.x) + std::fabs(r.dir.y) + std::fabs(r.dir.z));
-            vec2 o = d.z >= 0 ? vec2(d.x, d.y)
-                              : vec2((1 - std::fabs(d.y)) * (d.x >= 0 ? 1 : -1), (1 - std::fabs(d.x)) * (d.y >= 0 ? 1 : -1));
-            std::uint64_t du = std::uint64_t(std::clamp((o.x * 0.5f + 0.5f) * 255.0f, 0.0f, 255.0f));
-            std::uint64_t dv = std::uint64_t(std::clamp((o.y * 0.5f + 0.5f) * 255.0f, 0.0f, 255.0f));
-            keys[i] = {std::uint64_t(cardinalBin(r.dir)) << 61 | morton << 16 | du << 8 | dv, std::uint32_t(i)};
-        }
+        for (size_t i = range.begin(); i < range.end(); ++i) keys[i] = {frame.key(rays[i]), std::uint32_t(i)};
     });
     radixSort(keys, scratch);
     tmp.resize(n);

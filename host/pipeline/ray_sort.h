@@ -16,9 +16,20 @@
 
 namespace spw {
 
+// The Morton sort's key of a ray in a batch whose origins span [lo, hi]: the cardinal bin (bits
+// 61-63), a 45-bit Morton code of the origin quantised to 2^15 steps along each axis of the
+// bounds (bits 16-60), and an 8+8-bit octahedral direction (bits 0-15).
+struct MortonFrame {
+    vec3 lo, scale;
+    static MortonFrame of(const std::vector<RayState>& rays);
+    std::uint64_t key(const RayState& ray) const;
+};
 
+// Sorts by MortonFrame::of(rays).key, stably.
 void sortRaysMorton(std::vector<RayState>& rays, std::vector<KeyIndex>& keys, std::vector<KeyIndex>& scratch,
                     std::vector<RayState>& tmp);
+// Splits at the median origin along the bounds' longest axis, recursively, down to 4096 rays,
+// then at the median direction likewise down to 64.
 void sortRaysMedian(std::vector<RayState>& rays);
 
 // The `auto` rule. Sorting costs a fixed time per ray and saves traversal time only when

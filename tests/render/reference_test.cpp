@@ -1,5 +1,6 @@
 // The reference backend against closed forms: every assertion compares with an analytic value
-// within a standard error computed from the render's own samples.
+// within a standard error computed from the render's own samples. Every render here runs the
+// reference backend (the library's RenderConfig defaults to cpu).
 #include "host/camera.h"
 #include "test_util.h"
 
@@ -10,6 +11,12 @@
 
 namespace spw::test {
 namespace {
+
+RenderConfig referenceConfig() {
+    RenderConfig cfg;
+    cfg.backend = "reference";
+    return cfg;
+}
 
 std::unique_ptr<RenderResult> renderWithStats(const Scene& scene, const RenderConfig& cfg, PixelStats* stats) {
     return render(scene, cfg, [&](int, int, const Film& film) {
@@ -38,7 +45,7 @@ TEST_P(ClosedEnclosure, MeanMatchesLeOverOneMinusAlbedo) {
     const double a = GetParam();
     TempDir dir;
     Scene scene = loadScene(enclosureScene(dir, a, 400));
-    auto result = render(scene, RenderConfig{});
+    auto result = render(scene, referenceConfig());
     MeanError m = meanAndError(result->film->image());
     const double expected = 1.0 / (1.0 - a);
     std::printf("albedo %.3f: mean %.5f, expected %.5f, standard error %.5f\n", a, m.mean, expected, m.stderror);
@@ -77,7 +84,7 @@ TEST(QuadLight, PixelsMatchPolygonIrradiance) {
                                        "light: {type: Quad, translation: [0, 1, 0], rotation: [90, 0, 0], scale: [1, 0.5], intensity: 3}\n");
     Scene scene = loadScene(path);
     PixelStats ps;
-    auto result = renderWithStats(scene, RenderConfig{}, &ps);
+    auto result = renderWithStats(scene, referenceConfig(), &ps);
     const std::vector<vec3> corners = {{-0.5f, 1, -0.25f}, {0.5f, 1, -0.25f}, {0.5f, 1, 0.25f}, {-0.5f, 1, 0.25f}};
     CameraModel cam(scene, 1);
     double worstZ = 0, sumZ = 0;
@@ -116,7 +123,7 @@ TEST(Mis, StrategiesAgreeAndMisHasLowestVariance) {
     Scene scene = loadScene(path);
     PixelStats stats[3];
     for (uint s : {kStrategyMis, kStrategyLight, kStrategyBsdf}) {
-        RenderConfig cfg;
+        RenderConfig cfg = referenceConfig();
         cfg.strategy = s;
         renderWithStats(scene, cfg, &stats[s]);
     }
@@ -135,13 +142,13 @@ TEST(Mis, StrategiesAgreeAndMisHasLowestVariance) {
 std::vector<float> renderCornell(int threads) {
     Scene scene = loadScene(sourceDir() + "/scenes/cornell-box.yaml");
     scene.image.width = scene.image.height = 48;
-    RenderConfig cfg;
+    RenderConfig cfg = referenceConfig();
     cfg.threads = threads;
     cfg.spp = 8;
     return render(scene, cfg)->film->image();
 }
 
-TEST(Determinism, SameImageBitForBitWithOneAndTwoThreads) {
+TEST(Determinism, ReferenceImageIsTheSameBitForBitWithOneAndTwoThreads) {
     std::vector<float> one = renderCornell(1), two = renderCornell(2);
     ASSERT_EQ(one.size(), two.size());
     EXPECT_EQ(std::memcmp(one.data(), two.data(), one.size() * sizeof(float)), 0);
@@ -159,7 +166,7 @@ TEST(MaxDepth, ZeroShowsOnlyEmitters) {
                                       "object: {filename: floor.obj, shader: 0}\n"
                                       "shader: {type: Lambert}\n"
                                       "light: {type: Quad, translation: [0, 3, 0], rotation: [90, 0, 0], intensity: 5}\n"));
-    EXPECT_EQ(mean(render(scene, RenderConfig{})->film->image()), 0.0);
+    EXPECT_EQ(mean(render(scene, referenceConfig())->film->image()), 0.0);
     // The same floor emitting itself is seen at exactly its radiance.
     Scene lit = loadScene(dir.write("d0e.yaml",
                                     "image: {width: 8, height: 8}\n"
@@ -167,7 +174,7 @@ TEST(MaxDepth, ZeroShowsOnlyEmitters) {
                                     "camera: {look at: {eye: [0, 2, 0], target: [0, 0, 0], up: [0, 0, -1]}, fov: 60}\n"
                                     "object: {filename: floor.obj, shader: 0}\n"
                                     "shader: {type: Emissive, emission: [0.25, 0.5, 2]}\n"));
-    std::vector<float> img = render(lit, RenderConfig{})->film->image();
+    std::vector<float> img = render(lit, referenceConfig())->film->image();
     for (size_t i = 0; i < img.size(); i += 3) {
         ASSERT_FLOAT_EQ(img[i], 0.25f);
         ASSERT_FLOAT_EQ(img[i + 1], 0.5f);
