@@ -231,8 +231,9 @@ int renderCommand(const std::vector<std::string>& args) {
                      (unsigned long long)result->stats.nonFiniteSamples);
     if (result->stats.saturatedSamples > 0)
         std::fprintf(stderr,
-                     "spillway: warning: %llu sample values exceeded the film's range (2^22 times the brightest "
-                     "emitter) and were clamped: the image is darker than it should be where they landed\n",
+                     "spillway: warning: %llu sample values exceeded the film's range (at least 2^16 times the "
+                     "brightest emitter) and were clamped: the image is darker than it should be where they "
+                     "landed\n",
                      (unsigned long long)result->stats.saturatedSamples);
     image.commit();
     if (stats) stats->commit();

@@ -256,15 +256,9 @@ Mesh loadObjMesh(const std::string& path, const glm::dmat4& objectToWorld, const
                     // round once, to float, at the end.
                     const size_t vi = size_t(ix.vertex_index);
                     const glm::dvec3 world = glm::dvec3(objectToWorld * glm::dvec4(obj.positions[vi], 1.0)) - origin;
-                    const double far = std::max({std::fabs(world.x), std::fabs(world.y), std::fabs(world.z)});
-                    if (!(far <= kMaxDistance)) {
-                        char where[64];
-                        std::snprintf(where, sizeof where, "%.3g", far);
-                        throw SceneError(path, obj.positionLines[vi],
-                                         std::string("vertex lies ") + where + " units from the camera after the "
-                                         "object's transform (scene " + sceneFile + ":" + std::to_string(sceneLine) +
-                                         "); Spillway renders within " + kMaxDistanceText + " units of it");
-                    }
+                    const std::string far = beyondReach(world, "vertex (after the object's transform, scene " +
+                                                                       sceneFile + ":" + std::to_string(sceneLine) + ")");
+                    if (!far.empty()) throw SceneError(path, obj.positionLines[vi], far);
                     mesh.positions.push_back(vec3(world));
                     if (hasNormals) {
                         glm::dvec3 n(0.0);

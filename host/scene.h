@@ -35,11 +35,9 @@ class SceneError : public std::runtime_error {
 // Every position, after its transforms, lies within this many units of the camera: squared
 // distances stay below 1e31, far inside float, and ray origins far inside Embree's 1.8e18.
 constexpr double kMaxDistance = 1e15;
-constexpr const char* kMaxDistanceText = "1e15";
 // Emission (each channel) and a quad light's intensity x colour: products with BSDF values,
 // MIS weights and 1/pdf keep about 1e18 of headroom below float's 3.4e38.
 constexpr double kMaxRadiance = 1e20;
-constexpr const char* kMaxRadianceText = "1e20";
 // Bounces a path may take (settings: max depth): what the compact ray record's bounce field holds,
 // so that every backend renders every scene the loader accepts.
 constexpr int kMaxDepth = 0x7FFF;
@@ -137,6 +135,10 @@ struct Scene {
 
     bool usesTextures() const;
 };
+
+// Empty when `p` (relative to the camera) lies within kMaxDistance of it; else the message that
+// says so, naming `what` (the loader and the OBJ reader report it at their own file and line).
+std::string beyondReach(const glm::dvec3& p, const std::string& what);
 
 // Parses and validates a scene file. Throws SceneError (file:line: message) on any problem.
 Scene loadScene(const std::string& path);

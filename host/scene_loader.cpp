@@ -93,19 +93,16 @@ class Reader {
     template <int N>
     glm::vec<N, float> vec(const YAML::Node& n, const std::string& what, double lo = -HUGE_VAL,
                            double hi = HUGE_VAL) const {
-        if (!n.IsSequence() || n.size() != N)
-            fail(n, what + " must be a list of " + std::to_string(N) + " numbers");
-        glm::vec<N, float> v;
-        for (int i = 0; i < N; ++i) v[i] = float(number(n[i], what, lo, hi));
-        return v;
+        return glm::vec<N, float>(dvec<N>(n, what, lo, hi));
     }
 
     template <int N>
-    glm::vec<N, double> dvec(const YAML::Node& n, const std::string& what) const {
+    glm::vec<N, double> dvec(const YAML::Node& n, const std::string& what, double lo = -HUGE_VAL,
+                             double hi = HUGE_VAL) const {
         if (!n.IsSequence() || n.size() != N)
             fail(n, what + " must be a list of " + std::to_string(N) + " numbers");
         glm::vec<N, double> v;
-        for (int i = 0; i < N; ++i) v[i] = number(n[i], what);
+        for (int i = 0; i < N; ++i) v[i] = number(n[i], what, lo, hi);
         return v;
     }
 
@@ -159,12 +156,9 @@ glm::dmat4 readTransform(const Reader& rd, const YAML::Node& n, const std::strin
     return m;
 }
 
-// A point `p` (relative to the camera) must lie within kMaxDistance of it.
 void checkDistance(const Reader& rd, const YAML::Node& at, const glm::dvec3& p, const std::string& what) {
-    const double far = std::max({std::fabs(p.x), std::fabs(p.y), std::fabs(p.z)});
-    if (!(far <= kMaxDistance))
-        rd.fail(at, what + " lies " + Reader::fmt(far) + " units from the camera; Spillway renders within " +
-                        kMaxDistanceText + " units of it");
+    const std::string why = beyondReach(p, what);
+    if (!why.empty()) rd.fail(at, why);
 }
 
 void readImage(const Reader& rd, const YAML::Node& n, ImageSettings& img) {
@@ -457,23 +451,16 @@ Shader readLight(const Reader& rd, const YAML::Node& n, const glm::dvec3& origin
     rd.checkKeys(n, "Quad light", {"type", "translation", "rotation", "scale", "intensity", "colour"});
     glm::dvec2 size(1.0);
     if (n["scale"]) {
-        size = rd.dvec<2>(n["scale"], "light scale");
-        for (int i = 0; i < 2; ++i)
-            if (!(size[i] >= 1e-30 && size[i] <= kMaxDistance))
-                rd.fail(n["scale"], "light scale must be in [1e-30, " + std::string(kMaxDistanceText) + "], not " +
-                                        Reader::fmt(size[i]));
+        size = rd.dvec<2>(n["scale"], "light scale", 1e-30, kMaxDistance);
     }
     const double intensity = n["intensity"] ? rd.number(n["intensity"], "light intensity", 0.0, kMaxRadiance) : 1.0;
-    const glm::dvec3 colour = n["colour"] ? rd.dvec<3>(n["colour"], "light colour") : glm::dvec3(1.0);
+    const glm::dvec3 colour = n["colour"] ? rd.dvec<3>(n["colour"], "light colour", 0.0, kMaxRadiance) : glm::dvec3(1.0);
     for (int i = 0; i < 3; ++i) {
-        if (!(colour[i] >= 0.0 && colour[i] <= kMaxRadiance))
-            rd.fail(n["colour"], "light colour must be in [0, " + std::string(kMaxRadianceText) + "], not " +
-                                     Reader::fmt(colour[i]));
         // The product is the light's radiance: it must fit the same range as any emission.
         if (intensity * colour[i] > kMaxRadiance)
             rd.fail(n["colour"] ? n["colour"] : n["intensity"],
                     "light intensity x colour = " + Reader::fmt(intensity * colour[i]) + " exceeds " +
-                        kMaxRadianceText + ", the brightest radiance Spillway renders");
+                        Reader::fmt(kMaxRadiance) + ", the brightest radiance Spillway renders");
     }
     const glm::dmat4 xf = readTransform(rd, n, "light", false);
 
@@ -502,6 +489,13 @@ Shader readLight(const Reader& rd, const YAML::Node& n, const glm::dvec3& origin
 }
 
 } // namespace
+
+std::string beyondReach(const glm::dvec3& p, const std::string& what) {
+    const double far = std::max({std::fabs(p.x), std::fabs(p.y), std::fabs(p.z)});
+    if (far <= kMaxDistance) return "";
+    return what + " lies " + Reader::fmt(far) + " units from the camera; Spillway renders within " +
+           Reader::fmt(kMaxDistance) + " units of it";
+}
 
 float Camera::tanHalfFovX() const {
     if (fovDegrees) return std::tan(glm::radians(*fovDegrees) * 0.5f);
@@ -621,7 +615,7 @@ Scene loadScene(const std::string& path) {
             const YAML::Node cam = static_cast<const YAML::Node&>(root)["camera"];
             rd.fail(cam["focal distance"] ? cam["focal distance"] : cam,
                     "the focal plane's corners lie " + Reader::fmt(corner) + " units from the camera; Spillway renders "
-                    "within " + kMaxDistanceText + " units of it");
+                    "within " + Reader::fmt(kMaxDistance) + " units of it");
         }
     }
     if ((unsigned long long)img.width * img.height * img.samplesPerIteration() > 0xFFFFFFFFull)

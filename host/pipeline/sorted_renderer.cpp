@@ -11,7 +11,6 @@
 #include <tbb/parallel_for.h>
 
 #include <chrono>
-#include <filesystem>
 
 namespace spw {
 
