@@ -26,7 +26,7 @@ uint roundingKey(uint key, uint sampleIndex) { return pcg4d(uvec4(key, sampleInd
 } // namespace
 
 Film::Film(int width, int height, const Filter& filter, float brightestRadiance, int samplesPerIteration)
-    : width_(width), height_(height), filter_(filter),
+    : width_(width), height_(height), samplesPerIteration_(uint(samplesPerIteration)), filter_(filter),
       acc_(new std::atomic<std::int64_t>[size_t(width) * height * 8]),
       sum_(size_t(width) * height * 8, 0.0), lastIteration_(size_t(width) * height * 3, 0.0f) {
     // No clamp on e: the scale is a double, and every emission the loader accepts (up to
@@ -70,11 +70,15 @@ void Film::splat(vec2 filmPos, uint sampleIndex, vec3 radiance, uint key) {
         return;
     }
     if (radiance.x == 0.0f && radiance.y == 0.0f && radiance.z == 0.0f) return;
-    filtered(filmPos, int(sampleIndex & 1u), radiance, 0.0f, roundingKey(key, sampleIndex));
+    filtered(filmPos, halfOf(sampleIndex), radiance, 0.0f, roundingKey(key, sampleIndex));
 }
 
 void Film::addSample(vec2 filmPos, uint sampleIndex) {
-    filtered(filmPos, int(sampleIndex & 1u), vec3(0.0f), 1.0f, roundingKey(0u, sampleIndex));
+    filtered(filmPos, halfOf(sampleIndex), vec3(0.0f), 1.0f, roundingKey(0u, sampleIndex));
+}
+
+int Film::halfOf(uint sampleIndex) const {
+    return int((sampleIndex / samplesPerIteration_ + sampleIndex % samplesPerIteration_) & 1u);
 }
 
 void Film::filtered(vec2 filmPos, int half, vec3 radiance, float weight, uint key) {

@@ -62,10 +62,12 @@ class Film {
     double fixedPointScale() const { return scale_; }
 
   private:
+    int halfOf(uint sampleIndex) const;
     void filtered(vec2 filmPos, int half, vec3 radiance, float weight, uint key);
     void add(int px, int py, int half, vec3 value, float weight, uint key);
 
     int width_, height_;
+    uint samplesPerIteration_;
     Filter filter_;
     double scale_;       // radiance units -> fixed-point units
     double weightScale_; // filter weight -> fixed-point units
