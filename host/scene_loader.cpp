@@ -578,13 +578,27 @@ Scene loadScene(const std::string& path) {
             else if (key == "sampler") scene.sampler = readSampler(rd, v);
             else if (key == "object" || key == "objects") {
                 if (key == "objects" && !v.IsSequence()) rd.fail(v, "'objects' must be a list");
-                each([&](const YAML::Node& e) { readObject(rd, e, dir, scene, pending); });
+                each([&](const YAML::Node& e) {
+                    if (scene.meshes.size() + lightMeshes.size() >= size_t(kMaxObjects))
+                        rd.fail(e, "more than " + std::to_string(kMaxObjects) + " objects (lights included)");
+                    readObject(rd, e, dir, scene, pending);
+                });
             } else if (key == "shader" || key == "shaders") {
                 if (key == "shaders" && !v.IsSequence()) rd.fail(v, "'shaders' must be a list");
-                each([&](const YAML::Node& e) { readShader(rd, e, textures, scene); });
+                each([&](const YAML::Node& e) {
+                    if (scene.shaders.size() + lightShaders.size() >= size_t(kMaxShaders))
+                        rd.fail(e, "more than " + std::to_string(kMaxShaders) + " shaders (one per light included)");
+                    readShader(rd, e, textures, scene);
+                });
             } else if (key == "light" || key == "lights") {
                 if (key == "lights" && !v.IsSequence()) rd.fail(v, "'lights' must be a list");
-                each([&](const YAML::Node& e) { lightShaders.push_back(readLight(rd, e, scene.origin, lightMeshes)); });
+                each([&](const YAML::Node& e) {
+                    if (scene.shaders.size() + lightShaders.size() >= size_t(kMaxShaders) ||
+                        scene.meshes.size() + lightMeshes.size() >= size_t(kMaxObjects))
+                        rd.fail(e, "more than " + std::to_string(kMaxShaders) + " shaders or " +
+                                       std::to_string(kMaxObjects) + " objects (one of each per light included)");
+                    lightShaders.push_back(readLight(rd, e, scene.origin, lightMeshes));
+                });
             } else {
                 rd.fail(it->first, "unknown entry '" + key +
                                        "' (image, settings, camera, filter, sampler, object, shader, light)");

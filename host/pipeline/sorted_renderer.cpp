@@ -1,5 +1,7 @@
 #include "host/pipeline/sorted_renderer.h"
 
+#include "host/pipeline/hit_sort.h"
+
 #include "embree_backend/batch_traversal.h"
 #include "host/pipeline/parallel.h"
 #include "host/pipeline/radix_sort.h"
@@ -36,8 +38,6 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
-
-constexpr std::uint64_t kMissKey = ~0ull;
 
 // The same shadeSurface() the kernels run, as C++: shaded at submit, one slot (TBB already
 // keeps every core busy, so there is nothing to overlap).
@@ -230,7 +230,7 @@ void SortedRenderer::startBatch(RayBatch& batch, int slot) {
                 std::uint64_t key = kMissKey;
                 if (h.geomID != RTC_INVALID_GEOMETRY_ID) {
                     const std::uint64_t shader = std::uint64_t(ctx_.scene.meshes[h.geomID].shader);
-                    key = sortHits ? (shader << 52 | std::uint64_t(h.geomID) << 32 | h.primID) : 0;
+                    key = sortHits ? hitSortKey(uint(shader), h.geomID, h.primID) : 0;
                 }
                 s.keys[i] = {key, std::uint32_t(i)};
             }
@@ -273,18 +273,11 @@ void SortedRenderer::startBatch(RayBatch& batch, int slot) {
     {
         StageTimer t(times, "shade");
         s.ranges.clear();
-        size_t begin = 0;
-        while (begin < hitCount) {
-            size_t end = hitCount;
-            uint model = kMixedModels;
-            if (config_.sortsHits()) {
-                const std::uint64_t shader = s.keys[begin].key >> 52;
-                end = begin + 1;
-                while (end < hitCount && s.keys[end].key >> 52 == shader) ++end;
-                model = ctx_.scene.shaders[size_t(shader)].params.model;
-            }
-            s.ranges.push_back({model, begin, end - begin});
-            begin = end;
+        if (config_.sortsHits()) {
+            for (const ShaderRun& run : shaderRuns(s.keys, hitCount))
+                s.ranges.push_back({ctx_.scene.shaders[run.shader].params.model, run.begin, run.count});
+        } else if (hitCount > 0) {
+            s.ranges.push_back({kMixedModels, 0, hitCount});
         }
         shading_->submit(slot, s.ranges);
     }

@@ -402,6 +402,33 @@ TEST(Loader, QuadLightRotatedNinetyAboutXFacesDown) {
     expectNear(hi, vec3(3, 5, -2), 1e-5f, "upper corner");
 }
 
+// The hit-sort key holds 12 bits of shader and 20 of object: the loader caps both, a light
+// counting one of each, and names the first element beyond the cap.
+TEST(Loader, ShaderAndObjectCountsStayWithinTheHitKey) {
+    TempDir dir;
+    std::string shaders = "shaders:\n";
+    for (int i = 0; i < kMaxShaders - 1; ++i) shaders += "  - {type: Lambert}\n";
+    const std::string light = "lights:\n  - {type: Quad}\n  - {type: Quad}\n";
+    // kMaxShaders - 1 shaders and one light fit; a second light does not.
+    const std::string full = dir.write("full.yaml", shaders + "lights:\n  - {type: Quad}\n");
+    EXPECT_EQ(loadScene(full).shaders.size(), size_t(kMaxShaders));
+    const std::string over = dir.write("over.yaml", shaders + light);
+    try {
+        loadScene(over);
+        ADD_FAILURE() << "loaded " << kMaxShaders + 1 << " shaders";
+    } catch (const SceneError& e) {
+        EXPECT_EQ(e.line(), kMaxShaders + 3) << e.what();
+        EXPECT_NE(std::string(e.what()).find("more than 4095 shaders"), std::string::npos) << e.what();
+    }
+    const std::string lightsFirst = dir.write("first.yaml", light + shaders);
+    try {
+        loadScene(lightsFirst);
+        ADD_FAILURE() << "loaded " << kMaxShaders + 1 << " shaders";
+    } catch (const SceneError& e) {
+        EXPECT_EQ(e.line(), 3 + kMaxShaders) << e.what(); // the last shader
+    }
+}
+
 // ---- errors, through the real binary ----------------------------------------------------------
 
 struct ErrorCase {

@@ -1,0 +1,100 @@
+// Hit sorting itself, not only the images it leaves unchanged: the radix sort of hit keys is a
+// permutation ordered by key, misses last; shaderRuns() gives one contiguous run per shader that
+// was hit, covering every hit; and the largest indices the loader accepts keep their order and
+// never read as a miss.
+#include "host/pipeline/hit_sort.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <random>
+#include <set>
+
+namespace spw {
+namespace {
+
+struct Hit {
+    bool miss;
+    uint shader, object, primitive;
+};
+
+// `n` hits over `shaders` shaders, a fifth of them misses, in random order.
+std::vector<Hit> randomHits(size_t n, uint shaders, unsigned seed) {
+    std::mt19937 rng(seed);
+    std::vector<Hit> hits(n);
+    for (Hit& h : hits) {
+        h.miss = rng() % 5 == 0;
+        h.shader = rng() % shaders;
+        h.object = rng() % 300;
+        h.primitive = rng();
+    }
+    return hits;
+}
+
+std::vector<KeyIndex> keysOf(const std::vector<Hit>& hits) {
+    std::vector<KeyIndex> keys(hits.size());
+    for (size_t i = 0; i < hits.size(); ++i) {
+        const Hit& h = hits[i];
+        keys[i] = {h.miss ? kMissKey : hitSortKey(h.shader, h.object, h.primitive), std::uint32_t(i)};
+    }
+    return keys;
+}
+
+TEST(HitSort, KeysSortIntoOneContiguousRunPerShaderWithMissesLast) {
+    for (uint shaders : {1u, 3u, 40u, uint(kMaxShaders)}) {
+        std::vector<Hit> hits = randomHits(100000, shaders, shaders);
+        std::vector<KeyIndex> keys = keysOf(hits), scratch;
+        radixSort(keys, scratch);
+
+        // A permutation of the input, ordered by key, each key the one its hit was given.
+        std::vector<bool> seen(hits.size(), false);
+        for (size_t i = 0; i < keys.size(); ++i) {
+            ASSERT_LT(keys[i].index, hits.size());
+            ASSERT_FALSE(seen[keys[i].index]) << "index " << keys[i].index << " twice";
+            seen[keys[i].index] = true;
+            if (i > 0) {
+                ASSERT_LE(keys[i - 1].key, keys[i].key) << "at " << i;
+            }
+        }
+        const std::vector<KeyIndex> original = keysOf(hits);
+        for (const KeyIndex& k : keys) ASSERT_EQ(k.key, original[k.index].key);
+
+        // Misses last; the runs cover every hit, one per shader that was hit, each holding
+        // exactly that shader's hits.
+        const size_t hitCount = size_t(std::count_if(hits.begin(), hits.end(), [](const Hit& h) { return !h.miss; }));
+        for (size_t i = hitCount; i < keys.size(); ++i) ASSERT_EQ(keys[i].key, kMissKey);
+        std::set<uint> shadersHit;
+        std::vector<size_t> perShader(shaders, 0);
+        for (const Hit& h : hits)
+            if (!h.miss) shadersHit.insert(h.shader), ++perShader[h.shader];
+        std::vector<ShaderRun> runs = shaderRuns(keys, hitCount);
+        ASSERT_EQ(runs.size(), shadersHit.size()) << shaders << " shaders";
+        size_t next = 0;
+        for (size_t r = 0; r < runs.size(); ++r) {
+            EXPECT_EQ(runs[r].begin, next);
+            if (r > 0) {
+                EXPECT_LT(runs[r - 1].shader, runs[r].shader);
+            }
+            EXPECT_EQ(runs[r].count, perShader[runs[r].shader]) << "shader " << runs[r].shader;
+            for (size_t i = runs[r].begin; i < runs[r].begin + runs[r].count; ++i)
+                ASSERT_EQ(hits[keys[i].index].shader, runs[r].shader);
+            next = runs[r].begin + runs[r].count;
+        }
+        EXPECT_EQ(next, hitCount);
+    }
+}
+
+// Within a shader, hits order by object, then primitive (coherent vertex and texture reads).
+TEST(HitSort, KeyOrdersByShaderThenObjectThenPrimitive) {
+    const uint maxShader = uint(kMaxShaders) - 1, maxObject = uint(kMaxObjects) - 1;
+    EXPECT_LT(hitSortKey(0, maxObject, 0xFFFFFFFFu), hitSortKey(1, 0, 0));
+    EXPECT_LT(hitSortKey(5, 7, 0xFFFFFFFFu), hitSortKey(5, 8, 0));
+    EXPECT_LT(hitSortKey(5, 7, 1), hitSortKey(5, 7, 2));
+    EXPECT_NE(hitSortKey(maxShader, maxObject, 0xFFFFFFFFu), kMissKey);
+    EXPECT_LT(hitSortKey(maxShader, maxObject, 0xFFFFFFFFu), kMissKey);
+    EXPECT_EQ(shaderOfKey(hitSortKey(maxShader, maxObject, 0xFFFFFFFFu)), maxShader);
+    EXPECT_EQ(shaderOfKey(hitSortKey(maxShader - 1, 0, 0)), maxShader - 1);
+}
+
+} // namespace
+} // namespace spw
