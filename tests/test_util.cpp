@@ -1,5 +1,7 @@
 #include "test_util.h"
 
+#include <gtest/gtest.h>
+
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -110,6 +112,54 @@ MeanError PixelStats::imageMean() const {
     for (size_t i = 0; i < pixels(); ++i) m += mean(i), var += meanVariance(i);
     const double p = double(pixels());
     return {m / p, std::sqrt(var) / p};
+}
+
+std::vector<std::vector<float>> iterationImages(const Scene& scene, const RenderConfig& config) {
+    std::vector<std::vector<float>> images;
+    render(scene, config, [&](int, int, const Film& film) { images.push_back(film.lastIterationImage()); });
+    return images;
+}
+
+PixelStats pairedDifference(const std::vector<std::vector<float>>& a, const std::vector<std::vector<float>>& b) {
+    PixelStats d;
+    EXPECT_EQ(a.size(), b.size()) << "iterations";
+    for (size_t k = 0; k < std::min(a.size(), b.size()); ++k) {
+        EXPECT_EQ(a[k].size(), b[k].size());
+        std::vector<float> diff(a[k].size());
+        for (size_t i = 0; i < diff.size(); ++i) diff[i] = a[k][i] - b[k][i];
+        d.add(diff);
+    }
+    return d;
+}
+
+void expectNoPairedDifference(const PixelStats& d, int width, int height, const std::string& what,
+                              double tolerance) {
+    ASSERT_EQ(d.pixels(), size_t(width) * size_t(height)) << what;
+    ASSERT_GE(d.n, 2) << what;
+    const MeanError m = d.imageMean();
+    size_t outliers = 0;
+    for (size_t i = 0; i < d.pixels(); ++i)
+        if (std::fabs(d.mean(i)) > 4.5 * d.stderror(i) + tolerance + 1e-12) ++outliers;
+    double worstBlockZ = 0;
+    for (int by = 0; by < height; by += 8)
+        for (int bx = 0; bx < width; bx += 8) {
+            double sum = 0, var = 0, allowed = 0;
+            for (int y = by; y < std::min(height, by + 8); ++y)
+                for (int x = bx; x < std::min(width, bx + 8); ++x) {
+                    const size_t i = size_t(y) * size_t(width) + size_t(x);
+                    sum += d.mean(i);
+                    var += d.meanVariance(i);
+                    allowed += tolerance;
+                }
+            const double excess = std::max(0.0, std::fabs(sum) - allowed);
+            if (excess > 0.0) worstBlockZ = std::max(worstBlockZ, excess / std::sqrt(var));
+        }
+    std::printf("  %-40s paired difference %+.3g +- %.3g (z %+.2f), worst 8x8 block |z| %.2f, outlier pixels %zu/%zu\n",
+                what.c_str(), m.mean, m.stderror, m.stderror > 0 ? m.mean / m.stderror : 0.0, worstBlockZ, outliers,
+                d.pixels());
+    EXPECT_LE(std::fabs(m.mean), 4.0 * m.stderror + tolerance) << what;
+    EXPECT_LT(worstBlockZ, 4.5) << what;
+    EXPECT_LE(double(outliers), 0.001 * double(d.pixels())) << what;
 }
 
 std::string insideCubeObj() {

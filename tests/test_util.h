@@ -86,6 +86,22 @@ struct PixelStats {
     MeanError imageMean() const;
 };
 
+// The images of a render's iterations, one by one (Film::lastIterationImage() after each).
+std::vector<std::vector<float>> iterationImages(const Scene& scene, const RenderConfig& config);
+
+// The per-iteration difference a - b of two renders, as PixelStats. For renders that share
+// their random numbers (same seed, same sample counts) most of the noise cancels iteration by
+// iteration: what is left is the difference between the two renderers, and its standard errors
+// come from its own spread, far smaller than either render's (pixels and iterations independent).
+PixelStats pairedDifference(const std::vector<std::vector<float>>& a, const std::vector<std::vector<float>>& b);
+
+// Asserts that a paired difference has mean zero: over the image within 4 standard errors, no
+// 8x8 block beyond 4.5, and at most 0.1 % of pixels beyond 4.5 (a difference that is exactly 0
+// everywhere passes). `tolerance`: a difference per pixel that is allowed on top (for scenes
+// that are the same only up to float rounding of their input). Prints the figures, labelled `what`.
+void expectNoPairedDifference(const PixelStats& d, int width, int height, const std::string& what,
+                              double tolerance = 0.0);
+
 // An axis-aligned box [-1,1]^3 whose faces point inward, as OBJ text.
 std::string insideCubeObj();
 // A square [-h,h]^2 at y = 0 facing +Y, as OBJ text.

@@ -41,6 +41,7 @@ struct Counters {
 
 struct Rendered {
     PixelStats stats;
+    std::vector<std::vector<float>> iterations; // each iteration's image
     std::vector<float> image;
     Counters counters;
 };
@@ -50,7 +51,10 @@ Rendered renderScene(const Scene& scene, const std::string& backend, std::option
     cfg.backend = backend;
     cfg.spp = spp;
     Rendered r;
-    auto result = render(scene, cfg, [&](int, int, const Film& film) { r.stats.add(film.lastIterationImage()); });
+    auto result = render(scene, cfg, [&](int, int, const Film& film) {
+        r.stats.add(film.lastIterationImage());
+        r.iterations.push_back(film.lastIterationImage());
+    });
     r.image = result->film->image();
     r.counters.cameraRays = result->stats.cameraRays.load();
     r.counters.bounceRays = result->stats.bounceRays.load();
@@ -192,7 +196,12 @@ TEST(Extreme, CornellBoxIsTheSameAtAnyScaleAndDistance) {
         for (const Variant& v : variants) {
             const Scene scene = loadScene(dir.write("v.yaml", cornellYaml(v.scale, v.translation, kSize, 2, 24)));
             const Rendered r = renderScene(scene, backend);
-            expectSameImage(ref.stats, r.stats, kSize, kSize, backend + ": " + v.name);
+            // Same seed: the scaled or moved box traces nearly the same paths, so the paired
+            // difference (per iteration) is tiny and a bias far below either render's noise fails.
+            // Scaling rounds every coordinate to float again (relative 6e-8), which shifts pixels
+            // by about 1e-7 of the image's mean, consistently: 1e-6 of it is allowed per pixel.
+            expectNoPairedDifference(pairedDifference(r.iterations, ref.iterations), kSize, kSize,
+                                     backend + ": " + v.name, 1e-6 * mean(ref.image));
             EXPECT_EQ(r.counters.nonFiniteSamples, 0u) << v.name;
             EXPECT_TRUE(finiteAndNonNegative(r.image)) << v.name;
         }
