@@ -100,9 +100,11 @@ void encodeRay(const RayState& r, RayFormat format, uvec4 rounding, std::uint8_t
     put24(p, u);
     put24(p + 3, v);
     p += 6;
+    // One random number for the three channels: rounding stays monotone, so the largest channel
+    // (what Russian roulette reads) is still unbiased after rounding (ray_record.h).
     put<std::uint16_t>(p, toBfloat16(r.path.beta.x, rounding.x));
-    put<std::uint16_t>(p, toBfloat16(r.path.beta.y, rounding.y));
-    put<std::uint16_t>(p, toBfloat16(r.path.beta.z, rounding.z));
+    put<std::uint16_t>(p, toBfloat16(r.path.beta.y, rounding.x));
+    put<std::uint16_t>(p, toBfloat16(r.path.beta.z, rounding.x));
     put<std::uint16_t>(p, std::uint16_t(floatBitsToUint(r.path.prevPdf) >> 16));
     put<std::uint16_t>(p, std::uint16_t(std::min(r.path.bounce, kMaxCompactBounce) |
                                         ((r.path.flags & kPathSpecular) ? 0x8000u : 0u)));
