@@ -1,5 +1,7 @@
 #include "test_util.h"
 
+#include "host/vk/context.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -12,6 +14,39 @@
 #include <sys/wait.h>
 
 namespace spw::test {
+
+namespace {
+
+// Every Vulkan render in the suite runs under the Khronos validation layer, the spillway
+// processes the CLI tests start included (they inherit the environment), and any message the
+// layer reports during a test fails it: the listener names the test and the process exits 1
+// (ctest runs one test per process), as a listener may not add failures itself. The one test
+// that provokes a message on purpose (to show the layer is live) is exempt. In the sanitized
+// build only the Vulkan* tests ask for the layer (and run without leak detection): LeakSanitizer
+// reports the layer's allocations after the loader has unloaded it (README, "Tests").
+class ValidationListener : public ::testing::EmptyTestEventListener {
+    std::uint64_t before_ = 0;
+    bool failed_ = false;
+    void OnTestStart(const ::testing::TestInfo&) override { before_ = vk::validationMessageCount(); }
+    void OnTestEnd(const ::testing::TestInfo& info) override {
+        const std::uint64_t messages = vk::validationMessageCount() - before_;
+        if (messages == 0 || std::string(info.name()) == "ValidationLayerIsLiveAndCounted") return;
+        std::fprintf(stderr, "FAILED: the Vulkan validation layer reported %llu message(s) during %s.%s (see above)\n",
+                     (unsigned long long)messages, info.test_suite_name(), info.name());
+        failed_ = true;
+    }
+    void OnTestProgramEnd(const ::testing::UnitTest&) override {
+        if (failed_) std::_Exit(1);
+    }
+};
+
+const bool kValidationEverywhere = [] {
+    if (!kAddressSanitizer) ::setenv("SPILLWAY_VK_VALIDATION", "1", 1);
+    ::testing::UnitTest::GetInstance()->listeners().Append(new ValidationListener);
+    return true;
+}();
+
+} // namespace
 
 TempDir::TempDir() {
     std::random_device rd;

@@ -3,6 +3,7 @@
 #include "test_util.h"
 
 #include <gtest/gtest.h>
+
 #include <nlohmann/json.hpp>
 
 #include <cmath>
@@ -10,6 +11,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <sys/inotify.h>
 #include <sys/resource.h>
 #include <sys/wait.h>
 #include <thread>
@@ -230,7 +232,7 @@ TEST(Spill, SmallBudgetSpillsReadsBackAndBoundsMemory) {
     EXPECT_EQ(filesIn(spill.path()), 0u);
 }
 
-TEST(Spill, NoFileLeftAfterNormalRunErrorOrSigint) {
+TEST(Spill, NoFileLeftAfterNormalRunErrorOrAnySignal) {
     TempDir dir, spill;
     const std::string scene = heavyScene(dir);
     std::vector<std::string> args = {"render", scene, "--quiet", "--memory-budget", "1", "--spill-dir", spill.path()};
@@ -250,27 +252,36 @@ TEST(Spill, NoFileLeftAfterNormalRunErrorOrSigint) {
     EXPECT_FALSE(std::filesystem::exists(dir.file("full.json"))) << "stats written for a failed render";
     EXPECT_EQ(filesIn(spill.path()), 0u);
 
-    // SIGINT while batches are on disk: wait until the process holds an open spill file.
+    // SIGINT, SIGTERM and SIGKILL while batches are on disk: wait until the process holds an
+    // open spill file, then signal it. The spill file is made with O_TMPFILE: it never has a
+    // name, so even SIGKILL (no handler runs) leaves nothing. inotify proves the "never": a
+    // file created and then unlinked would raise IN_CREATE in the folder, however quickly.
     std::vector<std::string> slow = args;
     slow.insert(slow.end(), {"-o", dir.file("slow.exr"), "--spp", "1024"});
-    bool sawSpill = false, sawName = false;
-    ChildResult sig = runChild(slow, [&](pid_t pid) {
-        for (int i = 0; i < 400 && !sawSpill; ++i) {
-            std::error_code ec;
-            for (const auto& e : std::filesystem::directory_iterator("/proc/" + std::to_string(pid) + "/fd", ec)) {
-                std::string target = std::filesystem::read_symlink(e.path(), ec).string();
-                if (target.rfind(spill.path(), 0) == 0) sawSpill = true;
+    for (int signal : {SIGINT, SIGTERM, SIGKILL}) {
+        const int watch = inotify_init1(IN_NONBLOCK | IN_CLOEXEC);
+        ASSERT_GE(watch, 0);
+        ASSERT_GE(inotify_add_watch(watch, spill.path().c_str(), IN_CREATE | IN_MOVED_TO), 0);
+        bool sawSpill = false;
+        ChildResult sig = runChild(slow, [&](pid_t pid) {
+            for (int i = 0; i < 400 && !sawSpill; ++i) {
+                std::error_code ec;
+                for (const auto& e : std::filesystem::directory_iterator("/proc/" + std::to_string(pid) + "/fd", ec)) {
+                    std::string target = std::filesystem::read_symlink(e.path(), ec).string();
+                    if (target.rfind(spill.path(), 0) == 0) sawSpill = true;
+                }
+                if (!sawSpill) std::this_thread::sleep_for(std::chrono::milliseconds(25));
             }
-            sawName = sawName || filesIn(spill.path()) > 0;
-            if (!sawSpill) std::this_thread::sleep_for(std::chrono::milliseconds(25));
-        }
-        sawName = sawName || filesIn(spill.path()) > 0;
-        kill(pid, SIGINT);
-    });
-    EXPECT_TRUE(sawSpill) << "the render never opened a spill file";
-    EXPECT_FALSE(sawName) << "a spill file was visible by name in the spill folder";
-    EXPECT_EQ(sig.status, -SIGINT);
-    EXPECT_EQ(filesIn(spill.path()), 0u);
+            kill(pid, signal);
+        });
+        char events[4096];
+        const ssize_t got = read(watch, events, sizeof events);
+        close(watch);
+        EXPECT_TRUE(sawSpill) << "the render never opened a spill file (signal " << signal << ")";
+        EXPECT_LE(got, 0) << "a file got a name in the spill folder (signal " << signal << ")";
+        EXPECT_EQ(sig.status, -signal);
+        EXPECT_EQ(filesIn(spill.path()), 0u) << "signal " << signal;
+    }
 }
 
 TEST(Spill, UnwritableSpillFolderExitsOneNamingIt) {

@@ -501,6 +501,8 @@ const ErrorCase kErrorCases[] = {
      "alpha"},
     {"ConductorColourAboveOne", "shader:\n  type: Conductor\n  colour: [1, 1.2, 1]\n", 3, "colour"},
     {"ConductorTakesNoIor", "shader:\n  type: Conductor\n  ior: 1.5\n", 3, "ior"},
+    {"IorBelowRange", "shader:\n  type: Dielectric\n  ior: 1.0\n", 3, "ior"},
+    {"IorAboveRange", "shader:\n  type: Dielectric\n  ior: 10.5\n", 3, "ior"},
     {"DielectricIorBelowOne", "shaders:\n  - {type: Lambert}\n  - {type: Dielectric, ior: 0.8}\n", 3, "ior"},
     {"DielectricNegativeAlpha", "shader:\n  type: Dielectric\n  alpha: -0.1\n", 3, "alpha"},
     {"DielectricTakesNoColour", "shader:\n  type: Dielectric\n  colour: [1, 1, 1]\n", 3, "colour"},

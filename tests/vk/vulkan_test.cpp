@@ -179,6 +179,19 @@ TEST(VulkanDevice, ValidationLayerIsLiveAndCounted) {
     EXPECT_GE(context.validationMessages(), 1u);
 }
 
+// Every Vulkan render in the suite runs validated, not only the ones that ask for it: the test
+// helpers set SPILLWAY_VK_VALIDATION=1 for the whole process (and the spillway processes it
+// starts), and fail any test during which the layer reported a message (tests/test_util.cpp).
+// Not in the sanitized build, where only the Vulkan* tests ask for it.
+TEST(VulkanDevice, EveryRenderInTheSuiteRunsUnderTheValidationLayer) {
+    RenderConfig cfg;
+    cfg.backend = "vulkan";
+    cfg.spp = 1;
+    ASSERT_FALSE(cfg.vulkan.validation);
+    auto result = render(smallCornell(8), cfg);
+    EXPECT_EQ(result->stats.extra["vulkan"]["validation"].get<bool>(), !kAddressSanitizer);
+}
+
 // --- vulkan against cpu --------------------------------------------------------------------
 
 // Measured: 99.9th percentile 1.3e-6, max 2.1e-6, nothing diverged.
