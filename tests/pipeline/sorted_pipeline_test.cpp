@@ -34,17 +34,45 @@ bool sameBits(const std::vector<float>& a, const std::vector<float>& b) {
 
 // With full-precision rays the sorted pipeline traces exactly the reference's paths with the
 // same random numbers, and the fixed-point film makes the sums order-independent: the images
-// are identical, not merely close.
+// are identical, not merely close. The Cornell box (Lambert, Stratified, Box filter) and a
+// scene with every surface model, a Layered image texture, a Gaussian filter and a thin lens.
 TEST(SortedPipeline, FullPrecisionRaysGiveTheReferenceImageBitForBit) {
-    Scene scene = smallCornell(40);
-    RenderConfig ref;
-    ref.backend = "reference";
-    ref.spp = 8;
-    RenderConfig cpu = ref;
-    cpu.backend = "cpu";
-    cpu.pipeline.rayFormat = RayFormat::Full;
-    cpu.pipeline.binExponent = 10;
-    EXPECT_TRUE(sameBits(renderImage(scene, ref), renderImage(scene, cpu)));
+    TempDir dir;
+    dir.write("tex.ppm", "P3\n2 2\n255\n255 0 0  0 255 0\n0 0 255  255 255 255\n");
+    const std::string box = sourceDir() + "/scenes/cornell-box/";
+    const Scene everyModel = loadScene(dir.write(
+        "models.yaml",
+        "image: {width: 24, height: 24, sample base: 2, iterations: 2}\n"
+        "settings: {min depth: 2, max depth: 12}\n"
+        "camera: {type: ThinLens, look at: {eye: [278, 273, -800], target: [278, 273, 0]}, fov: 39.3,\n"
+        "         aperture radius: 5, focal distance: 1000}\n"
+        "filter: {type: Gaussian, width: 1.5}\n"
+        "shaders:\n"
+        "  - type: Lambert\n"
+        "    texture: {type: Layered, upper: {type: Standard, string: tex.ppm}, lower: {type: Constant, colour: [0.7, 0.7, 0.7]},\n"
+        "              mask: {type: Constant, colour: [0.5, 0.5, 0.5]}}\n"
+        "  - {type: Conductor, colour: [0.95, 0.64, 0.54], alpha: 0.3}\n"
+        "  - {type: Conductor, colour: [0.9, 0.9, 0.9]}\n"
+        "  - {type: Dielectric, ior: 1.5, alpha: 0.2}\n"
+        "  - {type: Dielectric, ior: 1.33}\n"
+        "objects:\n"
+        "  - {filename: " + box + "white.obj, shader: 0}\n"
+        "  - {filename: " + box + "red.obj, shader: 1}\n"
+        "  - {filename: " + box + "green.obj, shader: 2}\n"
+        "  - {filename: " + box + "blocks.obj, shader: 3}\n"
+        "light: {type: Quad, translation: [278, 548.7, 279.5], rotation: [90, 0, 0], scale: [130, 105], colour: [17, 12, 4]}\n"));
+    for (const Scene& scene : {smallCornell(40), everyModel}) {
+        RenderConfig ref;
+        ref.backend = "reference";
+        ref.spp = 8;
+        RenderConfig cpu = ref;
+        cpu.backend = "cpu";
+        cpu.pipeline.rayFormat = RayFormat::Full;
+        cpu.pipeline.binExponent = 10;
+        const std::vector<float> a = renderImage(scene, ref), b = renderImage(scene, cpu);
+        EXPECT_GT(mean(a), 0.0);
+        EXPECT_TRUE(sameBits(a, b)) << scene.file;
+    }
 }
 
 // Compact rays (32 bytes: octahedral direction, stochastically rounded bfloat16 throughput)
