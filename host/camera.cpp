@@ -3,6 +3,8 @@
 #include "shared/rng.h"
 #include "shared/sampling.h"
 
+#include <cmath>
+
 namespace spw {
 
 CameraModel::CameraModel(const Scene& scene, int sampleBase)
@@ -27,7 +29,13 @@ vec2 CameraModel::filmPosition(uint x, uint y, uint sample, uint sampleIndex, ui
             offset = vec2(u.x, u.y);
     }
     offset = glm::min(offset, vec2(kOneMinusEpsilon));
-    return vec2(float(x), float(y)) + offset;
+    // float(x) + offset rounds up to x + 1 when offset is within half an ulp of x + 1 of 1 (for
+    // x >= 2, offsets above 1 - 2^-24 x): the sample would land in the next pixel, and the
+    // backends would disagree on which pixel's film it belongs to. Keep it in its own pixel.
+    vec2 p = vec2(float(x), float(y)) + offset;
+    if (p.x >= float(x + 1u)) p.x = std::nextafter(float(x + 1u), 0.0f);
+    if (p.y >= float(y + 1u)) p.y = std::nextafter(float(y + 1u), 0.0f);
+    return p;
 }
 
 CameraRay CameraModel::generate(uint x, uint y, uint sample, uint sampleIndex, uint seed) const {

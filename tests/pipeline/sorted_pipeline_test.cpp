@@ -61,7 +61,13 @@ TEST(SortedPipeline, FullPrecisionRaysGiveTheReferenceImageBitForBit) {
         "  - {filename: " + box + "green.obj, shader: 2}\n"
         "  - {filename: " + box + "blocks.obj, shader: 3}\n"
         "light: {type: Quad, translation: [278, 548.7, 279.5], rotation: [90, 0, 0], scale: [130, 105], colour: [17, 12, 4]}\n"));
-    for (const Scene& scene : {smallCornell(40), everyModel}) {
+    // A 16384 x 4 strip at 4 spp: a sample whose offset in its pixel is within half an ulp of
+    // 1 rounds to the next pixel's edge (float(x) + offset == x + 1) about 2^-24 x of the time,
+    // some fifty times here; the reference once splatted those into the next pixel.
+    Scene strip = smallCornell(4);
+    strip.image.width = 16384;
+    strip.settings.maxDepth = 2;
+    for (const Scene& scene : {smallCornell(40), everyModel, strip}) {
         RenderConfig ref;
         ref.backend = "reference";
         ref.spp = 8;
