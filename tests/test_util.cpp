@@ -167,6 +167,25 @@ PixelStats pairedDifference(const std::vector<std::vector<float>>& a, const std:
     return d;
 }
 
+double worstBlockZ(int width, int height, const std::function<double(size_t)>& difference,
+                   const std::function<double(size_t)>& variance, double allowed) {
+    double worst = 0;
+    for (int by = 0; by < height; by += 8)
+        for (int bx = 0; bx < width; bx += 8) {
+            double sum = 0, var = 0, allowance = 0;
+            for (int y = by; y < std::min(height, by + 8); ++y)
+                for (int x = bx; x < std::min(width, bx + 8); ++x) {
+                    const size_t i = size_t(y) * size_t(width) + size_t(x);
+                    sum += difference(i);
+                    var += variance(i);
+                    allowance += allowed;
+                }
+            const double excess = std::max(0.0, std::fabs(sum) - allowance);
+            if (excess > 0.0) worst = std::max(worst, excess / std::sqrt(var));
+        }
+    return worst;
+}
+
 void expectNoPairedDifference(const PixelStats& d, int width, int height, const std::string& what,
                               double tolerance) {
     ASSERT_EQ(d.pixels(), size_t(width) * size_t(height)) << what;
@@ -175,25 +194,13 @@ void expectNoPairedDifference(const PixelStats& d, int width, int height, const 
     size_t outliers = 0;
     for (size_t i = 0; i < d.pixels(); ++i)
         if (std::fabs(d.mean(i)) > 4.5 * d.stderror(i) + tolerance + 1e-12) ++outliers;
-    double worstBlockZ = 0;
-    for (int by = 0; by < height; by += 8)
-        for (int bx = 0; bx < width; bx += 8) {
-            double sum = 0, var = 0, allowed = 0;
-            for (int y = by; y < std::min(height, by + 8); ++y)
-                for (int x = bx; x < std::min(width, bx + 8); ++x) {
-                    const size_t i = size_t(y) * size_t(width) + size_t(x);
-                    sum += d.mean(i);
-                    var += d.meanVariance(i);
-                    allowed += tolerance;
-                }
-            const double excess = std::max(0.0, std::fabs(sum) - allowed);
-            if (excess > 0.0) worstBlockZ = std::max(worstBlockZ, excess / std::sqrt(var));
-        }
+    const double worstZ = worstBlockZ(
+        width, height, [&](size_t i) { return d.mean(i); }, [&](size_t i) { return d.meanVariance(i); }, tolerance);
     std::printf("  %-40s paired difference %+.3g +- %.3g (z %+.2f), worst 8x8 block |z| %.2f, outlier pixels %zu/%zu\n",
-                what.c_str(), m.mean, m.stderror, m.stderror > 0 ? m.mean / m.stderror : 0.0, worstBlockZ, outliers,
+                what.c_str(), m.mean, m.stderror, m.stderror > 0 ? m.mean / m.stderror : 0.0, worstZ, outliers,
                 d.pixels());
     EXPECT_LE(std::fabs(m.mean), 4.0 * m.stderror + tolerance) << what;
-    EXPECT_LT(worstBlockZ, 4.5) << what;
+    EXPECT_LT(worstZ, 4.5) << what;
     EXPECT_LE(double(outliers), 0.001 * double(d.pixels())) << what;
 }
 

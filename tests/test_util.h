@@ -5,6 +5,7 @@
 #include "host/render.h"
 #include "host/scene.h"
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -94,6 +95,12 @@ std::vector<std::vector<float>> iterationImages(const Scene& scene, const Render
 // iteration: what is left is the difference between the two renderers, and its standard errors
 // come from its own spread, far smaller than either render's (pixels and iterations independent).
 PixelStats pairedDifference(const std::vector<std::vector<float>>& a, const std::vector<std::vector<float>>& b);
+
+// The largest |z| over the image's 8x8 blocks of a per-pixel difference: |sum of the
+// differences| less `allowed` per pixel, over the square root of the sum of their variances
+// (a block whose difference is within the allowance counts 0).
+double worstBlockZ(int width, int height, const std::function<double(size_t)>& difference,
+                   const std::function<double(size_t)>& variance, double allowed = 0.0);
 
 // Asserts that a paired difference has mean zero: over the image within 4 standard errors, no
 // 8x8 block beyond 4.5, and at most 0.1 % of pixels beyond 4.5 (a difference that is exactly 0

@@ -93,23 +93,13 @@ void expectSameImage(const PixelStats& a, const PixelStats& b, int width, int he
         const double s = std::sqrt(a.meanVariance(i) + b.meanVariance(i));
         if (std::fabs(a.mean(i) - b.mean(i)) > 4.5 * s + 1e-6) ++outliers;
     }
-    double worstBlockZ = 0;
-    for (int by = 0; by < height; by += 8)
-        for (int bx = 0; bx < width; bx += 8) {
-            double da = 0, db = 0, var = 0;
-            for (int y = by; y < std::min(height, by + 8); ++y)
-                for (int x = bx; x < std::min(width, bx + 8); ++x) {
-                    const size_t i = size_t(y * width + x);
-                    da += a.mean(i);
-                    db += b.mean(i);
-                    var += a.meanVariance(i) + b.meanVariance(i);
-                }
-            worstBlockZ = std::max(worstBlockZ, std::fabs(da - db) / std::max(std::sqrt(var), 1e-9));
-        }
+    const double worstZ = worstBlockZ(
+        width, height, [&](size_t i) { return a.mean(i) - b.mean(i); },
+        [&](size_t i) { return std::max(a.meanVariance(i) + b.meanVariance(i), 1e-18); });
     std::printf("  %-40s mean %.5f vs %.5f (se %.5f, z %+.2f), worst 8x8 block |z| %.2f, outlier pixels %zu/%zu\n",
-                what.c_str(), mb.mean, ma.mean, se, (mb.mean - ma.mean) / se, worstBlockZ, outliers, a.pixels());
+                what.c_str(), mb.mean, ma.mean, se, (mb.mean - ma.mean) / se, worstZ, outliers, a.pixels());
     EXPECT_NEAR(mb.mean, ma.mean, 4.0 * se) << what;
-    EXPECT_LT(worstBlockZ, 4.5) << what;
+    EXPECT_LT(worstZ, 4.5) << what;
     EXPECT_LE(double(outliers), 0.005 * double(a.pixels())) << what;
 }
 
