@@ -12,8 +12,10 @@
 // at 2^40 or below the clamp likewise. For the usual N (up to 64) that is 2^40 and a clamp 2^20
 // times the brightest emitter. Non-finite samples are counted and dropped, never added.
 //
-// Even and odd samples (by render-wide sample index) accumulate apart, in two half buffers:
-// their difference estimates the image's own error without a reference (halfBufferRelMse).
+// The samples accumulate in two half buffers, a sample's half being (iteration + its index
+// within the iteration) mod 2: over any two iterations each half takes every stratum of the
+// Stratified and Grid samplers once, so the halves are identically distributed and their
+// difference estimates the image's own error without a reference (halfBufferRelMse).
 #pragma once
 
 #include "host/scene.h"
@@ -49,7 +51,7 @@ class Film {
 
     // The render so far: sum of weighted radiance / sum of weights, RGB, row-major.
     std::vector<float> image() const;
-    // The render of the even (half 0) or odd (half 1) samples alone.
+    // The render of one half's samples alone (half 0 or 1).
     std::vector<float> halfImage(int half) const;
     // relMSE of image() estimated from the halves: per value (A - B)^2 / 4 / (m^2 + 0.01),
     // averaged; (A - B)^2 / 4 is an unbiased estimate of the variance of m = (A + B) / 2.
@@ -62,7 +64,7 @@ class Film {
     double fixedPointScale() const { return scale_; }
 
   private:
-    int halfOf(uint sampleIndex) const;
+    int halfOf(uint sampleIndex) const; // (iteration + index within it) mod 2
     void filtered(vec2 filmPos, int half, vec3 radiance, float weight, uint key);
     void add(int px, int py, int half, vec3 value, float weight, uint key);
 
