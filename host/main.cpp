@@ -28,7 +28,7 @@ namespace {
 const char* kUsage = R"(Spillway: a breadth-first, sorted-deferred-shading path tracer.
 
 usage:
-  spillway render SCENE [options]   render a scene file (see SCENE_FORMAT.md)
+  spillway render SCENE [options]   render a scene file (see docs/scene-format.md)
   spillway compare A B [options]    error metrics of image A against reference B
   spillway devices                  the Vulkan devices, their drivers, and which are usable
   spillway --help                   this text

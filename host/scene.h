@@ -1,4 +1,4 @@
-// The scene: everything SCENE_FORMAT.md describes, resolved to world space and immutable once
+// The scene: everything docs/scene-format.md describes, resolved to world space and immutable once
 // loaded. Backends read it; nothing writes it after loadScene() returns.
 #pragma once
 

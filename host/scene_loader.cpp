@@ -1,4 +1,4 @@
-// The YAML scene loader: SCENE_FORMAT.md made executable. Every value is checked for type and
+// The YAML scene loader: docs/scene-format.md made executable. Every value is checked for type and
 // range where it is read, and every error names the file and line of the offending node.
 #include "host/obj_mesh.h"
 #include "host/scene.h"

@@ -1,4 +1,4 @@
-// The scene loader against SCENE_FORMAT.md: the thesis' Appendix B example loads as written,
+// The scene loader against docs/scene-format.md: the thesis' Appendix B example loads as written,
 // every class of bad input stops the program with "file:line:" and exit status 2 before anything
 // is rendered, a scene without entries takes the documented defaults, and transforms compose as
 // specified (scale, then R = Rz*Ry*Rx, then translation).
