@@ -1,5 +1,5 @@
 // The sorted deferred pipeline (Eisenacher et al. 2013, as the thesis builds it), one stage a
-// function, in the order DESIGN.md draws them:
+// function, in the order docs/design.md draws them:
 //
 //   generate   camera tiles -> thread-local ray buffers -> six directional bins
 //   load       the next batch from RAM or the spill file (the one after it prefetched)
