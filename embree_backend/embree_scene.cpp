@@ -120,13 +120,11 @@ void EmbreeScene::surfaceHit(uint geomID, uint primID, float u, float v, float t
     hit.offset = surfaceOffset(hit.p, p0, p1, p2, hit.ng);
 }
 
-} // namespace spw
-
-namespace spw {
 vec2 EmbreeScene::uvAt(uint geomID, uint primID, float u, float v) const {
     const Mesh& mesh = src_.meshes[geomID];
     if (mesh.uvs.empty()) return vec2(0.0f);
     const uvec3 tri = mesh.triangles[primID];
     return (1.0f - u - v) * mesh.uvs[tri.x] + u * mesh.uvs[tri.y] + v * mesh.uvs[tri.z];
 }
+
 } // namespace spw

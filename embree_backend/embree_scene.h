@@ -14,7 +14,7 @@ namespace spw {
 
 class EmbreeScene {
   public:
-    // `threads` = 0: Embree's default. Throws std::runtime_error on a device error.
+    // Builds the BVH on Embree's default device. Throws std::runtime_error on a device error.
     explicit EmbreeScene(const Scene& scene);
     ~EmbreeScene();
     EmbreeScene(const EmbreeScene&) = delete;

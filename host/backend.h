@@ -19,7 +19,7 @@ struct RenderContext {
     const EmbreeScene& embree;
     const TextureResolver& textures;
     const CameraModel& camera;
-    RenderParams params; // iteration is filled in per iteration
+    RenderParams params; // the render-wide values; each backend sets `iteration` in its own copy
     int threads;         // resolved thread count
     RenderStats& stats;
 };
