@@ -7,7 +7,6 @@
 namespace spw {
 namespace {
 
-
 float filterWeight1D(FilterType type, float d, float radius) {
     d = std::fabs(d);
     if (d >= radius) return 0.0f;

@@ -550,6 +550,14 @@ Scene loadScene(const std::string& path) {
     std::vector<Shader> lightShaders;
     std::set<std::string> seenOnce;
     TextureReader textures(rd, dir, scene);
+    // The hit key's limits (kMaxShaders, kMaxObjects), checked before each element that adds
+    // `shaders` shaders and `objects` objects (a light adds one of each): the error names it.
+    auto roomFor = [&](const YAML::Node& e, size_t shaders, size_t objects) {
+        if (scene.shaders.size() + lightShaders.size() + shaders > size_t(kMaxShaders))
+            rd.fail(e, "more than " + std::to_string(kMaxShaders) + " shaders (a light counts one)");
+        if (scene.meshes.size() + lightMeshes.size() + objects > size_t(kMaxObjects))
+            rd.fail(e, "more than " + std::to_string(kMaxObjects) + " objects (a light counts one)");
+    };
     try {
         // The camera first, wherever it stands in the file: everything else is placed relative to it.
         for (auto it = root.begin(); it != root.end(); ++it)
@@ -579,24 +587,19 @@ Scene loadScene(const std::string& path) {
             else if (key == "object" || key == "objects") {
                 if (key == "objects" && !v.IsSequence()) rd.fail(v, "'objects' must be a list");
                 each([&](const YAML::Node& e) {
-                    if (scene.meshes.size() + lightMeshes.size() >= size_t(kMaxObjects))
-                        rd.fail(e, "more than " + std::to_string(kMaxObjects) + " objects (lights included)");
+                    roomFor(e, 0, 1);
                     readObject(rd, e, dir, scene, pending);
                 });
             } else if (key == "shader" || key == "shaders") {
                 if (key == "shaders" && !v.IsSequence()) rd.fail(v, "'shaders' must be a list");
                 each([&](const YAML::Node& e) {
-                    if (scene.shaders.size() + lightShaders.size() >= size_t(kMaxShaders))
-                        rd.fail(e, "more than " + std::to_string(kMaxShaders) + " shaders (one per light included)");
+                    roomFor(e, 1, 0);
                     readShader(rd, e, textures, scene);
                 });
             } else if (key == "light" || key == "lights") {
                 if (key == "lights" && !v.IsSequence()) rd.fail(v, "'lights' must be a list");
                 each([&](const YAML::Node& e) {
-                    if (scene.shaders.size() + lightShaders.size() >= size_t(kMaxShaders) ||
-                        scene.meshes.size() + lightMeshes.size() >= size_t(kMaxObjects))
-                        rd.fail(e, "more than " + std::to_string(kMaxShaders) + " shaders or " +
-                                       std::to_string(kMaxObjects) + " objects (one of each per light included)");
+                    roomFor(e, 1, 1);
                     lightShaders.push_back(readLight(rd, e, scene.origin, lightMeshes));
                 });
             } else {

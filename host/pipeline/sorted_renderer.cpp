@@ -1,8 +1,7 @@
 #include "host/pipeline/sorted_renderer.h"
 
-#include "host/pipeline/hit_sort.h"
-
 #include "embree_backend/batch_traversal.h"
+#include "host/pipeline/hit_sort.h"
 #include "host/pipeline/parallel.h"
 #include "host/pipeline/radix_sort.h"
 #include "shared/path.h"
@@ -229,8 +228,7 @@ void SortedRenderer::startBatch(RayBatch& batch, int slot) {
                 const RTCHit& h = s.hits[i].hit;
                 std::uint64_t key = kMissKey;
                 if (h.geomID != RTC_INVALID_GEOMETRY_ID) {
-                    const std::uint64_t shader = std::uint64_t(ctx_.scene.meshes[h.geomID].shader);
-                    key = sortHits ? hitSortKey(uint(shader), h.geomID, h.primID) : 0;
+                    key = sortHits ? hitSortKey(uint(ctx_.scene.meshes[h.geomID].shader), h.geomID, h.primID) : 0;
                 }
                 s.keys[i] = {key, std::uint32_t(i)};
             }
