@@ -11,7 +11,7 @@
 #pragma once
 
 #include "embree_backend/embree_scene.h"
-#include "host/ray_record.h"
+#include "host/pipeline/ray_record.h"
 
 #include <vector>
 

@@ -2,7 +2,7 @@
 // with the robust flag, plus the emitter table that next-event estimation samples.
 #pragma once
 
-#include "host/scene.h"
+#include "host/scene/scene.h"
 #include "shared/scene_access.h"
 
 #include <embree3/rtcore.h>

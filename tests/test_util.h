@@ -2,8 +2,8 @@
 // the spillway binary, and statistics over images.
 #pragma once
 
-#include "host/render.h"
-#include "host/scene.h"
+#include "host/render/render.h"
+#include "host/scene/scene.h"
 
 #include <functional>
 #include <string>

@@ -5,7 +5,7 @@
 #pragma once
 
 #include "host/pipeline/radix_sort.h"
-#include "host/scene.h"
+#include "host/scene/scene.h"
 
 #include <cstdint>
 #include <vector>

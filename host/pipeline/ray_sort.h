@@ -8,7 +8,7 @@
 
 #include "host/pipeline/radix_sort.h"
 #include "host/pipeline/ray_sort_mode.h"
-#include "host/ray_record.h"
+#include "host/pipeline/ray_record.h"
 
 #include <cstdint>
 #include <string>

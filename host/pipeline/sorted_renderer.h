@@ -15,7 +15,7 @@
 //   bin        continuation rays -> thread-local buffers -> bins
 #pragma once
 
-#include "host/backend.h"
+#include "host/render/backend.h"
 #include "host/pipeline/batch_queue.h"
 #include "host/pipeline/ray_sort.h"
 #include "shared/shade_io.h"

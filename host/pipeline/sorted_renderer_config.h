@@ -2,7 +2,7 @@
 #pragma once
 
 #include "host/pipeline/ray_sort_mode.h"
-#include "host/ray_record.h"
+#include "host/pipeline/ray_record.h"
 
 #include <optional>
 #include <string>

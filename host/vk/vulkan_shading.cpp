@@ -1,7 +1,7 @@
 #include "host/vk/vulkan_shading.h"
 
 #include "embree_backend/embree_scene.h"
-#include "host/surface_models.h"
+#include "host/scene/surface_models.h"
 #include "host/vk/buffer.h"
 #include "host/vk/check.h"
 #include "host/vk/context.h"

@@ -13,7 +13,7 @@
 // emission and next-event estimation without emitters, and the per-hit albedo without textures.
 #pragma once
 
-#include "host/backend.h"
+#include "host/render/backend.h"
 #include "host/pipeline/sorted_renderer.h"
 
 #include <memory>

@@ -1,7 +1,7 @@
 // The BSDF interface every surface model implements, and the dispatch over models. Directions
 // point away from the surface; `fcos` means f(wo, wi) * |cos(ns, wi)|.
 //
-// Models (one file each, registered in host/surface_models.h):
+// Models (one file each, registered in host/scene/surface_models.h):
 //   Null       — no response: absorbs everything (emitter-only geometry)
 //   Lambert    — lambert.h
 //   Conductor  — conductor.h (GGX, Schlick Fresnel; alpha 0: mirror)

@@ -1,5 +1,5 @@
 // Structs that every backend's shading step reads and writes. Declared once, here; the C++
-// side checks their layout in host/shared_layout.cpp so that a GLSL scalar-block-layout view of
+// side checks their layout in host/render/shared_layout.cpp so that a GLSL scalar-block-layout view of
 // the same bytes stays in step.
 #ifndef SPILLWAY_SHARED_TYPES_H
 #define SPILLWAY_SHARED_TYPES_H
@@ -7,7 +7,7 @@
 
 SHARED_BEGIN
 
-// Surface models. The registry (host/surface_models.h) maps each to its name and code.
+// Surface models. The registry (host/scene/surface_models.h) maps each to its name and code.
 const uint kModelNull = 0u;
 const uint kModelLambert = 1u;
 const uint kModelConductor = 2u;

@@ -2,7 +2,7 @@
 // crashed, hung or rendered silently wrong. Each runs the real binary under a time limit and
 // asserts: no signal, no hang, exit 2 with FILE:LINE for a scene error and exit 1 for a runtime
 // failure, and no file left in the output folder (nor a changed one) on failure.
-#include "host/image_io.h"
+#include "host/image/image_io.h"
 #include "test_util.h"
 
 #include <gtest/gtest.h>

@@ -1,6 +1,6 @@
 // The spillway command line: usage and version, exit status 2 for every kind of bad usage, the
 // Cornell box rendered to both output formats, the --stats JSON, and --seed reproducibility.
-#include "host/image_io.h"
+#include "host/image/image_io.h"
 #include "test_util.h"
 
 #include <gtest/gtest.h>

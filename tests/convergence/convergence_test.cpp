@@ -1,6 +1,6 @@
 // Error against time: the half-buffer error estimate, the convergence rate of every backend,
 // --error-csv and --time-limit.
-#include "host/compare.h"
+#include "host/image/compare.h"
 #include "test_util.h"
 
 #include <gtest/gtest.h>

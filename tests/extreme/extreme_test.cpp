@@ -14,9 +14,9 @@
 //     non-negative and never create energy.
 // Standard errors come from the renders' own samples: per pixel over iterations (PixelStats) or
 // over pixels when every pixel estimates the same value.
-#include "host/camera.h"
-#include "host/compare.h"
-#include "host/film.h"
+#include "host/render/camera.h"
+#include "host/image/compare.h"
+#include "host/image/film.h"
 #include "test_util.h"
 
 #include <gtest/gtest.h>

@@ -1,9 +1,9 @@
 #include "fuzz_targets.h"
 
-#include "host/image_io.h"
-#include "host/obj_mesh.h"
-#include "host/render.h"
-#include "host/scene.h"
+#include "host/image/image_io.h"
+#include "host/scene/obj_mesh.h"
+#include "host/render/render.h"
+#include "host/scene/scene.h"
 
 #include <cstdlib>
 #include <filesystem>

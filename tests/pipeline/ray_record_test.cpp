@@ -1,8 +1,8 @@
-// The compact ray record's claims (host/ray_record.h): the direction within the octahedral
+// The compact ray record's claims (host/pipeline/ray_record.h): the direction within the octahedral
 // grid's error bound, the throughput's stochastic rounding unbiased and order-keeping, the MIS
 // pdf stored exactly once quantised (so the two MIS weights still sum to one), and the exact
 // fields exact. The full record round-trips every bit.
-#include "host/ray_record.h"
+#include "host/pipeline/ray_record.h"
 #include "shared/sampling.h"
 
 #include <gtest/gtest.h>

@@ -1,6 +1,6 @@
 // The film's guard: a NaN or Inf sample is counted and dropped, never added, so one bad path
 // cannot blacken or whiten a pixel (the CLI reports the count on stderr at the end).
-#include "host/film.h"
+#include "host/image/film.h"
 
 #include <gtest/gtest.h>
 

@@ -2,7 +2,7 @@
 // image mask) on a plane in a white furnace, each pixel's centre on a texel's centre, rendered
 // with BSDF sampling only and max depth 1 so that every sample is exactly the albedo it found.
 // And the texture system exists only for scenes with image textures.
-#include "host/textures.h"
+#include "host/scene/textures.h"
 #include "test_util.h"
 
 #include <OpenImageIO/imageio.h>

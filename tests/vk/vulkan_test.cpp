@@ -3,9 +3,9 @@
 // backend's image up to float rounding (the shading math is the same source), build only the
 // pipelines a scene needs, and fail or fall back cleanly when no driver is visible.
 #include "embree_backend/embree_scene.h"
-#include "host/camera.h"
-#include "host/surface_models.h"
-#include "host/textures.h"
+#include "host/render/camera.h"
+#include "host/scene/surface_models.h"
+#include "host/scene/textures.h"
 #include "host/vk/check.h"
 #include "host/vk/context.h"
 #include "host/vk/spirv.h"
@@ -511,7 +511,7 @@ TEST(VulkanBuffers, StagingTwoDimensionalAndWindowedDispatchesGiveTheSameImage) 
 
 TEST(SurfaceModels, EveryRegisteredModelHasItsKernel) {
     EXPECT_EQ(kSurfaceModelCount, size_t(kModelCount))
-        << "a kModel* constant is missing from host/surface_models.h";
+        << "a kModel* constant is missing from host/scene/surface_models.h";
     std::set<std::string> registered;
     for (size_t i = 0; i < kSurfaceModelCount; ++i) {
         const SurfaceModelInfo& m = kSurfaceModels[i];

@@ -1,4 +1,4 @@
-#include "host/camera.h"
+#include "host/render/camera.h"
 
 #include "shared/rng.h"
 #include "shared/sampling.h"

@@ -1,11 +1,11 @@
-#include "host/render.h"
+#include "host/render/render.h"
 
 #include "embree_backend/embree_scene.h"
 #include "embree_backend/reference_renderer.h"
-#include "host/backend.h"
-#include "host/camera.h"
+#include "host/render/backend.h"
+#include "host/render/camera.h"
 #include "host/pipeline/sorted_renderer.h"
-#include "host/textures.h"
+#include "host/scene/textures.h"
 #include "host/vk/context.h"
 #include "host/vk/vulkan_shading.h"
 

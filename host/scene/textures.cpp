@@ -1,6 +1,6 @@
-#include "host/textures.h"
+#include "host/scene/textures.h"
 
-#include "host/image_io.h"
+#include "host/image/image_io.h"
 
 #include <OpenImageIO/texture.h>
 

@@ -1,4 +1,4 @@
-#include "host/stats.h"
+#include "host/render/stats.h"
 
 namespace spw {
 

@@ -1,4 +1,4 @@
-#include "host/film.h"
+#include "host/image/film.h"
 
 #include "shared/rng.h"
 

@@ -1,6 +1,6 @@
-#include "host/image_io.h"
+#include "host/image/image_io.h"
 
-#include "host/output_file.h"
+#include "host/image/output_file.h"
 
 #include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>

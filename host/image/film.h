@@ -18,7 +18,7 @@
 // difference estimates the image's own error without a reference (halfBufferRelMse).
 #pragma once
 
-#include "host/scene.h"
+#include "host/scene/scene.h"
 
 #include <atomic>
 #include <cstdint>

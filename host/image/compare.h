@@ -16,7 +16,7 @@
 // input error (unreadable or non-image file, sizes differ, heatmap not writable).
 #pragma once
 
-#include "host/image_io.h"
+#include "host/image/image_io.h"
 
 #include <nlohmann/json.hpp>
 

@@ -1,4 +1,4 @@
-#include "host/error_csv.h"
+#include "host/app/error_csv.h"
 
 #include <cmath>
 #include <sstream>

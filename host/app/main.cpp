@@ -1,12 +1,12 @@
 // The spillway command line. Exit status: 0 success, 1 runtime failure (disk, device),
 // 2 bad input (usage or scene error).
-#include "host/compare.h"
-#include "host/error_csv.h"
-#include "host/image_io.h"
-#include "host/output_file.h"
-#include "host/progress.h"
-#include "host/render.h"
-#include "host/scene.h"
+#include "host/image/compare.h"
+#include "host/app/error_csv.h"
+#include "host/image/image_io.h"
+#include "host/image/output_file.h"
+#include "host/app/progress.h"
+#include "host/render/render.h"
+#include "host/scene/scene.h"
 #include "host/vk/context.h"
 
 #include <cmath>
@@ -210,7 +210,7 @@ int renderCommand(const std::vector<std::string>& args) {
     progress.finish();
 
     // Every output is written whole, and flushed, before any is given its name: a failure in
-    // any of them leaves none (host/output_file.h).
+    // any of them leaves none (host/image/output_file.h).
     spw::OutputFile image(output);
     {
         spw::StageTimer t(result->stats.stages, "write image");

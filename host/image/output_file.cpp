@@ -1,4 +1,4 @@
-#include "host/output_file.h"
+#include "host/image/output_file.h"
 
 #include <cerrno>
 #include <csignal>

@@ -22,7 +22,7 @@ inline float srgbToLinear(float c) {
 bool isSupportedOutput(const std::string& path);
 // The file's bytes, in the format the path's extension names (.exr float, .png 8-bit sRGB).
 std::vector<unsigned char> encodeImage(const std::string& path, const ImageRGB& image);
-// Writes the image whole or not at all (host/output_file.h). Throws std::runtime_error naming
+// Writes the image whole or not at all (host/image/output_file.h). Throws std::runtime_error naming
 // the path when the file cannot be written.
 void writeImage(const std::string& path, const ImageRGB& image);
 // An 8-bit sRGB RGB image (compare's heatmap) with a description in its metadata, written the same way.

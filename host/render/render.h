@@ -2,10 +2,10 @@
 // iterations into the film and fills in the stats. The CLI and the tests both call this.
 #pragma once
 
-#include "host/film.h"
-#include "host/render_config.h"
-#include "host/scene.h"
-#include "host/stats.h"
+#include "host/image/film.h"
+#include "host/render/render_config.h"
+#include "host/scene/scene.h"
+#include "host/render/stats.h"
 
 #include <functional>
 #include <memory>

@@ -1,7 +1,7 @@
 // The YAML scene loader: docs/scene-format.md made executable. Every value is checked for type and
 // range where it is read, and every error names the file and line of the offending node.
-#include "host/obj_mesh.h"
-#include "host/scene.h"
+#include "host/scene/obj_mesh.h"
+#include "host/scene/scene.h"
 
 #include <OpenImageIO/imageio.h>
 #include <glm/gtc/matrix_transform.hpp>

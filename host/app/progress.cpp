@@ -1,4 +1,4 @@
-#include "host/progress.h"
+#include "host/app/progress.h"
 
 namespace spw {
 namespace {

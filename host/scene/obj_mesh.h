@@ -1,4 +1,4 @@
-// Wavefront OBJ meshes, transformed to the scene's camera-relative world (host/scene.h).
+// Wavefront OBJ meshes, transformed to the scene's camera-relative world (host/scene/scene.h).
 //
 // tinyobjloader parses and triangulates, but it passes over what it cannot read: a number it
 // cannot parse becomes 0, an unknown statement is skipped, an index naming no element is kept
@@ -9,7 +9,7 @@
 // transform and the shift to the camera happen before the one rounding to float.
 #pragma once
 
-#include "host/scene.h"
+#include "host/scene/scene.h"
 
 #include <glm/mat4x4.hpp>
 #include <glm/vec3.hpp>

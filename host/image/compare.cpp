@@ -1,4 +1,4 @@
-#include "host/compare.h"
+#include "host/image/compare.h"
 
 #include <OpenImageIO/imageio.h>
 

@@ -1,6 +1,6 @@
-#include "host/ray_record.h"
+#include "host/pipeline/ray_record.h"
 
-#include "host/scene.h"
+#include "host/scene/scene.h"
 
 #include <cmath>
 #include <cstring>

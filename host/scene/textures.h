@@ -8,7 +8,7 @@
 // children-first order, so sharing never multiplies work.
 #pragma once
 
-#include "host/scene.h"
+#include "host/scene/scene.h"
 
 #include <memory>
 #include <vector>

@@ -4,7 +4,7 @@
 // contribution arrives instead of carrying it in every ray.
 #pragma once
 
-#include "host/scene.h"
+#include "host/scene/scene.h"
 
 namespace spw {
 

@@ -4,10 +4,10 @@
 // `spillway compare` against it.
 #pragma once
 
-#include "host/compare.h"
-#include "host/film.h"
+#include "host/image/compare.h"
+#include "host/image/film.h"
 
-#include "host/output_file.h"
+#include "host/image/output_file.h"
 
 #include <optional>
 #include <string>
