@@ -1,5 +1,6 @@
 #include "embree_backend/batch_traversal.h"
 
+#include <embree3/rtcore.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
@@ -10,7 +11,9 @@ namespace {
 // Rays per rtcIntersect1M call: large enough to amortise the call, small enough to balance
 // across threads and to keep a group's rays in cache.
 constexpr size_t kGroup = 256;
+constexpr float kInfinity = std::numeric_limits<float>::infinity();
 
+// Every ray Spillway traces is filled here: from 0 to tmax, no motion, every geometry.
 void fillRay(RTCRay& r, vec3 o, vec3 d, float tmax) {
     r.org_x = o.x;
     r.org_y = o.y;
@@ -25,23 +28,37 @@ void fillRay(RTCRay& r, vec3 o, vec3 d, float tmax) {
     r.id = 0;
     r.flags = 0;
 }
+
+void fillRayHit(RTCRayHit& rh, vec3 o, vec3 d) {
+    fillRay(rh.ray, o, d, kInfinity);
+    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+}
+
+HitRecord toHitRecord(const RTCRayHit& rh) {
+    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return HitRecord{kNoHit, 0, 0.0f, 0.0f, 0.0f};
+    return HitRecord{rh.hit.geomID, rh.hit.primID, rh.hit.u, rh.hit.v, rh.ray.tfar};
+}
+
+RTCIntersectContext context(bool coherent) {
+    RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    ctx.flags = coherent ? RTC_INTERSECT_CONTEXT_FLAG_COHERENT : RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
+    return ctx;
+}
 } // namespace
 
-void intersectBatch(const EmbreeScene& scene, const std::vector<RayState>& rays, bool coherent,
-                    std::vector<RTCRayHit>& hits) {
-    hits.resize(rays.size());
-    const size_t groups = (rays.size() + kGroup - 1) / kGroup;
+void intersectBatch(const EmbreeScene& scene, const RayStream& rays, bool coherent,
+                    std::vector<HitRecord>& hits) {
+    hits.resize(rays.count);
+    const size_t groups = (rays.count + kGroup - 1) / kGroup;
     tbb::parallel_for(size_t(0), groups, [&](size_t g) {
-        const size_t begin = g * kGroup, end = std::min(rays.size(), begin + kGroup);
-        for (size_t i = begin; i < end; ++i) {
-            fillRay(hits[i].ray, rays[i].origin, rays[i].dir, std::numeric_limits<float>::infinity());
-            hits[i].hit.geomID = RTC_INVALID_GEOMETRY_ID;
-            hits[i].hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-        }
-        RTCIntersectContext ctx;
-        rtcInitIntersectContext(&ctx);
-        ctx.flags = coherent ? RTC_INTERSECT_CONTEXT_FLAG_COHERENT : RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
-        rtcIntersect1M(scene.handle(), &ctx, &hits[begin], unsigned(end - begin), sizeof(RTCRayHit));
+        const size_t begin = g * kGroup, end = std::min(rays.count, begin + kGroup);
+        RTCRayHit buf[kGroup];
+        for (size_t i = begin; i < end; ++i) fillRayHit(buf[i - begin], rays.originAt(i), rays.dirAt(i));
+        RTCIntersectContext ctx = context(coherent);
+        rtcIntersect1M(scene.handle(), &ctx, buf, unsigned(end - begin), sizeof(RTCRayHit));
+        for (size_t i = begin; i < end; ++i) hits[i] = toHitRecord(buf[i - begin]);
     });
 }
 
@@ -53,12 +70,28 @@ void occludedBatch(const EmbreeScene& scene, const std::vector<ShadowRay>& rays,
         const size_t begin = g * kGroup, end = std::min(rays.size(), begin + kGroup);
         RTCRay buf[kGroup];
         for (size_t i = begin; i < end; ++i) fillRay(buf[i - begin], rays[i].origin, rays[i].dir, rays[i].tmax);
-        RTCIntersectContext ctx;
-        rtcInitIntersectContext(&ctx);
-        ctx.flags = coherent ? RTC_INTERSECT_CONTEXT_FLAG_COHERENT : RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
+        RTCIntersectContext ctx = context(coherent);
         rtcOccluded1M(scene.handle(), &ctx, buf, unsigned(end - begin), sizeof(RTCRay));
         for (size_t i = begin; i < end; ++i) occluded[i] = buf[i - begin].tfar < 0.0f ? 1 : 0;
     });
+}
+
+HitRecord intersectOne(const EmbreeScene& scene, vec3 origin, vec3 dir) {
+    RTCRayHit rh;
+    fillRayHit(rh, origin, dir);
+    RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    rtcIntersect1(scene.handle(), &ctx, &rh);
+    return toHitRecord(rh);
+}
+
+bool occludedOne(const EmbreeScene& scene, const ShadowRay& ray) {
+    RTCRay r;
+    fillRay(r, ray.origin, ray.dir, ray.tmax);
+    RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    rtcOccluded1(scene.handle(), &ctx, &r);
+    return r.tfar < 0.0f;
 }
 
 } // namespace spw

@@ -1,7 +1,9 @@
-// Embree traversal of whole batches for the sorted backends: closest hits for a batch of rays,
-// and occlusion for a batch of shadow rays. Both split the batch into groups traced with
+// Embree traversal, the only place rays meet Embree: whole batches for the sorted backends
+// (closest hits for a batch of rays, occlusion for a batch of shadow rays) and one ray at a time
+// for the depth-first reference. The batch calls split the batch into groups traced with
 // rtcIntersect1M / rtcOccluded1M, with the coherent context flag only when the batch was sorted
-// (Embree's coherent mode halves throughput on incoherent rays).
+// (Embree's coherent mode halves throughput on incoherent rays). What comes back is Spillway's
+// own HitRecord: no Embree type leaves embree_backend/.
 //
 // Why streams and not packets: on Morton-sorted batches, 8-wide packets (rtcIntersect8 over
 // consecutive sorted rays) measured slower than rtcIntersect1M with the coherent flag: traverse
@@ -11,14 +13,31 @@
 #pragma once
 
 #include "embree_backend/embree_scene.h"
-#include "host/pipeline/ray_record.h"
 
+#include <cstdint>
 #include <vector>
 
 namespace spw {
 
-void intersectBatch(const EmbreeScene& scene, const std::vector<RayState>& rays, bool coherent,
-                    std::vector<RTCRayHit>& hits);
+// A batch's rays as traversal reads them: `count` origins and unit directions, each `stride`
+// bytes after the last, so that the pipeline's own ray array is traced where it lies.
+struct RayStream {
+    const vec3* origin;
+    const vec3* dir;
+    size_t stride;
+    size_t count;
+    vec3 originAt(size_t i) const { return at(origin, i); }
+    vec3 dirAt(size_t i) const { return at(dir, i); }
+
+  private:
+    vec3 at(const vec3* first, size_t i) const {
+        return *reinterpret_cast<const vec3*>(reinterpret_cast<const char*>(first) + i * stride);
+    }
+};
+
+// hits[i]: ray i's closest hit, or mesh == kNoHit.
+void intersectBatch(const EmbreeScene& scene, const RayStream& rays, bool coherent,
+                    std::vector<HitRecord>& hits);
 
 struct ShadowRay {
     vec3 origin;
@@ -28,5 +47,9 @@ struct ShadowRay {
 // occluded[i] = 1 when something blocks ray i before its tmax.
 void occludedBatch(const EmbreeScene& scene, const std::vector<ShadowRay>& rays, bool coherent,
                    std::vector<std::uint8_t>& occluded);
+
+// One ray, for the depth-first reference: the closest hit, and whether a shadow ray is blocked.
+HitRecord intersectOne(const EmbreeScene& scene, vec3 origin, vec3 dir);
+bool occludedOne(const EmbreeScene& scene, const ShadowRay& ray);
 
 } // namespace spw

@@ -3,6 +3,8 @@
 #include "shared/offset.h"
 #include "shared/sampling.h"
 
+#include <embree3/rtcore.h>
+
 #include <stdexcept>
 
 namespace spw {
@@ -118,6 +120,13 @@ void EmbreeScene::surfaceHit(uint geomID, uint primID, float u, float v, float t
     hit.emitter = base >= 0 ? uint(base) + primID : kNoEmitter;
     hit.albedo = vec3(0.0f);
     hit.offset = surfaceOffset(hit.p, p0, p1, p2, hit.ng);
+}
+
+SurfaceHit EmbreeScene::setUpHit(const HitRecord& h, const TextureResolver& textures) const {
+    SurfaceHit hit;
+    surfaceHit(h.mesh, h.prim, h.u, h.v, h.t, hit);
+    hit.albedo = textures.albedo(src_.shaders[hit.shader], uvAt(h.mesh, h.prim, h.u, h.v));
+    return hit;
 }
 
 vec2 EmbreeScene::uvAt(uint geomID, uint primID, float u, float v) const {

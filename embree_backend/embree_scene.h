@@ -3,14 +3,27 @@
 #pragma once
 
 #include "host/scene/scene.h"
+#include "host/scene/textures.h"
 #include "shared/scene_access.h"
-
-#include <embree3/rtcore.h>
 
 #include <string>
 #include <vector>
 
+// Embree's handles, declared as Embree declares them, so that <embree3/rtcore.h> stays inside
+// embree_backend/.
+struct RTCDeviceTy;
+struct RTCSceneTy;
+
 namespace spw {
+
+// A closest hit in Spillway's terms, what traversal hands the rest of the renderer: the mesh
+// (Embree's geometry id), the triangle, Embree's barycentric u and v, and the distance.
+constexpr uint kNoHit = 0xFFFFFFFFu;
+struct HitRecord {
+    uint mesh; // kNoHit: the ray missed
+    uint prim;
+    float u, v, t;
+};
 
 class EmbreeScene {
   public:
@@ -20,7 +33,7 @@ class EmbreeScene {
     EmbreeScene(const EmbreeScene&) = delete;
     EmbreeScene& operator=(const EmbreeScene&) = delete;
 
-    RTCScene handle() const { return scene_; }
+    RTCSceneTy* handle() const { return scene_; }
     const Scene& scene() const { return src_; }
 
     // The shading view: shaders, emitters and their CDF.
@@ -28,18 +41,21 @@ class EmbreeScene {
     const std::vector<Emitter>& emitters() const { return emitters_; }
     float brightestEmission() const { return brightest_; }
 
-    // World-space hit description for (geometry, primitive, Embree's u, v) at distance t.
-    // The albedo is left for the texture stage.
-    void surfaceHit(uint geomID, uint primID, float u, float v, float t, SurfaceHit& hit) const;
-    // Interpolated texture coordinates (0, 0 when the mesh has none).
-    vec2 uvAt(uint geomID, uint primID, float u, float v) const;
+    // Hit setup, the same on every backend: the world-space hit (position, normals, self-
+    // intersection offset, shader, emitter) and the albedo the shader's texture gives there.
+    SurfaceHit setUpHit(const HitRecord& h, const TextureResolver& textures) const;
     // Throws if Embree reported an error since the last check.
     void checkError(const char* what) const;
 
   private:
     const Scene& src_;
-    RTCDevice device_ = nullptr;
-    RTCScene scene_ = nullptr;
+    // World-space hit for (mesh, triangle, Embree's u, v) at distance t; albedo left at 0.
+    void surfaceHit(uint geomID, uint primID, float u, float v, float t, SurfaceHit& hit) const;
+    // Interpolated texture coordinates (0, 0 when the mesh has none).
+    vec2 uvAt(uint geomID, uint primID, float u, float v) const;
+
+    RTCDeviceTy* device_ = nullptr;
+    RTCSceneTy* scene_ = nullptr;
     std::vector<ShaderParams> shaders_;
     std::vector<Emitter> emitters_;
     std::vector<float> cdf_;

@@ -2,7 +2,7 @@
 
 namespace spw {
 
-std::vector<ShaderRun> shaderRuns(const std::vector<KeyIndex>& keys, size_t hitCount) {
+std::vector<ShaderRun> shaderRuns(const std::vector<SortedHit>& keys, size_t hitCount) {
     std::vector<ShaderRun> runs;
     size_t begin = 0;
     while (begin < hitCount) {

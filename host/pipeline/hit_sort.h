@@ -14,6 +14,10 @@ namespace spw {
 
 constexpr std::uint64_t kMissKey = ~0ull;
 
+// One entry of the hit sort (MoonRay's SortedEntry): the hit's key, hitSortKey() or kMissKey,
+// and the hit's index in its batch. It is the radix sort's own entry type.
+using SortedHit = KeyIndex;
+
 inline std::uint64_t hitSortKey(uint shader, uint object, uint primitive) {
     return std::uint64_t(shader) << 52 | std::uint64_t(object) << 32 | primitive;
 }
@@ -26,6 +30,6 @@ struct ShaderRun {
 };
 
 // The maximal runs of one shader in keys[0, hitCount), which must be sorted by hitSortKey.
-std::vector<ShaderRun> shaderRuns(const std::vector<KeyIndex>& keys, size_t hitCount);
+std::vector<ShaderRun> shaderRuns(const std::vector<SortedHit>& keys, size_t hitCount);
 
 } // namespace spw

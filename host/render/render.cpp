@@ -4,6 +4,7 @@
 #include "embree_backend/reference_renderer.h"
 #include "host/render/backend.h"
 #include "host/render/camera.h"
+#include "host/pipeline/cpu_shading.h"
 #include "host/pipeline/sorted_renderer.h"
 #include "host/scene/textures.h"
 #include "host/vk/context.h"

@@ -14,7 +14,7 @@
 #pragma once
 
 #include "host/render/backend.h"
-#include "host/pipeline/sorted_renderer.h"
+#include "host/pipeline/shading_engine.h"
 
 #include <memory>
 

@@ -3,6 +3,7 @@
 // backend's image up to float rounding (the shading math is the same source), build only the
 // pipelines a scene needs, and fail or fall back cleanly when no driver is visible.
 #include "embree_backend/embree_scene.h"
+#include "host/pipeline/cpu_shading.h"
 #include "host/render/camera.h"
 #include "host/scene/surface_models.h"
 #include "host/scene/textures.h"
@@ -327,9 +328,7 @@ PerHit shadeSameHits(ShadingMode mode) {
             float u = unit(rng), v = unit(rng);
             if (u + v > 1.0f) u = 1.0f - u, v = 1.0f - v;
             ShadeInput& in = inputs[i];
-            embree.surfaceHit(mesh, prim, u, v, 10.0f + 1000.0f * unit(rng), in.hit);
-            in.hit.albedo =
-                textures.albedo(scene.shaders[in.hit.shader], embree.uvAt(mesh, prim, u, v));
+            in.hit = embree.setUpHit(HitRecord{mesh, prim, u, v, 10.0f + 1000.0f * unit(rng)}, textures);
             vec3 d = glm::normalize(vec3(unit(rng) - 0.5f, unit(rng) - 0.5f, unit(rng) - 0.5f));
             if (rng() % 8 != 0 && glm::dot(d, in.hit.ng) > 0.0f)
                 d = -d; // mostly the front, some backs

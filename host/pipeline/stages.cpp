@@ -1,0 +1,191 @@
+#include "host/pipeline/stages.h"
+
+#include "host/pipeline/parallel.h"
+#include "host/pipeline/radix_sort.h"
+#include "shared/path.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+
+namespace spw {
+namespace {
+
+RenderParams paramsAt(const RenderContext& ctx, uint iteration) {
+    RenderParams rp = ctx.params;
+    rp.iteration = iteration;
+    return rp;
+}
+
+// The random numbers that round a ray's compact record: the path's own (dimension kDimRounding).
+uvec4 roundingBits(const RenderParams& rp, const PathState& path) {
+    return pcg4d(uvec4(pathPixel(rp, path.pathId), pathSample(rp, path.pathId),
+                       (path.bounce << 8u) | kDimRounding, rp.seed));
+}
+
+// Where a path's contributions land on the film.
+vec2 filmPosition(const RenderContext& ctx, const RenderParams& rp, uint pathId) {
+    const uint pixel = pathPixel(rp, pathId), s = pathId % rp.samplesPerIteration;
+    const uint width = uint(ctx.scene.image.width);
+    const uint x = pixel % width, y = pixel / width;
+    // The Box filter needs only the pixel: skip re-deriving the sample's position in it.
+    if (ctx.scene.filter.type == FilterType::Box) return vec2(float(x) + 0.5f, float(y) + 0.5f);
+    return ctx.camera.filmPosition(x, y, s, pathSample(rp, pathId), rp.seed);
+}
+
+} // namespace
+
+void generateCameraRays(const RenderContext& ctx, uint iteration, RayFormat format, Film& film,
+                        DirectionalBins& bins) {
+    const Scene& scene = ctx.scene;
+    const RenderParams rp = paramsAt(ctx, iteration);
+    const int width = scene.image.width, height = scene.image.height, tile = scene.settings.bucketSize;
+    const uint spi = rp.samplesPerIteration;
+    const int tilesX = (width + tile - 1) / tile, tilesY = (height + tile - 1) / tile;
+    tbb::parallel_for(0, tilesX * tilesY, [&](int t) {
+        const int x0 = (t % tilesX) * tile, y0 = (t / tilesX) * tile;
+        RayBuffer buffer; // the tile's thread-local buffer, handed to the bins whole
+        for (int y = y0; y < std::min(height, y0 + tile); ++y)
+            for (int x = x0; x < std::min(width, x0 + tile); ++x)
+                for (uint s = 0; s < spi; ++s) {
+                    CameraRay cr = ctx.camera.generate(uint(x), uint(y), s, iteration * spi + s, rp.seed);
+                    film.addSample(cr.filmPos, iteration * spi + s);
+                    RayState r;
+                    r.origin = cr.origin;
+                    r.dir = cr.dir;
+                    r.path = PathState{};
+                    r.path.beta = vec3(1.0f);
+                    r.path.pathId = uint(y * width + x) * spi + s;
+                    buffer.push(r, format, roundingBits(rp, r.path));
+                }
+        ctx.stats.cameraRays += buffer.count;
+        bins.add(buffer);
+    });
+}
+
+size_t decompressRays(RayBatch& batch, std::vector<RayState>& rays) {
+    const size_t n = batch.count;
+    const size_t recordBytes = rayRecordBytes(batch.format);
+    rays.resize(n);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 4096), [&](const tbb::blocked_range<size_t>& r) {
+        for (size_t i = r.begin(); i < r.end(); ++i) decodeRay(&batch.bytes[i * recordBytes], batch.format, rays[i]);
+    });
+    std::vector<std::uint8_t>().swap(batch.bytes);
+    return parallelCount(n, [&](size_t i) { return rays[i].path.bounce == 0; });
+}
+
+void traverse(const EmbreeScene& embree, const std::vector<RayState>& rays, bool coherent,
+              std::vector<HitRecord>& hits) {
+    if (rays.empty()) {
+        hits.clear();
+        return;
+    }
+    intersectBatch(embree, RayStream{&rays[0].origin, &rays[0].dir, sizeof(RayState), rays.size()}, coherent, hits);
+}
+
+size_t sortHits(const Scene& scene, const std::vector<HitRecord>& hits, bool byShader,
+                std::vector<SortedHit>& order, std::vector<SortedHit>& scratch) {
+    const size_t n = hits.size();
+    order.resize(n);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, n, kParallelGrain), [&](const tbb::blocked_range<size_t>& r) {
+        for (size_t i = r.begin(); i < r.end(); ++i) {
+            const HitRecord& h = hits[i];
+            std::uint64_t key = kMissKey;
+            if (h.mesh != kNoHit) key = byShader ? hitSortKey(uint(scene.meshes[h.mesh].shader), h.mesh, h.prim) : 0;
+            order[i] = {key, std::uint32_t(i)};
+        }
+    });
+    const size_t hitCount = parallelCount(n, [&](size_t i) { return order[i].key != kMissKey; });
+    if (byShader) {
+        radixSort(order, scratch);
+    } else {
+        // No sort: keep traversal order, just move the misses out.
+        std::stable_partition(order.begin(), order.end(), [](const SortedHit& k) { return k.key != kMissKey; });
+    }
+    return hitCount;
+}
+
+void setUpHits(const RenderContext& ctx, const std::vector<RayState>& rays,
+               const std::vector<HitRecord>& hits, const std::vector<SortedHit>& order,
+               size_t hitCount, ShadeInput* inputs, uvec2* paths) {
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, hitCount, 1024), [&](const tbb::blocked_range<size_t>& r) {
+        for (size_t i = r.begin(); i < r.end(); ++i) {
+            const std::uint32_t k = order[i].index;
+            ShadeInput in; // assembled here, stored whole: one sequential write into the slot
+            in.hit = ctx.embree.setUpHit(hits[k], ctx.textures);
+            in.path = rays[k].path;
+            in.rayDir = rays[k].dir;
+            in.pad0 = 0.0f;
+            inputs[i] = in;
+            paths[i] = uvec2(in.path.pathId, in.path.bounce);
+        }
+    });
+}
+
+void shadeRanges(const Scene& scene, const std::vector<SortedHit>& order, size_t hitCount,
+                 bool byShader, std::vector<ShadeRange>& ranges) {
+    ranges.clear();
+    if (byShader) {
+        // The sort keys carry the shader in their top bits.
+        for (const ShaderRun& run : shaderRuns(order, hitCount))
+            ranges.push_back({scene.shaders[run.shader].params.model, run.begin, run.count});
+    } else if (hitCount > 0) {
+        ranges.push_back({kMixedModels, 0, hitCount});
+    }
+}
+
+void gatherShadowRays(const ShadeResult* results, size_t hitCount, std::vector<std::uint32_t>& owner,
+                      std::vector<ShadowRay>& shadows) {
+    parallelSelect(hitCount, [&](size_t i) { return (results[i].flags & kShadeShadow) != 0; }, owner);
+    shadows.resize(owner.size());
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, shadows.size(), kParallelGrain), [&](const tbb::blocked_range<size_t>& r) {
+        for (size_t j = r.begin(); j < r.end(); ++j) {
+            const ShadeResult& res = results[owner[j]];
+            shadows[j] = {res.shadowOrigin, res.shadowDir, res.shadowTmax};
+        }
+    });
+}
+
+void accumulate(const RenderContext& ctx, uint iteration, const ShadeResult* results,
+                const uvec2* paths, size_t hitCount, const std::vector<std::uint32_t>& shadowOwner,
+                const std::vector<std::uint8_t>& occluded, Film& film) {
+    const RenderParams rp = paramsAt(ctx, iteration);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, hitCount, 1024), [&](const tbb::blocked_range<size_t>& r) {
+        for (size_t i = r.begin(); i < r.end(); ++i)
+            if (results[i].flags & kShadeEmitted) {
+                const uvec2 p = paths[i]; // (pathId, bounce)
+                film.splat(filmPosition(ctx, rp, p.x), pathSample(rp, p.x), results[i].emitted, filmKey(p.x, p.y, false));
+            }
+    });
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, shadowOwner.size(), 1024), [&](const tbb::blocked_range<size_t>& r) {
+        for (size_t j = r.begin(); j < r.end(); ++j)
+            if (!occluded[j]) {
+                const size_t i = shadowOwner[j];
+                const uvec2 p = paths[i]; // (pathId, bounce)
+                film.splat(filmPosition(ctx, rp, p.x), pathSample(rp, p.x), results[i].shadowContribution,
+                           filmKey(p.x, p.y, true));
+            }
+    });
+}
+
+void binContinuations(const RenderContext& ctx, uint iteration, RayFormat format,
+                      const ShadeResult* results, size_t hitCount, DirectionalBins& bins) {
+    const RenderParams rp = paramsAt(ctx, iteration);
+    const size_t chunk = size_t(ctx.scene.settings.shadingSize);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, hitCount, chunk), [&](const tbb::blocked_range<size_t>& r) {
+        RayBuffer buffer;
+        for (size_t i = r.begin(); i < r.end(); ++i) {
+            const ShadeResult& res = results[i];
+            if (!(res.flags & kShadeContinue)) continue;
+            RayState ray;
+            ray.origin = res.nextOrigin;
+            ray.dir = res.nextDir;
+            ray.path = res.next;
+            buffer.push(ray, format, roundingBits(rp, ray.path));
+        }
+        bins.add(buffer);
+    });
+}
+
+} // namespace spw

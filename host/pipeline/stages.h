@@ -1,0 +1,70 @@
+// The sorted deferred pipeline's stages (Eisenacher et al. 2013, as the thesis builds it), in the
+// order docs/design.md draws the data flow. SortedRenderer (sorted_renderer.cpp) calls them one a
+// line; each is timed in --stats under the name given here.
+//
+//   generate      camera tiles -> thread-local ray buffers -> six directional bins
+//   load          the next batch from RAM or the spill file      BatchQueue::pop (batch_queue.h)
+//   decompress    32- or 48-byte records -> RayState
+//   sort rays     Morton radix sort, median split, or none        ray_sort.h; RaySortPolicy decides
+//   traverse      closest hits of the whole batch                 intersectBatch (embree_backend/)
+//   sort hits     by (shader, object, primitive), misses last
+//   hit setup     world-space hit and texture albedo, in sorted order, into the engine's inputs
+//   shade         one pass per shader range                       ShadingEngine (shading_engine.h)
+//   shade wait    until the engine's results are complete
+//   shadow        next-event rays, traced with Embree's occlusion call
+//   accumulate    emitted and unoccluded contributions into the film
+//   bin           continuation rays -> thread-local ray buffers -> bins
+#pragma once
+
+#include "embree_backend/batch_traversal.h"
+#include "host/pipeline/batch_queue.h"
+#include "host/pipeline/hit_sort.h"
+#include "host/pipeline/ray_record.h"
+#include "host/pipeline/shading_engine.h"
+#include "host/render/backend.h"
+
+#include <cstdint>
+#include <vector>
+
+namespace spw {
+
+// generate: every pixel's samples of the iteration as camera rays into the bins; each sample
+// is counted in the film (its filter weight) as it is made.
+void generateCameraRays(const RenderContext& ctx, uint iteration, RayFormat format, Film& film,
+                        DirectionalBins& bins);
+
+// decompress: the batch's records into `rays`, the records freed. Returns how many are camera rays.
+size_t decompressRays(RayBatch& batch, std::vector<RayState>& rays);
+
+// traverse: the rays' closest hits.
+void traverse(const EmbreeScene& embree, const std::vector<RayState>& rays, bool coherent,
+              std::vector<HitRecord>& hits);
+
+// sort hits: one SortedHit per ray, the hits first (by shader, object, primitive when
+// `byShader`, else in traversal order), the misses after them. Returns the number of hits.
+size_t sortHits(const Scene& scene, const std::vector<HitRecord>& hits, bool byShader,
+                std::vector<SortedHit>& order, std::vector<SortedHit>& scratch);
+
+// hit setup: inputs[i] and paths[i] (pathId, bounce) for the i-th hit in `order`.
+void setUpHits(const RenderContext& ctx, const std::vector<RayState>& rays,
+               const std::vector<HitRecord>& hits, const std::vector<SortedHit>& order,
+               size_t hitCount, ShadeInput* inputs, uvec2* paths);
+
+// shade: the ranges the engine shades, one per shader run (by shader) or one over every hit.
+void shadeRanges(const Scene& scene, const std::vector<SortedHit>& order, size_t hitCount,
+                 bool byShader, std::vector<ShadeRange>& ranges);
+
+// shadow: the shadow rays the shading made, and for each the hit it belongs to.
+void gatherShadowRays(const ShadeResult* results, size_t hitCount, std::vector<std::uint32_t>& owner,
+                      std::vector<ShadowRay>& shadows);
+
+// accumulate: what each hit emitted, and each unoccluded shadow ray's contribution, into the film.
+void accumulate(const RenderContext& ctx, uint iteration, const ShadeResult* results,
+                const uvec2* paths, size_t hitCount, const std::vector<std::uint32_t>& shadowOwner,
+                const std::vector<std::uint8_t>& occluded, Film& film);
+
+// bin: the continuation rays, encoded, into the bins.
+void binContinuations(const RenderContext& ctx, uint iteration, RayFormat format,
+                      const ShadeResult* results, size_t hitCount, DirectionalBins& bins);
+
+} // namespace spw
