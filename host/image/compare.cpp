@@ -14,7 +14,6 @@
 namespace spw {
 namespace {
 
-constexpr double kRelEpsilon = 0.01; // relmse denominator: b^2 + kRelEpsilon
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
@@ -303,7 +302,7 @@ ImageMetrics compareImages(const ImageRGB& a, const ImageRGB& b) {
         for (int c = 0; c < 3; ++c) {
             const double va = pa[c], vb = pb[c], d = va - vb;
             sum2 += d * d;
-            sumRel += d * d / (vb * vb + kRelEpsilon);
+            sumRel += d * d / (vb * vb + kRelMseEpsilon);
             sumAbs += std::abs(d);
             if (std::abs(d) > m.maxAbs || m.maxAbsX < 0) {
                 m.maxAbs = std::abs(d);
@@ -392,7 +391,7 @@ std::vector<double> relativeErrorPerPixel(const ImageRGB& a, const ImageRGB& b) 
         double s = 0;
         for (int c = 0; c < 3; ++c) {
             const double d = double(pa[c]) - double(pb[c]);
-            s += d * d / (double(pb[c]) * pb[c] + kRelEpsilon);
+            s += d * d / (double(pb[c]) * pb[c] + kRelMseEpsilon);
         }
         err[i] = s / 3.0;
     }

@@ -39,6 +39,10 @@ struct ImageMetrics {
     std::array<double, 3> meanA{}, meanB{};
 };
 
+// relMSE's denominator is b^2 + kRelMseEpsilon: it keeps black pixels finite. The film's
+// half-buffer estimate (film.cpp) uses the same, so that the two are one measure.
+constexpr double kRelMseEpsilon = 0.01;
+
 // Metrics of `a` against the reference `b`. Throws std::invalid_argument when the sizes differ.
 ImageMetrics compareImages(const ImageRGB& a, const ImageRGB& b);
 

@@ -1,5 +1,6 @@
 #include "host/image/film.h"
 
+#include "host/image/compare.h"
 #include "shared/rng.h"
 
 #include <cmath>
@@ -152,7 +153,7 @@ double Film::halfBufferRelMse() const {
         if (!(s[3] > 0 && s[7] > 0)) continue;
         for (int c = 0; c < 3; ++c) {
             double a = s[c] / s[3], b = s[4 + c] / s[7], m = (s[c] + s[4 + c]) / (s[3] + s[7]);
-            total += (a - b) * (a - b) / 4.0 / (m * m + 0.01);
+            total += (a - b) * (a - b) / 4.0 / (m * m + kRelMseEpsilon);
             ++count;
         }
     }
