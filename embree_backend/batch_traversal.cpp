@@ -79,8 +79,7 @@ void occludedBatch(const EmbreeScene& scene, const std::vector<ShadowRay>& rays,
 HitRecord intersectOne(const EmbreeScene& scene, vec3 origin, vec3 dir) {
     RTCRayHit rh;
     fillRayHit(rh, origin, dir);
-    RTCIntersectContext ctx;
-    rtcInitIntersectContext(&ctx);
+    RTCIntersectContext ctx = context(false);
     rtcIntersect1(scene.handle(), &ctx, &rh);
     return toHitRecord(rh);
 }
@@ -88,8 +87,7 @@ HitRecord intersectOne(const EmbreeScene& scene, vec3 origin, vec3 dir) {
 bool occludedOne(const EmbreeScene& scene, const ShadowRay& ray) {
     RTCRay r;
     fillRay(r, ray.origin, ray.dir, ray.tmax);
-    RTCIntersectContext ctx;
-    rtcInitIntersectContext(&ctx);
+    RTCIntersectContext ctx = context(false);
     rtcOccluded1(scene.handle(), &ctx, &r);
     return r.tfar < 0.0f;
 }

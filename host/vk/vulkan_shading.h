@@ -4,7 +4,7 @@
 // largest batch so far, a command buffer, a fence and a timestamp query pool. submit() records
 // one dispatch per non-empty shader range, with {offset, count} in push constants, and returns
 // at once; finish() waits on the fence. Meanwhile the renderer loads, traverses and sets up the
-// next batch into the other slot. Inputs are written by the texture stage straight into the
+// next batch into the other slot. Inputs are written by the hit-setup stage straight into the
 // mapped buffer where memory is device-local and host-visible (lavapipe, integrated GPUs,
 // resizable BAR); elsewhere the engine records staging copies (host/vk/buffer.h).
 //
