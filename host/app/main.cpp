@@ -1,10 +1,11 @@
 // The spillway command line. Exit status: 0 success, 1 runtime failure (disk, device),
 // 2 bad input (usage or scene error).
-#include "host/image/compare.h"
+#include "host/app/compare_command.h"
 #include "host/app/error_csv.h"
+#include "host/app/progress.h"
+#include "host/app/usage_error.h"
 #include "host/image/image_io.h"
 #include "host/image/output_file.h"
-#include "host/app/progress.h"
 #include "host/render/render.h"
 #include "host/scene/scene.h"
 #include "host/vk/context.h"
@@ -24,6 +25,8 @@
 #endif
 
 namespace {
+
+using spw::UsageError;
 
 const char* kUsage = R"(Spillway: a breadth-first, sorted-deferred-shading path tracer.
 
@@ -68,10 +71,6 @@ exit status: 0 done; 1 runtime failure (disk, device, an output that cannot be w
 2 bad usage or scene error (printed as FILE:LINE: message). On any failure no output file
 is written or changed, and no temporary file is left.
 )";
-
-struct UsageError : std::runtime_error {
-    using std::runtime_error::runtime_error;
-};
 
 long long parseInteger(const std::string& flag, const std::string& v, long long lo, long long hi) {
     size_t used = 0;

@@ -1,4 +1,4 @@
-// Image comparison: `spillway compare A B`, error metrics of a test image A against a
+// Image comparison, what `spillway compare A B` (host/app/compare_command.h) computes: error metrics of a test image A against a
 // reference B, a false-colour heatmap of the per-pixel relative error, and pass/fail bounds.
 //
 // Metrics run over every channel value of every pixel where all six values (A's and B's RGB)
@@ -12,8 +12,6 @@
 // Per-channel means of A and B are over the same compared pixels. With no pixel compared every
 // metric is NaN (null in JSON) and every threshold fails.
 //
-// compareCommand exit status: 0 all bounds met, 1 a --threshold bound exceeded, 2 usage or
-// input error (unreadable or non-image file, sizes differ, heatmap not writable).
 #pragma once
 
 #include "host/image/image_io.h"
@@ -62,10 +60,12 @@ struct Threshold {
 Threshold parseThreshold(const std::string& text);
 // The metric by its threshold name; throws std::invalid_argument on an unknown name.
 double metricValue(const ImageMetrics& metrics, const std::string& metric);
+// True for a metric whose threshold is a lower bound (psnr); throws like metricValue.
+bool isLowerBound(const std::string& metric);
 // True when the metric is within its bound; a NaN metric never is.
 bool meetsThreshold(const ImageMetrics& metrics, const Threshold& threshold);
 
-// Per pixel, the channel mean of (a - b)^2 / (b^2 + 0.01); NaN where either pixel is
+// Per pixel, the channel mean of (a - b)^2 / (b^2 + kRelMseEpsilon); NaN where either pixel is
 // non-finite. Its mean over the finite pixels is relmse.
 std::vector<double> relativeErrorPerPixel(const ImageRGB& a, const ImageRGB& b);
 
@@ -87,12 +87,5 @@ struct HeatmapInfo {
 // the sizes differ.
 HeatmapInfo writeHeatmap(const std::string& path, const ImageRGB& a, const ImageRGB& b);
 
-// The usage text of the compare command.
-const char* compareUsage();
-
-// `spillway compare A B [--json] [--heatmap FILE.png] [--threshold METRIC=VALUE]...`, given
-// the arguments after "compare". Prints a table (or JSON with --json) to stdout, failed bounds
-// and errors to stderr; returns 0, 1 or 2 as described at the top of this file.
-int compareCommand(const std::vector<std::string>& args);
 
 } // namespace spw

@@ -21,33 +21,18 @@ void put24(std::uint8_t* p, uint v) {
 }
 uint get24(const std::uint8_t* p) { return uint(p[0]) | uint(p[1]) << 8 | uint(p[2]) << 16; }
 
-// Octahedral map of a unit vector to [-1, 1]^2, in double so the 24-bit grid is the only rounding.
 void octEncode(vec3 d, uint& u, uint& v) {
-    double x = d.x, y = d.y, z = d.z;
-    double n = std::fabs(x) + std::fabs(y) + std::fabs(z);
-    x /= n;
-    y /= n;
-    if (z < 0) {
-        double ox = (1.0 - std::fabs(y)) * (x >= 0 ? 1.0 : -1.0);
-        double oy = (1.0 - std::fabs(x)) * (y >= 0 ? 1.0 : -1.0);
-        x = ox;
-        y = oy;
-    }
-    u = uint((x * 0.5 + 0.5) * kOctScale + 0.5); // round to nearest (the value is >= 0)
-    v = uint((y * 0.5 + 0.5) * kOctScale + 0.5);
+    const glm::dvec2 p = octahedralMap(d);
+    u = uint((p.x * 0.5 + 0.5) * kOctScale + 0.5); // round to nearest (the value is >= 0)
+    v = uint((p.y * 0.5 + 0.5) * kOctScale + 0.5);
 }
 
 vec3 octDecode(uint u, uint v) {
-    double x = double(u) / kOctScale * 2.0 - 1.0, y = double(v) / kOctScale * 2.0 - 1.0;
-    double z = 1.0 - std::fabs(x) - std::fabs(y);
-    if (z < 0) {
-        double ox = (1.0 - std::fabs(y)) * (x >= 0 ? 1.0 : -1.0);
-        double oy = (1.0 - std::fabs(x)) * (y >= 0 ? 1.0 : -1.0);
-        x = ox;
-        y = oy;
-    }
-    double len = std::sqrt(x * x + y * y + z * z);
-    return vec3(float(x / len), float(y / len), float(z / len));
+    glm::dvec2 p(double(u) / kOctScale * 2.0 - 1.0, double(v) / kOctScale * 2.0 - 1.0);
+    const double z = 1.0 - std::fabs(p.x) - std::fabs(p.y);
+    if (z < 0) p = octahedralFold(p);
+    const double len = std::sqrt(p.x * p.x + p.y * p.y + z * z);
+    return vec3(float(p.x / len), float(p.y / len), float(z / len));
 }
 
 // bfloat16 with stochastic rounding: round the magnitude up with probability (dropped bits / 2^16).
@@ -77,6 +62,17 @@ template <class T> T get(const std::uint8_t*& p) {
 }
 
 } // namespace
+
+glm::dvec2 octahedralFold(glm::dvec2 p) {
+    return glm::dvec2((1.0 - std::fabs(p.y)) * (p.x >= 0 ? 1.0 : -1.0), (1.0 - std::fabs(p.x)) * (p.y >= 0 ? 1.0 : -1.0));
+}
+
+glm::dvec2 octahedralMap(vec3 d) {
+    const double x = d.x, y = d.y, z = d.z;
+    const double n = std::fabs(x) + std::fabs(y) + std::fabs(z);
+    const glm::dvec2 p(x / n, y / n);
+    return z < 0 ? octahedralFold(p) : p;
+}
 
 RayFormat parseRayFormat(const std::string& name) {
     if (name == "compact") return RayFormat::Compact;

@@ -56,6 +56,12 @@ RayFormat parseRayFormat(const std::string& name); // "compact" | "full"; throws
 void encodeRay(const RayState& ray, RayFormat format, uvec4 rounding, std::uint8_t* out);
 void decodeRay(const std::uint8_t* in, RayFormat format, RayState& ray);
 
+// The octahedral map (Cigolle et al. 2014) of a direction to [-1, 1]^2, in double so that the
+// compact record's 2^24 grid is its only rounding; the Morton key (ray_sort.cpp) quantises the
+// same map to 8 bits. octahedralFold is the lower hemisphere's fold, its own inverse.
+glm::dvec2 octahedralMap(vec3 d);
+glm::dvec2 octahedralFold(glm::dvec2 p);
+
 // The cardinal direction bin of a direction: 0..5 for +X, -X, +Y, -Y, +Z, -Z (dominant axis).
 inline uint cardinalBin(vec3 d) {
     vec3 a = glm::abs(d);

@@ -111,11 +111,9 @@ std::uint64_t MortonFrame::key(const RayState& r) const {
     std::uint64_t morton =
         spread3(std::uint64_t(q.x)) | spread3(std::uint64_t(q.y)) << 1 | spread3(std::uint64_t(q.z)) << 2;
     // 8+8-bit octahedral direction.
-    vec3 d = r.dir / (std::fabs(r.dir.x) + std::fabs(r.dir.y) + std::fabs(r.dir.z));
-    vec2 o = d.z >= 0 ? vec2(d.x, d.y)
-                      : vec2((1 - std::fabs(d.y)) * (d.x >= 0 ? 1 : -1), (1 - std::fabs(d.x)) * (d.y >= 0 ? 1 : -1));
-    std::uint64_t du = std::uint64_t(std::clamp((o.x * 0.5f + 0.5f) * 255.0f, 0.0f, 255.0f));
-    std::uint64_t dv = std::uint64_t(std::clamp((o.y * 0.5f + 0.5f) * 255.0f, 0.0f, 255.0f));
+    const glm::dvec2 o = octahedralMap(r.dir);
+    std::uint64_t du = std::uint64_t(std::clamp((o.x * 0.5 + 0.5) * 255.0, 0.0, 255.0));
+    std::uint64_t dv = std::uint64_t(std::clamp((o.y * 0.5 + 0.5) * 255.0, 0.0, 255.0));
     return std::uint64_t(cardinalBin(r.dir)) << 61 | morton << 16 | du << 8 | dv;
 }
 

@@ -2,6 +2,7 @@
 // non-finite pixels, channel means), the thresholds' exit status, the errors' exit status and
 // messages, the JSON output and the heatmap's pixels. The command is run through
 // compareCommand, the function main calls for "compare".
+#include "host/app/compare_command.h"
 #include "host/image/compare.h"
 #include "test_util.h"
 

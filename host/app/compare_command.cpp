@@ -1,0 +1,200 @@
+#include "host/app/compare_command.h"
+
+#include "host/app/usage_error.h"
+#include "host/image/compare.h"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <stdexcept>
+
+namespace spw {
+namespace {
+
+ImageRGB readInput(const std::string& path) {
+    std::error_code ec;
+    if (!std::filesystem::exists(path, ec))
+        throw std::runtime_error("cannot read '" + path + "': no such file");
+    if (std::filesystem::is_directory(path, ec))
+        throw std::runtime_error("cannot read '" + path + "': it is a folder");
+    ImageRGB img = readImage(path); // its errors name the path
+    if (img.width <= 0 || img.height <= 0)
+        throw std::runtime_error("cannot read '" + path + "': the image is empty");
+    return img;
+}
+
+std::string formatValue(double v) {
+    if (std::isnan(v)) return "n/a";
+    if (std::isinf(v)) return v > 0 ? "inf" : "-inf";
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.6g", v);
+    return buf;
+}
+
+void printTable(const std::string& pathA, const std::string& pathB, const ImageMetrics& m) {
+    std::printf("A (test)       %s\n", pathA.c_str());
+    std::printf("B (reference)  %s\n", pathB.c_str());
+    std::printf("size           %d x %d, %zu of %zu pixels compared\n", m.width, m.height,
+                m.comparedPixels, m.pixels);
+    std::printf("non-finite     A: %zu  B: %zu pixels\n\n", m.nonFiniteA, m.nonFiniteB);
+    std::printf("  mse          %s\n", formatValue(m.mse).c_str());
+    std::printf("  rmse         %s\n", formatValue(m.rmse).c_str());
+    std::printf("  relmse       %s\n", formatValue(m.relMse).c_str());
+    std::printf("  mae          %s\n", formatValue(m.mae).c_str());
+    if (m.maxAbsX >= 0)
+        std::printf("  maxabs       %s at pixel (%d, %d)\n", formatValue(m.maxAbs).c_str(),
+                    m.maxAbsX, m.maxAbsY);
+    else
+        std::printf("  maxabs       %s\n", formatValue(m.maxAbs).c_str());
+    std::printf("  psnr         %s dB (peak 1.0, linear)%s\n\n", formatValue(m.psnr).c_str(),
+                std::isinf(m.psnr) ? ", images identical" : "");
+    std::printf("  channel means  %-12s %-12s %s\n", "R", "G", "B");
+    std::printf("  A              %-12s %-12s %s\n", formatValue(m.meanA[0]).c_str(),
+                formatValue(m.meanA[1]).c_str(), formatValue(m.meanA[2]).c_str());
+    std::printf("  B              %-12s %-12s %s\n", formatValue(m.meanB[0]).c_str(),
+                formatValue(m.meanB[1]).c_str(), formatValue(m.meanB[2]).c_str());
+}
+
+int runCompare(const std::vector<std::string>& args) {
+    std::vector<std::string> files;
+    std::vector<Threshold> thresholds;
+    std::string heatmapPath;
+    bool json = false;
+    for (std::size_t i = 0; i < args.size(); ++i) {
+        std::string a = args[i], inlineValue;
+        bool hasInline = false;
+        if (a.rfind("--", 0) == 0 && a.find('=') != std::string::npos) {
+            inlineValue = a.substr(a.find('=') + 1);
+            a = a.substr(0, a.find('='));
+            hasInline = true;
+        }
+        auto value = [&]() -> std::string {
+            if (hasInline) return inlineValue;
+            if (i + 1 >= args.size()) throw UsageError(a + " needs a value");
+            return args[++i];
+        };
+        if (a == "-h" || a == "--help") {
+            std::fputs(compareUsage(), stdout);
+            return 0;
+        } else if (a == "--json") {
+            json = true;
+        } else if (a == "--heatmap") {
+            heatmapPath = value();
+            std::string ext = std::filesystem::path(heatmapPath).extension().string();
+            std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+            if (ext != ".png") throw UsageError("--heatmap '" + heatmapPath + "' must end in .png");
+        } else if (a == "--threshold") {
+            try {
+                thresholds.push_back(parseThreshold(value()));
+            } catch (const std::invalid_argument& e) {
+                throw UsageError(std::string("--threshold: ") + e.what());
+            }
+        } else if (a.size() > 1 && a[0] == '-') {
+            throw UsageError("unknown option '" + a + "'");
+        } else {
+            files.push_back(a);
+        }
+    }
+    if (files.size() != 2)
+        throw UsageError("compare takes two images, A and the reference B (" +
+                         std::to_string(files.size()) + " given)");
+
+    const ImageRGB a = readInput(files[0]);
+    const ImageRGB b = readInput(files[1]);
+    if (a.width != b.width || a.height != b.height)
+        throw std::runtime_error("image sizes differ: '" + files[0] + "' is " +
+                                 std::to_string(a.width) + "x" + std::to_string(a.height) + ", '" +
+                                 files[1] + "' is " + std::to_string(b.width) + "x" +
+                                 std::to_string(b.height));
+    const ImageMetrics m = compareImages(a, b);
+
+    HeatmapInfo heat;
+    if (!heatmapPath.empty()) heat = writeHeatmap(heatmapPath, a, b);
+
+    bool passed = true;
+    nlohmann::json verdicts = nlohmann::json::array();
+    std::vector<std::string> lines, failures;
+    for (const Threshold& t : thresholds) {
+        const bool ok = meetsThreshold(m, t);
+        const bool lowerBound = isLowerBound(t.metric);
+        const double v = metricValue(m, t.metric);
+        passed = passed && ok;
+        nlohmann::json j = {{"metric", t.metric},
+                            {"bound", t.bound},
+                            {"kind", lowerBound ? "min" : "max"},
+                            {"value", std::isfinite(v) ? nlohmann::json(v) : nlohmann::json()},
+                            {"passed", ok}};
+        verdicts.push_back(j);
+        const std::string bound = formatValue(t.bound), value = formatValue(v);
+        lines.push_back("threshold " + t.metric + (lowerBound ? " >= " : " <= ") + bound + ": " +
+                        (ok ? "pass" : "FAIL") + " (" + value + ")");
+        if (!ok)
+            failures.push_back(t.metric + " = " + value +
+                               (lowerBound ? " is below the bound " : " exceeds the bound ") +
+                               bound);
+    }
+
+    if (json) {
+        nlohmann::json out = toJson(m);
+        out["a"] = files[0];
+        out["b"] = files[1];
+        out["thresholds"] = verdicts;
+        out["passed"] = passed;
+        if (!heatmapPath.empty())
+            out["heatmap"] = {{"path", heatmapPath},
+                              {"error_low", heat.low},
+                              {"error_high", heat.high},
+                              {"scale", "log10"}};
+        std::printf("%s\n", out.dump(2).c_str());
+    } else {
+        printTable(files[0], files[1], m);
+        if (!heatmapPath.empty())
+            std::printf("\nheatmap        %s (relative error, log10 bar from %s to %s)\n",
+                        heatmapPath.c_str(), formatValue(heat.low).c_str(),
+                        formatValue(heat.high).c_str());
+        if (!lines.empty()) std::printf("\n");
+        for (const std::string& l : lines)
+            std::printf("%s\n", l.c_str());
+    }
+    std::fflush(stdout);
+    if (m.comparedPixels == 0)
+        std::fprintf(stderr, "spillway compare: warning: no pixel is finite in both images\n");
+    for (const std::string& f : failures)
+        std::fprintf(stderr, "spillway compare: %s\n", f.c_str());
+    return passed ? 0 : 1;
+}
+
+} // namespace
+
+const char* compareUsage() {
+    return R"(usage: spillway compare A B [--json] [--heatmap FILE.png] [--threshold METRIC=V]...
+
+Compares image A against the reference B (EXR or PNG, same size) over the pixels finite in
+both: mse, rmse, relmse (mean (a-b)^2/(b^2+0.01)), mae, maxabs, psnr (peak 1.0, linear),
+per-channel means and the count of non-finite pixels in each.
+
+  --json                  print the metrics as JSON instead of a table
+  --heatmap FILE.png      write the per-pixel relative error as a false-colour picture
+  --threshold METRIC=V    fail (exit 1) when METRIC exceeds V; psnr fails when below V.
+                          METRIC: mse, rmse, relmse, mae, maxabs, psnr. May be repeated.
+
+exit status: 0 within bounds, 1 a bound exceeded, 2 bad usage or unreadable input
+)";
+}
+
+int compareCommand(const std::vector<std::string>& args) {
+    try {
+        return runCompare(args);
+    } catch (const UsageError& e) {
+        std::fflush(stdout);
+        std::fprintf(stderr, "spillway compare: %s\n(try spillway compare --help)\n", e.what());
+    } catch (const std::exception& e) {
+        std::fflush(stdout);
+        std::fprintf(stderr, "spillway compare: %s\n", e.what());
+    }
+    return 2;
+}
+
+} // namespace spw
