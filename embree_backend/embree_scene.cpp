@@ -1,7 +1,6 @@
 #include "embree_backend/embree_scene.h"
 
 #include "shared/offset.h"
-#include "shared/sampling.h"
 
 #include <embree3/rtcore.h>
 
@@ -15,7 +14,7 @@ void onEmbreeError(void* user, RTCError code, const char* message) {
 }
 } // namespace
 
-EmbreeScene::EmbreeScene(const Scene& scene) : src_(scene) {
+EmbreeScene::EmbreeScene(const Scene& scene, const SceneLights& lights) : src_(scene), lights_(lights) {
     device_ = rtcNewDevice(nullptr);
     if (!device_) throw std::runtime_error("cannot create the Embree device (error " +
                                            std::to_string(int(rtcGetDeviceError(nullptr))) + ")");
@@ -24,11 +23,6 @@ EmbreeScene::EmbreeScene(const Scene& scene) : src_(scene) {
     rtcSetSceneFlags(scene_, RTC_SCENE_FLAG_ROBUST);
     rtcSetSceneBuildQuality(scene_, RTC_BUILD_QUALITY_HIGH);
 
-    for (const Shader& s : scene.shaders) shaders_.push_back(s.params);
-
-    emitterBase_.assign(scene.meshes.size(), -1);
-    double totalPower = 0.0;
-    std::vector<double> powers; // per emitter, normalised into pickPdf below
     for (size_t m = 0; m < scene.meshes.size(); ++m) {
         const Mesh& mesh = scene.meshes[m];
         RTCGeometry g = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
@@ -43,41 +37,6 @@ EmbreeScene::EmbreeScene(const Scene& scene) : src_(scene) {
         rtcCommitGeometry(g);
         rtcAttachGeometryByID(scene_, g, unsigned(m));
         rtcReleaseGeometry(g);
-
-        const ShaderParams& sp = shaders_[size_t(mesh.shader)];
-        if (maxComponent(sp.emission) <= 0.0f) continue;
-        brightest_ = std::max(brightest_, maxComponent(sp.emission));
-        emitterBase_[m] = int(emitters_.size());
-        bool twoSided = (sp.flags & kShaderTwoSided) != 0;
-        for (const uvec3& t : mesh.triangles) {
-            Emitter e{};
-            e.p0 = mesh.positions[t.x];
-            e.e1 = mesh.positions[t.y] - e.p0;
-            e.e2 = mesh.positions[t.z] - e.p0;
-            vec3 c = glm::cross(e.e1, e.e2);
-            e.area = 0.5f * glm::length(c);
-            e.normal = glm::normalize(c);
-            e.twoSided = twoSided ? 1u : 0u;
-            e.radiance = sp.emission;
-            // Power = L * area * pi per emitting side.
-            // In double: radiance (up to 1e20) times area can pass float's range.
-            const double power = double(luminance(sp.emission)) * double(e.area) * kPi * (twoSided ? 2.0 : 1.0);
-            powers.push_back(power);
-            totalPower += power;
-            emitters_.push_back(e);
-        }
-    }
-    if (totalPower > 0.0) {
-        double running = 0.0;
-        for (size_t i = 0; i < emitters_.size(); ++i) {
-            running += powers[i];
-            emitters_[i].pickPdf = float(powers[i] / totalPower);
-            cdf_.push_back(float(running / totalPower));
-        }
-        cdf_.back() = 1.0f;
-    } else {
-        emitters_.clear(); // emission [0, 0, 0]: nothing to sample
-        emitterBase_.assign(scene.meshes.size(), -1);
     }
     rtcCommitScene(scene_);
     checkError("building the scene");
@@ -90,15 +49,6 @@ EmbreeScene::~EmbreeScene() {
 
 void EmbreeScene::checkError(const char* what) const {
     if (!error_.empty()) throw std::runtime_error(error_ + " (while " + what + ")");
-}
-
-SceneView EmbreeScene::view() const {
-    SceneView v;
-    v.shaders = shaders_.data();
-    v.emitters = emitters_.data();
-    v.emitterCdf = cdf_.data();
-    v.emitterCount = uint(emitters_.size());
-    return v;
 }
 
 void EmbreeScene::surfaceHit(uint geomID, uint primID, float u, float v, float t, SurfaceHit& hit) const {
@@ -116,8 +66,7 @@ void EmbreeScene::surfaceHit(uint geomID, uint primID, float u, float v, float t
         if (len > 0.0f) hit.ns = n / len;
     }
     hit.shader = uint(mesh.shader);
-    int base = emitterBase_[geomID];
-    hit.emitter = base >= 0 ? uint(base) + primID : kNoEmitter;
+    hit.emitter = lights_.emitterOf(geomID, primID);
     hit.albedo = vec3(0.0f);
     hit.offset = surfaceOffset(hit.p, p0, p1, p2, hit.ng);
 }

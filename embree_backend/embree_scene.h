@@ -1,10 +1,11 @@
 // The scene as Embree sees it: one triangle geometry per mesh (geometry id = mesh index), built
-// with the robust flag, plus the emitter table that next-event estimation samples.
+// with the robust flag, and hit setup on it. The shader table and the emitters are the scene
+// side's (host/scene/lights.h).
 #pragma once
 
+#include "host/scene/lights.h"
 #include "host/scene/scene.h"
 #include "host/scene/textures.h"
-#include "shared/scene_access.h"
 
 #include <string>
 #include <vector>
@@ -28,18 +29,14 @@ struct HitRecord {
 class EmbreeScene {
   public:
     // Builds the BVH on Embree's default device. Throws std::runtime_error on a device error.
-    explicit EmbreeScene(const Scene& scene);
+    // `lights` gives each hit its emitter index; both must outlive this.
+    EmbreeScene(const Scene& scene, const SceneLights& lights);
     ~EmbreeScene();
     EmbreeScene(const EmbreeScene&) = delete;
     EmbreeScene& operator=(const EmbreeScene&) = delete;
 
     RTCSceneTy* handle() const { return scene_; }
     const Scene& scene() const { return src_; }
-
-    // The shading view: shaders, emitters and their CDF.
-    SceneView view() const;
-    const std::vector<Emitter>& emitters() const { return emitters_; }
-    float brightestEmission() const { return brightest_; }
 
     // Hit setup, the same on every backend: the world-space hit (position, normals, self-
     // intersection offset, shader, emitter) and the albedo the shader's texture gives there.
@@ -56,11 +53,7 @@ class EmbreeScene {
 
     RTCDeviceTy* device_ = nullptr;
     RTCSceneTy* scene_ = nullptr;
-    std::vector<ShaderParams> shaders_;
-    std::vector<Emitter> emitters_;
-    std::vector<float> cdf_;
-    std::vector<int> emitterBase_; // per mesh: index of its first emitter, or -1
-    float brightest_ = 0.0f;
+    const SceneLights& lights_;
     mutable std::string error_;
 };
 

@@ -10,7 +10,7 @@ namespace spw {
 void ReferenceRenderer::renderIteration(uint iteration, Film& film) {
     const Scene& scene = ctx_.scene;
     const EmbreeScene& embree = ctx_.embree;
-    const SceneView view = embree.view();
+    const SceneView view = ctx_.lights.view();
     RenderParams rp = ctx_.params;
     rp.iteration = iteration;
     const int width = scene.image.width, height = scene.image.height;

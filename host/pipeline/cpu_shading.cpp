@@ -1,6 +1,5 @@
 #include "host/pipeline/cpu_shading.h"
 
-#include "embree_backend/embree_scene.h"
 #include "shared/path.h"
 
 #include <tbb/blocked_range.h>
@@ -41,7 +40,7 @@ class CpuShading : public ShadingEngine {
 } // namespace
 
 std::unique_ptr<ShadingEngine> makeCpuShading(const RenderContext& ctx) {
-    return std::make_unique<CpuShading>(ctx.embree.view(), ctx.params, size_t(ctx.scene.settings.shadingSize));
+    return std::make_unique<CpuShading>(ctx.lights.view(), ctx.params, size_t(ctx.scene.settings.shadingSize));
 }
 
 } // namespace spw

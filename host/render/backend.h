@@ -5,6 +5,7 @@
 #include "host/render/camera.h"
 #include "host/image/film.h"
 #include "host/render/render_config.h"
+#include "host/scene/lights.h"
 #include "host/scene/scene.h"
 #include "host/render/stats.h"
 #include "host/scene/textures.h"
@@ -16,6 +17,7 @@ class EmbreeScene;
 struct RenderContext {
     const Scene& scene;
     const RenderConfig& config;
+    const SceneLights& lights; // shaders and emitters, as shading reads them
     const EmbreeScene& embree;
     const TextureResolver& textures;
     const CameraModel& camera;

@@ -88,10 +88,11 @@ std::unique_ptr<RenderResult> renderWithProgress(const Scene& scene, const Rende
     stats.iterations = plan.iterations;
     stats.threads = threads;
 
+    const SceneLights lights(scene);
     std::unique_ptr<EmbreeScene> embree;
     {
         StageTimer t(stats.stages, "build bvh");
-        embree = std::make_unique<EmbreeScene>(scene);
+        embree = std::make_unique<EmbreeScene>(scene, lights);
     }
     TextureResolver textures(scene);
     CameraModel camera(scene, plan.sampleBase);
@@ -103,11 +104,11 @@ std::unique_ptr<RenderResult> renderWithProgress(const Scene& scene, const Rende
     params.maxDepth = uint(scene.settings.maxDepth);
     params.threshold = scene.settings.threshold;
     params.strategy = config.strategy;
-    params.emitterCount = uint(embree->emitters().size());
+    params.emitterCount = uint(lights.emitters().size());
 
-    RenderContext ctx{scene, config, *embree, textures, camera, params, threads, stats};
+    RenderContext ctx{scene, config, lights, *embree, textures, camera, params, threads, stats};
     result->film = std::make_unique<Film>(scene.image.width, scene.image.height, scene.filter,
-                                          embree->brightestEmission(), int(params.samplesPerIteration));
+                                          lights.brightestEmission(), int(params.samplesPerIteration));
     std::unique_ptr<Backend> backend;
     if (config.backend == "reference") backend = std::make_unique<ReferenceRenderer>(ctx);
     else if (vulkan) backend = std::make_unique<SortedRenderer>(ctx, config.pipeline, makeVulkanShading(ctx, config.pipeline, *vulkan));

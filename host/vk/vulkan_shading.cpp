@@ -1,6 +1,5 @@
 #include "host/vk/vulkan_shading.h"
 
-#include "embree_backend/embree_scene.h"
 #include "host/scene/surface_models.h"
 #include "host/vk/buffer.h"
 #include "host/vk/check.h"
@@ -110,7 +109,7 @@ VulkanShading::VulkanShading(const RenderContext& ctx, const PipelineConfig& pip
     std::fill(std::begin(modelPipeline_), std::end(modelPipeline_), -1);
     try {
         const VkPhysicalDeviceLimits& limits = vk_.properties().limits;
-        const SceneView view = ctx.embree.view();
+        const SceneView view = ctx.lights.view();
         const Scene& scene = ctx.scene;
 
         // What the scene needs: the models its meshes use, emitters, textures.

@@ -291,7 +291,8 @@ struct PerHit {
 PerHit shadeSameHits(ShadingMode mode) {
     TempDir dir;
     Scene scene = everyModelScene(dir);
-    EmbreeScene embree(scene);
+    SceneLights lights(scene);
+    EmbreeScene embree(scene, lights);
     TextureResolver textures(scene);
     CameraModel camera(scene, 1);
     RenderStats stats;
@@ -306,8 +307,8 @@ PerHit shadeSameHits(ShadingMode mode) {
     params.maxDepth = 12;
     params.threshold = scene.settings.threshold;
     params.strategy = kStrategyMis;
-    params.emitterCount = uint(embree.emitters().size());
-    RenderContext ctx{scene, cfg, embree, textures, camera, params, 2, stats};
+    params.emitterCount = uint(lights.emitters().size());
+    RenderContext ctx{scene, cfg, lights, embree, textures, camera, params, 2, stats};
 
     const std::uint64_t before = vk::validationMessageCount();
     PerHit out;

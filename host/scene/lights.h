@@ -1,0 +1,37 @@
+// What shading reads of the scene besides the hit: the shader table, and the lights. Every
+// triangle of a mesh whose shader emits is an emitter; next-event estimation picks one with
+// probability proportional to its power (the CDF), and the film's fixed-point scale reads the
+// brightest emission. Built from the Scene alone, apart from the BVH (embree_backend/), as
+// pbrt-v4 builds its lights and light sampler apart from the aggregate.
+#pragma once
+
+#include "host/scene/scene.h"
+#include "shared/scene_access.h"
+
+#include <vector>
+
+namespace spw {
+
+class SceneLights {
+  public:
+    explicit SceneLights(const Scene& scene);
+
+    // The shading view: shaders, emitters and their CDF.
+    SceneView view() const;
+    const std::vector<Emitter>& emitters() const { return emitters_; }
+    float brightestEmission() const { return brightest_; }
+    // The emitter index of a mesh's triangle, or kNoEmitter.
+    uint emitterOf(uint mesh, uint triangle) const {
+        const int base = emitterBase_[mesh];
+        return base >= 0 ? uint(base) + triangle : kNoEmitter;
+    }
+
+  private:
+    std::vector<ShaderParams> shaders_;
+    std::vector<Emitter> emitters_;
+    std::vector<float> cdf_;
+    std::vector<int> emitterBase_; // per mesh: index of its first emitter, or -1
+    float brightest_ = 0.0f;
+};
+
+} // namespace spw
