@@ -131,7 +131,7 @@ int renderCommand(const std::vector<std::string>& args) {
     std::string scenePath, output, statsPath, errorCsvPath, referencePath;
     bool quiet = false;
     spw::RenderConfig config;
-    config.backend = "auto";
+    config.backend = spw::BackendKind::Auto;
     for (size_t i = 0; i < args.size(); ++i) {
         const std::string& a = args[i];
         auto value = [&]() -> std::string {
@@ -144,7 +144,7 @@ int renderCommand(const std::vector<std::string>& args) {
         }
         if (a == "-o" || a == "--output") output = value();
         else if (a == "--spp") config.spp = int(parseInteger(a, value(), 1, 1 << 24));
-        else if (a == "--backend") config.backend = value();
+        else if (a == "--backend") config.backend = choice(a, value(), spw::parseBackend);
         else if (a == "--device") config.vulkan.device = value();
         else if (a == "--shading") config.pipeline.shading = choice(a, value(), spw::parseShadingMode);
         else if (a == "--threads") config.threads = int(parseInteger(a, value(), 1, 1024));
@@ -169,8 +169,6 @@ int renderCommand(const std::vector<std::string>& args) {
         else throw UsageError("more than one scene given ('" + scenePath + "', '" + a + "')");
     }
     if (scenePath.empty()) throw UsageError("render needs a scene file");
-    if (config.backend != "reference" && config.backend != "cpu" && config.backend != "vulkan" && config.backend != "auto")
-        throw UsageError("unknown backend '" + config.backend + "' (auto, vulkan, cpu or reference)");
     if (output.empty()) output = std::filesystem::path(scenePath).stem().string() + ".exr";
     if (!spw::isSupportedOutput(output)) throw UsageError("output '" + output + "' must end in .exr or .png");
     if (!referencePath.empty() && errorCsvPath.empty()) throw UsageError("--reference goes with --error-csv");

@@ -74,12 +74,6 @@ glm::dvec2 octahedralMap(vec3 d) {
     return z < 0 ? octahedralFold(p) : p;
 }
 
-RayFormat parseRayFormat(const std::string& name) {
-    if (name == "compact") return RayFormat::Compact;
-    if (name == "full") return RayFormat::Full;
-    throw std::invalid_argument("unknown ray format '" + name + "' (compact or full)");
-}
-
 void encodeRay(const RayState& r, RayFormat format, uvec4 rounding, std::uint8_t* out) {
     std::uint8_t* p = out;
     for (int i = 0; i < 3; ++i) put<float>(p, r.origin[i]);

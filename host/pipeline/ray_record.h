@@ -30,6 +30,7 @@
 // bounce | flags << 16.
 #pragma once
 
+#include "host/render/render_config.h"
 #include "shared/types.h"
 
 #include <cstddef>
@@ -44,13 +45,11 @@ struct RayState {
     PathState path;
 };
 
-enum class RayFormat { Compact, Full };
 constexpr size_t kCompactRayBytes = 32;
 constexpr size_t kFullRayBytes = 48;
 constexpr uint kMaxCompactBounce = 0x7FFF;
 
 inline size_t rayRecordBytes(RayFormat f) { return f == RayFormat::Compact ? kCompactRayBytes : kFullRayBytes; }
-RayFormat parseRayFormat(const std::string& name); // "compact" | "full"; throws invalid_argument
 
 // `rounding`: four uniform 32-bit words for the stochastic rounding (compact only).
 void encodeRay(const RayState& ray, RayFormat format, uvec4 rounding, std::uint8_t* out);

@@ -81,24 +81,6 @@ void medianByOrigin(RayState* r, size_t n) {
 
 } // namespace
 
-RaySortMode parseRaySortMode(const std::string& name) {
-    if (name == "auto") return RaySortMode::Auto;
-    if (name == "morton") return RaySortMode::Morton;
-    if (name == "median") return RaySortMode::Median;
-    if (name == "off") return RaySortMode::Off;
-    throw std::invalid_argument("unknown ray sort '" + name + "' (auto, morton, median or off)");
-}
-
-const char* raySortName(RaySortMode mode) {
-    switch (mode) {
-    case RaySortMode::Auto: return "auto";
-    case RaySortMode::Morton: return "morton";
-    case RaySortMode::Median: return "median";
-    case RaySortMode::Off: return "off";
-    }
-    return "?";
-}
-
 MortonFrame MortonFrame::of(const std::vector<RayState>& rays) {
     const Bounds b = originBounds(rays.data(), rays.size());
     const vec3 extent = b.hi - b.lo;

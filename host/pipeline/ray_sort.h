@@ -7,7 +7,6 @@
 #pragma once
 
 #include "host/pipeline/radix_sort.h"
-#include "host/pipeline/ray_sort_mode.h"
 #include "host/pipeline/ray_record.h"
 
 #include <cstdint>

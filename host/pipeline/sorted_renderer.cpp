@@ -31,14 +31,6 @@ using Clock = std::chrono::steady_clock;
 double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 } // namespace
 
-ShadingMode parseShadingMode(const std::string& name) {
-    if (name == "sorted") return ShadingMode::Sorted;
-    if (name == "megakernel") return ShadingMode::Megakernel;
-    throw std::invalid_argument("unknown shading '" + name + "' (sorted or megakernel)");
-}
-
-const char* shadingModeName(ShadingMode mode) { return mode == ShadingMode::Sorted ? "sorted" : "megakernel"; }
-
 SortedRenderer::SortedRenderer(const RenderContext& ctx, const PipelineConfig& config,
                                std::unique_ptr<ShadingEngine> shading)
     : ctx_(ctx), config_(config), shading_(std::move(shading)), policy_(config.raySort),
@@ -169,7 +161,7 @@ void SortedRenderer::publishStats() {
     x["bytes_spilled_written"] = c.bytesWritten;
     x["bytes_spilled_read"] = c.bytesRead;
     x["peak_ray_bytes_in_ram"] = c.peakRamBytes;
-    x["ray_format"] = config_.rayFormat == RayFormat::Compact ? "compact" : "full";
+    x["ray_format"] = rayFormatName(config_.rayFormat);
     x["ray_record_bytes"] = rayRecordBytes(config_.rayFormat);
     x["ray_sort"] = raySortName(config_.raySort);
     x["hit_sort"] = config_.sortsHits();

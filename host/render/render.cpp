@@ -51,8 +51,6 @@ std::unique_ptr<RenderResult> render(const Scene& scene, const RenderConfig& con
 
 std::unique_ptr<RenderResult> renderWithProgress(const Scene& scene, const RenderConfig& config,
                                                  const ProgressCallback& onIteration) {
-    if (config.backend != "reference" && config.backend != "cpu" && config.backend != "vulkan" && config.backend != "auto")
-        throw std::invalid_argument("unknown backend '" + config.backend + "' (reference, cpu, vulkan or auto)");
     if (config.pipeline.rayFormat == RayFormat::Compact && scene.settings.maxDepth > int(kMaxCompactBounce))
         throw std::invalid_argument("max depth " + std::to_string(scene.settings.maxDepth) +
                                     " exceeds the compact ray's " + std::to_string(kMaxCompactBounce) + " bounces");
@@ -63,20 +61,20 @@ std::unique_ptr<RenderResult> renderWithProgress(const Scene& scene, const Rende
     auto result = std::make_unique<RenderResult>();
     RenderStats& stats = result->stats;
     const SamplingPlan plan = planSampling(scene.image, config.spp);
-    stats.backend = config.backend;
+    stats.backend = backendName(config.backend);
     stats.device = cpuName();
 
     // Vulkan only when asked for (vulkan, or auto): never for cpu or reference. `auto` takes the
     // first usable device and falls back to cpu, saying so on stderr, when there is none.
     std::unique_ptr<vk::Context> vulkan;
-    if (config.backend == "vulkan" || config.backend == "auto") {
+    if (config.backend == BackendKind::Vulkan || config.backend == BackendKind::Auto) {
         StageTimer t(stats.stages, "vulkan init");
         try {
             vulkan = std::make_unique<vk::Context>(config.vulkan);
             stats.backend = "vulkan";
             stats.device = vulkan->info().name;
         } catch (const vk::NoDeviceError& e) {
-            if (config.backend == "vulkan") throw std::runtime_error(std::string("--backend vulkan: ") + e.what());
+            if (config.backend == BackendKind::Vulkan) throw std::runtime_error(std::string("--backend vulkan: ") + e.what());
             std::fprintf(stderr, "spillway: no Vulkan device; rendering on cpu\n");
             stats.backend = "cpu";
             stats.extra["backend_fallback"] = e.what();
@@ -110,7 +108,7 @@ std::unique_ptr<RenderResult> renderWithProgress(const Scene& scene, const Rende
     result->film = std::make_unique<Film>(scene.image.width, scene.image.height, scene.filter,
                                           lights.brightestEmission(), int(params.samplesPerIteration));
     std::unique_ptr<Backend> backend;
-    if (config.backend == "reference") backend = std::make_unique<ReferenceRenderer>(ctx);
+    if (config.backend == BackendKind::Reference) backend = std::make_unique<ReferenceRenderer>(ctx);
     else if (vulkan) backend = std::make_unique<SortedRenderer>(ctx, config.pipeline, makeVulkanShading(ctx, config.pipeline, *vulkan));
     else backend = std::make_unique<SortedRenderer>(ctx, config.pipeline, makeCpuShading(ctx));
     double renderSeconds = 0;

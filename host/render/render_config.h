@@ -1,13 +1,55 @@
-// Everything about a render that is not the scene: passed explicitly, never global.
+// Everything about a render that is not the scene: passed explicitly, never global. A leaf:
+// it includes nothing of the renderer, so that every part of it (pipeline, vk, the backends)
+// may read its own knobs here without reaching up. The names each option takes on the command
+// line are parsed in render_config.cpp, in one place.
 #pragma once
 
-#include "host/pipeline/sorted_renderer_config.h"
 #include "shared/types.h"
 
 #include <optional>
 #include <string>
 
 namespace spw {
+
+// Which renderer: the sorted pipeline shading with Vulkan or C++, or the depth-first reference.
+// Auto: Vulkan where a device exists, else cpu.
+enum class BackendKind { Auto, Vulkan, Cpu, Reference };
+BackendKind parseBackend(const std::string& name); // auto | vulkan | cpu | reference
+const char* backendName(BackendKind kind);
+
+// How rays wait between bounces (host/pipeline/ray_record.h): 32-byte compact records, or
+// 48-byte full ones that keep every bit.
+enum class RayFormat { Compact, Full };
+RayFormat parseRayFormat(const std::string& name); // compact | full
+const char* rayFormatName(RayFormat format);
+
+// How a batch's rays are ordered before traversal (host/pipeline/ray_sort.h).
+enum class RaySortMode { Auto, Morton, Median, Off };
+RaySortMode parseRaySortMode(const std::string& name); // auto | morton | median | off
+const char* raySortName(RaySortMode mode);
+
+// How hits are shaded. Sorted: hits sorted by (shader, object, primitive), one homogeneous
+// dispatch per shader range, each with its model's own kernel. Megakernel (the ablation): the
+// hits stay unsorted and one uber-shader switches on the model per hit. Unsorted hits (also
+// --hit-sort off) always take the megakernel: they have no homogeneous ranges.
+enum class ShadingMode { Sorted, Megakernel };
+ShadingMode parseShadingMode(const std::string& name); // "sorted" | "megakernel"; throws invalid_argument
+const char* shadingModeName(ShadingMode mode);
+
+// What the scene's settings do not say about the pipeline: the ablation knobs.
+struct PipelineConfig {
+    RayFormat rayFormat = RayFormat::Compact;
+    RaySortMode raySort = RaySortMode::Auto;
+    bool hitSort = true;
+    ShadingMode shading = ShadingMode::Sorted;
+    // Hits are sorted only for sorted shading.
+    bool sortsHits() const { return hitSort && shading == ShadingMode::Sorted; }
+    std::optional<int> binExponent;         // overrides settings: bin exponent
+    std::optional<double> memoryBudgetMiB;  // overrides settings: memory budget
+    std::string spillDir;                   // empty: the system temp folder
+};
+
+// Every parse* throws std::invalid_argument naming the value and the choices.
 
 // The Vulkan backend's knobs (--device, and what the tests switch on).
 struct VulkanConfig {
@@ -22,10 +64,9 @@ struct VulkanConfig {
 };
 
 struct RenderConfig {
-    // reference | cpu | vulkan | auto (vulkan where a device exists, else cpu). The library's
-    // default stays cpu so that callers that do not ask for a device never initialise Vulkan;
-    // the CLI's default is auto.
-    std::string backend = "cpu";
+    // The library's default stays cpu so that callers that do not ask for a device never
+    // initialise Vulkan; the CLI's default is auto.
+    BackendKind backend = BackendKind::Cpu;
     int threads = 0;                    // 0: every core
     std::optional<int> spp;             // overrides sample base and iterations
     std::optional<std::uint32_t> seed;  // overrides settings.seed

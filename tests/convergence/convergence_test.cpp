@@ -34,7 +34,7 @@ const Reference& highSppReference(int size) {
     if (it != refs.end()) return it->second;
     Scene scene = cornell(size);
     RenderConfig cfg;
-    cfg.backend = "reference";
+    cfg.backend = BackendKind::Reference;
     cfg.spp = size < 48 ? 16384 : 4096;
     cfg.seed = 12345; // independent of the test renders' random numbers
     auto result = render(scene, cfg);
@@ -53,7 +53,7 @@ Series convergence(const std::string& backend, std::uint32_t seed, int size, int
     Scene scene = cornell(size);
     const Reference& ref = highSppReference(size);
     RenderConfig cfg;
-    cfg.backend = backend;
+    cfg.backend = parseBackend(backend);
     cfg.spp = firstSpp * 16;
     cfg.seed = seed;
     Series s{};

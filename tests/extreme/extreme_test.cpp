@@ -48,7 +48,7 @@ struct Rendered {
 
 Rendered renderScene(const Scene& scene, const std::string& backend, std::optional<int> spp = {}) {
     RenderConfig cfg;
-    cfg.backend = backend;
+    cfg.backend = parseBackend(backend);
     cfg.spp = spp;
     Rendered r;
     auto result = render(scene, cfg, [&](int, int, const Film& film) {
@@ -473,7 +473,7 @@ TEST(Extreme, MisStrategiesAgreeOnGlossyAndDeltaLobes) {
             std::vector<float> images[3];
             for (uint strategy : {kStrategyMis, kStrategyLight, kStrategyBsdf}) {
                 RenderConfig cfg;
-                cfg.backend = backend;
+                cfg.backend = parseBackend(backend);
                 cfg.strategy = strategy;
                 auto result = render(scene, cfg, [&](int, int, const Film& f) { stats[strategy].add(f.lastIterationImage()); });
                 images[strategy] = result->film->image();

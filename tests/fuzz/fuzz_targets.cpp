@@ -74,7 +74,7 @@ Outcome scene(const std::uint8_t* data, std::size_t size, std::string* detail) {
             s.image.iterations = 1;
             s.settings.maxDepth = std::min(s.settings.maxDepth, 3);
             RenderConfig config;
-            config.backend = "reference";
+            config.backend = BackendKind::Reference;
             config.threads = 1;
             render(s, config);
         },

@@ -69,10 +69,10 @@ TEST(SortedPipeline, FullPrecisionRaysGiveTheReferenceImageBitForBit) {
     strip.settings.maxDepth = 2;
     for (const Scene& scene : {smallCornell(40), everyModel, strip}) {
         RenderConfig ref;
-        ref.backend = "reference";
+        ref.backend = BackendKind::Reference;
         ref.spp = 8;
         RenderConfig cpu = ref;
-        cpu.backend = "cpu";
+        cpu.backend = BackendKind::Cpu;
         cpu.pipeline.rayFormat = RayFormat::Full;
         cpu.pipeline.binExponent = 10;
         const std::vector<float> a = renderImage(scene, ref), b = renderImage(scene, cpu);
@@ -88,10 +88,10 @@ TEST(SortedPipeline, FullPrecisionRaysGiveTheReferenceImageBitForBit) {
 // fails: the test fails with a 0.5 % scale on the compact throughput).
 void expectAgreesWithReference(const Scene& scene, int iterations, const std::string& what) {
     RenderConfig ref;
-    ref.backend = "reference";
+    ref.backend = BackendKind::Reference;
     ref.spp = iterations * scene.image.samplesPerIteration();
     RenderConfig cpu = ref;
-    cpu.backend = "cpu";
+    cpu.backend = BackendKind::Cpu;
     cpu.pipeline.binExponent = 10;
     expectNoPairedDifference(pairedDifference(iterationImages(scene, cpu), iterationImages(scene, ref)),
                              scene.image.width, scene.image.height, what);

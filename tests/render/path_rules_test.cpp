@@ -18,7 +18,7 @@ struct Counts {
 
 Counts countRays(const Scene& scene, const std::string& backend) {
     RenderConfig cfg;
-    cfg.backend = backend;
+    cfg.backend = parseBackend(backend);
     auto r = render(scene, cfg);
     return {double(r->stats.cameraRays.load()), double(r->stats.bounceRays.load()), double(r->stats.shadowRays.load()),
             r->film->image()};
@@ -96,7 +96,7 @@ TEST(PathRules, DielectricAtBothEndsOfItsIorRange) {
                               shader + "\nobjects:\n  - {filename: enclosure.obj, shader: 0}\n  - {filename: plane.obj, shader: 1}\n"));
             for (const std::string& backend : backendsUnderTest()) {
                 RenderConfig cfg;
-                cfg.backend = backend;
+                cfg.backend = parseBackend(backend);
                 PixelStats s;
                 auto r = render(scene, cfg, [&](int, int, const Film& f) { s.add(f.lastIterationImage()); });
                 const MeanError m = s.imageMean();

@@ -14,7 +14,7 @@ namespace {
 
 RenderConfig referenceConfig() {
     RenderConfig cfg;
-    cfg.backend = "reference";
+    cfg.backend = BackendKind::Reference;
     return cfg;
 }
 

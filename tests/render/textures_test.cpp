@@ -67,7 +67,7 @@ TEST(Textures, LayeredImageOverConstantByImageMaskOnEveryBackend) {
                   "  - {filename: plane.obj, shader: 1}\n"));
     for (const std::string& backend : backendsUnderTest()) {
         RenderConfig cfg;
-        cfg.backend = backend;
+        cfg.backend = parseBackend(backend);
         cfg.strategy = kStrategyBsdf;
         // Full-precision rays: the compact record would round the albedo (now the throughput)
         // to bfloat16, unbiased but 2^-8 apart (CompactRay.* test that on its own).

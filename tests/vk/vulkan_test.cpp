@@ -63,7 +63,7 @@ Scene enclosure(const TempDir& dir) {
 
 RenderConfig validatedVulkan(int spp) {
     RenderConfig cfg;
-    cfg.backend = "vulkan";
+    cfg.backend = BackendKind::Vulkan;
     cfg.vulkan.validation = true;
     cfg.spp = spp;
     return cfg;
@@ -186,7 +186,7 @@ TEST(VulkanDevice, ValidationLayerIsLiveAndCounted) {
 // Not in the sanitized build, where only the Vulkan* tests ask for it.
 TEST(VulkanDevice, EveryRenderInTheSuiteRunsUnderTheValidationLayer) {
     RenderConfig cfg;
-    cfg.backend = "vulkan";
+    cfg.backend = BackendKind::Vulkan;
     cfg.spp = 1;
     ASSERT_FALSE(cfg.vulkan.validation);
     auto result = render(smallCornell(8), cfg);
@@ -200,7 +200,7 @@ TEST(VulkanVsCpu, CornellBoxAgreesUpToFloatRounding) {
     Scene scene = smallCornell(32);
     RenderConfig vkCfg = validatedVulkan(16);
     RenderConfig cpuCfg = vkCfg;
-    cpuCfg.backend = "cpu";
+    cpuCfg.backend = BackendKind::Cpu;
     std::vector<std::vector<float>> v, c;
     auto result = renderValidated(scene, vkCfg, &v);
     render(scene, cpuCfg, [&](int, int, const Film& film) { c.push_back(film.lastIterationImage()); });
@@ -218,7 +218,7 @@ TEST(VulkanVsCpu, ClosedEnclosureAgreesUpToFloatRounding) {
     Scene scene = enclosure(dir);
     RenderConfig vkCfg = validatedVulkan(32);
     RenderConfig cpuCfg = vkCfg;
-    cpuCfg.backend = "cpu";
+    cpuCfg.backend = BackendKind::Cpu;
     std::vector<std::vector<float>> v, c;
     auto result = renderValidated(scene, vkCfg, &v);
     render(scene, cpuCfg, [&](int, int, const Film& film) { c.push_back(film.lastIterationImage()); });
@@ -297,7 +297,7 @@ PerHit shadeSameHits(ShadingMode mode) {
     CameraModel camera(scene, 1);
     RenderStats stats;
     RenderConfig cfg;
-    cfg.backend = "vulkan";
+    cfg.backend = BackendKind::Vulkan;
     cfg.vulkan.validation = true;
     cfg.pipeline.shading = mode;
     RenderParams params{};
@@ -462,7 +462,7 @@ TEST(VulkanMegakernel, MatchesCpuAndBuildsOnlyTheUberShader) {
     RenderConfig vkCfg = validatedVulkan(8);
     vkCfg.pipeline.shading = ShadingMode::Megakernel;
     RenderConfig cpuCfg = vkCfg;
-    cpuCfg.backend = "cpu";
+    cpuCfg.backend = BackendKind::Cpu;
     std::vector<std::vector<float>> vi, ci;
     auto v = renderValidated(scene, vkCfg, &vi);
     render(scene, cpuCfg, [&](int, int, const Film& film) { ci.push_back(film.lastIterationImage()); });
