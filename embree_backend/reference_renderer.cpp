@@ -28,9 +28,7 @@ void ReferenceRenderer::renderIteration(uint iteration, Film& film) {
                         const uint sampleIndex = iteration * spi + s;
                         CameraRay cr = ctx_.camera.generate(uint(x), uint(y), s, sampleIndex, rp.seed);
                         film.addSample(cr.filmPos, sampleIndex);
-                        PathState st{};
-                        st.beta = vec3(1.0f);
-                        st.pathId = pixel * spi + s;
+                        PathState st = cameraPath(rp, pixel, s);
                         vec3 org = cr.origin, dir = cr.dir;
                         ++camera;
                         for (;;) {

@@ -54,9 +54,7 @@ void generateCameraRays(const RenderContext& ctx, uint iteration, RayFormat form
                     RayState r;
                     r.origin = cr.origin;
                     r.dir = cr.dir;
-                    r.path = PathState{};
-                    r.path.beta = vec3(1.0f);
-                    r.path.pathId = uint(y * width + x) * spi + s;
+                    r.path = cameraPath(rp, uint(y * width + x), s);
                     buffer.push(r, format, roundingBits(rp, r.path));
                 }
         ctx.stats.cameraRays += buffer.count;

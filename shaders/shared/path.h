@@ -19,6 +19,18 @@ SHARED_FN uint pathSample(RenderParams rp, uint pathId) {
     return rp.iteration * rp.samplesPerIteration + pathId % rp.samplesPerIteration;
 }
 
+// A camera path's state before its first bounce: throughput 1, sample `s` of `pixel`.
+SHARED_FN PathState cameraPath(RenderParams rp, uint pixel, uint s) {
+    PathState st;
+    st.beta = vec3(1.0f);
+    st.prevPdf = 0.0f;
+    st.pathId = pixel * rp.samplesPerIteration + s;
+    st.bounce = 0u;
+    st.flags = 0u;
+    st.pad0 = 0u;
+    return st;
+}
+
 SHARED_FN void shadeSurface(SCENE_PARAM RenderParams rp, SurfaceHit hit, vec3 rayDir, PathState st,
                             OUT(ShadeResult) r) {
     r.flags = 0u;
