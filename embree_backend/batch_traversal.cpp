@@ -43,7 +43,8 @@ HitRecord toHitRecord(const RTCRayHit& rh) {
 RTCIntersectContext context(bool coherent) {
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
-    ctx.flags = coherent ? RTC_INTERSECT_CONTEXT_FLAG_COHERENT : RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
+    ctx.flags =
+        coherent ? RTC_INTERSECT_CONTEXT_FLAG_COHERENT : RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
     return ctx;
 }
 } // namespace
@@ -55,10 +56,12 @@ void intersectBatch(const EmbreeScene& scene, const RayStream& rays, bool cohere
     tbb::parallel_for(size_t(0), groups, [&](size_t g) {
         const size_t begin = g * kGroup, end = std::min(rays.count, begin + kGroup);
         RTCRayHit buf[kGroup];
-        for (size_t i = begin; i < end; ++i) fillRayHit(buf[i - begin], rays.originAt(i), rays.dirAt(i));
+        for (size_t i = begin; i < end; ++i)
+            fillRayHit(buf[i - begin], rays.originAt(i), rays.dirAt(i));
         RTCIntersectContext ctx = context(coherent);
         rtcIntersect1M(scene.handle(), &ctx, buf, unsigned(end - begin), sizeof(RTCRayHit));
-        for (size_t i = begin; i < end; ++i) hits[i] = toHitRecord(buf[i - begin]);
+        for (size_t i = begin; i < end; ++i)
+            hits[i] = toHitRecord(buf[i - begin]);
     });
 }
 
@@ -69,10 +72,12 @@ void occludedBatch(const EmbreeScene& scene, const std::vector<ShadowRay>& rays,
     tbb::parallel_for(size_t(0), groups, [&](size_t g) {
         const size_t begin = g * kGroup, end = std::min(rays.size(), begin + kGroup);
         RTCRay buf[kGroup];
-        for (size_t i = begin; i < end; ++i) fillRay(buf[i - begin], rays[i].origin, rays[i].dir, rays[i].tmax);
+        for (size_t i = begin; i < end; ++i)
+            fillRay(buf[i - begin], rays[i].origin, rays[i].dir, rays[i].tmax);
         RTCIntersectContext ctx = context(coherent);
         rtcOccluded1M(scene.handle(), &ctx, buf, unsigned(end - begin), sizeof(RTCRay));
-        for (size_t i = begin; i < end; ++i) occluded[i] = buf[i - begin].tfar < 0.0f ? 1 : 0;
+        for (size_t i = begin; i < end; ++i)
+            occluded[i] = buf[i - begin].tfar < 0.0f ? 1 : 0;
     });
 }
 

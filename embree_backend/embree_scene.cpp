@@ -10,14 +10,17 @@ namespace spw {
 namespace {
 void onEmbreeError(void* user, RTCError code, const char* message) {
     auto* error = static_cast<std::string*>(user);
-    if (error->empty()) *error = "Embree error " + std::to_string(int(code)) + ": " + (message ? message : "");
+    if (error->empty())
+        *error = "Embree error " + std::to_string(int(code)) + ": " + (message ? message : "");
 }
 } // namespace
 
-EmbreeScene::EmbreeScene(const Scene& scene, const SceneLights& lights) : src_(scene), lights_(lights) {
+EmbreeScene::EmbreeScene(const Scene& scene, const SceneLights& lights)
+    : src_(scene), lights_(lights) {
     device_ = rtcNewDevice(nullptr);
-    if (!device_) throw std::runtime_error("cannot create the Embree device (error " +
-                                           std::to_string(int(rtcGetDeviceError(nullptr))) + ")");
+    if (!device_)
+        throw std::runtime_error("cannot create the Embree device (error " +
+                                 std::to_string(int(rtcGetDeviceError(nullptr))) + ")");
     rtcSetDeviceErrorFunction(device_, onEmbreeError, &error_);
     scene_ = rtcNewScene(device_);
     rtcSetSceneFlags(scene_, RTC_SCENE_FLAG_ROBUST);
@@ -26,14 +29,18 @@ EmbreeScene::EmbreeScene(const Scene& scene, const SceneLights& lights) : src_(s
     for (size_t m = 0; m < scene.meshes.size(); ++m) {
         const Mesh& mesh = scene.meshes[m];
         RTCGeometry g = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
-        auto* vb = static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
-                                                               3 * sizeof(float), mesh.positions.size()));
+        auto* vb = static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0,
+                                                               RTC_FORMAT_FLOAT3, 3 * sizeof(float),
+                                                               mesh.positions.size()));
         for (size_t i = 0; i < mesh.positions.size(); ++i)
-            for (int k = 0; k < 3; ++k) vb[3 * i + k] = mesh.positions[i][k];
-        auto* ib = static_cast<unsigned*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
-                                                                  3 * sizeof(unsigned), mesh.triangles.size()));
+            for (int k = 0; k < 3; ++k)
+                vb[3 * i + k] = mesh.positions[i][k];
+        auto* ib = static_cast<unsigned*>(
+            rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                    3 * sizeof(unsigned), mesh.triangles.size()));
         for (size_t i = 0; i < mesh.triangles.size(); ++i)
-            for (int k = 0; k < 3; ++k) ib[3 * i + k] = mesh.triangles[i][k];
+            for (int k = 0; k < 3; ++k)
+                ib[3 * i + k] = mesh.triangles[i][k];
         rtcCommitGeometry(g);
         rtcAttachGeometryByID(scene_, g, unsigned(m));
         rtcReleaseGeometry(g);
@@ -51,7 +58,8 @@ void EmbreeScene::checkError(const char* what) const {
     if (!error_.empty()) throw std::runtime_error(error_ + " (while " + what + ")");
 }
 
-void EmbreeScene::surfaceHit(uint geomID, uint primID, float u, float v, float t, SurfaceHit& hit) const {
+void EmbreeScene::surfaceHit(uint geomID, uint primID, float u, float v, float t,
+                             SurfaceHit& hit) const {
     const Mesh& mesh = src_.meshes[geomID];
     const uvec3 tri = mesh.triangles[primID];
     const vec3 p0 = mesh.positions[tri.x], p1 = mesh.positions[tri.y], p2 = mesh.positions[tri.z];

@@ -19,14 +19,16 @@ void ReferenceRenderer::renderIteration(uint iteration, Film& film) {
 
     StageTimer timer(ctx_.stats.stages, "trace and shade");
     tbb::parallel_for(
-        tbb::blocked_range2d<int>(0, height, tile, 0, width, tile), [&](const tbb::blocked_range2d<int>& r) {
+        tbb::blocked_range2d<int>(0, height, tile, 0, width, tile),
+        [&](const tbb::blocked_range2d<int>& r) {
             std::uint64_t camera = 0, bounce = 0, shadow = 0;
             for (int y = r.rows().begin(); y < r.rows().end(); ++y)
                 for (int x = r.cols().begin(); x < r.cols().end(); ++x)
                     for (uint s = 0; s < spi; ++s) {
                         const uint pixel = uint(y * width + x);
                         const uint sampleIndex = iteration * spi + s;
-                        CameraRay cr = ctx_.camera.generate(uint(x), uint(y), s, sampleIndex, rp.seed);
+                        CameraRay cr =
+                            ctx_.camera.generate(uint(x), uint(y), s, sampleIndex, rp.seed);
                         film.addSample(cr.filmPos, sampleIndex);
                         PathState st = cameraPath(rp, pixel, s);
                         vec3 org = cr.origin, dir = cr.dir;
@@ -38,11 +40,14 @@ void ReferenceRenderer::renderIteration(uint iteration, Film& film) {
                             ShadeResult res;
                             shadeSurface(view, rp, hit, dir, st, res);
                             if (res.flags & kShadeEmitted)
-                                film.splat(cr.filmPos, sampleIndex, res.emitted, filmKey(st.pathId, st.bounce, false));
+                                film.splat(cr.filmPos, sampleIndex, res.emitted,
+                                           filmKey(st.pathId, st.bounce, false));
                             if (res.flags & kShadeShadow) {
                                 ++shadow;
-                                if (!occludedOne(embree, {res.shadowOrigin, res.shadowDir, res.shadowTmax}))
-                                    film.splat(cr.filmPos, sampleIndex, res.shadowContribution, filmKey(st.pathId, st.bounce, true));
+                                if (!occludedOne(embree,
+                                                 {res.shadowOrigin, res.shadowDir, res.shadowTmax}))
+                                    film.splat(cr.filmPos, sampleIndex, res.shadowContribution,
+                                               filmKey(st.pathId, st.bounce, true));
                             }
                             if (!(res.flags & kShadeContinue)) break;
                             ++bounce;

@@ -27,11 +27,15 @@ namespace {
 class ValidationListener : public ::testing::EmptyTestEventListener {
     std::uint64_t before_ = 0;
     bool failed_ = false;
-    void OnTestStart(const ::testing::TestInfo&) override { before_ = vk::validationMessageCount(); }
+    void OnTestStart(const ::testing::TestInfo&) override {
+        before_ = vk::validationMessageCount();
+    }
     void OnTestEnd(const ::testing::TestInfo& info) override {
         const std::uint64_t messages = vk::validationMessageCount() - before_;
         if (messages == 0 || std::string(info.name()) == "ValidationLayerIsLiveAndCounted") return;
-        std::fprintf(stderr, "FAILED: the Vulkan validation layer reported %llu message(s) during %s.%s (see above)\n",
+        std::fprintf(stderr,
+                     "FAILED: the Vulkan validation layer reported %llu message(s) during %s.%s "
+                     "(see above)\n",
                      (unsigned long long)messages, info.test_suite_name(), info.name());
         failed_ = true;
     }
@@ -72,7 +76,9 @@ std::string TempDir::write(const std::string& name, const std::string& text) con
     return p;
 }
 
-std::string sourceDir() { return SPILLWAY_SOURCE_DIR; }
+std::string sourceDir() {
+    return SPILLWAY_SOURCE_DIR;
+}
 
 std::string readFile(const std::string& path) {
     std::ifstream in(path, std::ios::binary);
@@ -82,12 +88,17 @@ std::string readFile(const std::string& path) {
 }
 
 std::string replaceAll(std::string s, const std::string& key, const std::string& value) {
-    for (size_t at = 0; (at = s.find(key, at)) != std::string::npos; at += value.size()) s.replace(at, key.size(), value);
+    for (size_t at = 0; (at = s.find(key, at)) != std::string::npos; at += value.size())
+        s.replace(at, key.size(), value);
     return s;
 }
 
-std::vector<std::string> backendsUnderTest() { return {"reference", "cpu", "vulkan"}; }
-std::string binary() { return SPILLWAY_BINARY; }
+std::vector<std::string> backendsUnderTest() {
+    return {"reference", "cpu", "vulkan"};
+}
+std::string binary() {
+    return SPILLWAY_BINARY;
+}
 
 CommandResult runSpillway(const std::string& args) {
     std::string cmd = binary() + " " + args + " 2>&1";
@@ -96,14 +107,16 @@ CommandResult runSpillway(const std::string& args) {
     std::string out;
     char buf[4096];
     size_t n;
-    while ((n = fread(buf, 1, sizeof buf, p)) > 0) out.append(buf, n);
+    while ((n = fread(buf, 1, sizeof buf, p)) > 0)
+        out.append(buf, n);
     int st = pclose(p);
     return {WIFEXITED(st) ? WEXITSTATUS(st) : -1, out};
 }
 
 double mean(const std::vector<float>& rgb) {
     double s = 0;
-    for (float v : rgb) s += v;
+    for (float v : rgb)
+        s += v;
     return rgb.empty() ? 0.0 : s / double(rgb.size());
 }
 
@@ -134,34 +147,41 @@ double PixelStats::variance(size_t i) const {
     return std::max(0.0, (sum2[i] - n * mean(i) * mean(i)) / (n - 1));
 }
 
-double PixelStats::stderror(size_t i) const { return std::sqrt(meanVariance(i)); }
+double PixelStats::stderror(size_t i) const {
+    return std::sqrt(meanVariance(i));
+}
 
 double PixelStats::averageVariance() const {
     double v = 0;
-    for (size_t i = 0; i < pixels(); ++i) v += variance(i);
+    for (size_t i = 0; i < pixels(); ++i)
+        v += variance(i);
     return v / double(pixels());
 }
 
 MeanError PixelStats::imageMean() const {
     double m = 0, var = 0;
-    for (size_t i = 0; i < pixels(); ++i) m += mean(i), var += meanVariance(i);
+    for (size_t i = 0; i < pixels(); ++i)
+        m += mean(i), var += meanVariance(i);
     const double p = double(pixels());
     return {m / p, std::sqrt(var) / p};
 }
 
 std::vector<std::vector<float>> iterationImages(const Scene& scene, const RenderConfig& config) {
     std::vector<std::vector<float>> images;
-    render(scene, config, [&](int, int, const Film& film) { images.push_back(film.lastIterationImage()); });
+    render(scene, config,
+           [&](int, int, const Film& film) { images.push_back(film.lastIterationImage()); });
     return images;
 }
 
-PixelStats pairedDifference(const std::vector<std::vector<float>>& a, const std::vector<std::vector<float>>& b) {
+PixelStats pairedDifference(const std::vector<std::vector<float>>& a,
+                            const std::vector<std::vector<float>>& b) {
     PixelStats d;
     EXPECT_EQ(a.size(), b.size()) << "iterations";
     for (size_t k = 0; k < std::min(a.size(), b.size()); ++k) {
         EXPECT_EQ(a[k].size(), b[k].size());
         std::vector<float> diff(a[k].size());
-        for (size_t i = 0; i < diff.size(); ++i) diff[i] = a[k][i] - b[k][i];
+        for (size_t i = 0; i < diff.size(); ++i)
+            diff[i] = a[k][i] - b[k][i];
         d.add(diff);
     }
     return d;
@@ -195,10 +215,12 @@ void expectNoPairedDifference(const PixelStats& d, int width, int height, const 
     for (size_t i = 0; i < d.pixels(); ++i)
         if (std::fabs(d.mean(i)) > 4.5 * d.stderror(i) + tolerance + 1e-12) ++outliers;
     const double worstZ = worstBlockZ(
-        width, height, [&](size_t i) { return d.mean(i); }, [&](size_t i) { return d.meanVariance(i); }, tolerance);
-    std::printf("  %-40s paired difference %+.3g +- %.3g (z %+.2f), worst 8x8 block |z| %.2f, outlier pixels %zu/%zu\n",
-                what.c_str(), m.mean, m.stderror, m.stderror > 0 ? m.mean / m.stderror : 0.0, worstZ, outliers,
-                d.pixels());
+        width, height, [&](size_t i) { return d.mean(i); },
+        [&](size_t i) { return d.meanVariance(i); }, tolerance);
+    std::printf("  %-40s paired difference %+.3g +- %.3g (z %+.2f), worst 8x8 block |z| %.2f, "
+                "outlier pixels %zu/%zu\n",
+                what.c_str(), m.mean, m.stderror, m.stderror > 0 ? m.mean / m.stderror : 0.0,
+                worstZ, outliers, d.pixels());
     EXPECT_LE(std::fabs(m.mean), 4.0 * m.stderror + tolerance) << what;
     EXPECT_LT(worstZ, 4.5) << what;
     EXPECT_LE(double(outliers), 0.001 * double(d.pixels())) << what;
@@ -218,8 +240,8 @@ std::string insideCubeObj() {
 
 std::string floorObj(float h) {
     char buf[256];
-    std::snprintf(buf, sizeof buf, "v %g 0 %g\nv %g 0 %g\nv %g 0 %g\nv %g 0 %g\nf 1 2 3 4\n", -h, -h, -h, h, h,
-                  h, h, -h);
+    std::snprintf(buf, sizeof buf, "v %g 0 %g\nv %g 0 %g\nv %g 0 %g\nv %g 0 %g\nf 1 2 3 4\n", -h,
+                  -h, -h, h, h, h, h, -h);
     return buf;
 }
 

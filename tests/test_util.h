@@ -94,7 +94,8 @@ std::vector<std::vector<float>> iterationImages(const Scene& scene, const Render
 // their random numbers (same seed, same sample counts) most of the noise cancels iteration by
 // iteration: what is left is the difference between the two renderers, and its standard errors
 // come from its own spread, far smaller than either render's (pixels and iterations independent).
-PixelStats pairedDifference(const std::vector<std::vector<float>>& a, const std::vector<std::vector<float>>& b);
+PixelStats pairedDifference(const std::vector<std::vector<float>>& a,
+                            const std::vector<std::vector<float>>& b);
 
 // The largest |z| over the image's 8x8 blocks of a per-pixel difference: |sum of the
 // differences| less `allowed` per pixel, over the square root of the sum of their variances

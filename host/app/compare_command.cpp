@@ -83,7 +83,8 @@ int runCompare(const std::vector<std::string>& args) {
         } else if (a == "--heatmap") {
             heatmapPath = value();
             std::string ext = std::filesystem::path(heatmapPath).extension().string();
-            std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+            std::transform(ext.begin(), ext.end(), ext.begin(),
+                           [](unsigned char c) { return char(std::tolower(c)); });
             if (ext != ".png") throw UsageError("--heatmap '" + heatmapPath + "' must end in .png");
         } else if (a == "--threshold") {
             try {

@@ -19,7 +19,8 @@ void ErrorCsv::addRow(int iteration, int spp, double seconds, const Film& film) 
     if (reference_) {
         ImageMetrics m = compareImages({film.width(), film.height(), film.image()}, *reference_);
         row << "," << m.mse << "," << m.rmse << "," << m.relMse << "," << m.mae << ","
-            << (std::isinf(m.psnr) ? std::string("inf") : std::to_string(m.psnr)) << "," << m.maxAbs;
+            << (std::isinf(m.psnr) ? std::string("inf") : std::to_string(m.psnr)) << ","
+            << m.maxAbs;
     }
     row << "\n";
     out_.write(row.str());

@@ -80,9 +80,11 @@ long long parseInteger(const std::string& flag, const std::string& v, long long 
     } catch (const std::exception&) {
         used = 0;
     }
-    if (used != v.size() || v.empty()) throw UsageError(flag + " takes an integer, not '" + v + "'");
+    if (used != v.size() || v.empty())
+        throw UsageError(flag + " takes an integer, not '" + v + "'");
     if (n < lo || n > hi)
-        throw UsageError(flag + " must be in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
+        throw UsageError(flag + " must be in [" + std::to_string(lo) + ", " + std::to_string(hi) +
+                         "]");
     return n;
 }
 
@@ -94,8 +96,11 @@ double parseNumber(const std::string& flag, const std::string& v, double lo, dou
     } catch (const std::exception&) {
         used = 0;
     }
-    if (used != v.size() || v.empty() || !std::isfinite(x)) throw UsageError(flag + " takes a number, not '" + v + "'");
-    if (x < lo || x > hi) throw UsageError(flag + " must be in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
+    if (used != v.size() || v.empty() || !std::isfinite(x))
+        throw UsageError(flag + " takes a number, not '" + v + "'");
+    if (x < lo || x > hi)
+        throw UsageError(flag + " must be in [" + std::to_string(lo) + ", " + std::to_string(hi) +
+                         "]");
     return x;
 }
 
@@ -118,12 +123,14 @@ int devicesCommand(const std::vector<std::string>& args) {
         return 1;
     }
     if (devices.empty()) {
-        std::fprintf(stderr, "spillway: no Vulkan device (the loader found drivers but no device)\n");
+        std::fprintf(stderr,
+                     "spillway: no Vulkan device (the loader found drivers but no device)\n");
         return 1;
     }
     for (const spw::vk::DeviceInfo& d : devices)
-        std::printf("%u: %s\n   type: %s, Vulkan %s, driver: %s\n   %s\n", d.index, d.name.c_str(), d.type.c_str(),
-                    d.api.c_str(), d.driver.c_str(), d.usable ? "usable" : ("unusable: " + d.whyNot).c_str());
+        std::printf("%u: %s\n   type: %s, Vulkan %s, driver: %s\n   %s\n", d.index, d.name.c_str(),
+                    d.type.c_str(), d.api.c_str(), d.driver.c_str(),
+                    d.usable ? "usable" : ("unusable: " + d.whyNot).c_str());
     return 0;
 }
 
@@ -142,36 +149,58 @@ int renderCommand(const std::vector<std::string>& args) {
             std::fputs(kUsage, stdout);
             return 0;
         }
-        if (a == "-o" || a == "--output") output = value();
-        else if (a == "--spp") config.spp = int(parseInteger(a, value(), 1, 1 << 24));
-        else if (a == "--backend") config.backend = choice(a, value(), spw::parseBackend);
-        else if (a == "--device") config.vulkan.device = value();
-        else if (a == "--shading") config.pipeline.shading = choice(a, value(), spw::parseShadingMode);
-        else if (a == "--threads") config.threads = int(parseInteger(a, value(), 1, 1024));
-        else if (a == "--seed") config.seed = std::uint32_t(parseInteger(a, value(), 0, 0xFFFFFFFFLL));
-        else if (a == "--stats") statsPath = value();
-        else if (a == "--quiet") quiet = true;
-        else if (a == "--error-csv") errorCsvPath = value();
-        else if (a == "--reference") referencePath = value();
-        else if (a == "--time-limit") config.timeLimitSeconds = parseNumber(a, value(), 1e-3, 1e9);
-        else if (a == "--bin-exponent") config.pipeline.binExponent = int(parseInteger(a, value(), 4, 24));
-        else if (a == "--memory-budget") config.pipeline.memoryBudgetMiB = parseNumber(a, value(), 1.0 / 1024, 1 << 20);
-        else if (a == "--spill-dir") config.pipeline.spillDir = value();
-        else if (a == "--ray-sort") config.pipeline.raySort = choice(a, value(), spw::parseRaySortMode);
-        else if (a == "--ray-format") config.pipeline.rayFormat = choice(a, value(), spw::parseRayFormat);
+        if (a == "-o" || a == "--output")
+            output = value();
+        else if (a == "--spp")
+            config.spp = int(parseInteger(a, value(), 1, 1 << 24));
+        else if (a == "--backend")
+            config.backend = choice(a, value(), spw::parseBackend);
+        else if (a == "--device")
+            config.vulkan.device = value();
+        else if (a == "--shading")
+            config.pipeline.shading = choice(a, value(), spw::parseShadingMode);
+        else if (a == "--threads")
+            config.threads = int(parseInteger(a, value(), 1, 1024));
+        else if (a == "--seed")
+            config.seed = std::uint32_t(parseInteger(a, value(), 0, 0xFFFFFFFFLL));
+        else if (a == "--stats")
+            statsPath = value();
+        else if (a == "--quiet")
+            quiet = true;
+        else if (a == "--error-csv")
+            errorCsvPath = value();
+        else if (a == "--reference")
+            referencePath = value();
+        else if (a == "--time-limit")
+            config.timeLimitSeconds = parseNumber(a, value(), 1e-3, 1e9);
+        else if (a == "--bin-exponent")
+            config.pipeline.binExponent = int(parseInteger(a, value(), 4, 24));
+        else if (a == "--memory-budget")
+            config.pipeline.memoryBudgetMiB = parseNumber(a, value(), 1.0 / 1024, 1 << 20);
+        else if (a == "--spill-dir")
+            config.pipeline.spillDir = value();
+        else if (a == "--ray-sort")
+            config.pipeline.raySort = choice(a, value(), spw::parseRaySortMode);
+        else if (a == "--ray-format")
+            config.pipeline.rayFormat = choice(a, value(), spw::parseRayFormat);
         else if (a == "--hit-sort") {
             std::string v = value();
-            if (v != "on" && v != "off") throw UsageError("--hit-sort takes on or off, not '" + v + "'");
+            if (v != "on" && v != "off")
+                throw UsageError("--hit-sort takes on or off, not '" + v + "'");
             config.pipeline.hitSort = v == "on";
-        }
-        else if (!a.empty() && a[0] == '-') throw UsageError("unknown option '" + a + "'");
-        else if (scenePath.empty()) scenePath = a;
-        else throw UsageError("more than one scene given ('" + scenePath + "', '" + a + "')");
+        } else if (!a.empty() && a[0] == '-')
+            throw UsageError("unknown option '" + a + "'");
+        else if (scenePath.empty())
+            scenePath = a;
+        else
+            throw UsageError("more than one scene given ('" + scenePath + "', '" + a + "')");
     }
     if (scenePath.empty()) throw UsageError("render needs a scene file");
     if (output.empty()) output = std::filesystem::path(scenePath).stem().string() + ".exr";
-    if (!spw::isSupportedOutput(output)) throw UsageError("output '" + output + "' must end in .exr or .png");
-    if (!referencePath.empty() && errorCsvPath.empty()) throw UsageError("--reference goes with --error-csv");
+    if (!spw::isSupportedOutput(output))
+        throw UsageError("output '" + output + "' must end in .exr or .png");
+    if (!referencePath.empty() && errorCsvPath.empty())
+        throw UsageError("--reference goes with --error-csv");
     // Every output path is checked before any work, so that a typo costs no render.
     for (const std::string* path : {&output, &statsPath, &errorCsvPath})
         if (!path->empty()) spw::checkWritable(*path);
@@ -179,8 +208,8 @@ int renderCommand(const std::vector<std::string>& args) {
     spw::Scene scene = spw::loadScene(scenePath);
     for (const spw::Mesh& m : scene.meshes)
         if (m.droppedTriangles > 0)
-            std::fprintf(stderr, "spillway: warning: %s: dropped %d zero-area triangle%s\n", m.name.c_str(),
-                         m.droppedTriangles, m.droppedTriangles == 1 ? "" : "s");
+            std::fprintf(stderr, "spillway: warning: %s: dropped %d zero-area triangle%s\n",
+                         m.name.c_str(), m.droppedTriangles, m.droppedTriangles == 1 ? "" : "s");
 
     std::optional<spw::ImageRGB> reference;
     if (!referencePath.empty()) {
@@ -190,20 +219,23 @@ int renderCommand(const std::vector<std::string>& args) {
             throw UsageError(e.what());
         }
         if (reference->width != scene.image.width || reference->height != scene.image.height)
-            throw UsageError("reference '" + referencePath + "' is " + std::to_string(reference->width) + "x" +
-                             std::to_string(reference->height) + ", the scene renders " +
-                             std::to_string(scene.image.width) + "x" + std::to_string(scene.image.height));
+            throw UsageError(
+                "reference '" + referencePath + "' is " + std::to_string(reference->width) + "x" +
+                std::to_string(reference->height) + ", the scene renders " +
+                std::to_string(scene.image.width) + "x" + std::to_string(scene.image.height));
     }
     std::unique_ptr<spw::ErrorCsv> errorCsv;
-    if (!errorCsvPath.empty()) errorCsv = std::make_unique<spw::ErrorCsv>(errorCsvPath, std::move(reference));
+    if (!errorCsvPath.empty())
+        errorCsv = std::make_unique<spw::ErrorCsv>(errorCsvPath, std::move(reference));
 
     spw::ProgressBar progress(!quiet && isatty(STDERR_FILENO));
     const spw::SamplingPlan plan = spw::planSampling(scene.image, config.spp);
     const int sppPerIteration = plan.sampleBase * plan.sampleBase;
-    auto result = spw::renderWithProgress(scene, config, [&](const spw::IterationInfo& info, const spw::Film& film) {
-        if (errorCsv) errorCsv->addRow(info.done, info.spp, info.renderSeconds, film);
-        progress.update(info.done, info.total, info.spp, info.total * sppPerIteration);
-    });
+    auto result = spw::renderWithProgress(
+        scene, config, [&](const spw::IterationInfo& info, const spw::Film& film) {
+            if (errorCsv) errorCsv->addRow(info.done, info.spp, info.renderSeconds, film);
+            progress.update(info.done, info.total, info.spp, info.total * sppPerIteration);
+        });
     progress.finish();
 
     // Every output is written whole, and flushed, before any is given its name: a failure in
@@ -211,8 +243,8 @@ int renderCommand(const std::vector<std::string>& args) {
     spw::OutputFile image(output);
     {
         spw::StageTimer t(result->stats.stages, "write image");
-        const std::vector<unsigned char> bytes =
-            spw::encodeImage(output, {scene.image.width, scene.image.height, result->film->image()});
+        const std::vector<unsigned char> bytes = spw::encodeImage(
+            output, {scene.image.width, scene.image.height, result->film->image()});
         image.write(bytes.data(), bytes.size());
         image.flush();
     }
@@ -227,11 +259,13 @@ int renderCommand(const std::vector<std::string>& args) {
         std::fprintf(stderr, "spillway: warning: %llu non-finite samples were dropped\n",
                      (unsigned long long)result->stats.nonFiniteSamples);
     if (result->stats.saturatedSamples > 0)
-        std::fprintf(stderr,
-                     "spillway: warning: %llu sample values exceeded the film's range (at least 2^16 times the "
-                     "brightest emitter) and were clamped: the image is darker than it should be where they "
-                     "landed\n",
-                     (unsigned long long)result->stats.saturatedSamples);
+        std::fprintf(
+            stderr,
+            "spillway: warning: %llu sample values exceeded the film's range (at least 2^16 times "
+            "the "
+            "brightest emitter) and were clamped: the image is darker than it should be where they "
+            "landed\n",
+            (unsigned long long)result->stats.saturatedSamples);
     image.commit();
     if (stats) stats->commit();
     if (errorCsv) errorCsv->commit();

@@ -12,14 +12,15 @@ std::string clock(double s) {
 
 void ProgressBar::update(int done, int total, int sppDone, int sppTotal) {
     if (!enabled_) return;
-    double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+    double elapsed =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
     double eta = done > 0 ? elapsed * (total - done) / done : 0.0;
     const int width = 30;
     int filled = total > 0 ? done * width / total : width;
     std::string bar(size_t(filled), '#');
     bar.resize(width, '.');
-    std::fprintf(stderr, "\r[%s] iteration %d/%d  %d/%d spp  %s elapsed  ETA %s ", bar.c_str(), done, total,
-                 sppDone, sppTotal, clock(elapsed).c_str(), clock(eta).c_str());
+    std::fprintf(stderr, "\r[%s] iteration %d/%d  %d/%d spp  %s elapsed  ETA %s ", bar.c_str(),
+                 done, total, sppDone, sppTotal, clock(elapsed).c_str(), clock(eta).c_str());
     std::fflush(stderr);
     drawn_ = true;
 }

@@ -9,7 +9,8 @@ namespace spw {
 
 class ProgressBar {
   public:
-    explicit ProgressBar(bool enabled) : enabled_(enabled), start_(std::chrono::steady_clock::now()) {}
+    explicit ProgressBar(bool enabled)
+        : enabled_(enabled), start_(std::chrono::steady_clock::now()) {}
     void update(int done, int total, int sppDone, int sppTotal);
     void finish();
 

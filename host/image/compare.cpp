@@ -216,7 +216,9 @@ double metricValue(const ImageMetrics& metrics, const std::string& metric) {
     return metrics.*findMetric(metric).field;
 }
 
-bool isLowerBound(const std::string& metric) { return findMetric(metric).lowerBound; }
+bool isLowerBound(const std::string& metric) {
+    return findMetric(metric).lowerBound;
+}
 
 bool meetsThreshold(const ImageMetrics& metrics, const Threshold& threshold) {
     const MetricName& m = findMetric(threshold.metric);

@@ -1,5 +1,6 @@
-// Image comparison, what `spillway compare A B` (host/app/compare_command.h) computes: error metrics of a test image A against a
-// reference B, a false-colour heatmap of the per-pixel relative error, and pass/fail bounds.
+// Image comparison, what `spillway compare A B` (host/app/compare_command.h) computes: error
+// metrics of a test image A against a reference B, a false-colour heatmap of the per-pixel relative
+// error, and pass/fail bounds.
 //
 // Metrics run over every channel value of every pixel where all six values (A's and B's RGB)
 // are finite; a pixel with any NaN or infinity is counted in that image's non-finite count and
@@ -86,6 +87,5 @@ struct HeatmapInfo {
 // std::runtime_error naming the path when it cannot be written, std::invalid_argument when
 // the sizes differ.
 HeatmapInfo writeHeatmap(const std::string& path, const ImageRGB& a, const ImageRGB& b);
-
 
 } // namespace spw

@@ -21,20 +21,26 @@ float filterWeight1D(FilterType type, float d, float radius) {
 // the render-wide sample index, so that every iteration rounds with fresh random numbers. Without
 // the sample index a pixel whose value repeats each iteration (a tiny light seen through the
 // Grid sampler) would be rounded the same way every time: a bias of up to one fixed-point step.
-uint roundingKey(uint key, uint sampleIndex) { return pcg4d(uvec4(key, sampleIndex, 0xF11Du, 0x2545F491u)).x; }
+uint roundingKey(uint key, uint sampleIndex) {
+    return pcg4d(uvec4(key, sampleIndex, 0xF11Du, 0x2545F491u)).x;
+}
 
 } // namespace
 
-Film::Film(int width, int height, const Filter& filter, float brightestRadiance, int samplesPerIteration)
-    : width_(width), height_(height), samplesPerIteration_(uint(samplesPerIteration)), filter_(filter),
-      acc_(new std::atomic<std::int64_t>[size_t(width) * height * 8]),
+Film::Film(int width, int height, const Filter& filter, float brightestRadiance,
+           int samplesPerIteration)
+    : width_(width), height_(height), samplesPerIteration_(uint(samplesPerIteration)),
+      filter_(filter), acc_(new std::atomic<std::int64_t>[size_t(width) * height * 8]),
       sum_(size_t(width) * height * 8, 0.0), lastIteration_(size_t(width) * height * 3, 0.0f) {
     // No clamp on e: the scale is a double, and every emission the loader accepts (up to
     // kMaxRadiance, down to the smallest float) keeps its brightest sample at 2^40.
-    const int e = brightestRadiance > 0.0f ? int(std::ceil(std::log2(double(brightestRadiance)))) : 0;
+    const int e =
+        brightestRadiance > 0.0f ? int(std::ceil(std::log2(double(brightestRadiance)))) : 0;
     // N adds at most per accumulator and iteration: a sample reaches (floor(2r) + 1)^2 pixels.
-    const double reach = filter.type == FilterType::Box ? 1.0 : std::floor(2.0 * double(filter.radius)) + 1.0;
-    const int logAdds = int(std::ceil(std::log2(std::max(1.0, double(samplesPerIteration) * reach * reach))));
+    const double reach =
+        filter.type == FilterType::Box ? 1.0 : std::floor(2.0 * double(filter.radius)) + 1.0;
+    const int logAdds =
+        int(std::ceil(std::log2(std::max(1.0, double(samplesPerIteration) * reach * reach))));
     maxAdd_ = std::ldexp(1.0, 62 - logAdds);
     const int top = std::min(40, 62 - logAdds - 16); // the brightest sample's exponent
     scale_ = std::ldexp(1.0, top - e);
@@ -43,13 +49,15 @@ Film::Film(int width, int height, const Filter& filter, float brightestRadiance,
 }
 
 void Film::beginIteration() {
-    for (size_t i = 0; i < size_t(width_) * height_ * 8; ++i) acc_[i].store(0, std::memory_order_relaxed);
+    for (size_t i = 0; i < size_t(width_) * height_ * 8; ++i)
+        acc_[i].store(0, std::memory_order_relaxed);
 }
 
 void Film::add(int px, int py, int half, vec3 value, float weight, uint key) {
     std::atomic<std::int64_t>* a = &acc_[(size_t(py) * width_ + px) * 8 + size_t(half) * 4];
     uvec4 h = pcg4d(uvec4(key, uint(py * width_ + px), 0x5157u, 0x9E3779B9u));
-    const double in[4] = {value.x * scale_, value.y * scale_, value.z * scale_, weight * weightScale_};
+    const double in[4] = {value.x * scale_, value.y * scale_, value.z * scale_,
+                          weight * weightScale_};
     const uint rnd[4] = {h.x, h.y, h.z, h.w};
     for (int c = 0; c < 4; ++c) {
         double v = in[c];
@@ -109,14 +117,16 @@ void Film::endIteration() {
         for (int h = 0; h < 2; ++h) {
             double v[4];
             for (int c = 0; c < 4; ++c)
-                v[c] = double(acc_[i * 8 + size_t(h) * 4 + size_t(c)].load(std::memory_order_relaxed)) /
+                v[c] = double(acc_[i * 8 + size_t(h) * 4 + size_t(c)].load(
+                           std::memory_order_relaxed)) /
                        (c < 3 ? scale_ : weightScale_);
             for (int c = 0; c < 4; ++c) {
                 sum_[i * 8 + size_t(h) * 4 + size_t(c)] += v[c];
                 it[c] += v[c];
             }
         }
-        for (int c = 0; c < 3; ++c) lastIteration_[i * 3 + c] = it[3] > 0 ? float(it[c] / it[3]) : 0.0f;
+        for (int c = 0; c < 3; ++c)
+            lastIteration_[i * 3 + c] = it[3] > 0 ? float(it[c] / it[3]) : 0.0f;
     }
     beginIteration();
 }
@@ -128,7 +138,8 @@ std::vector<float> Film::image() const {
         const double* s = &sum_[i * 8];
         double w = s[3] + s[7];
         if (w > 0)
-            for (int c = 0; c < 3; ++c) out[i * 3 + c] = float((s[c] + s[4 + c]) / w);
+            for (int c = 0; c < 3; ++c)
+                out[i * 3 + c] = float((s[c] + s[4 + c]) / w);
     }
     return out;
 }
@@ -139,7 +150,8 @@ std::vector<float> Film::halfImage(int half) const {
     for (size_t i = 0; i < n; ++i) {
         const double* s = &sum_[i * 8 + size_t(half) * 4];
         if (s[3] > 0)
-            for (int c = 0; c < 3; ++c) out[i * 3 + c] = float(s[c] / s[3]);
+            for (int c = 0; c < 3; ++c)
+                out[i * 3 + c] = float(s[c] / s[3]);
     }
     return out;
 }

@@ -36,7 +36,8 @@ inline uint filmKey(uint pathId, uint bounce, bool shadow) {
 class Film {
   public:
     // `samplesPerIteration`: camera samples per pixel in one iteration (sample base^2).
-    Film(int width, int height, const Filter& filter, float brightestRadiance, int samplesPerIteration = 1);
+    Film(int width, int height, const Filter& filter, float brightestRadiance,
+         int samplesPerIteration = 1);
 
     int width() const { return width_; }
     int height() const { return height_; }
@@ -71,9 +72,9 @@ class Film {
     int width_, height_;
     uint samplesPerIteration_;
     Filter filter_;
-    double scale_;       // radiance units -> fixed-point units
-    double weightScale_; // filter weight -> fixed-point units
-    double maxAdd_;      // the clamp of one add, in fixed-point units
+    double scale_;                                     // radiance units -> fixed-point units
+    double weightScale_;                               // filter weight -> fixed-point units
+    double maxAdd_;                                    // the clamp of one add, in fixed-point units
     std::unique_ptr<std::atomic<std::int64_t>[]> acc_; // 8 per pixel: (r, g, b, weight) x 2 halves
     std::vector<double> sum_;                          // 8 per pixel, whole render
     std::vector<float> lastIteration_;

@@ -15,7 +15,8 @@ namespace {
 
 std::string extension(const std::string& path) {
     std::string e = std::filesystem::path(path).extension().string();
-    std::transform(e.begin(), e.end(), e.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+    std::transform(e.begin(), e.end(), e.begin(),
+                   [](unsigned char c) { return char(std::tolower(c)); });
     return e;
 }
 
@@ -36,8 +37,8 @@ namespace {
 
 // Encodes through OpenImageIO into memory (the format by the path's extension): OpenImageIO
 // never touches the destination, so a failure leaves no file.
-std::vector<unsigned char> encode(const std::string& path, const OIIO::ImageSpec& spec, OIIO::TypeDesc format,
-                                  const void* data) {
+std::vector<unsigned char> encode(const std::string& path, const OIIO::ImageSpec& spec,
+                                  OIIO::TypeDesc format, const void* data) {
     std::vector<unsigned char> bytes;
     OIIO::Filesystem::IOVecOutput proxy(bytes);
     auto out = OIIO::ImageOutput::create(path, &proxy);
@@ -52,9 +53,11 @@ std::vector<unsigned char> encode(const std::string& path, const OIIO::ImageSpec
 } // namespace
 
 std::vector<unsigned char> encodeImage(const std::string& path, const ImageRGB& image) {
-    if (!isSupportedOutput(path)) throw std::runtime_error("cannot write '" + path + "': use .exr or .png");
+    if (!isSupportedOutput(path))
+        throw std::runtime_error("cannot write '" + path + "': use .exr or .png");
     const bool png = extension(path) == ".png";
-    OIIO::ImageSpec spec(image.width, image.height, 3, png ? OIIO::TypeDesc::UINT8 : OIIO::TypeDesc::FLOAT);
+    OIIO::ImageSpec spec(image.width, image.height, 3,
+                         png ? OIIO::TypeDesc::UINT8 : OIIO::TypeDesc::FLOAT);
     spec.attribute("oiio:ColorSpace", png ? "sRGB" : "Linear");
     spec.attribute("Software", "Spillway");
     if (png) {

@@ -25,7 +25,8 @@ std::vector<unsigned char> encodeImage(const std::string& path, const ImageRGB& 
 // Writes the image whole or not at all (host/image/output_file.h). Throws std::runtime_error naming
 // the path when the file cannot be written.
 void writeImage(const std::string& path, const ImageRGB& image);
-// An 8-bit sRGB RGB image (compare's heatmap) with a description in its metadata, written the same way.
+// An 8-bit sRGB RGB image (compare's heatmap) with a description in its metadata, written the same
+// way.
 void writeImage8(const std::string& path, int width, int height, const unsigned char* rgb,
                  const std::string& software, const std::string& description);
 // Reads any image OpenImageIO reads; 8-bit sRGB data are linearised. Throws on failure.

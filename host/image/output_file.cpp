@@ -24,8 +24,8 @@ std::string folderOf(const std::string& path) {
 std::string temporaryName(const std::string& path) {
     static int counter = 0;
     fs::path p(path);
-    return (p.parent_path() / ("." + p.filename().string() + ".spillway-" + std::to_string(::getpid()) + "-" +
-                               std::to_string(counter++)))
+    return (p.parent_path() / ("." + p.filename().string() + ".spillway-" +
+                               std::to_string(::getpid()) + "-" + std::to_string(counter++)))
         .string();
 }
 
@@ -141,7 +141,9 @@ void writeFileAtomically(const std::string& path, const void* data, std::size_t 
 }
 
 void checkWritable(const std::string& path) {
-    auto fail = [&](const std::string& why) { throw std::runtime_error("cannot write '" + path + "': " + why); };
+    auto fail = [&](const std::string& why) {
+        throw std::runtime_error("cannot write '" + path + "': " + why);
+    };
     struct stat st {};
     if (::stat(path.c_str(), &st) == 0) {
         if (S_ISDIR(st.st_mode)) fail("it is a folder");
@@ -153,7 +155,8 @@ void checkWritable(const std::string& path) {
     const std::string dir = folderOf(path);
     if (::stat(dir.c_str(), &st) != 0) fail("folder '" + dir + "': " + std::strerror(errno));
     if (!S_ISDIR(st.st_mode)) fail("'" + dir + "' is not a folder");
-    if (::access(dir.c_str(), W_OK | X_OK) != 0) fail("folder '" + dir + "': " + std::strerror(errno));
+    if (::access(dir.c_str(), W_OK | X_OK) != 0)
+        fail("folder '" + dir + "': " + std::strerror(errno));
 }
 
 } // namespace spw

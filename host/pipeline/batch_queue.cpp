@@ -24,7 +24,8 @@ SpillFile::SpillFile(const std::string& dir) : dir_(dir) {
         if (fd_ >= 0) ::unlink(name.data());
     }
     if (fd_ < 0)
-        throw std::runtime_error("cannot create a spill file in '" + dir + "': " + std::strerror(errno));
+        throw std::runtime_error("cannot create a spill file in '" + dir +
+                                 "': " + std::strerror(errno));
 }
 
 SpillFile::~SpillFile() {
@@ -101,7 +102,9 @@ void BatchQueue::push(RayBatch&& batch) {
         batch.bytes.shrink_to_fit();
         e.batch = std::move(batch);
     }
-    counters_.peakRamBytes = std::max<std::uint64_t>(counters_.peakRamBytes, ramBytes_ + std::uint64_t(std::max<std::int64_t>(0, outsideBytes_)));
+    counters_.peakRamBytes = std::max<std::uint64_t>(
+        counters_.peakRamBytes,
+        ramBytes_ + std::uint64_t(std::max<std::int64_t>(0, outsideBytes_)));
     entries_.push_back(std::move(e));
     if (entries_.size() == 1) startPrefetch();
 }
@@ -149,7 +152,9 @@ bool BatchQueue::empty() const {
 void BatchQueue::noteOutsideBytes(std::int64_t delta) {
     std::lock_guard<std::mutex> lock(mutex_);
     outsideBytes_ += delta;
-    counters_.peakRamBytes = std::max<std::uint64_t>(counters_.peakRamBytes, ramBytes_ + std::uint64_t(std::max<std::int64_t>(0, outsideBytes_)));
+    counters_.peakRamBytes = std::max<std::uint64_t>(
+        counters_.peakRamBytes,
+        ramBytes_ + std::uint64_t(std::max<std::int64_t>(0, outsideBytes_)));
 }
 
 QueueCounters BatchQueue::counters() const {
@@ -178,7 +183,8 @@ void DirectionalBins::add(RayBuffer& buffer) {
             while (at < src.size()) {
                 if (bin.capacity() < batchBytes) bin.reserve(batchBytes);
                 const size_t take = std::min(src.size() - at, batchBytes - bin.size());
-                bin.insert(bin.end(), src.begin() + std::ptrdiff_t(at), src.begin() + std::ptrdiff_t(at + take));
+                bin.insert(bin.end(), src.begin() + std::ptrdiff_t(at),
+                           src.begin() + std::ptrdiff_t(at + take));
                 at += take;
                 if (bin.size() == batchBytes) {
                     RayBatch batch;
@@ -192,7 +198,8 @@ void DirectionalBins::add(RayBuffer& buffer) {
         }
         queue_.noteOutsideBytes(std::int64_t(src.size()) - std::int64_t(full.size() * batchBytes));
         src.clear();
-        for (RayBatch& batch : full) queue_.push(std::move(batch));
+        for (RayBatch& batch : full)
+            queue_.push(std::move(batch));
     }
     buffer.count = 0;
 }

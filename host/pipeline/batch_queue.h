@@ -72,7 +72,7 @@ class BatchQueue {
 
   private:
     struct Entry {
-        RayBatch batch;          // bytes empty when spilled
+        RayBatch batch; // bytes empty when spilled
         bool spilled = false;
         std::uint64_t offset = 0, size = 0;
     };

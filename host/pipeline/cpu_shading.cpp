@@ -10,7 +10,8 @@ namespace {
 
 class CpuShading : public ShadingEngine {
   public:
-    CpuShading(SceneView view, RenderParams params, size_t chunk) : view_(view), params_(params), chunk_(chunk) {}
+    CpuShading(SceneView view, RenderParams params, size_t chunk)
+        : view_(view), params_(params), chunk_(chunk) {}
     void beginIteration(uint iteration) override { params_.iteration = iteration; }
     ShadeSlot reserve(int /*slot*/, size_t count) override {
         inputs_.resize(count);
@@ -21,10 +22,12 @@ class CpuShading : public ShadingEngine {
         for (const ShadeRange& range : ranges) {
             const ShadeInput* in = &inputs_[range.begin];
             ShadeResult* out = &results_[range.begin];
-            tbb::parallel_for(tbb::blocked_range<size_t>(0, range.count, chunk_), [&](const tbb::blocked_range<size_t>& r) {
-                for (size_t i = r.begin(); i < r.end(); ++i)
-                    shadeSurface(view_, params_, in[i].hit, in[i].rayDir, in[i].path, out[i]);
-            });
+            tbb::parallel_for(tbb::blocked_range<size_t>(0, range.count, chunk_),
+                              [&](const tbb::blocked_range<size_t>& r) {
+                                  for (size_t i = r.begin(); i < r.end(); ++i)
+                                      shadeSurface(view_, params_, in[i].hit, in[i].rayDir,
+                                                   in[i].path, out[i]);
+                              });
         }
     }
     void finish(int /*slot*/) override {}
@@ -40,7 +43,8 @@ class CpuShading : public ShadingEngine {
 } // namespace
 
 std::unique_ptr<ShadingEngine> makeCpuShading(const RenderContext& ctx) {
-    return std::make_unique<CpuShading>(ctx.lights.view(), ctx.params, size_t(ctx.scene.settings.shadingSize));
+    return std::make_unique<CpuShading>(ctx.lights.view(), ctx.params,
+                                        size_t(ctx.scene.settings.shadingSize));
 }
 
 } // namespace spw

@@ -8,7 +8,8 @@ std::vector<ShaderRun> shaderRuns(const std::vector<SortedHit>& keys, size_t hit
     while (begin < hitCount) {
         const uint shader = shaderOfKey(keys[begin].key);
         size_t end = begin + 1;
-        while (end < hitCount && shaderOfKey(keys[end].key) == shader) ++end;
+        while (end < hitCount && shaderOfKey(keys[end].key) == shader)
+            ++end;
         runs.push_back({shader, begin, end - begin});
         begin = end;
     }

@@ -21,7 +21,9 @@ using SortedHit = KeyIndex;
 inline std::uint64_t hitSortKey(uint shader, uint object, uint primitive) {
     return std::uint64_t(shader) << 52 | std::uint64_t(object) << 32 | primitive;
 }
-inline uint shaderOfKey(std::uint64_t key) { return uint(key >> 52); }
+inline uint shaderOfKey(std::uint64_t key) {
+    return uint(key >> 52);
+}
 
 // A run of sorted hits that share one shader: [begin, begin + count).
 struct ShaderRun {

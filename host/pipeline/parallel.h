@@ -18,7 +18,8 @@ template <class Pred> size_t parallelCount(size_t n, Pred pred) {
     return tbb::parallel_reduce(
         tbb::blocked_range<size_t>(0, n, kParallelGrain), size_t(0),
         [&](const tbb::blocked_range<size_t>& r, size_t c) {
-            for (size_t i = r.begin(); i < r.end(); ++i) c += pred(i) ? 1 : 0;
+            for (size_t i = r.begin(); i < r.end(); ++i)
+                c += pred(i) ? 1 : 0;
             return c;
         },
         [](size_t a, size_t b) { return a + b; });
@@ -30,10 +31,12 @@ template <class Pred> void parallelSelect(size_t n, Pred pred, std::vector<std::
     std::vector<size_t> offsets(chunks + 1, 0);
     tbb::parallel_for(size_t(0), chunks, [&](size_t c) {
         size_t count = 0;
-        for (size_t i = c * kParallelGrain; i < std::min(n, (c + 1) * kParallelGrain); ++i) count += pred(i) ? 1 : 0;
+        for (size_t i = c * kParallelGrain; i < std::min(n, (c + 1) * kParallelGrain); ++i)
+            count += pred(i) ? 1 : 0;
         offsets[c + 1] = count;
     });
-    for (size_t c = 0; c < chunks; ++c) offsets[c + 1] += offsets[c];
+    for (size_t c = 0; c < chunks; ++c)
+        offsets[c + 1] += offsets[c];
     out.resize(offsets[chunks]);
     tbb::parallel_for(size_t(0), chunks, [&](size_t c) {
         size_t at = offsets[c];

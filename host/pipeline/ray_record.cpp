@@ -8,7 +8,8 @@
 
 namespace spw {
 
-static_assert(kMaxCompactBounce >= uint(kMaxDepth), "the loader accepts depths the compact ray cannot hold");
+static_assert(kMaxCompactBounce >= uint(kMaxDepth),
+              "the loader accepts depths the compact ray cannot hold");
 
 namespace {
 
@@ -19,7 +20,9 @@ void put24(std::uint8_t* p, uint v) {
     p[1] = std::uint8_t(v >> 8);
     p[2] = std::uint8_t(v >> 16);
 }
-uint get24(const std::uint8_t* p) { return uint(p[0]) | uint(p[1]) << 8 | uint(p[2]) << 16; }
+uint get24(const std::uint8_t* p) {
+    return uint(p[0]) | uint(p[1]) << 8 | uint(p[2]) << 16;
+}
 
 void octEncode(vec3 d, uint& u, uint& v) {
     const glm::dvec2 p = octahedralMap(d);
@@ -64,7 +67,8 @@ template <class T> T get(const std::uint8_t*& p) {
 } // namespace
 
 glm::dvec2 octahedralFold(glm::dvec2 p) {
-    return glm::dvec2((1.0 - std::fabs(p.y)) * (p.x >= 0 ? 1.0 : -1.0), (1.0 - std::fabs(p.x)) * (p.y >= 0 ? 1.0 : -1.0));
+    return glm::dvec2((1.0 - std::fabs(p.y)) * (p.x >= 0 ? 1.0 : -1.0),
+                      (1.0 - std::fabs(p.x)) * (p.y >= 0 ? 1.0 : -1.0));
 }
 
 glm::dvec2 octahedralMap(vec3 d) {
@@ -76,11 +80,14 @@ glm::dvec2 octahedralMap(vec3 d) {
 
 void encodeRay(const RayState& r, RayFormat format, uvec4 rounding, std::uint8_t* out) {
     std::uint8_t* p = out;
-    for (int i = 0; i < 3; ++i) put<float>(p, r.origin[i]);
+    for (int i = 0; i < 3; ++i)
+        put<float>(p, r.origin[i]);
     put<std::uint32_t>(p, r.path.pathId);
     if (format == RayFormat::Full) {
-        for (int i = 0; i < 3; ++i) put<float>(p, r.dir[i]);
-        for (int i = 0; i < 3; ++i) put<float>(p, r.path.beta[i]);
+        for (int i = 0; i < 3; ++i)
+            put<float>(p, r.dir[i]);
+        for (int i = 0; i < 3; ++i)
+            put<float>(p, r.path.beta[i]);
         put<float>(p, r.path.prevPdf);
         put<std::uint32_t>(p, r.path.bounce | r.path.flags << 16);
         return;
@@ -102,12 +109,15 @@ void encodeRay(const RayState& r, RayFormat format, uvec4 rounding, std::uint8_t
 
 void decodeRay(const std::uint8_t* in, RayFormat format, RayState& r) {
     const std::uint8_t* p = in;
-    for (int i = 0; i < 3; ++i) r.origin[i] = get<float>(p);
+    for (int i = 0; i < 3; ++i)
+        r.origin[i] = get<float>(p);
     r.path.pathId = get<std::uint32_t>(p);
     r.path.pad0 = 0;
     if (format == RayFormat::Full) {
-        for (int i = 0; i < 3; ++i) r.dir[i] = get<float>(p);
-        for (int i = 0; i < 3; ++i) r.path.beta[i] = get<float>(p);
+        for (int i = 0; i < 3; ++i)
+            r.dir[i] = get<float>(p);
+        for (int i = 0; i < 3; ++i)
+            r.path.beta[i] = get<float>(p);
         r.path.prevPdf = get<float>(p);
         std::uint32_t bf = get<std::uint32_t>(p);
         r.path.bounce = bf & 0xFFFFu;

@@ -49,7 +49,9 @@ constexpr size_t kCompactRayBytes = 32;
 constexpr size_t kFullRayBytes = 48;
 constexpr uint kMaxCompactBounce = 0x7FFF;
 
-inline size_t rayRecordBytes(RayFormat f) { return f == RayFormat::Compact ? kCompactRayBytes : kFullRayBytes; }
+inline size_t rayRecordBytes(RayFormat f) {
+    return f == RayFormat::Compact ? kCompactRayBytes : kFullRayBytes;
+}
 
 // `rounding`: four uniform 32-bit words for the stochastic rounding (compact only).
 void encodeRay(const RayState& ray, RayFormat format, uvec4 rounding, std::uint8_t* out);

@@ -42,7 +42,8 @@ Bounds originBounds(const RayState* r, size_t n) {
     return tbb::parallel_reduce(
         tbb::blocked_range<size_t>(0, n, 1 << 14), Bounds(),
         [&](const tbb::blocked_range<size_t>& range, Bounds b) {
-            for (size_t i = range.begin(); i < range.end(); ++i) b.add(r[i].origin);
+            for (size_t i = range.begin(); i < range.end(); ++i)
+                b.add(r[i].origin);
             return b;
         },
         [](Bounds a, const Bounds& b) {
@@ -54,15 +55,20 @@ Bounds originBounds(const RayState* r, size_t n) {
 template <class Get> void medianSplit(RayState* r, size_t n, size_t leaf, Get get) {
     if (n <= leaf) return;
     Bounds b;
-    for (size_t i = 0; i < n; ++i) b.add(get(r[i]));
+    for (size_t i = 0; i < n; ++i)
+        b.add(get(r[i]));
     const int axis = b.longestAxis();
     if (b.hi[axis] <= b.lo[axis]) return; // all equal along every axis: nothing to split
     const size_t mid = n / 2;
-    std::nth_element(r, r + mid, r + n, [&](const RayState& a, const RayState& c) { return get(a)[axis] < get(c)[axis]; });
+    std::nth_element(r, r + mid, r + n, [&](const RayState& a, const RayState& c) {
+        return get(a)[axis] < get(c)[axis];
+    });
     auto left = [&] { medianSplit(r, mid, leaf, get); };
     auto right = [&] { medianSplit(r + mid, n - mid, leaf, get); };
-    if (n > 8192) tbb::parallel_invoke(left, right);
-    else left(), right();
+    if (n > 8192)
+        tbb::parallel_invoke(left, right);
+    else
+        left(), right();
 }
 
 void medianByOrigin(RayState* r, size_t n) {
@@ -72,11 +78,15 @@ void medianByOrigin(RayState* r, size_t n) {
         return;
     }
     Bounds b;
-    for (size_t i = 0; i < n; ++i) b.add(r[i].origin);
+    for (size_t i = 0; i < n; ++i)
+        b.add(r[i].origin);
     const int axis = b.longestAxis();
     const size_t mid = n / 2;
-    std::nth_element(r, r + mid, r + n, [&](const RayState& a, const RayState& c) { return a.origin[axis] < c.origin[axis]; });
-    tbb::parallel_invoke([&] { medianByOrigin(r, mid); }, [&] { medianByOrigin(r + mid, n - mid); });
+    std::nth_element(r, r + mid, r + n, [&](const RayState& a, const RayState& c) {
+        return a.origin[axis] < c.origin[axis];
+    });
+    tbb::parallel_invoke([&] { medianByOrigin(r, mid); },
+                         [&] { medianByOrigin(r + mid, n - mid); });
 }
 
 } // namespace
@@ -84,14 +94,15 @@ void medianByOrigin(RayState* r, size_t n) {
 MortonFrame MortonFrame::of(const std::vector<RayState>& rays) {
     const Bounds b = originBounds(rays.data(), rays.size());
     const vec3 extent = b.hi - b.lo;
-    return {b.lo, vec3(extent.x > 0 ? 32767.0f / extent.x : 0.0f, extent.y > 0 ? 32767.0f / extent.y : 0.0f,
+    return {b.lo, vec3(extent.x > 0 ? 32767.0f / extent.x : 0.0f,
+                       extent.y > 0 ? 32767.0f / extent.y : 0.0f,
                        extent.z > 0 ? 32767.0f / extent.z : 0.0f)};
 }
 
 std::uint64_t MortonFrame::key(const RayState& r) const {
     vec3 q = glm::clamp((r.origin - lo) * scale, vec3(0.0f), vec3(32767.0f));
-    std::uint64_t morton =
-        spread3(std::uint64_t(q.x)) | spread3(std::uint64_t(q.y)) << 1 | spread3(std::uint64_t(q.z)) << 2;
+    std::uint64_t morton = spread3(std::uint64_t(q.x)) | spread3(std::uint64_t(q.y)) << 1 |
+                           spread3(std::uint64_t(q.z)) << 2;
     // 8+8-bit octahedral direction.
     const glm::dvec2 o = octahedralMap(r.dir);
     std::uint64_t du = std::uint64_t(std::clamp((o.x * 0.5 + 0.5) * 255.0, 0.0, 255.0));
@@ -99,32 +110,40 @@ std::uint64_t MortonFrame::key(const RayState& r) const {
     return std::uint64_t(cardinalBin(r.dir)) << 61 | morton << 16 | du << 8 | dv;
 }
 
-void sortRaysMorton(std::vector<RayState>& rays, std::vector<KeyIndex>& keys, std::vector<KeyIndex>& scratch,
-                    std::vector<RayState>& tmp) {
+void sortRaysMorton(std::vector<RayState>& rays, std::vector<KeyIndex>& keys,
+                    std::vector<KeyIndex>& scratch, std::vector<RayState>& tmp) {
     const size_t n = rays.size();
     if (n < 2) return;
     const MortonFrame frame = MortonFrame::of(rays);
     keys.resize(n);
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 4096), [&](const tbb::blocked_range<size_t>& range) {
-        for (size_t i = range.begin(); i < range.end(); ++i) keys[i] = {frame.key(rays[i]), std::uint32_t(i)};
-    });
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 4096),
+                      [&](const tbb::blocked_range<size_t>& range) {
+                          for (size_t i = range.begin(); i < range.end(); ++i)
+                              keys[i] = {frame.key(rays[i]), std::uint32_t(i)};
+                      });
     radixSort(keys, scratch);
     tmp.resize(n);
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 4096), [&](const tbb::blocked_range<size_t>& range) {
-        for (size_t i = range.begin(); i < range.end(); ++i) tmp[i] = rays[keys[i].index];
-    });
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 4096),
+                      [&](const tbb::blocked_range<size_t>& range) {
+                          for (size_t i = range.begin(); i < range.end(); ++i)
+                              tmp[i] = rays[keys[i].index];
+                      });
     rays.swap(tmp);
 }
 
-void sortRaysMedian(std::vector<RayState>& rays) { medianByOrigin(rays.data(), rays.size()); }
+void sortRaysMedian(std::vector<RayState>& rays) {
+    medianByOrigin(rays.data(), rays.size());
+}
 
 RaySortMode RaySortPolicy::choose(double cameraFraction) {
     if (mode_ != RaySortMode::Auto) return mode_;
     if (cameraFraction > 0.5) return RaySortMode::Off;
     ++decisions_;
     bool sort;
-    if (samples_[0] == 0) sort = false;
-    else if (samples_[1] == 0) sort = true;
+    if (samples_[0] == 0)
+        sort = false;
+    else if (samples_[1] == 0)
+        sort = true;
     else {
         sort = cost_[1] < cost_[0];
         if (decisions_ % 16 == 0) sort = !sort; // keep the other estimate fresh

@@ -25,8 +25,8 @@ struct MortonFrame {
 };
 
 // Sorts by MortonFrame::of(rays).key, stably.
-void sortRaysMorton(std::vector<RayState>& rays, std::vector<KeyIndex>& keys, std::vector<KeyIndex>& scratch,
-                    std::vector<RayState>& tmp);
+void sortRaysMorton(std::vector<RayState>& rays, std::vector<KeyIndex>& keys,
+                    std::vector<KeyIndex>& scratch, std::vector<RayState>& tmp);
 // Splits at the median origin along the bounds' longest axis, recursively, down to 4096 rays,
 // then at the median direction likewise down to 64.
 void sortRaysMedian(std::vector<RayState>& rays);

@@ -28,7 +28,9 @@ struct SortedRenderer::Scratch {
 
 namespace {
 using Clock = std::chrono::steady_clock;
-double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+double since(Clock::time_point t) {
+    return std::chrono::duration<double>(Clock::now() - t).count();
+}
 } // namespace
 
 SortedRenderer::SortedRenderer(const RenderContext& ctx, const PipelineConfig& config,
@@ -41,9 +43,11 @@ SortedRenderer::SortedRenderer(const RenderContext& ctx, const PipelineConfig& c
     // the queue keeps the rest of the budget (none when six batches already exceed it, so that
     // every batch spills). Peak rays in RAM <= max(budget, six batches), as --help states.
     const std::uint64_t budget = std::uint64_t(budgetMiB * 1024.0 * 1024.0);
-    const std::uint64_t binBytes = 6 * (std::uint64_t(1) << exponent) * rayRecordBytes(config.rayFormat);
+    const std::uint64_t binBytes =
+        6 * (std::uint64_t(1) << exponent) * rayRecordBytes(config.rayFormat);
     // The spill folder is resolved (and the file made) only when a batch first spills.
-    queue_ = std::make_unique<BatchQueue>(budget > binBytes ? budget - binBytes : 0, config.spillDir);
+    queue_ =
+        std::make_unique<BatchQueue>(budget > binBytes ? budget - binBytes : 0, config.spillDir);
     bins_ = std::make_unique<DirectionalBins>(config.rayFormat, exponent, *queue_);
 }
 
@@ -101,8 +105,10 @@ void SortedRenderer::startBatch(RayBatch& batch, int slot) {
     const auto sortStart = Clock::now();
     if (mode == RaySortMode::Morton || mode == RaySortMode::Median) {
         StageTimer t(times, "sort rays");
-        if (mode == RaySortMode::Morton) sortRaysMorton(s.rays, s.rayKeys, s.keyTmp, s.rayTmp);
-        else sortRaysMedian(s.rays);
+        if (mode == RaySortMode::Morton)
+            sortRaysMorton(s.rays, s.rayKeys, s.keyTmp, s.rayTmp);
+        else
+            sortRaysMedian(s.rays);
     }
     {
         StageTimer t(times, "traverse");
@@ -118,7 +124,8 @@ void SortedRenderer::startBatch(RayBatch& batch, int slot) {
         StageTimer t(times, "hit setup");
         flight.shading = shading_->reserve(slot, flight.hitCount);
         flight.paths.resize(flight.hitCount);
-        setUpHits(ctx_, s.rays, s.hits, s.order, flight.hitCount, flight.shading.inputs, flight.paths.data());
+        setUpHits(ctx_, s.rays, s.hits, s.order, flight.hitCount, flight.shading.inputs,
+                  flight.paths.data());
     }
     {
         StageTimer t(times, "shade");
@@ -144,7 +151,8 @@ void SortedRenderer::finishBatch(int slot, uint iteration, Film& film) {
     }
     {
         StageTimer t(times, "accumulate");
-        accumulate(ctx_, iteration, results, flight.paths.data(), flight.hitCount, s.shadowOwner, s.occluded, film);
+        accumulate(ctx_, iteration, results, flight.paths.data(), flight.hitCount, s.shadowOwner,
+                   s.occluded, film);
     }
     {
         StageTimer t(times, "bin");
@@ -165,7 +173,8 @@ void SortedRenderer::publishStats() {
     x["ray_record_bytes"] = rayRecordBytes(config_.rayFormat);
     x["ray_sort"] = raySortName(config_.raySort);
     x["hit_sort"] = config_.sortsHits();
-    x["shading"] = shadingModeName(config_.sortsHits() ? ShadingMode::Sorted : ShadingMode::Megakernel);
+    x["shading"] =
+        shadingModeName(config_.sortsHits() ? ShadingMode::Sorted : ShadingMode::Megakernel);
     x["batches_ray_sorted"] = policy_.sortedBatches();
     x["batches_ray_unsorted_measured"] = policy_.unsortedBatches();
     shading_->publishStats(ctx_.stats);

@@ -40,7 +40,8 @@ void generateCameraRays(const RenderContext& ctx, uint iteration, RayFormat form
                         DirectionalBins& bins) {
     const Scene& scene = ctx.scene;
     const RenderParams rp = paramsAt(ctx, iteration);
-    const int width = scene.image.width, height = scene.image.height, tile = scene.settings.bucketSize;
+    const int width = scene.image.width, height = scene.image.height,
+              tile = scene.settings.bucketSize;
     const uint spi = rp.samplesPerIteration;
     const int tilesX = (width + tile - 1) / tile, tilesY = (height + tile - 1) / tile;
     tbb::parallel_for(0, tilesX * tilesY, [&](int t) {
@@ -49,7 +50,8 @@ void generateCameraRays(const RenderContext& ctx, uint iteration, RayFormat form
         for (int y = y0; y < std::min(height, y0 + tile); ++y)
             for (int x = x0; x < std::min(width, x0 + tile); ++x)
                 for (uint s = 0; s < spi; ++s) {
-                    CameraRay cr = ctx.camera.generate(uint(x), uint(y), s, iteration * spi + s, rp.seed);
+                    CameraRay cr =
+                        ctx.camera.generate(uint(x), uint(y), s, iteration * spi + s, rp.seed);
                     film.addSample(cr.filmPos, iteration * spi + s);
                     RayState r;
                     r.origin = cr.origin;
@@ -66,9 +68,11 @@ size_t decompressRays(RayBatch& batch, std::vector<RayState>& rays) {
     const size_t n = batch.count;
     const size_t recordBytes = rayRecordBytes(batch.format);
     rays.resize(n);
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 4096), [&](const tbb::blocked_range<size_t>& r) {
-        for (size_t i = r.begin(); i < r.end(); ++i) decodeRay(&batch.bytes[i * recordBytes], batch.format, rays[i]);
-    });
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 4096),
+                      [&](const tbb::blocked_range<size_t>& r) {
+                          for (size_t i = r.begin(); i < r.end(); ++i)
+                              decodeRay(&batch.bytes[i * recordBytes], batch.format, rays[i]);
+                      });
     std::vector<std::uint8_t>().swap(batch.bytes);
     return parallelCount(n, [&](size_t i) { return rays[i].path.bounce == 0; });
 }
@@ -79,27 +83,32 @@ void traverse(const EmbreeScene& embree, const std::vector<RayState>& rays, bool
         hits.clear();
         return;
     }
-    intersectBatch(embree, RayStream{&rays[0].origin, &rays[0].dir, sizeof(RayState), rays.size()}, coherent, hits);
+    intersectBatch(embree, RayStream{&rays[0].origin, &rays[0].dir, sizeof(RayState), rays.size()},
+                   coherent, hits);
 }
 
 size_t sortHits(const Scene& scene, const std::vector<HitRecord>& hits, bool byShader,
                 std::vector<SortedHit>& order, std::vector<SortedHit>& scratch) {
     const size_t n = hits.size();
     order.resize(n);
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, n, kParallelGrain), [&](const tbb::blocked_range<size_t>& r) {
-        for (size_t i = r.begin(); i < r.end(); ++i) {
-            const HitRecord& h = hits[i];
-            std::uint64_t key = kMissKey;
-            if (h.mesh != kNoHit) key = byShader ? hitSortKey(uint(scene.meshes[h.mesh].shader), h.mesh, h.prim) : 0;
-            order[i] = {key, std::uint32_t(i)};
-        }
-    });
+    tbb::parallel_for(
+        tbb::blocked_range<size_t>(0, n, kParallelGrain), [&](const tbb::blocked_range<size_t>& r) {
+            for (size_t i = r.begin(); i < r.end(); ++i) {
+                const HitRecord& h = hits[i];
+                std::uint64_t key = kMissKey;
+                if (h.mesh != kNoHit)
+                    key = byShader ? hitSortKey(uint(scene.meshes[h.mesh].shader), h.mesh, h.prim)
+                                   : 0;
+                order[i] = {key, std::uint32_t(i)};
+            }
+        });
     const size_t hitCount = parallelCount(n, [&](size_t i) { return order[i].key != kMissKey; });
     if (byShader) {
         radixSort(order, scratch);
     } else {
         // No sort: keep traversal order, just move the misses out.
-        std::stable_partition(order.begin(), order.end(), [](const SortedHit& k) { return k.key != kMissKey; });
+        std::stable_partition(order.begin(), order.end(),
+                              [](const SortedHit& k) { return k.key != kMissKey; });
     }
     return hitCount;
 }
@@ -107,18 +116,19 @@ size_t sortHits(const Scene& scene, const std::vector<HitRecord>& hits, bool byS
 void setUpHits(const RenderContext& ctx, const std::vector<RayState>& rays,
                const std::vector<HitRecord>& hits, const std::vector<SortedHit>& order,
                size_t hitCount, ShadeInput* inputs, uvec2* paths) {
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, hitCount, 1024), [&](const tbb::blocked_range<size_t>& r) {
-        for (size_t i = r.begin(); i < r.end(); ++i) {
-            const std::uint32_t k = order[i].index;
-            ShadeInput in; // assembled here, stored whole: one sequential write into the slot
-            in.hit = ctx.embree.setUpHit(hits[k], ctx.textures);
-            in.path = rays[k].path;
-            in.rayDir = rays[k].dir;
-            in.pad0 = 0.0f;
-            inputs[i] = in;
-            paths[i] = uvec2(in.path.pathId, in.path.bounce);
-        }
-    });
+    tbb::parallel_for(
+        tbb::blocked_range<size_t>(0, hitCount, 1024), [&](const tbb::blocked_range<size_t>& r) {
+            for (size_t i = r.begin(); i < r.end(); ++i) {
+                const std::uint32_t k = order[i].index;
+                ShadeInput in; // assembled here, stored whole: one sequential write into the slot
+                in.hit = ctx.embree.setUpHit(hits[k], ctx.textures);
+                in.path = rays[k].path;
+                in.rayDir = rays[k].dir;
+                in.pad0 = 0.0f;
+                inputs[i] = in;
+                paths[i] = uvec2(in.path.pathId, in.path.bounce);
+            }
+        });
 }
 
 void shadeRanges(const Scene& scene, const std::vector<SortedHit>& order, size_t hitCount,
@@ -133,57 +143,64 @@ void shadeRanges(const Scene& scene, const std::vector<SortedHit>& order, size_t
     }
 }
 
-void gatherShadowRays(const ShadeResult* results, size_t hitCount, std::vector<std::uint32_t>& owner,
-                      std::vector<ShadowRay>& shadows) {
-    parallelSelect(hitCount, [&](size_t i) { return (results[i].flags & kShadeShadow) != 0; }, owner);
+void gatherShadowRays(const ShadeResult* results, size_t hitCount,
+                      std::vector<std::uint32_t>& owner, std::vector<ShadowRay>& shadows) {
+    parallelSelect(
+        hitCount, [&](size_t i) { return (results[i].flags & kShadeShadow) != 0; }, owner);
     shadows.resize(owner.size());
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, shadows.size(), kParallelGrain), [&](const tbb::blocked_range<size_t>& r) {
-        for (size_t j = r.begin(); j < r.end(); ++j) {
-            const ShadeResult& res = results[owner[j]];
-            shadows[j] = {res.shadowOrigin, res.shadowDir, res.shadowTmax};
-        }
-    });
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, shadows.size(), kParallelGrain),
+                      [&](const tbb::blocked_range<size_t>& r) {
+                          for (size_t j = r.begin(); j < r.end(); ++j) {
+                              const ShadeResult& res = results[owner[j]];
+                              shadows[j] = {res.shadowOrigin, res.shadowDir, res.shadowTmax};
+                          }
+                      });
 }
 
 void accumulate(const RenderContext& ctx, uint iteration, const ShadeResult* results,
                 const uvec2* paths, size_t hitCount, const std::vector<std::uint32_t>& shadowOwner,
                 const std::vector<std::uint8_t>& occluded, Film& film) {
     const RenderParams rp = paramsAt(ctx, iteration);
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, hitCount, 1024), [&](const tbb::blocked_range<size_t>& r) {
-        for (size_t i = r.begin(); i < r.end(); ++i)
-            if (results[i].flags & kShadeEmitted) {
-                const uvec2 p = paths[i]; // (pathId, bounce)
-                film.splat(filmPosition(ctx, rp, p.x), pathSample(rp, p.x), results[i].emitted, filmKey(p.x, p.y, false));
-            }
-    });
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, shadowOwner.size(), 1024), [&](const tbb::blocked_range<size_t>& r) {
-        for (size_t j = r.begin(); j < r.end(); ++j)
-            if (!occluded[j]) {
-                const size_t i = shadowOwner[j];
-                const uvec2 p = paths[i]; // (pathId, bounce)
-                film.splat(filmPosition(ctx, rp, p.x), pathSample(rp, p.x), results[i].shadowContribution,
-                           filmKey(p.x, p.y, true));
-            }
-    });
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, hitCount, 1024),
+                      [&](const tbb::blocked_range<size_t>& r) {
+                          for (size_t i = r.begin(); i < r.end(); ++i)
+                              if (results[i].flags & kShadeEmitted) {
+                                  const uvec2 p = paths[i]; // (pathId, bounce)
+                                  film.splat(filmPosition(ctx, rp, p.x), pathSample(rp, p.x),
+                                             results[i].emitted, filmKey(p.x, p.y, false));
+                              }
+                      });
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, shadowOwner.size(), 1024),
+                      [&](const tbb::blocked_range<size_t>& r) {
+                          for (size_t j = r.begin(); j < r.end(); ++j)
+                              if (!occluded[j]) {
+                                  const size_t i = shadowOwner[j];
+                                  const uvec2 p = paths[i]; // (pathId, bounce)
+                                  film.splat(filmPosition(ctx, rp, p.x), pathSample(rp, p.x),
+                                             results[i].shadowContribution,
+                                             filmKey(p.x, p.y, true));
+                              }
+                      });
 }
 
 void binContinuations(const RenderContext& ctx, uint iteration, RayFormat format,
                       const ShadeResult* results, size_t hitCount, DirectionalBins& bins) {
     const RenderParams rp = paramsAt(ctx, iteration);
     const size_t chunk = size_t(ctx.scene.settings.shadingSize);
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, hitCount, chunk), [&](const tbb::blocked_range<size_t>& r) {
-        RayBuffer buffer;
-        for (size_t i = r.begin(); i < r.end(); ++i) {
-            const ShadeResult& res = results[i];
-            if (!(res.flags & kShadeContinue)) continue;
-            RayState ray;
-            ray.origin = res.nextOrigin;
-            ray.dir = res.nextDir;
-            ray.path = res.next;
-            buffer.push(ray, format, roundingBits(rp, ray.path));
-        }
-        bins.add(buffer);
-    });
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, hitCount, chunk),
+                      [&](const tbb::blocked_range<size_t>& r) {
+                          RayBuffer buffer;
+                          for (size_t i = r.begin(); i < r.end(); ++i) {
+                              const ShadeResult& res = results[i];
+                              if (!(res.flags & kShadeContinue)) continue;
+                              RayState ray;
+                              ray.origin = res.nextOrigin;
+                              ray.dir = res.nextDir;
+                              ray.path = res.next;
+                              buffer.push(ray, format, roundingBits(rp, ray.path));
+                          }
+                          bins.add(buffer);
+                      });
 }
 
 } // namespace spw

@@ -55,8 +55,8 @@ void shadeRanges(const Scene& scene, const std::vector<SortedHit>& order, size_t
                  bool byShader, std::vector<ShadeRange>& ranges);
 
 // shadow: the shadow rays the shading made, and for each the hit it belongs to.
-void gatherShadowRays(const ShadeResult* results, size_t hitCount, std::vector<std::uint32_t>& owner,
-                      std::vector<ShadowRay>& shadows);
+void gatherShadowRays(const ShadeResult* results, size_t hitCount,
+                      std::vector<std::uint32_t>& owner, std::vector<ShadowRay>& shadows);
 
 // accumulate: what each hit emitted, and each unoccluded shadow ray's contribution, into the film.
 void accumulate(const RenderContext& ctx, uint iteration, const ShadeResult* results,

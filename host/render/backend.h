@@ -2,12 +2,12 @@
 // Virtual calls happen per iteration, never per ray.
 #pragma once
 
-#include "host/render/camera.h"
 #include "host/image/film.h"
+#include "host/render/camera.h"
 #include "host/render/render_config.h"
+#include "host/render/stats.h"
 #include "host/scene/lights.h"
 #include "host/scene/scene.h"
-#include "host/render/stats.h"
 #include "host/scene/textures.h"
 
 namespace spw {

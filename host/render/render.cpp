@@ -2,10 +2,10 @@
 
 #include "embree_backend/embree_scene.h"
 #include "embree_backend/reference_renderer.h"
-#include "host/render/backend.h"
-#include "host/render/camera.h"
 #include "host/pipeline/cpu_shading.h"
 #include "host/pipeline/sorted_renderer.h"
+#include "host/render/backend.h"
+#include "host/render/camera.h"
 #include "host/scene/textures.h"
 #include "host/vk/context.h"
 #include "host/vk/vulkan_shading.h"
@@ -51,9 +51,11 @@ std::unique_ptr<RenderResult> render(const Scene& scene, const RenderConfig& con
 
 std::unique_ptr<RenderResult> renderWithProgress(const Scene& scene, const RenderConfig& config,
                                                  const ProgressCallback& onIteration) {
-    if (config.pipeline.rayFormat == RayFormat::Compact && scene.settings.maxDepth > int(kMaxCompactBounce))
+    if (config.pipeline.rayFormat == RayFormat::Compact &&
+        scene.settings.maxDepth > int(kMaxCompactBounce))
         throw std::invalid_argument("max depth " + std::to_string(scene.settings.maxDepth) +
-                                    " exceeds the compact ray's " + std::to_string(kMaxCompactBounce) + " bounces");
+                                    " exceeds the compact ray's " +
+                                    std::to_string(kMaxCompactBounce) + " bounces");
     const auto start = std::chrono::steady_clock::now();
     const int threads = config.threads > 0 ? config.threads : tbb::info::default_concurrency();
     tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
@@ -74,7 +76,8 @@ std::unique_ptr<RenderResult> renderWithProgress(const Scene& scene, const Rende
             stats.backend = "vulkan";
             stats.device = vulkan->info().name;
         } catch (const vk::NoDeviceError& e) {
-            if (config.backend == BackendKind::Vulkan) throw std::runtime_error(std::string("--backend vulkan: ") + e.what());
+            if (config.backend == BackendKind::Vulkan)
+                throw std::runtime_error(std::string("--backend vulkan: ") + e.what());
             std::fprintf(stderr, "spillway: no Vulkan device; rendering on cpu\n");
             stats.backend = "cpu";
             stats.extra["backend_fallback"] = e.what();
@@ -105,12 +108,17 @@ std::unique_ptr<RenderResult> renderWithProgress(const Scene& scene, const Rende
     params.emitterCount = uint(lights.emitters().size());
 
     RenderContext ctx{scene, config, lights, *embree, textures, camera, params, threads, stats};
-    result->film = std::make_unique<Film>(scene.image.width, scene.image.height, scene.filter,
-                                          lights.brightestEmission(), int(params.samplesPerIteration));
+    result->film =
+        std::make_unique<Film>(scene.image.width, scene.image.height, scene.filter,
+                               lights.brightestEmission(), int(params.samplesPerIteration));
     std::unique_ptr<Backend> backend;
-    if (config.backend == BackendKind::Reference) backend = std::make_unique<ReferenceRenderer>(ctx);
-    else if (vulkan) backend = std::make_unique<SortedRenderer>(ctx, config.pipeline, makeVulkanShading(ctx, config.pipeline, *vulkan));
-    else backend = std::make_unique<SortedRenderer>(ctx, config.pipeline, makeCpuShading(ctx));
+    if (config.backend == BackendKind::Reference)
+        backend = std::make_unique<ReferenceRenderer>(ctx);
+    else if (vulkan)
+        backend = std::make_unique<SortedRenderer>(
+            ctx, config.pipeline, makeVulkanShading(ctx, config.pipeline, *vulkan));
+    else
+        backend = std::make_unique<SortedRenderer>(ctx, config.pipeline, makeCpuShading(ctx));
     double renderSeconds = 0;
     int done = 0;
     while (done < plan.iterations) {
@@ -122,10 +130,13 @@ std::unique_ptr<RenderResult> renderWithProgress(const Scene& scene, const Rende
         }
         embree->checkError("tracing");
         textures.checkErrors();
-        renderSeconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - iterationStart).count();
+        renderSeconds +=
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - iterationStart)
+                .count();
         ++done;
         const int sppDone = done * plan.sampleBase * plan.sampleBase;
-        if (onIteration) onIteration({done, plan.iterations, sppDone, renderSeconds}, *result->film);
+        if (onIteration)
+            onIteration({done, plan.iterations, sppDone, renderSeconds}, *result->film);
         if (config.timeLimitSeconds && renderSeconds >= *config.timeLimitSeconds) break;
     }
     stats.iterations = done;
@@ -133,7 +144,8 @@ std::unique_ptr<RenderResult> renderWithProgress(const Scene& scene, const Rende
     stats.extra["render_seconds"] = renderSeconds;
     stats.nonFiniteSamples = result->film->nonFiniteSamples();
     stats.saturatedSamples = result->film->saturatedSamples();
-    stats.wallSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    stats.wallSeconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return result;
 }
 

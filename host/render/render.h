@@ -4,8 +4,8 @@
 
 #include "host/image/film.h"
 #include "host/render/render_config.h"
-#include "host/scene/scene.h"
 #include "host/render/stats.h"
+#include "host/scene/scene.h"
 
 #include <functional>
 #include <memory>
@@ -21,8 +21,8 @@ struct RenderResult {
 using IterationCallback = std::function<void(int, int, const Film&)>;
 
 struct IterationInfo {
-    int done = 0, total = 0; // iterations
-    int spp = 0;             // samples per pixel so far
+    int done = 0, total = 0;  // iterations
+    int spp = 0;              // samples per pixel so far
     double renderSeconds = 0; // time in the iterations so far, callbacks excluded
 };
 using ProgressCallback = std::function<void(const IterationInfo&, const Film&)>;

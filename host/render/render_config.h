@@ -33,7 +33,8 @@ const char* raySortName(RaySortMode mode);
 // hits stay unsorted and one uber-shader switches on the model per hit. Unsorted hits (also
 // --hit-sort off) always take the megakernel: they have no homogeneous ranges.
 enum class ShadingMode { Sorted, Megakernel };
-ShadingMode parseShadingMode(const std::string& name); // "sorted" | "megakernel"; throws invalid_argument
+ShadingMode
+parseShadingMode(const std::string& name); // "sorted" | "megakernel"; throws invalid_argument
 const char* shadingModeName(ShadingMode mode);
 
 // What the scene's settings do not say about the pipeline: the ablation knobs.
@@ -44,22 +45,22 @@ struct PipelineConfig {
     ShadingMode shading = ShadingMode::Sorted;
     // Hits are sorted only for sorted shading.
     bool sortsHits() const { return hitSort && shading == ShadingMode::Sorted; }
-    std::optional<int> binExponent;         // overrides settings: bin exponent
-    std::optional<double> memoryBudgetMiB;  // overrides settings: memory budget
-    std::string spillDir;                   // empty: the system temp folder
+    std::optional<int> binExponent;        // overrides settings: bin exponent
+    std::optional<double> memoryBudgetMiB; // overrides settings: memory budget
+    std::string spillDir;                  // empty: the system temp folder
 };
 
 // Every parse* throws std::invalid_argument naming the value and the choices.
 
 // The Vulkan backend's knobs (--device, and what the tests switch on).
 struct VulkanConfig {
-    std::string device;              // --device: an index into `spillway devices`, or part of a
-                                     // device name; empty: the first usable device
-    bool validation = false;         // Khronos validation layer + a messenger counting messages
-                                     // (also on when SPILLWAY_VK_VALIDATION=1)
-    bool forceStaging = false;       // staging copies even where memory is device-local and
-                                     // host-visible (tests the path discrete GPUs take)
-    std::uint32_t maxGroupsX = 0;    // tests: cap on workgroups per dimension (0: the device's)
+    std::string device;                // --device: an index into `spillway devices`, or part of a
+                                       // device name; empty: the first usable device
+    bool validation = false;           // Khronos validation layer + a messenger counting messages
+                                       // (also on when SPILLWAY_VK_VALIDATION=1)
+    bool forceStaging = false;         // staging copies even where memory is device-local and
+                                       // host-visible (tests the path discrete GPUs take)
+    std::uint32_t maxGroupsX = 0;      // tests: cap on workgroups per dimension (0: the device's)
     std::uint64_t maxBindingBytes = 0; // tests: cap on a bound buffer range (0: the device's)
 };
 
@@ -67,12 +68,12 @@ struct RenderConfig {
     // The library's default stays cpu so that callers that do not ask for a device never
     // initialise Vulkan; the CLI's default is auto.
     BackendKind backend = BackendKind::Cpu;
-    int threads = 0;                    // 0: every core
-    std::optional<int> spp;             // overrides sample base and iterations
-    std::optional<std::uint32_t> seed;  // overrides settings.seed
-    uint strategy = kStrategyMis;       // light/BSDF sampling ablation (tests, benchmarks)
-    PipelineConfig pipeline;            // the sorted backends' knobs
-    VulkanConfig vulkan;                // the vulkan backend's knobs
+    int threads = 0;                        // 0: every core
+    std::optional<int> spp;                 // overrides sample base and iterations
+    std::optional<std::uint32_t> seed;      // overrides settings.seed
+    uint strategy = kStrategyMis;           // light/BSDF sampling ablation (tests, benchmarks)
+    PipelineConfig pipeline;                // the sorted backends' knobs
+    VulkanConfig vulkan;                    // the vulkan backend's knobs
     std::optional<double> timeLimitSeconds; // stop after the iteration that crosses it
 };
 

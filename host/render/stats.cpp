@@ -35,15 +35,19 @@ nlohmann::json RenderStats::toJson() const {
     j["threads"] = threads;
     j["wall_seconds"] = wallSeconds;
     std::uint64_t total = cameraRays + bounceRays + shadowRays;
-    j["rays"] = {{"camera", cameraRays.load()}, {"bounce", bounceRays.load()},
-                 {"shadow", shadowRays.load()}, {"total", total}};
+    j["rays"] = {{"camera", cameraRays.load()},
+                 {"bounce", bounceRays.load()},
+                 {"shadow", shadowRays.load()},
+                 {"total", total}};
     j["rays_per_second"] = wallSeconds > 0 ? double(total) / wallSeconds : 0.0;
     j["non_finite_samples"] = nonFiniteSamples;
     j["saturated_samples"] = saturatedSamples;
     nlohmann::json st = nlohmann::json::object();
-    for (const auto& [name, secs] : stages.snapshot()) st[name] = secs;
+    for (const auto& [name, secs] : stages.snapshot())
+        st[name] = secs;
     j["stage_seconds"] = st;
-    for (auto it = extra.begin(); it != extra.end(); ++it) j[it.key()] = it.value();
+    for (auto it = extra.begin(); it != extra.end(); ++it)
+        j[it.key()] = it.value();
     return j;
 }
 

@@ -31,7 +31,9 @@ class StageTimer {
     StageTimer(StageTimes& times, const char* stage)
         : times_(times), stage_(stage), start_(std::chrono::steady_clock::now()) {}
     ~StageTimer() {
-        times_.add(stage_, std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count());
+        times_.add(
+            stage_,
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count());
     }
     StageTimer(const StageTimer&) = delete;
     StageTimer& operator=(const StageTimer&) = delete;

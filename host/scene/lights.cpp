@@ -7,7 +7,8 @@
 namespace spw {
 
 SceneLights::SceneLights(const Scene& scene) {
-    for (const Shader& s : scene.shaders) shaders_.push_back(s.params);
+    for (const Shader& s : scene.shaders)
+        shaders_.push_back(s.params);
 
     emitterBase_.assign(scene.meshes.size(), -1);
     double totalPower = 0.0;
@@ -31,7 +32,8 @@ SceneLights::SceneLights(const Scene& scene) {
             e.radiance = sp.emission;
             // Power = L * area * pi per emitting side.
             // In double: radiance (up to 1e20) times area can pass float's range.
-            const double power = double(luminance(sp.emission)) * double(e.area) * kPi * (twoSided ? 2.0 : 1.0);
+            const double power =
+                double(luminance(sp.emission)) * double(e.area) * kPi * (twoSided ? 2.0 : 1.0);
             powers.push_back(power);
             totalPower += power;
             emitters_.push_back(e);

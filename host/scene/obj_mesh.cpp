@@ -24,12 +24,15 @@ namespace {
 // free-form alike. tinyobjloader reads v, vt, vn, f, l, p, g, o, s, mtllib and usemtl and
 // skips the rest, as Spillway does; a word outside this list is not OBJ.
 const char* const kStatements[] = {
-    "v", "vt", "vn", "vp", "f", "l", "p", "g", "o", "s", "mtllib", "usemtl", "maplib", "usemap",
-    "cstype", "deg", "bmat", "step", "curv", "curv2", "surf", "parm", "trim", "hole", "scrv", "sp", "end",
-    "con", "mg", "bevel", "c_interp", "d_interp", "lod", "shadow_obj", "trace_obj", "ctech", "stech",
-    "call", "csh"};
+    "v",    "vt",         "vn",        "vp",     "f",      "l",      "p",        "g",
+    "o",    "s",          "mtllib",    "usemtl", "maplib", "usemap", "cstype",   "deg",
+    "bmat", "step",       "curv",      "curv2",  "surf",   "parm",   "trim",     "hole",
+    "scrv", "sp",         "end",       "con",    "mg",     "bevel",  "c_interp", "d_interp",
+    "lod",  "shadow_obj", "trace_obj", "ctech",  "stech",  "call",   "csh"};
 
-bool isBlank(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f'; }
+bool isBlank(char c) {
+    return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f';
+}
 
 // A decimal number as tinyobjloader parses one: sign, digits with an optional point, exponent.
 // strtod alone would also take hex floats, "inf" and "nan", which tinyobjloader reads otherwise.
@@ -37,17 +40,20 @@ bool isDecimal(const std::string& s) {
     size_t i = 0, n = s.size();
     if (i < n && (s[i] == '+' || s[i] == '-')) ++i;
     size_t digits = 0;
-    while (i < n && std::isdigit((unsigned char)s[i])) ++i, ++digits;
+    while (i < n && std::isdigit((unsigned char)s[i]))
+        ++i, ++digits;
     if (i < n && s[i] == '.') {
         ++i;
-        while (i < n && std::isdigit((unsigned char)s[i])) ++i, ++digits;
+        while (i < n && std::isdigit((unsigned char)s[i]))
+            ++i, ++digits;
     }
     if (digits == 0) return false;
     if (i < n && (s[i] == 'e' || s[i] == 'E')) {
         ++i;
         if (i < n && (s[i] == '+' || s[i] == '-')) ++i;
         size_t exp = 0;
-        while (i < n && std::isdigit((unsigned char)s[i])) ++i, ++exp;
+        while (i < n && std::isdigit((unsigned char)s[i]))
+            ++i, ++exp;
         if (exp == 0) return false;
     }
     return i == n;
@@ -71,7 +77,8 @@ class ObjChecker {
         for (size_t i = 0; i < t.size(); ++i) {
             const unsigned char c = (unsigned char)t[i];
             if ((c < 0x20 && c != '\n' && !isBlank(char(c))) || c == 0x7F) {
-                const int line = int(std::count(t.begin(), t.begin() + std::ptrdiff_t(i), '\n')) + 1;
+                const int line =
+                    int(std::count(t.begin(), t.begin() + std::ptrdiff_t(i), '\n')) + 1;
                 char hex[8];
                 std::snprintf(hex, sizeof hex, "0x%02X", c);
                 fail(line, std::string("byte ") + hex + " is not text: this is not an OBJ file");
@@ -82,28 +89,35 @@ class ObjChecker {
             size_t eol = t.find('\n', at);
             if (eol == std::string::npos) eol = t.size();
             const size_t hash = t.find('#', at);
-            if (hash < eol) std::fill(t.begin() + std::ptrdiff_t(hash), t.begin() + std::ptrdiff_t(eol), ' ');
+            if (hash < eol)
+                std::fill(t.begin() + std::ptrdiff_t(hash), t.begin() + std::ptrdiff_t(eol), ' ');
             statement(line, tokens(t, at, eol));
             at = eol + 1;
         }
         // Positive indices may name elements defined later in the file: check them at the end.
         for (int k = 0; k < 3; ++k)
             if (maxIndex_[k] > (long long)count(k))
-                fail(maxIndexLine_[k], std::string("index ") + std::to_string(maxIndex_[k]) + " names no " +
-                                           kKindNames[k] + ": the file has " + std::to_string(count(k)));
+                fail(maxIndexLine_[k], std::string("index ") + std::to_string(maxIndex_[k]) +
+                                           " names no " + kKindNames[k] + ": the file has " +
+                                           std::to_string(count(k)));
     }
 
   private:
-    static constexpr const char* kKindNames[3] = {"vertex ('v')", "texture coordinate ('vt')", "normal ('vn')"};
+    static constexpr const char* kKindNames[3] = {"vertex ('v')", "texture coordinate ('vt')",
+                                                  "normal ('vn')"};
 
-    [[noreturn]] void fail(int line, const std::string& message) const { throw SceneError(path_, line, message); }
+    [[noreturn]] void fail(int line, const std::string& message) const {
+        throw SceneError(path_, line, message);
+    }
 
     static std::vector<std::string> tokens(const std::string& t, size_t at, size_t eol) {
         std::vector<std::string> words;
         while (at < eol) {
-            while (at < eol && isBlank(t[at])) ++at;
+            while (at < eol && isBlank(t[at]))
+                ++at;
             const size_t start = at;
-            while (at < eol && !isBlank(t[at])) ++at;
+            while (at < eol && !isBlank(t[at]))
+                ++at;
             if (at > start) words.emplace_back(t, start, at - start);
         }
         return words;
@@ -113,10 +127,13 @@ class ObjChecker {
         return kind == 0 ? out_.positions.size() : kind == 1 ? out_.uvs : out_.normals;
     }
 
-    void numbers(int line, const std::vector<std::string>& w, size_t lo, size_t hi, double* values) const {
+    void numbers(int line, const std::vector<std::string>& w, size_t lo, size_t hi,
+                 double* values) const {
         const size_t n = w.size() - 1;
         if (n < lo || n > hi)
-            fail(line, "'" + w[0] + "' takes " + (lo == hi ? std::to_string(lo) : std::to_string(lo) + " to " + std::to_string(hi)) +
+            fail(line, "'" + w[0] + "' takes " +
+                           (lo == hi ? std::to_string(lo)
+                                     : std::to_string(lo) + " to " + std::to_string(hi)) +
                            " numbers, not " + std::to_string(n));
         for (size_t i = 1; i < w.size(); ++i) {
             const double v = std::strtod(w[i].c_str(), nullptr);
@@ -132,13 +149,17 @@ class ObjChecker {
         errno = 0;
         char* end = nullptr;
         const long long v = std::strtoll(text.c_str(), &end, 10);
-        if (text.empty() || *end != '\0' || (!std::isdigit((unsigned char)text[0]) && text[0] != '-' && text[0] != '+'))
+        if (text.empty() || *end != '\0' ||
+            (!std::isdigit((unsigned char)text[0]) && text[0] != '-' && text[0] != '+'))
             fail(line, "'" + text + "' is not an index");
         const long long have = (long long)count(kind);
-        if (v == 0) fail(line, std::string("index 0 names no ") + kKindNames[kind] + ": indices start at 1");
+        if (v == 0)
+            fail(line,
+                 std::string("index 0 names no ") + kKindNames[kind] + ": indices start at 1");
         if (errno == ERANGE || v < -have || v > std::numeric_limits<int>::max())
-            fail(line, std::string("index ") + text + " names no " + kKindNames[kind] + ": " +
-                           (v < 0 ? std::to_string(have) + " defined before this line" : "out of range"));
+            fail(line,
+                 std::string("index ") + text + " names no " + kKindNames[kind] + ": " +
+                     (v < 0 ? std::to_string(have) + " defined before this line" : "out of range"));
         if (v > maxIndex_[kind]) maxIndex_[kind] = v, maxIndexLine_[kind] = line;
     }
 
@@ -149,7 +170,8 @@ class ObjChecker {
         size_t at = 0;
         while (parts < 3) {
             const size_t slash = ref.find('/', at);
-            part[parts++] = ref.substr(at, slash == std::string::npos ? std::string::npos : slash - at);
+            part[parts++] =
+                ref.substr(at, slash == std::string::npos ? std::string::npos : slash - at);
             if (slash == std::string::npos) break;
             at = slash + 1;
             if (parts == 3) fail(line, "'" + ref + "' has more than three indices");
@@ -178,15 +200,19 @@ class ObjChecker {
             numbers(line, w, 1, 3, nullptr);
         } else if (s == "f") {
             if (w.size() < 4)
-                fail(line, "a face needs at least 3 vertices, this one has " + std::to_string(w.size() - 1));
-            for (size_t i = 1; i < w.size(); ++i) reference(line, w[i], true);
+                fail(line, "a face needs at least 3 vertices, this one has " +
+                               std::to_string(w.size() - 1));
+            for (size_t i = 1; i < w.size(); ++i)
+                reference(line, w[i], true);
             ++out_.faces;
         } else if (s == "l" || s == "p") {
             if (w.size() < (s == "l" ? 3u : 2u)) fail(line, "'" + s + "' has too few vertices");
-            for (size_t i = 1; i < w.size(); ++i) reference(line, w[i], false);
+            for (size_t i = 1; i < w.size(); ++i)
+                reference(line, w[i], false);
         } else if (std::find_if(std::begin(kStatements), std::end(kStatements),
                                 [&](const char* k) { return s == k; }) == std::end(kStatements)) {
-            fail(line, "'" + (s.size() > 40 ? s.substr(0, 40) + "..." : s) + "' is not an OBJ statement");
+            fail(line,
+                 "'" + (s.size() > 40 ? s.substr(0, 40) + "..." : s) + "' is not an OBJ statement");
         }
     }
 
@@ -201,7 +227,8 @@ std::string readFile(const std::string& path, const std::string& sceneFile, int 
     std::stringstream text;
     if (file) text << file.rdbuf();
     if (!file || file.bad())
-        throw SceneError(sceneFile, sceneLine, "cannot read OBJ file '" + path + "': " + std::strerror(errno));
+        throw SceneError(sceneFile, sceneLine,
+                         "cannot read OBJ file '" + path + "': " + std::strerror(errno));
     return text.str();
 }
 
@@ -212,7 +239,8 @@ Mesh loadObjMesh(const std::string& path, const glm::dmat4& objectToWorld, const
     ObjText obj;
     ObjChecker(path, obj).check(readFile(path, sceneFile, sceneLine));
     if (obj.faces == 0)
-        throw SceneError(sceneFile, sceneLine, "OBJ file '" + path + "' has no face ('f' statement): nothing to render");
+        throw SceneError(sceneFile, sceneLine,
+                         "OBJ file '" + path + "' has no face ('f' statement): nothing to render");
 
     tinyobj::ObjReaderConfig cfg;
     cfg.triangulate = true;
@@ -222,7 +250,8 @@ Mesh loadObjMesh(const std::string& path, const glm::dmat4& objectToWorld, const
     // Materials are ignored (shaders come from the scene): parse the geometry only.
     if (!reader.ParseFromString(obj.clean, "", cfg)) {
         std::string why = reader.Error();
-        while (!why.empty() && (why.back() == '\n' || why.back() == '\r')) why.pop_back();
+        while (!why.empty() && (why.back() == '\n' || why.back() == '\r'))
+            why.pop_back();
         throw SceneError(sceneFile, sceneLine, "cannot read OBJ file '" + path + "': " + why);
     }
     const tinyobj::attrib_t& a = reader.GetAttrib();
@@ -230,9 +259,12 @@ Mesh loadObjMesh(const std::string& path, const glm::dmat4& objectToWorld, const
     // out of bounds: refuse the file rather than trust either alone.
     if (a.vertices.size() != 3 * obj.positions.size() || a.normals.size() != 3 * obj.normals ||
         a.texcoords.size() != 2 * obj.uvs)
-        throw SceneError(sceneFile, sceneLine, "OBJ file '" + path + "': tinyobjloader read a different number of "
-                                                "vertices, normals or texture coordinates than the file holds");
-    const long long nv = (long long)obj.positions.size(), nn = (long long)obj.normals, nt = (long long)obj.uvs;
+        throw SceneError(sceneFile, sceneLine,
+                         "OBJ file '" + path +
+                             "': tinyobjloader read a different number of "
+                             "vertices, normals or texture coordinates than the file holds");
+    const long long nv = (long long)obj.positions.size(), nn = (long long)obj.normals,
+                    nt = (long long)obj.uvs;
 
     Mesh mesh;
     mesh.name = path;
@@ -246,8 +278,10 @@ Mesh loadObjMesh(const std::string& path, const glm::dmat4& objectToWorld, const
             uvec3 tri;
             for (int k = 0; k < 3; ++k) {
                 const tinyobj::index_t& ix = idx[f + k];
-                if (ix.vertex_index < 0 || ix.vertex_index >= nv || ix.normal_index >= nn || ix.texcoord_index >= nt)
-                    throw SceneError(sceneFile, sceneLine, "OBJ file '" + path + "': a face index is out of range");
+                if (ix.vertex_index < 0 || ix.vertex_index >= nv || ix.normal_index >= nn ||
+                    ix.texcoord_index >= nt)
+                    throw SceneError(sceneFile, sceneLine,
+                                     "OBJ file '" + path + "': a face index is out of range");
                 auto key = std::make_tuple(ix.vertex_index, hasNormals ? ix.normal_index : -1,
                                            hasUvs ? ix.texcoord_index : -1);
                 auto [it, inserted] = remap.try_emplace(key, uint(mesh.positions.size()));
@@ -255,9 +289,11 @@ Mesh loadObjMesh(const std::string& path, const glm::dmat4& objectToWorld, const
                     // In double until here: the object's transform and the shift to the camera
                     // round once, to float, at the end.
                     const size_t vi = size_t(ix.vertex_index);
-                    const glm::dvec3 world = glm::dvec3(objectToWorld * glm::dvec4(obj.positions[vi], 1.0)) - origin;
-                    const std::string far = beyondReach(world, "vertex (after the object's transform, scene " +
-                                                                       sceneFile + ":" + std::to_string(sceneLine) + ")");
+                    const glm::dvec3 world =
+                        glm::dvec3(objectToWorld * glm::dvec4(obj.positions[vi], 1.0)) - origin;
+                    const std::string far =
+                        beyondReach(world, "vertex (after the object's transform, scene " +
+                                               sceneFile + ":" + std::to_string(sceneLine) + ")");
                     if (!far.empty()) throw SceneError(path, obj.positionLines[vi], far);
                     mesh.positions.push_back(vec3(world));
                     if (hasNormals) {
@@ -267,7 +303,8 @@ Mesh loadObjMesh(const std::string& path, const glm::dmat4& objectToWorld, const
                                                       a.normals[3 * size_t(ix.normal_index) + 1],
                                                       a.normals[3 * size_t(ix.normal_index) + 2]);
                         const double len = glm::length(n);
-                        mesh.normals.push_back(len > 0.0 && std::isfinite(len) ? vec3(n / len) : vec3(0.0f));
+                        mesh.normals.push_back(len > 0.0 && std::isfinite(len) ? vec3(n / len)
+                                                                               : vec3(0.0f));
                     }
                     if (hasUvs) {
                         vec2 uv(0.0f);
@@ -279,15 +316,17 @@ Mesh loadObjMesh(const std::string& path, const glm::dmat4& objectToWorld, const
                 }
                 tri[k] = it->second;
             }
-            // Zero area as the renderer sees it: it normalises cross(e1, e2) in float, so |c|^2 must
-            // be a normal float (not 0, not a denormal that flush-to-zero turns into 0).
+            // Zero area as the renderer sees it: it normalises cross(e1, e2) in float, so |c|^2
+            // must be a normal float (not 0, not a denormal that flush-to-zero turns into 0).
             vec3 e1 = mesh.positions[tri.y] - mesh.positions[tri.x];
             vec3 e2 = mesh.positions[tri.z] - mesh.positions[tri.x];
             vec3 c = glm::cross(e1, e2);
             const float c2 = glm::dot(c, c);
             if (std::isinf(c2) || std::isnan(c2))
-                throw SceneError(sceneFile, sceneLine, "OBJ file '" + path + "' has a triangle too large for float "
-                                                       "(its normal overflows): edges must stay below about 1e9");
+                throw SceneError(sceneFile, sceneLine,
+                                 "OBJ file '" + path +
+                                     "' has a triangle too large for float "
+                                     "(its normal overflows): edges must stay below about 1e9");
             if (!(c2 >= std::numeric_limits<float>::min())) {
                 ++mesh.droppedTriangles;
                 continue;

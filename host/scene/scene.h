@@ -20,7 +20,8 @@ namespace spw {
 class SceneError : public std::runtime_error {
   public:
     SceneError(std::string file, int line, const std::string& message)
-        : std::runtime_error(file + (line > 0 ? ":" + std::to_string(line) : std::string()) + ": " + message),
+        : std::runtime_error(file + (line > 0 ? ":" + std::to_string(line) : std::string()) + ": " +
+                             message),
           file_(std::move(file)), line_(line) {}
     const std::string& file() const { return file_; }
     int line() const { return line_; }
@@ -76,8 +77,8 @@ struct Camera {
     // Looks along local -Z, +Y up. Its translation is always zero: the world is camera-relative
     // (Scene::origin is where the camera stands in the scene file's coordinates).
     mat4 cameraToWorld{1.0f};
-    float focalLength = 35.0f; // mm
-    float filmWidth = 35.0f;   // mm
+    float focalLength = 35.0f;       // mm
+    float filmWidth = 35.0f;         // mm
     std::optional<float> fovDegrees; // horizontal; overrides the focal length
     float apertureRadius = 0.0f;
     float focalDistance = 1.0f;
@@ -97,7 +98,7 @@ enum class TextureType { Constant, Standard, Layered };
 struct Texture {
     TextureType type = TextureType::Constant;
     vec3 colour{1.0f};
-    std::string path; // Standard: absolute path of the image
+    std::string path;                      // Standard: absolute path of the image
     int upper = -1, lower = -1, mask = -1; // Layered: indices into Scene::textures
     int line = 0;                          // where the scene file defines it
 };
@@ -117,7 +118,7 @@ struct Mesh {
     std::vector<vec2> uvs;
     std::vector<uvec3> triangles;
     int shader = 0;
-    std::string name; // the file, or "quad light N"
+    std::string name;         // the file, or "quad light N"
     int droppedTriangles = 0; // zero-area triangles left out when loading
 };
 
@@ -132,9 +133,9 @@ struct Scene {
     Camera camera;
     Filter filter;
     SamplerType sampler = SamplerType::Independent;
-    std::vector<Shader> shaders;   // scene shaders first, then one emissive Null per quad light
+    std::vector<Shader> shaders; // scene shaders first, then one emissive Null per quad light
     std::vector<Texture> textures;
-    std::vector<Mesh> meshes;      // objects first, then the quad lights' geometry
+    std::vector<Mesh> meshes; // objects first, then the quad lights' geometry
     int objectCount = 0;
     int quadLightCount = 0;
 

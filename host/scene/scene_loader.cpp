@@ -48,7 +48,8 @@ class Reader {
         for (auto it = map.begin(); it != map.end(); ++it) {
             std::string key = it->first.as<std::string>();
             bool known = false;
-            for (const char* a : allowed) known = known || key == a;
+            for (const char* a : allowed)
+                known = known || key == a;
             if (!known) fail(it->first, "unknown key '" + key + "' in " + what);
         }
     }
@@ -61,7 +62,8 @@ class Reader {
     double number(const YAML::Node& n, const std::string& what) const {
         if (!n.IsScalar()) fail(n, what + " must be a number");
         double v;
-        if (!YAML::convert<double>::decode(n, v)) fail(n, what + " must be a number, not '" + n.Scalar() + "'");
+        if (!YAML::convert<double>::decode(n, v))
+            fail(n, what + " must be a number, not '" + n.Scalar() + "'");
         if (!std::isfinite(v)) fail(n, what + " must be finite");
         return v;
     }
@@ -73,7 +75,8 @@ class Reader {
         return v;
     }
 
-    long long integer(const YAML::Node& n, const std::string& what, long long lo, long long hi) const {
+    long long integer(const YAML::Node& n, const std::string& what, long long lo,
+                      long long hi) const {
         if (!n.IsScalar()) fail(n, what + " must be an integer");
         long long v;
         if (!YAML::convert<long long>::decode(n, v))
@@ -86,7 +89,8 @@ class Reader {
 
     bool boolean(const YAML::Node& n, const std::string& what) const {
         bool v;
-        if (!n.IsScalar() || !YAML::convert<bool>::decode(n, v)) fail(n, what + " must be true or false");
+        if (!n.IsScalar() || !YAML::convert<bool>::decode(n, v))
+            fail(n, what + " must be true or false");
         return v;
     }
 
@@ -102,7 +106,8 @@ class Reader {
         if (!n.IsSequence() || n.size() != N)
             fail(n, what + " must be a list of " + std::to_string(N) + " numbers");
         glm::vec<N, double> v;
-        for (int i = 0; i < N; ++i) v[i] = number(n[i], what, lo, hi);
+        for (int i = 0; i < N; ++i)
+            v[i] = number(n[i], what, lo, hi);
         return v;
     }
 
@@ -143,20 +148,24 @@ glm::dmat4 rotationXYZ(glm::dvec3 degrees) {
 
 // translation * rotation * scale, reading whichever of the three keys are present. In double:
 // the scene is moved to the camera before anything is rounded to float.
-glm::dmat4 readTransform(const Reader& rd, const YAML::Node& n, const std::string& what, bool scale3) {
+glm::dmat4 readTransform(const Reader& rd, const YAML::Node& n, const std::string& what,
+                         bool scale3) {
     glm::dmat4 m(1.0);
-    if (n["translation"]) m = glm::translate(m, rd.dvec<3>(n["translation"], what + " translation"));
+    if (n["translation"])
+        m = glm::translate(m, rd.dvec<3>(n["translation"], what + " translation"));
     if (n["rotation"]) m = m * rotationXYZ(rd.dvec<3>(n["rotation"], what + " rotation"));
     if (scale3 && n["scale"]) {
         const YAML::Node& s = n["scale"];
-        glm::dvec3 sc = s.IsScalar() ? glm::dvec3(rd.number(s, what + " scale")) : rd.dvec<3>(s, what + " scale");
+        glm::dvec3 sc = s.IsScalar() ? glm::dvec3(rd.number(s, what + " scale"))
+                                     : rd.dvec<3>(s, what + " scale");
         if (sc.x == 0 || sc.y == 0 || sc.z == 0) rd.fail(s, what + " scale must not be zero");
         m = glm::scale(m, sc);
     }
     return m;
 }
 
-void checkDistance(const Reader& rd, const YAML::Node& at, const glm::dvec3& p, const std::string& what) {
+void checkDistance(const Reader& rd, const YAML::Node& at, const glm::dvec3& p,
+                   const std::string& what) {
     const std::string why = beyondReach(p, what);
     if (!why.empty()) rd.fail(at, why);
 }
@@ -167,10 +176,12 @@ void readImage(const Reader& rd, const YAML::Node& n, ImageSettings& img) {
     if (n["height"]) img.height = int(rd.integer(n["height"], "image height", 1, kMaxDimension));
     if (n["sample base"])
         img.sampleBase = int(rd.integer(n["sample base"], "sample base", 1, kMaxSampleBase));
-    if (n["iterations"]) img.iterations = int(rd.integer(n["iterations"], "iterations", 1, 1 << 24));
+    if (n["iterations"])
+        img.iterations = int(rd.integer(n["iterations"], "iterations", 1, 1 << 24));
     if ((long long)img.width * img.height > kMaxPixels)
         rd.fail(n, "image of " + std::to_string(img.width) + "x" + std::to_string(img.height) +
-                       " pixels is larger than the " + std::to_string(kMaxPixels) + " pixels Spillway renders");
+                       " pixels is larger than the " + std::to_string(kMaxPixels) +
+                       " pixels Spillway renders");
     // Render-wide sample indices are 32-bit (they key the random numbers): refuse more samples
     // per pixel than that holds instead of silently repeating random numbers.
     if ((long long)img.samplesPerIteration() * img.iterations > 0xFFFFFFFFLL)
@@ -180,14 +191,17 @@ void readImage(const Reader& rd, const YAML::Node& n, ImageSettings& img) {
 }
 
 void readSettings(const Reader& rd, const YAML::Node& n, Settings& s) {
-    rd.checkKeys(n, "settings", {"min depth", "max depth", "threshold", "bucket size", "shading size",
-                                 "bin exponent", "memory budget", "seed"});
+    rd.checkKeys(n, "settings",
+                 {"min depth", "max depth", "threshold", "bucket size", "shading size",
+                  "bin exponent", "memory budget", "seed"});
     if (n["min depth"]) s.minDepth = int(rd.integer(n["min depth"], "min depth", 0, kMaxDepth));
     if (n["max depth"]) s.maxDepth = int(rd.integer(n["max depth"], "max depth", 0, kMaxDepth));
     if (n["threshold"]) s.threshold = float(rd.number(n["threshold"], "threshold", 0.0, 1e30));
     if (n["bucket size"]) s.bucketSize = int(rd.integer(n["bucket size"], "bucket size", 1, 4096));
-    if (n["shading size"]) s.shadingSize = int(rd.integer(n["shading size"], "shading size", 1, 1 << 24));
-    if (n["bin exponent"]) s.binExponent = int(rd.integer(n["bin exponent"], "bin exponent", 4, 24));
+    if (n["shading size"])
+        s.shadingSize = int(rd.integer(n["shading size"], "shading size", 1, 1 << 24));
+    if (n["bin exponent"])
+        s.binExponent = int(rd.integer(n["bin exponent"], "bin exponent", 4, 24));
     if (n["memory budget"])
         s.memoryBudgetMiB = rd.number(n["memory budget"], "memory budget", 1.0 / 1024, 1 << 20);
     if (n["seed"]) s.seed = std::uint32_t(rd.integer(n["seed"], "seed", 0, 0xFFFFFFFFLL));
@@ -195,14 +209,18 @@ void readSettings(const Reader& rd, const YAML::Node& n, Settings& s) {
 
 // Reads the camera and returns its position in the file's coordinates: the scene's origin.
 glm::dvec3 readCamera(const Reader& rd, const YAML::Node& n, Camera& c) {
-    rd.checkKeys(n, "camera", {"type", "translation", "rotation", "look at", "focal length", "fov",
-                               "aperture radius", "focal distance", "film width"});
+    rd.checkKeys(n, "camera",
+                 {"type", "translation", "rotation", "look at", "focal length", "fov",
+                  "aperture radius", "focal distance", "film width"});
     glm::dvec3 origin(0.0);
     if (n["type"]) {
         std::string t = rd.string(n["type"], "camera type");
-        if (t == "PinHole") c.type = CameraType::PinHole;
-        else if (t == "ThinLens") c.type = CameraType::ThinLens;
-        else rd.fail(n["type"], "unknown camera type '" + t + "' (PinHole or ThinLens)");
+        if (t == "PinHole")
+            c.type = CameraType::PinHole;
+        else if (t == "ThinLens")
+            c.type = CameraType::ThinLens;
+        else
+            rd.fail(n["type"], "unknown camera type '" + t + "' (PinHole or ThinLens)");
     }
     if (n["look at"]) {
         const YAML::Node& la = n["look at"];
@@ -218,7 +236,8 @@ glm::dvec3 readCamera(const Reader& rd, const YAML::Node& n, Camera& c) {
         const glm::dvec3 d = target - eye;
         const double span = std::max({std::fabs(d.x), std::fabs(d.y), std::fabs(d.z)});
         if (span == 0) rd.fail(la, "look at eye and target are the same point");
-        if (!std::isfinite(span)) rd.fail(la, "look at eye and target are too far apart for double precision");
+        if (!std::isfinite(span))
+            rd.fail(la, "look at eye and target are too far apart for double precision");
         checkDistance(rd, la["target"], d, "look at target");
         const double upSpan = std::max({std::fabs(up.x), std::fabs(up.y), std::fabs(up.z)});
         if (upSpan == 0) rd.fail(la["up"], "look at up must not be zero");
@@ -235,16 +254,19 @@ glm::dvec3 readCamera(const Reader& rd, const YAML::Node& n, Camera& c) {
         m[3] = glm::dvec4(0, 0, 0, 1);
         c.cameraToWorld = mat4(m);
     }
-    if (n["focal length"]) c.focalLength = float(rd.number(n["focal length"], "focal length", 1e-6, 1e9));
+    if (n["focal length"])
+        c.focalLength = float(rd.number(n["focal length"], "focal length", 1e-6, 1e9));
     if (n["film width"]) c.filmWidth = float(rd.number(n["film width"], "film width", 1e-6, 1e9));
     if (n["fov"]) {
         c.fovDegrees = float(rd.number(n["fov"], "fov", 1e-4, 179.9));
     }
     // The lens and the focal plane lie within kMaxDistance of the camera like everything else.
     if (n["aperture radius"])
-        c.apertureRadius = float(rd.number(n["aperture radius"], "aperture radius", 0.0, kMaxDistance));
+        c.apertureRadius =
+            float(rd.number(n["aperture radius"], "aperture radius", 0.0, kMaxDistance));
     if (n["focal distance"])
-        c.focalDistance = float(rd.number(n["focal distance"], "focal distance", 1e-30, kMaxDistance));
+        c.focalDistance =
+            float(rd.number(n["focal distance"], "focal distance", 1e-30, kMaxDistance));
     if (c.type == CameraType::PinHole && (n["aperture radius"] || n["focal distance"]))
         rd.fail(n, "aperture radius and focal distance need camera type ThinLens");
     // fov is bounded by its range; focal length and film width must give no wider a view, or
@@ -258,10 +280,14 @@ glm::dvec3 readCamera(const Reader& rd, const YAML::Node& n, Camera& c) {
 void readFilter(const Reader& rd, const YAML::Node& n, Filter& f) {
     rd.checkKeys(n, "filter", {"type", "width"});
     std::string t = n["type"] ? rd.string(n["type"], "filter type") : "Box";
-    if (t == "Box") f = {FilterType::Box, 0.5f};
-    else if (t == "Tent") f = {FilterType::Tent, 1.0f};
-    else if (t == "Gaussian") f = {FilterType::Gaussian, 1.5f};
-    else rd.fail(n["type"], "unknown filter type '" + t + "' (Box, Tent or Gaussian)");
+    if (t == "Box")
+        f = {FilterType::Box, 0.5f};
+    else if (t == "Tent")
+        f = {FilterType::Tent, 1.0f};
+    else if (t == "Gaussian")
+        f = {FilterType::Gaussian, 1.5f};
+    else
+        rd.fail(n["type"], "unknown filter type '" + t + "' (Box, Tent or Gaussian)");
     if (n["width"]) {
         float w = float(rd.number(n["width"], "filter width", 1e-3, 16.0));
         if (f.type != FilterType::Box) f.radius = w;
@@ -283,17 +309,21 @@ SamplerType readSampler(const Reader& rd, const YAML::Node& n) {
 // without end.
 class TextureReader {
   public:
-    TextureReader(const Reader& rd, const fs::path& dir, Scene& scene) : rd_(rd), dir_(dir), scene_(scene) {}
+    TextureReader(const Reader& rd, const fs::path& dir, Scene& scene)
+        : rd_(rd), dir_(dir), scene_(scene) {}
 
     int read(const YAML::Node& n, int depth = 1) {
         if (depth > kMaxTextureDepth)
-            rd_.fail(n, "textures nest deeper than " + std::to_string(kMaxTextureDepth) + " levels");
+            rd_.fail(n,
+                     "textures nest deeper than " + std::to_string(kMaxTextureDepth) + " levels");
         // yaml-cpp has no node identity but is(); nodes sharing a position in the file are the
         // only candidates for being the same node.
         std::vector<Seen>& atPos = seen_[n.Mark().pos];
         for (const Seen& e : atPos)
             if (e.node.is(n)) {
-                if (e.index < 0) rd_.fail(n, "texture contains itself (a YAML alias used inside its own anchor)");
+                if (e.index < 0)
+                    rd_.fail(n,
+                             "texture contains itself (a YAML alias used inside its own anchor)");
                 return e.index;
             }
         atPos.push_back({n, -1});
@@ -311,12 +341,15 @@ class TextureReader {
 
     int readNode(const YAML::Node& n, int depth) {
         const Reader& rd = rd_;
-        rd.checkKeys(n, "texture", {"type", "colour", "string", "filename", "upper", "lower", "mask"});
+        rd.checkKeys(n, "texture",
+                     {"type", "colour", "string", "filename", "upper", "lower", "mask"});
         if (!n["type"]) rd.fail(n, "texture needs a type (Constant, Standard or Layered)");
         std::string t = rd.string(n["type"], "texture type");
         Texture tex;
         tex.line = n.Mark().line + 1;
-        auto only = [&](std::initializer_list<const char*> keys) { rd.checkKeys(n, t + " texture", keys); };
+        auto only = [&](std::initializer_list<const char*> keys) {
+            rd.checkKeys(n, t + " texture", keys);
+        };
         if (t == "Constant") {
             only({"type", "colour"});
             tex.type = TextureType::Constant;
@@ -327,7 +360,8 @@ class TextureReader {
             YAML::Node f = n["string"] ? n["string"] : n["filename"];
             if (!f) rd.fail(n, "Standard texture needs 'string' (or 'filename'): the image file");
             fs::path p = dir_ / rd.string(f, "texture file");
-            if (!fs::is_regular_file(p)) rd.fail(f, "texture file '" + p.string() + "' does not exist");
+            if (!fs::is_regular_file(p))
+                rd.fail(f, "texture file '" + p.string() + "' does not exist");
             tex.path = fs::absolute(p).lexically_normal().string();
             checkImage(f, tex.path);
         } else if (t == "Layered") {
@@ -353,8 +387,10 @@ class TextureReader {
         auto in = OIIO::ImageInput::open(path);
         if (!in) {
             std::string why = OIIO::geterror();
-            while (!why.empty() && (why.back() == '\n' || why.back() == '\r')) why.pop_back();
-            rd_.fail(at, "texture file '" + path + "' is not an image OpenImageIO can read: " + why);
+            while (!why.empty() && (why.back() == '\n' || why.back() == '\r'))
+                why.pop_back();
+            rd_.fail(at,
+                     "texture file '" + path + "' is not an image OpenImageIO can read: " + why);
         }
         const OIIO::ImageSpec& spec = in->spec();
         if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0)
@@ -388,10 +424,13 @@ void readShader(const Reader& rd, const YAML::Node& n, TextureReader& textures, 
         rd.checkKeys(n, t + " shader", {"type", "emission", "two sided"});
         if (t == "Emissive" && !n["emission"]) rd.fail(n, "Emissive shader needs 'emission'");
     } else if (t == "Lambert") {
-        rd.checkKeys(n, "Lambert shader", {"type", "emission", "two sided", "reflectance", "colour", "texture"});
+        rd.checkKeys(n, "Lambert shader",
+                     {"type", "emission", "two sided", "reflectance", "colour", "texture"});
         p.model = kModelLambert;
-        if (n["reflectance"]) p.reflectance = float(rd.number(n["reflectance"], "reflectance", 0.0, 1.0));
-        if (n["colour"] && n["texture"]) rd.fail(n["texture"], "Lambert takes colour or texture, not both");
+        if (n["reflectance"])
+            p.reflectance = float(rd.number(n["reflectance"], "reflectance", 0.0, 1.0));
+        if (n["colour"] && n["texture"])
+            rd.fail(n["texture"], "Lambert takes colour or texture, not both");
         if (n["colour"]) p.colour = rd.vec<3>(n["colour"], "colour", 0.0, 1.0);
         if (n["texture"]) {
             s.texture = textures.read(n["texture"]);
@@ -431,7 +470,8 @@ void readObject(const Reader& rd, const YAML::Node& n, const fs::path& dir, Scen
     if (t != "Polygon") rd.fail(n["type"], "unknown object type '" + t + "' (Polygon)");
     if (!n["filename"]) rd.fail(n, "object needs a filename (an OBJ file)");
     fs::path p = dir / rd.string(n["filename"], "object filename");
-    if (!fs::is_regular_file(p)) rd.fail(n["filename"], "object file '" + p.string() + "' does not exist");
+    if (!fs::is_regular_file(p))
+        rd.fail(n["filename"], "object file '" + p.string() + "' does not exist");
     int shader = n["shader"] ? int(rd.integer(n["shader"], "object shader", 0, 1 << 30)) : 0;
     const glm::dmat4 xf = readTransform(rd, n, "object", true);
     Mesh mesh = loadObjMesh(p.string(), xf, scene.origin, rd.file(), n["filename"].Mark().line + 1);
@@ -443,38 +483,48 @@ void readObject(const Reader& rd, const YAML::Node& n, const fs::path& dir, Scen
 
 // A quad light becomes two triangles (appended to lightMeshes) and an emissive Null shader of
 // its own (returned); both go after the scene's objects and shaders once the file is read.
-Shader readLight(const Reader& rd, const YAML::Node& n, const glm::dvec3& origin, std::vector<Mesh>& lightMeshes) {
+Shader readLight(const Reader& rd, const YAML::Node& n, const glm::dvec3& origin,
+                 std::vector<Mesh>& lightMeshes) {
     if (!n.IsMap() || !n["type"]) rd.fail(n, "light needs a type (Quad)");
     std::string t = rd.string(n["type"], "light type");
-    if (t == "Point" || t == "Environment") rd.fail(n["type"], "light type '" + t + "' is not supported yet");
+    if (t == "Point" || t == "Environment")
+        rd.fail(n["type"], "light type '" + t + "' is not supported yet");
     if (t != "Quad") rd.fail(n["type"], "unknown light type '" + t + "' (Quad)");
-    rd.checkKeys(n, "Quad light", {"type", "translation", "rotation", "scale", "intensity", "colour"});
+    rd.checkKeys(n, "Quad light",
+                 {"type", "translation", "rotation", "scale", "intensity", "colour"});
     glm::dvec2 size(1.0);
     if (n["scale"]) {
         size = rd.dvec<2>(n["scale"], "light scale", 1e-30, kMaxDistance);
     }
-    const double intensity = n["intensity"] ? rd.number(n["intensity"], "light intensity", 0.0, kMaxRadiance) : 1.0;
-    const glm::dvec3 colour = n["colour"] ? rd.dvec<3>(n["colour"], "light colour", 0.0, kMaxRadiance) : glm::dvec3(1.0);
+    const double intensity =
+        n["intensity"] ? rd.number(n["intensity"], "light intensity", 0.0, kMaxRadiance) : 1.0;
+    const glm::dvec3 colour =
+        n["colour"] ? rd.dvec<3>(n["colour"], "light colour", 0.0, kMaxRadiance) : glm::dvec3(1.0);
     for (int i = 0; i < 3; ++i) {
         // The product is the light's radiance: it must fit the same range as any emission.
         if (intensity * colour[i] > kMaxRadiance)
             rd.fail(n["colour"] ? n["colour"] : n["intensity"],
-                    "light intensity x colour = " + Reader::fmt(intensity * colour[i]) + " exceeds " +
-                        Reader::fmt(kMaxRadiance) + ", the brightest radiance Spillway renders");
+                    "light intensity x colour = " + Reader::fmt(intensity * colour[i]) +
+                        " exceeds " + Reader::fmt(kMaxRadiance) +
+                        ", the brightest radiance Spillway renders");
     }
     const glm::dmat4 xf = readTransform(rd, n, "light", false);
 
     Mesh m;
     m.name = "quad light " + std::to_string(lightMeshes.size());
-    for (glm::dvec2 c : {glm::dvec2(-0.5, -0.5), glm::dvec2(0.5, -0.5), glm::dvec2(0.5, 0.5), glm::dvec2(-0.5, 0.5)}) {
-        const glm::dvec3 p = glm::dvec3(xf * glm::dvec4(c.x * size.x, c.y * size.y, 0.0, 1.0)) - origin;
+    for (glm::dvec2 c : {glm::dvec2(-0.5, -0.5), glm::dvec2(0.5, -0.5), glm::dvec2(0.5, 0.5),
+                         glm::dvec2(-0.5, 0.5)}) {
+        const glm::dvec3 p =
+            glm::dvec3(xf * glm::dvec4(c.x * size.x, c.y * size.y, 0.0, 1.0)) - origin;
         checkDistance(rd, n, p, "quad light corner");
         m.positions.push_back(vec3(p));
     }
     m.triangles = {uvec3(0, 1, 2), uvec3(0, 2, 3)};
-    // A light too small (or too far out) for float to span: refuse it rather than divide by its area.
+    // A light too small (or too far out) for float to span: refuse it rather than divide by its
+    // area.
     for (const uvec3& tri : m.triangles) {
-        vec3 c = glm::cross(m.positions[tri.y] - m.positions[tri.x], m.positions[tri.z] - m.positions[tri.x]);
+        vec3 c = glm::cross(m.positions[tri.y] - m.positions[tri.x],
+                            m.positions[tri.z] - m.positions[tri.x]);
         float a2 = glm::dot(c, c);
         if (!(a2 >= std::numeric_limits<float>::min()) || !std::isfinite(a2))
             rd.fail(n, "quad light has no area in float after its scale and transform");
@@ -516,10 +566,14 @@ std::string readSceneText(const std::string& path) {
     if (ec) throw SceneError(path, 0, "cannot open the scene file: " + ec.message());
     if (fs::is_directory(st)) throw SceneError(path, 0, "is a folder, not a scene file");
     std::ifstream in(path, std::ios::binary);
-    if (!in) throw SceneError(path, 0, std::string("cannot open the scene file: ") + std::strerror(errno));
+    if (!in)
+        throw SceneError(path, 0,
+                         std::string("cannot open the scene file: ") + std::strerror(errno));
     std::stringstream text;
     text << in.rdbuf();
-    if (in.bad()) throw SceneError(path, 0, std::string("cannot read the scene file: ") + std::strerror(errno));
+    if (in.bad())
+        throw SceneError(path, 0,
+                         std::string("cannot read the scene file: ") + std::strerror(errno));
     return text.str();
 }
 
@@ -534,8 +588,9 @@ Scene loadScene(const std::string& path) {
     try {
         root = YAML::Load(text);
     } catch (const YAML::DeepRecursion& e) {
-        throw SceneError(path, e.mark.line + 1, "YAML nests deeper than yaml-cpp's limit of " +
-                                                    std::to_string(e.depth() - 1) + " levels");
+        throw SceneError(path, e.mark.line + 1,
+                         "YAML nests deeper than yaml-cpp's limit of " +
+                             std::to_string(e.depth() - 1) + " levels");
     } catch (const YAML::ParserException& e) {
         throw SceneError(path, e.mark.line + 1, "YAML syntax error: " + e.msg);
     } catch (const YAML::Exception& e) {
@@ -554,12 +609,15 @@ Scene loadScene(const std::string& path) {
     // `shaders` shaders and `objects` objects (a light adds one of each): the error names it.
     auto roomFor = [&](const YAML::Node& e, size_t shaders, size_t objects) {
         if (scene.shaders.size() + lightShaders.size() + shaders > size_t(kMaxShaders))
-            rd.fail(e, "more than " + std::to_string(kMaxShaders) + " shaders (a light counts one)");
+            rd.fail(e,
+                    "more than " + std::to_string(kMaxShaders) + " shaders (a light counts one)");
         if (scene.meshes.size() + lightMeshes.size() + objects > size_t(kMaxObjects))
-            rd.fail(e, "more than " + std::to_string(kMaxObjects) + " objects (a light counts one)");
+            rd.fail(e,
+                    "more than " + std::to_string(kMaxObjects) + " objects (a light counts one)");
     };
     try {
-        // The camera first, wherever it stands in the file: everything else is placed relative to it.
+        // The camera first, wherever it stands in the file: everything else is placed relative to
+        // it.
         for (auto it = root.begin(); it != root.end(); ++it)
             if (it->first.IsScalar() && it->first.Scalar() == "camera") {
                 scene.origin = readCamera(rd, it->second, scene.camera);
@@ -567,23 +625,30 @@ Scene loadScene(const std::string& path) {
             }
         for (auto it = root.begin(); it != root.end(); ++it) {
             std::string key = it->first.as<std::string>();
-            const YAML::Node v = it->second; // a handle: a reference would dangle (the iterator returns a proxy)
-            bool single = key == "image" || key == "settings" || key == "camera" || key == "filter" ||
-                          key == "sampler";
+            const YAML::Node v =
+                it->second; // a handle: a reference would dangle (the iterator returns a proxy)
+            bool single = key == "image" || key == "settings" || key == "camera" ||
+                          key == "filter" || key == "sampler";
             if (single && !seenOnce.insert(key).second)
                 rd.fail(it->first, "'" + key + "' may appear only once");
             auto each = [&](const std::function<void(const YAML::Node&)>& fn) {
                 if (v.IsSequence()) {
-                    for (const YAML::Node& e : v) fn(e);
+                    for (const YAML::Node& e : v)
+                        fn(e);
                 } else {
                     fn(v);
                 }
             };
-            if (key == "image") readImage(rd, v, scene.image);
-            else if (key == "settings") readSettings(rd, v, scene.settings);
-            else if (key == "camera") continue; // read above
-            else if (key == "filter") readFilter(rd, v, scene.filter);
-            else if (key == "sampler") scene.sampler = readSampler(rd, v);
+            if (key == "image")
+                readImage(rd, v, scene.image);
+            else if (key == "settings")
+                readSettings(rd, v, scene.settings);
+            else if (key == "camera")
+                continue; // read above
+            else if (key == "filter")
+                readFilter(rd, v, scene.filter);
+            else if (key == "sampler")
+                scene.sampler = readSampler(rd, v);
             else if (key == "object" || key == "objects") {
                 if (key == "objects" && !v.IsSequence()) rd.fail(v, "'objects' must be a list");
                 each([&](const YAML::Node& e) {
@@ -603,8 +668,9 @@ Scene loadScene(const std::string& path) {
                     lightShaders.push_back(readLight(rd, e, scene.origin, lightMeshes));
                 });
             } else {
-                rd.fail(it->first, "unknown entry '" + key +
-                                       "' (image, settings, camera, filter, sampler, object, shader, light)");
+                rd.fail(it->first,
+                        "unknown entry '" + key +
+                            "' (image, settings, camera, filter, sampler, object, shader, light)");
             }
         }
     } catch (const YAML::Exception& e) {
@@ -614,8 +680,9 @@ Scene loadScene(const std::string& path) {
     const int sceneShaders = int(scene.shaders.size());
     for (const PendingObject& o : pending)
         if (o.shader >= sceneShaders)
-            rd.fail(o.line, "object uses shader " + std::to_string(o.shader) + " but the scene has " +
-                                std::to_string(sceneShaders) + " shader" + (sceneShaders == 1 ? "" : "s"));
+            rd.fail(o.line, "object uses shader " + std::to_string(o.shader) +
+                                " but the scene has " + std::to_string(sceneShaders) + " shader" +
+                                (sceneShaders == 1 ? "" : "s"));
     scene.objectCount = int(scene.meshes.size());
     scene.quadLightCount = int(lightMeshes.size());
     for (size_t i = 0; i < lightMeshes.size(); ++i) {
@@ -631,13 +698,17 @@ Scene loadScene(const std::string& path) {
         if (!(corner <= kMaxDistance)) {
             const YAML::Node cam = static_cast<const YAML::Node&>(root)["camera"];
             rd.fail(cam["focal distance"] ? cam["focal distance"] : cam,
-                    "the focal plane's corners lie " + Reader::fmt(corner) + " units from the camera; Spillway renders "
-                    "within " + Reader::fmt(kMaxDistance) + " units of it");
+                    "the focal plane's corners lie " + Reader::fmt(corner) +
+                        " units from the camera; Spillway renders "
+                        "within " +
+                        Reader::fmt(kMaxDistance) + " units of it");
         }
     }
     if ((unsigned long long)img.width * img.height * img.samplesPerIteration() > 0xFFFFFFFFull)
-        rd.fail(1, "width x height x sample base^2 exceeds 2^32 samples per iteration; lower the sample "
-                   "base and raise iterations");
+        rd.fail(
+            1,
+            "width x height x sample base^2 exceeds 2^32 samples per iteration; lower the sample "
+            "base and raise iterations");
     return scene;
 }
 

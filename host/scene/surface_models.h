@@ -16,10 +16,10 @@
 
 #include <cstddef>
 
-#define SPW_SURFACE_MODELS(X)                                                                                \
-    X(Null, kModelNull, "null")                                                                              \
-    X(Lambert, kModelLambert, "lambert")                                                                     \
-    X(Conductor, kModelConductor, "conductor")                                                               \
+#define SPW_SURFACE_MODELS(X)                                                                      \
+    X(Null, kModelNull, "null")                                                                    \
+    X(Lambert, kModelLambert, "lambert")                                                           \
+    X(Conductor, kModelConductor, "conductor")                                                     \
     X(Dielectric, kModelDielectric, "dielectric")
 
 namespace spw {

@@ -36,7 +36,8 @@ void visit(const Scene& scene, int t, std::vector<int>& slotOf, std::vector<int>
     if (slotOf[size_t(t)] >= 0) return;
     const Texture& tex = scene.textures[size_t(t)];
     if (tex.type == TextureType::Layered)
-        for (int child : {tex.upper, tex.lower, tex.mask}) visit(scene, child, slotOf, order);
+        for (int child : {tex.upper, tex.lower, tex.mask})
+            visit(scene, child, slotOf, order);
     slotOf[size_t(t)] = int(order.size());
     order.push_back(t);
 }
@@ -55,12 +56,14 @@ TextureResolver::TextureResolver(const Scene& scene) : scene_(scene) {
             const Texture& tex = scene.textures[size_t(t)];
             Op op{tex.type, t, -1, -1, -1};
             if (tex.type == TextureType::Layered)
-                op.upper = slotOf[size_t(tex.upper)], op.lower = slotOf[size_t(tex.lower)], op.mask = slotOf[size_t(tex.mask)];
+                op.upper = slotOf[size_t(tex.upper)], op.lower = slotOf[size_t(tex.lower)],
+                op.mask = slotOf[size_t(tex.mask)];
             program.push_back(op);
         }
     }
     bool any = false;
-    for (const Texture& t : scene.textures) any = any || t.type == TextureType::Standard;
+    for (const Texture& t : scene.textures)
+        any = any || t.type == TextureType::Standard;
     if (!any) return;
     impl_ = std::make_unique<Impl>();
     impl_->system = OIIO::TextureSystem::create(false);
@@ -72,9 +75,11 @@ TextureResolver::TextureResolver(const Scene& scene) : scene_(scene) {
         Impl::Image& img = impl_->images[i];
         OIIO::ustring name(t.path);
         img.handle = impl_->system->get_texture_handle(name);
-        const OIIO::ImageSpec* spec = img.handle ? impl_->system->imagespec(img.handle, nullptr, 0) : nullptr;
+        const OIIO::ImageSpec* spec =
+            img.handle ? impl_->system->imagespec(img.handle, nullptr, 0) : nullptr;
         if (!spec)
-            throw std::runtime_error("cannot read texture '" + t.path + "': " + impl_->system->geterror());
+            throw std::runtime_error("cannot read texture '" + t.path +
+                                     "': " + impl_->system->geterror());
         img.channels = spec->nchannels;
         std::string cs = spec->get_string_attribute("oiio:ColorSpace");
         img.srgb = cs == "sRGB" || (cs.empty() && spec->format == OIIO::TypeDesc::UINT8);
@@ -91,8 +96,8 @@ vec3 TextureResolver::lookup(int index, vec2 uv) const {
     float rgb[4] = {0, 0, 0, 0};
     int nc = std::min(img.channels, 3);
     // OBJ's v grows upwards, image rows downwards. Zero derivatives: the finest MIP level.
-    if (!impl_->system->texture(img.handle, impl_->system->get_perthread_info(), opt, uv.x, 1.0f - uv.y, 0, 0, 0, 0,
-                                nc, rgb)) {
+    if (!impl_->system->texture(img.handle, impl_->system->get_perthread_info(), opt, uv.x,
+                                1.0f - uv.y, 0, 0, 0, 0, nc, rgb)) {
         if (!impl_->failed.exchange(true)) {
             std::lock_guard<std::mutex> lock(impl_->errorMutex);
             impl_->failedTexture = index;
@@ -110,7 +115,8 @@ void TextureResolver::checkErrors() const {
     std::lock_guard<std::mutex> lock(impl_->errorMutex);
     const Texture& t = scene_.textures[size_t(impl_->failedTexture)];
     std::string why = impl_->error;
-    while (!why.empty() && (why.back() == '\n' || why.back() == '\r')) why.pop_back();
+    while (!why.empty() && (why.back() == '\n' || why.back() == '\r'))
+        why.pop_back();
     throw SceneError(scene_.file, t.line, "texture file '" + t.path + "' cannot be read: " + why);
 }
 

@@ -34,8 +34,8 @@ class TextureResolver {
     // One node of a flattened tree: its operands are slots of earlier nodes.
     struct Op {
         TextureType type;
-        int texture;             // index into Scene::textures
-        int upper, lower, mask;  // Layered: operand slots
+        int texture;            // index into Scene::textures
+        int upper, lower, mask; // Layered: operand slots
     };
     vec3 lookup(int texture, vec2 uv) const;
     struct Impl;

@@ -26,7 +26,8 @@ SHARED_FN bool bsdfIsDelta(ShaderParams sh) {
 
 // f * |cos| and the solid-angle pdf of sampling wi. `albedo`: the hit's reflectance x texture
 // (the Conductor's F0).
-SHARED_FN vec3 bsdfEval(ShaderParams sh, vec3 albedo, vec3 ng, vec3 ns, vec3 wo, vec3 wi, OUT(float) pdf) {
+SHARED_FN vec3 bsdfEval(ShaderParams sh, vec3 albedo, vec3 ng, vec3 ns, vec3 wo, vec3 wi,
+                        OUT(float) pdf) {
     pdf = 0.0f;
     if (sh.model == kModelLambert) return lambertEval(albedo, ng, ns, wo, wi, pdf);
     if (sh.model == kModelConductor) return conductorEval(albedo, sh.alpha, ng, ns, wo, wi, pdf);
@@ -36,16 +37,19 @@ SHARED_FN vec3 bsdfEval(ShaderParams sh, vec3 albedo, vec3 ng, vec3 ns, vec3 wo,
 
 // Samples wi; returns false when the model absorbs. weight = fcos / pdf (for a delta lobe: its
 // fcos over the probability of having picked it). u: x, y pick the direction, z the lobe.
-SHARED_FN bool bsdfSample(ShaderParams sh, vec3 albedo, vec3 ng, vec3 ns, vec3 wo, vec3 u, OUT(vec3) wi,
-                          OUT(vec3) weight, OUT(float) pdf, OUT(bool) specular) {
+SHARED_FN bool bsdfSample(ShaderParams sh, vec3 albedo, vec3 ng, vec3 ns, vec3 wo, vec3 u,
+                          OUT(vec3) wi, OUT(vec3) weight, OUT(float) pdf, OUT(bool) specular) {
     specular = false;
     pdf = 0.0f;
     weight = vec3(0.0f);
     wi = vec3(0.0f);
-    if (sh.model == kModelLambert) return lambertSample(albedo, ng, ns, wo, vec2(u.x, u.y), wi, weight, pdf);
+    if (sh.model == kModelLambert)
+        return lambertSample(albedo, ng, ns, wo, vec2(u.x, u.y), wi, weight, pdf);
     if (sh.model == kModelConductor)
-        return conductorSample(albedo, sh.alpha, ng, ns, wo, vec2(u.x, u.y), wi, weight, pdf, specular);
-    if (sh.model == kModelDielectric) return dielectricSample(sh.ior, sh.alpha, ng, ns, wo, u, wi, weight, pdf, specular);
+        return conductorSample(albedo, sh.alpha, ng, ns, wo, vec2(u.x, u.y), wi, weight, pdf,
+                               specular);
+    if (sh.model == kModelDielectric)
+        return dielectricSample(sh.ior, sh.alpha, ng, ns, wo, u, wi, weight, pdf, specular);
     return false;
 }
 

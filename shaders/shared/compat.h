@@ -45,12 +45,12 @@ using glm::mix;
 using glm::normalize;
 using glm::sign;
 using glm::uintBitsToFloat;
-using std::sqrt;
-using std::cos;
-using std::sin;
 using std::atan;
+using std::cos;
 using std::exp;
 using std::floor;
+using std::sin;
+using std::sqrt;
 } // namespace spw
 
 #define SHARED_FN inline

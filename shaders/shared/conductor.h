@@ -21,7 +21,8 @@ SHARED_FN vec3 schlickFresnel(vec3 f0, float cosTheta) {
     return f0 + (vec3(1.0f) - f0) * (m2 * m2 * m);
 }
 
-SHARED_FN vec3 conductorEval(vec3 f0, float alpha, vec3 ng, vec3 ns, vec3 wo, vec3 wi, OUT(float) pdf) {
+SHARED_FN vec3 conductorEval(vec3 f0, float alpha, vec3 ng, vec3 ns, vec3 wo, vec3 wi,
+                             OUT(float) pdf) {
     pdf = 0.0f;
     if (ggxIsSmooth(alpha)) return vec3(0.0f);
     if (dot(ng, wo) * dot(ng, wi) <= 0.0f) return vec3(0.0f);
@@ -41,8 +42,8 @@ SHARED_FN vec3 conductorEval(vec3 f0, float alpha, vec3 ng, vec3 ns, vec3 wo, ve
     return schlickFresnel(f0, dot(lo, h)) * (d * li.z / (2.0f * denom));
 }
 
-SHARED_FN bool conductorSample(vec3 f0, float alpha, vec3 ng, vec3 ns, vec3 wo, vec2 u, OUT(vec3) wi,
-                               OUT(vec3) weight, OUT(float) pdf, OUT(bool) specular) {
+SHARED_FN bool conductorSample(vec3 f0, float alpha, vec3 ng, vec3 ns, vec3 wo, vec2 u,
+                               OUT(vec3) wi, OUT(vec3) weight, OUT(float) pdf, OUT(bool) specular) {
     Frame f = shadingFrame(ns, ng, wo);
     vec3 lo = frameToLocal(f, wo);
     if (lo.z <= 0.0f) return false;

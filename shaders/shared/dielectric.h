@@ -38,9 +38,12 @@ SHARED_FN float fresnelDielectric(float cosI, float eta, OUT(float) cosT) {
 }
 
 // The relative index eta = n_t / n_i for light leaving towards wo on the side of ng it is on.
-SHARED_FN float dielectricEta(float ior, vec3 ng, vec3 wo) { return dot(ng, wo) > 0.0f ? ior : 1.0f / ior; }
+SHARED_FN float dielectricEta(float ior, vec3 ng, vec3 wo) {
+    return dot(ng, wo) > 0.0f ? ior : 1.0f / ior;
+}
 
-SHARED_FN vec3 dielectricEval(float ior, float alpha, vec3 ng, vec3 ns, vec3 wo, vec3 wi, OUT(float) pdf) {
+SHARED_FN vec3 dielectricEval(float ior, float alpha, vec3 ng, vec3 ns, vec3 wo, vec3 wi,
+                              OUT(float) pdf) {
     pdf = 0.0f;
     if (ggxIsSmooth(alpha)) return vec3(0.0f);
     float go = dot(ng, wo);
@@ -61,7 +64,8 @@ SHARED_FN vec3 dielectricEval(float ior, float alpha, vec3 ng, vec3 ns, vec3 wo,
     if (h.z < 0.0f) h = -h;
     float oh = dot(lo, h);
     float ih = dot(li, h);
-    if (oh <= 0.0f || (isReflection ? ih <= 0.0f : ih >= 0.0f)) return vec3(0.0f); // back-facing microfacet
+    if (oh <= 0.0f || (isReflection ? ih <= 0.0f : ih >= 0.0f))
+        return vec3(0.0f); // back-facing microfacet
     float cosT;
     float F = fresnelDielectric(oh, eta, cosT);
     float d = ggxD(h, alpha);
@@ -83,8 +87,9 @@ SHARED_FN vec3 dielectricEval(float ior, float alpha, vec3 ng, vec3 ns, vec3 wo,
     return vec3((1.0f - F) * d * 2.0f * ci * (-ih) * oh / (denomG * s2 * eta * eta));
 }
 
-SHARED_FN bool dielectricSample(float ior, float alpha, vec3 ng, vec3 ns, vec3 wo, vec3 u, OUT(vec3) wi,
-                                OUT(vec3) weight, OUT(float) pdf, OUT(bool) specular) {
+SHARED_FN bool dielectricSample(float ior, float alpha, vec3 ng, vec3 ns, vec3 wo, vec3 u,
+                                OUT(vec3) wi, OUT(vec3) weight, OUT(float) pdf,
+                                OUT(bool) specular) {
     float go = dot(ng, wo);
     if (go == 0.0f) return false;
     float eta = dielectricEta(ior, ng, wo);

@@ -26,7 +26,9 @@ SHARED_BEGIN
 // direction around it can sample and evaluate consistently (1e-4 rad).
 const float kGgxSmoothAlpha = 1e-4f;
 
-SHARED_FN bool ggxIsSmooth(float alpha) { return !(alpha >= kGgxSmoothAlpha); }
+SHARED_FN bool ggxIsSmooth(float alpha) {
+    return !(alpha >= kGgxSmoothAlpha);
+}
 
 // D(h) for a unit half vector in the local frame (0 below the surface).
 SHARED_FN float ggxD(vec3 h, float alpha) {
@@ -81,8 +83,12 @@ SHARED_FN vec3 ggxSampleVisibleNormal(vec3 wo, float alpha, vec2 u) {
 }
 
 // The local frame around n: world direction to local coordinates and back.
-SHARED_FN vec3 toLocal(vec3 w, vec3 t, vec3 b, vec3 n) { return vec3(dot(w, t), dot(w, b), dot(w, n)); }
-SHARED_FN vec3 fromLocal(vec3 l, vec3 t, vec3 b, vec3 n) { return normalize(l.x * t + l.y * b + l.z * n); }
+SHARED_FN vec3 toLocal(vec3 w, vec3 t, vec3 b, vec3 n) {
+    return vec3(dot(w, t), dot(w, b), dot(w, n));
+}
+SHARED_FN vec3 fromLocal(vec3 l, vec3 t, vec3 b, vec3 n) {
+    return normalize(l.x * t + l.y * b + l.z * n);
+}
 
 // The frame the microfacet models work in: the shading normal turned to wo's side, and two
 // tangents. Built once per eval or sample.
@@ -97,8 +103,12 @@ SHARED_FN Frame shadingFrame(vec3 ns, vec3 ng, vec3 wo) {
     makeFrame(f.n, f.t, f.b);
     return f;
 }
-SHARED_FN vec3 frameToLocal(Frame f, vec3 w) { return toLocal(w, f.t, f.b, f.n); }
-SHARED_FN vec3 frameToWorld(Frame f, vec3 l) { return fromLocal(l, f.t, f.b, f.n); }
+SHARED_FN vec3 frameToLocal(Frame f, vec3 w) {
+    return toLocal(w, f.t, f.b, f.n);
+}
+SHARED_FN vec3 frameToWorld(Frame f, vec3 l) {
+    return fromLocal(l, f.t, f.b, f.n);
+}
 
 SHARED_END
 #endif

@@ -14,8 +14,10 @@ SHARED_FN uint pickEmitter(SCENE_PARAM uint count, float u) {
     uint hi = count - 1u;
     while (lo < hi) {
         uint mid = (lo + hi) >> 1u;
-        if (EMITTER_CDF(mid) > u) hi = mid;
-        else lo = mid + 1u;
+        if (EMITTER_CDF(mid) > u)
+            hi = mid;
+        else
+            lo = mid + 1u;
     }
     return lo;
 }

@@ -14,7 +14,9 @@
 SHARED_BEGIN
 
 // The pixel and the render-wide sample index of a path.
-SHARED_FN uint pathPixel(RenderParams rp, uint pathId) { return pathId / rp.samplesPerIteration; }
+SHARED_FN uint pathPixel(RenderParams rp, uint pathId) {
+    return pathId / rp.samplesPerIteration;
+}
 SHARED_FN uint pathSample(RenderParams rp, uint pathId) {
     return rp.iteration * rp.samplesPerIteration + pathId % rp.samplesPerIteration;
 }
@@ -84,7 +86,9 @@ SHARED_FN void shadeSurface(SCENE_PARAM RenderParams rp, SurfaceHit hit, vec3 ra
             float bsdfPdf;
             vec3 fcos = bsdfEval(sh, hit.albedo, hit.ng, hit.ns, wo, wi, bsdfPdf);
             if (lightPdf > 0.0f && maxComponent(fcos) > 0.0f) {
-                float w = rp.strategy == kStrategyMis ? powerHeuristic(lightPdf, quantizePdf(bsdfPdf)) : 1.0f;
+                float w = rp.strategy == kStrategyMis
+                              ? powerHeuristic(lightPdf, quantizePdf(bsdfPdf))
+                              : 1.0f;
                 r.shadowOrigin = offsetOrigin(hit.p, hit.ng, hit.offset, wi);
                 r.shadowDir = wi;
                 // Stop short of the emitter's own surface, whatever the scene's scale.
@@ -102,8 +106,8 @@ SHARED_FN void shadeSurface(SCENE_PARAM RenderParams rp, SurfaceHit hit, vec3 ra
     vec3 weight;
     float pdf;
     bool specular;
-    if (!bsdfSample(sh, hit.albedo, hit.ng, hit.ns, wo, vec3(uBsdf.x, uBsdf.y, uBsdf.z), wi, weight, pdf,
-                    specular))
+    if (!bsdfSample(sh, hit.albedo, hit.ng, hit.ns, wo, vec3(uBsdf.x, uBsdf.y, uBsdf.z), wi, weight,
+                    pdf, specular))
         return;
     vec3 beta = st.beta * weight;
     if (st.bounce >= rp.minDepth) {

@@ -12,10 +12,10 @@ SHARED_BEGIN
 
 // Which group of four dimensions a purpose draws from. A bounce uses a handful; the camera
 // uses its own pseudo-bounce so that its numbers never collide with bounce 0's.
-const uint kDimLight = 0u;     // x: emitter pick, y,z: point on the emitter, w: RR
-const uint kDimBsdf = 1u;      // x,y: direction, z: lobe choice, w: spare
-const uint kDimRounding = 2u;  // stochastic rounding of compact ray fields and the film
-const uint kDimCamera = 3u;    // x,y: position in the pixel, z,w: lens
+const uint kDimLight = 0u;    // x: emitter pick, y,z: point on the emitter, w: RR
+const uint kDimBsdf = 1u;     // x,y: direction, z: lobe choice, w: spare
+const uint kDimRounding = 2u; // stochastic rounding of compact ray fields and the film
+const uint kDimCamera = 3u;   // x,y: position in the pixel, z,w: lens
 const uint kBounceCamera = 255u;
 
 SHARED_FN uvec4 pcg4d(uvec4 v) {
@@ -33,7 +33,9 @@ SHARED_FN uvec4 pcg4d(uvec4 v) {
 }
 
 // A 32-bit word to a float in [0, 1): the top 24 bits, so every value is exact.
-SHARED_FN float uintToUnit(uint x) { return float(x >> 8u) * (1.0f / 16777216.0f); }
+SHARED_FN float uintToUnit(uint x) {
+    return float(x >> 8u) * (1.0f / 16777216.0f);
+}
 
 // Four uniform numbers for (seed, pixel, sample, bounce, group). `sampleIndex` counts samples of
 // the whole render (iteration * samples per iteration + sample), so iterations differ.

@@ -80,9 +80,13 @@ SHARED_FN vec3 facingShadingNormal(vec3 ns, vec3 ng, vec3 wo) {
     return dot(n, ng * side) > 0.0f ? n : ng * side;
 }
 
-SHARED_FN float maxComponent(vec3 v) { return max(v.x, max(v.y, v.z)); }
+SHARED_FN float maxComponent(vec3 v) {
+    return max(v.x, max(v.y, v.z));
+}
 
-SHARED_FN float luminance(vec3 c) { return dot(c, vec3(0.2126f, 0.7152f, 0.0722f)); }
+SHARED_FN float luminance(vec3 c) {
+    return dot(c, vec3(0.2126f, 0.7152f, 0.0722f));
+}
 
 SHARED_END
 #endif

@@ -1,6 +1,6 @@
 // Structs that every backend's shading step reads and writes. Declared once, here; the C++
-// side checks their layout in host/render/shared_layout.cpp so that a GLSL scalar-block-layout view of
-// the same bytes stays in step.
+// side checks their layout in host/render/shared_layout.cpp so that a GLSL scalar-block-layout view
+// of the same bytes stays in step.
 #ifndef SPILLWAY_SHARED_TYPES_H
 #define SPILLWAY_SHARED_TYPES_H
 #include "compat.h"
@@ -88,8 +88,8 @@ const uint kShadeShadow = 2u;
 const uint kShadeContinue = 4u;
 
 struct ShadeResult {
-    uint flags;             // kShade*
-    vec3 emitted;           // beta * Le * MIS weight, for the film now
+    uint flags;   // kShade*
+    vec3 emitted; // beta * Le * MIS weight, for the film now
     vec3 shadowOrigin;
     float shadowTmax;
     vec3 shadowDir;

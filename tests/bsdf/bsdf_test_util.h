@@ -52,12 +52,13 @@ inline vec3 directionAround(vec3 n, double thetaDeg, double phi) {
     vec3 t, b;
     makeFrame(n, t, b);
     const double th = thetaDeg * M_PI / 180.0;
-    return glm::normalize(float(std::sin(th) * std::cos(phi)) * t + float(std::sin(th) * std::sin(phi)) * b +
-                          float(std::cos(th)) * n);
+    return glm::normalize(float(std::sin(th) * std::cos(phi)) * t +
+                          float(std::sin(th) * std::sin(phi)) * b + float(std::cos(th)) * n);
 }
 
 inline bool finiteNonNegative(vec3 v) {
-    return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z) && v.x >= 0 && v.y >= 0 && v.z >= 0;
+    return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z) && v.x >= 0 && v.y >= 0 &&
+           v.z >= 0;
 }
 
 // Uniform numbers in [0, 1) on the renderer's 24-bit grid.
@@ -107,7 +108,9 @@ inline double upperIncompleteGamma(double a, double x) {
 }
 
 // P(chi^2_dof >= x).
-inline double chiSquarePValue(double x, int dof) { return upperIncompleteGamma(0.5 * dof, 0.5 * x); }
+inline double chiSquarePValue(double x, int dof) {
+    return upperIncompleteGamma(0.5 * dof, 0.5 * x);
+}
 
 // The per-test threshold that keeps the whole suite of `tests` at `significance` (Šidák).
 inline double sidakThreshold(double significance, int tests) {
@@ -123,12 +126,15 @@ struct ChiSquareResult {
 // pbrt's pooling: cells sorted by expected count; those expecting < minExpected are pooled
 // (and further cells join the pool until it expects minExpected). A sample in a cell the pdf
 // says is empty (beyond a 1e-5 share for rounding) fails outright.
-inline ChiSquareResult chiSquare(const std::vector<double>& observed, const std::vector<double>& expected,
-                                 double sampleCount, double minExpected = 5.0) {
+inline ChiSquareResult chiSquare(const std::vector<double>& observed,
+                                 const std::vector<double>& expected, double sampleCount,
+                                 double minExpected = 5.0) {
     ChiSquareResult r;
     std::vector<size_t> order(observed.size());
-    for (size_t i = 0; i < order.size(); ++i) order[i] = i;
-    std::sort(order.begin(), order.end(), [&](size_t a, size_t b) { return expected[a] < expected[b]; });
+    for (size_t i = 0; i < order.size(); ++i)
+        order[i] = i;
+    std::sort(order.begin(), order.end(),
+              [&](size_t a, size_t b) { return expected[a] < expected[b]; });
     double pooledObs = 0, pooledExp = 0;
     for (size_t i : order) {
         if (expected[i] <= 0.0) {
@@ -172,7 +178,9 @@ struct Warp {
         lo = std::atan((a - c) / k);
         hi = std::atan((b - c) / k);
     }
-    double toUnit(double x) const { return std::clamp((std::atan((x - c) / k) - lo) / (hi - lo), 0.0, 1.0); }
+    double toUnit(double x) const {
+        return std::clamp((std::atan((x - c) / k) - lo) / (hi - lo), 0.0, 1.0);
+    }
     double fromUnit(double s) const { return c + k * std::tan(lo + s * (hi - lo)); }
     double jacobian(double s) const { // dx/ds
         const double x = fromUnit(s) - c;
@@ -204,8 +212,8 @@ struct HemisphereGrid {
     }
 
     vec3 direction(double th, double ph) const {
-        return glm::normalize(float(std::sin(th) * std::cos(ph)) * t + float(std::sin(th) * std::sin(ph)) * b +
-                              float(std::cos(th)) * pole);
+        return glm::normalize(float(std::sin(th) * std::cos(ph)) * t +
+                              float(std::sin(th) * std::sin(ph)) * b + float(std::cos(th)) * pole);
     }
     // The cell of a direction in this hemisphere (angles in double: near the pole, acos of a
     // float cosine would be quantised to 3e-4 rad, coarser than a 1e-3 lobe).
@@ -213,8 +221,10 @@ struct HemisphereGrid {
         const glm::dvec3 dw(w), dp(pole), dt(t), db(b);
         const double th = std::atan2(glm::length(glm::cross(dw, dp)), glm::dot(dw, dp));
         double ph = std::atan2(glm::dot(dw, db), glm::dot(dw, dt));
-        while (ph < phi.a) ph += 2 * M_PI;
-        while (ph >= phi.b) ph -= 2 * M_PI;
+        while (ph < phi.a)
+            ph += 2 * M_PI;
+        while (ph >= phi.b)
+            ph -= 2 * M_PI;
         const int i = std::min(nTheta - 1, int(theta.toUnit(th) * nTheta));
         const int j = std::min(nPhi - 1, int(phi.toUnit(ph) * nPhi));
         return i * nPhi + j;
@@ -234,13 +244,15 @@ struct HemisphereGrid {
             for (int j = 0; j < nPhi; ++j) {
                 const double s0 = double(i) / nTheta, s1 = double(i + 1) / nTheta;
                 const double u0 = double(j) / nPhi, u1 = double(j + 1) / nPhi;
-                out[size_t(i * nPhi + j)] = adaptive(f, s0, s1, u0, u1, gauss(f, s0, s1, u0, u1), 0);
+                out[size_t(i * nPhi + j)] =
+                    adaptive(f, s0, s1, u0, u1, gauss(f, s0, s1, u0, u1), 0);
             }
         return out;
     }
 
   private:
-    template <class F> glm::dvec2 gauss(const F& f, double s0, double s1, double u0, double u1) const {
+    template <class F>
+    glm::dvec2 gauss(const F& f, double s0, double s1, double u0, double u1) const {
         static const double x4[4] = {-0.8611363115940526, -0.3399810435848563, 0.3399810435848563,
                                      0.8611363115940526};
         static const double w4[4] = {0.3478548451374538, 0.6521451548625461, 0.6521451548625461,
@@ -258,10 +270,11 @@ struct HemisphereGrid {
         return sum * (0.25 * (s1 - s0) * (u1 - u0));
     }
     template <class F>
-    glm::dvec2 adaptive(const F& f, double s0, double s1, double u0, double u1, glm::dvec2 whole, int depth) const {
+    glm::dvec2 adaptive(const F& f, double s0, double s1, double u0, double u1, glm::dvec2 whole,
+                        int depth) const {
         const double sm = 0.5 * (s0 + s1), um = 0.5 * (u0 + u1);
-        const glm::dvec2 q[4] = {gauss(f, s0, sm, u0, um), gauss(f, sm, s1, u0, um), gauss(f, s0, sm, um, u1),
-                                 gauss(f, sm, s1, um, u1)};
+        const glm::dvec2 q[4] = {gauss(f, s0, sm, u0, um), gauss(f, sm, s1, u0, um),
+                                 gauss(f, s0, sm, um, u1), gauss(f, sm, s1, um, u1)};
         const glm::dvec2 split = q[0] + q[1] + q[2] + q[3];
         if (depth >= 7) return split;
         // A support boundary close to an edge can hide from both Gauss rules (their outermost
@@ -269,11 +282,16 @@ struct HemisphereGrid {
         int zero = 0;
         for (double a : {0.001, 0.5, 0.999})
             for (double c : {0.001, 0.5, 0.999})
-                zero += f(direction(theta.fromUnit(s0 + a * (s1 - s0)), phi.fromUnit(u0 + c * (u1 - u0)))).x == 0.0;
+                zero += f(direction(theta.fromUnit(s0 + a * (s1 - s0)),
+                                    phi.fromUnit(u0 + c * (u1 - u0))))
+                            .x == 0.0;
         const bool mixedSupport = zero > 0 && zero < 9;
-        if (!mixedSupport && std::fabs(split.x - whole.x) <= 1e-8 + 1e-3 * std::fabs(split.x)) return split;
-        return adaptive(f, s0, sm, u0, um, q[0], depth + 1) + adaptive(f, sm, s1, u0, um, q[1], depth + 1) +
-               adaptive(f, s0, sm, um, u1, q[2], depth + 1) + adaptive(f, sm, s1, um, u1, q[3], depth + 1);
+        if (!mixedSupport && std::fabs(split.x - whole.x) <= 1e-8 + 1e-3 * std::fabs(split.x))
+            return split;
+        return adaptive(f, s0, sm, u0, um, q[0], depth + 1) +
+               adaptive(f, sm, s1, u0, um, q[1], depth + 1) +
+               adaptive(f, s0, sm, um, u1, q[2], depth + 1) +
+               adaptive(f, sm, s1, um, u1, q[3], depth + 1);
     }
 
   public:
@@ -287,12 +305,12 @@ struct ExpectedLobes {
 
 struct SamplingReport {
     ChiSquareResult chi2;
-    double pdfIntegral = 0;    // quadrature of the eval pdf over the sphere
-    double successShare = 0;   // samples not absorbed / all
-    double fcosIntegral = 0;   // quadrature of f |cos|: the albedo
-    double meanWeight = 0;     // mean sample weight (0 for absorbed): the albedo, by sampling
+    double pdfIntegral = 0;  // quadrature of the eval pdf over the sphere
+    double successShare = 0; // samples not absorbed / all
+    double fcosIntegral = 0; // quadrature of f |cos|: the albedo
+    double meanWeight = 0;   // mean sample weight (0 for absorbed): the albedo, by sampling
     double meanWeightError = 0;
-    size_t mismatches = 0;     // samples whose eval disagrees with what sampling returned
+    size_t mismatches = 0; // samples whose eval disagrees with what sampling returned
     size_t samples = 0;
 };
 
@@ -342,8 +360,9 @@ inline SamplingReport testSampling(const BsdfUnderTest& m, const ExpectedLobes& 
                          std::fabs(fcos.z - expect.z) <= tolerance * expect.z + slack;
         if (!pdfOk || !fOk || specular) {
             if (r.mismatches < 3)
-                std::printf("    mismatch: wi (%g %g %g) sampled pdf %g eval pdf %g, weight*pdf %g eval fcos %g\n", wi.x,
-                            wi.y, wi.z, pdf, pdfEval, expect.x, fcos.x);
+                std::printf("    mismatch: wi (%g %g %g) sampled pdf %g eval pdf %g, weight*pdf %g "
+                            "eval fcos %g\n",
+                            wi.x, wi.y, wi.z, pdf, pdfEval, expect.x, fcos.x);
             ++r.mismatches;
         }
     }
@@ -373,12 +392,14 @@ inline SamplingReport testSampling(const BsdfUnderTest& m, const ExpectedLobes& 
 // The assertions every rough model's case makes; `tests`: the suite's number of chi-square tests.
 inline void expectSamplingMatchesPdf(const SamplingReport& r, int tests, const std::string& what) {
     const double threshold = sidakThreshold(0.01, tests);
-    std::printf("  %-44s chi2 %9.1f dof %4d p %.4f | int pdf %.6f, kept %.6f | int fcos %.6f, mean weight %.6f "
+    std::printf("  %-44s chi2 %9.1f dof %4d p %.4f | int pdf %.6f, kept %.6f | int fcos %.6f, mean "
+                "weight %.6f "
                 "+- %.6f\n",
-                what.c_str(), r.chi2.chi2, r.chi2.dof, r.chi2.pValue, r.pdfIntegral, r.successShare, r.fcosIntegral,
-                r.meanWeight, r.meanWeightError);
+                what.c_str(), r.chi2.chi2, r.chi2.dof, r.chi2.pValue, r.pdfIntegral, r.successShare,
+                r.fcosIntegral, r.meanWeight, r.meanWeightError);
     EXPECT_TRUE(r.chi2.failure.empty()) << what << ": " << r.chi2.failure;
-    EXPECT_GE(r.chi2.pValue, threshold) << what << ": chi2 " << r.chi2.chi2 << " with " << r.chi2.dof << " dof";
+    EXPECT_GE(r.chi2.pValue, threshold)
+        << what << ": chi2 " << r.chi2.chi2 << " with " << r.chi2.dof << " dof";
     // The pdf integrates to the share of samples kept (1 but for samples the model absorbs).
     const double n = double(r.samples);
     const double p = std::clamp(r.successShare, 1e-9, 1.0);

@@ -35,11 +35,13 @@ TEST(Conductor, SampledDirectionsFollowThePdf) {
             BsdfUnderTest m = conductor(alpha, theta);
             char name[96];
             std::snprintf(name, sizeof name, "conductor alpha %g, theta %g", alpha, theta);
-            expectSamplingMatchesPdf(testSampling(m, mirrorLobe(m), 200000, 1000 + uint(theta)), tests, name);
+            expectSamplingMatchesPdf(testSampling(m, mirrorLobe(m), 200000, 1000 + uint(theta)),
+                                     tests, name);
         }
     // In a tilted frame, wo on the back of ng (the model turns to wo's side).
     BsdfUnderTest m = conductor(0.3f, 130.0, glm::normalize(vec3(-0.2f, 0.7f, 0.4f)));
-    expectSamplingMatchesPdf(testSampling(m, mirrorLobe(m), 200000, 3), tests, "conductor alpha 0.3, back side, tilted");
+    expectSamplingMatchesPdf(testSampling(m, mirrorLobe(m), 200000, 3), tests,
+                             "conductor alpha 0.3, back side, tilted");
 }
 
 // Schlick's approximation at values worked by hand: F0 = 0.04 (glass-like) at 60 degrees is
@@ -51,7 +53,8 @@ TEST(Conductor, SchlickFresnelMatchesHandWorkedValues) {
     EXPECT_NEAR(at60.y, 0.5 + 0.5 / 32.0, 1e-7);
     EXPECT_NEAR(at60.z, 0.9 + 0.1 / 32.0, 1e-7);
     EXPECT_EQ(schlickFresnel(f0, 1.0f), f0);
-    for (int k = 0; k < 3; ++k) EXPECT_NEAR(schlickFresnel(f0, 0.0f)[k], 1.0, 1e-7);
+    for (int k = 0; k < 3; ++k)
+        EXPECT_NEAR(schlickFresnel(f0, 0.0f)[k], 1.0, 1e-7);
 }
 
 // With F0 = 1 and a vanishing alpha the rough model becomes the mirror: it keeps all energy.
@@ -74,7 +77,8 @@ TEST(Conductor, SmoothIsADeltaLobe) {
             vec3 wi, weight;
             float pdf;
             bool specular;
-            ASSERT_TRUE(bsdfSample(m.sh, m.albedo, m.ng, m.ns, m.wo, u.next3(), wi, weight, pdf, specular));
+            ASSERT_TRUE(
+                bsdfSample(m.sh, m.albedo, m.ng, m.ns, m.wo, u.next3(), wi, weight, pdf, specular));
             EXPECT_TRUE(specular);
             const vec3 mirror = 2.0f * glm::dot(m.wo, m.ng) * m.ng - m.wo;
             EXPECT_LT(glm::length(wi - mirror), 1e-6f);
@@ -82,7 +86,8 @@ TEST(Conductor, SmoothIsADeltaLobe) {
             // F = F0 + (1 - F0)(1 - cos theta)^5, with F0 below 1 in two channels.
             const double c = std::cos(theta * M_PI / 180.0), s5 = std::pow(1.0 - c, 5.0);
             for (int k = 0; k < 3; ++k)
-                EXPECT_NEAR(weight[k], kF0[k] + (1.0 - kF0[k]) * s5, 2e-6) << "theta " << theta << ", channel " << k;
+                EXPECT_NEAR(weight[k], kF0[k] + (1.0 - kF0[k]) * s5, 2e-6)
+                    << "theta " << theta << ", channel " << k;
             float evalPdf = 1;
             EXPECT_EQ(bsdfEval(m.sh, m.albedo, m.ng, m.ns, m.wo, wi, evalPdf), vec3(0.0f));
             EXPECT_EQ(evalPdf, 0.0f);
@@ -104,16 +109,18 @@ TEST(Conductor, FiniteAtTinyAlphaAndGrazingAngles) {
                     const vec3 wi = directionAround(m.ng, ti, 0.4 + dphi);
                     float pdf;
                     const vec3 f = bsdfEval(m.sh, m.albedo, m.ng, m.ns, m.wo, wi, pdf);
-                    ASSERT_TRUE(std::isfinite(pdf) && pdf >= 0.0f) << alpha << " " << to << " " << ti;
-                    ASSERT_TRUE(finiteNonNegative(f))
+                    ASSERT_TRUE(std::isfinite(pdf) && pdf >= 0.0f)
                         << alpha << " " << to << " " << ti;
+                    ASSERT_TRUE(finiteNonNegative(f)) << alpha << " " << to << " " << ti;
                     ++checked;
                 }
                 for (int k = 0; k < 200; ++k) {
                     vec3 wi, weight;
                     float pdf;
                     bool specular;
-                    if (!bsdfSample(m.sh, m.albedo, m.ng, m.ns, m.wo, u.next3(), wi, weight, pdf, specular)) continue;
+                    if (!bsdfSample(m.sh, m.albedo, m.ng, m.ns, m.wo, u.next3(), wi, weight, pdf,
+                                    specular))
+                        continue;
                     ASSERT_TRUE(std::isfinite(pdf) && pdf > 0.0f) << alpha << " " << to;
                     ASSERT_TRUE(finiteNonNegative(weight));
                     ASSERT_LE(weight.x, 1.0f + 1e-5f) << "a conductor sample never gains energy";

@@ -74,12 +74,15 @@ TEST(Dielectric, SampledDirectionsFollowThePdf) {
                 char name[96];
                 std::snprintf(name, sizeof name, "dielectric alpha %g, theta %g, %s", alpha, theta,
                               inside ? "inside" : "outside");
-                expectSamplingMatchesPdf(testSampling(m, dielectricLobes(m), 200000, 2000 + uint(theta) + inside), tests,
-                                         name);
+                expectSamplingMatchesPdf(
+                    testSampling(m, dielectricLobes(m), 200000, 2000 + uint(theta) + inside), tests,
+                    name);
             }
-    // Inside, just past the critical angle (41.8 degrees): mostly reflection, a rough tail refracts.
+    // Inside, just past the critical angle (41.8 degrees): mostly reflection, a rough tail
+    // refracts.
     BsdfUnderTest m = dielectric(0.2f, 45.0, true);
-    expectSamplingMatchesPdf(testSampling(m, dielectricLobes(m), 200000, 7), tests, "dielectric alpha 0.2, inside, 45");
+    expectSamplingMatchesPdf(testSampling(m, dielectricLobes(m), 200000, 7), tests,
+                             "dielectric alpha 0.2, inside, 45");
 }
 
 // With a vanishing alpha the rough model keeps (almost) all energy: reflection plus refraction
@@ -96,7 +99,9 @@ TEST(Dielectric, NarrowLobeConservesEnergy) {
                 vec3 wi, weight;
                 float pdf;
                 bool specular;
-                if (!bsdfSample(m.sh, m.albedo, m.ng, m.ns, m.wo, u.next3(), wi, weight, pdf, specular)) continue;
+                if (!bsdfSample(m.sh, m.albedo, m.ng, m.ns, m.wo, u.next3(), wi, weight, pdf,
+                                specular))
+                    continue;
                 const bool refracted = glm::dot(wi, m.ng) * glm::dot(m.wo, m.ng) < 0;
                 sum += weight.x * (refracted ? eta * eta : 1.0f);
             }
@@ -121,7 +126,8 @@ TEST(Dielectric, SmoothIsTwoDeltaLobes) {
                 vec3 wi, weight;
                 float pdf;
                 bool specular;
-                ASSERT_TRUE(bsdfSample(m.sh, m.albedo, m.ng, m.ns, m.wo, u.next3(), wi, weight, pdf, specular));
+                ASSERT_TRUE(bsdfSample(m.sh, m.albedo, m.ng, m.ns, m.wo, u.next3(), wi, weight, pdf,
+                                       specular));
                 ASSERT_TRUE(specular);
                 float evalPdf = 1;
                 ASSERT_EQ(bsdfEval(m.sh, m.albedo, m.ng, m.ns, m.wo, wi, evalPdf), vec3(0.0f));
@@ -141,7 +147,8 @@ TEST(Dielectric, SmoothIsTwoDeltaLobes) {
             }
             // The reflected share is F: binomial, 4 standard deviations.
             const double sd = std::sqrt(F * (1 - F) / count);
-            EXPECT_NEAR(double(reflected) / count, F, 4 * sd + 1e-9) << "inside " << inside << " theta " << theta;
+            EXPECT_NEAR(double(reflected) / count, F, 4 * sd + 1e-9)
+                << "inside " << inside << " theta " << theta;
             if (inside && theta > 42.0) {
                 EXPECT_EQ(reflected, count) << "total internal reflection";
             }

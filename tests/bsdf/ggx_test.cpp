@@ -10,13 +10,15 @@ TEST(Ggx, ProjectedAreaAndVisibleNormalsIntegrateToOne) {
         // Cells following the lobe around the normal.
         HemisphereGrid grid(vec3(0, 0, 1), vec3(0, 0, 1), std::max(double(alpha), 1e-4), 32, 16);
         double projected = 0;
-        for (glm::dvec2 v : grid.integrate([&](vec3 h) { return glm::dvec2(double(ggxD(h, alpha)) * h.z, 0.0); }))
+        for (glm::dvec2 v :
+             grid.integrate([&](vec3 h) { return glm::dvec2(double(ggxD(h, alpha)) * h.z, 0.0); }))
             projected += v.x;
         EXPECT_NEAR(projected, 1.0, 1e-4) << "alpha " << alpha;
         for (double theta : {0.0, 45.0, 80.0, 89.9}) {
             const vec3 wo = directionAround(vec3(0, 0, 1), theta, 0.3);
             double visible = 0;
-            for (glm::dvec2 v : grid.integrate([&](vec3 h) { return glm::dvec2(ggxVisibleNormalPdf(wo, h, alpha), 0.0); }))
+            for (glm::dvec2 v : grid.integrate(
+                     [&](vec3 h) { return glm::dvec2(ggxVisibleNormalPdf(wo, h, alpha), 0.0); }))
                 visible += v.x;
             EXPECT_NEAR(visible, 1.0, 2e-4) << "alpha " << alpha << ", theta " << theta;
         }

@@ -27,22 +27,25 @@ struct Outcome {
 
 // The binary with a time limit (coreutils `timeout`, SIGKILL), reporting a signal as such.
 Outcome runLimited(const std::string& args, int seconds = 120, const std::string& prefix = "") {
-    const std::string cmd = prefix + "timeout -s KILL " + std::to_string(seconds) + " " + binary() + " " + args +
-                            " 2>&1; echo \"@status $?\"";
+    const std::string cmd = prefix + "timeout -s KILL " + std::to_string(seconds) + " " + binary() +
+                            " " + args + " 2>&1; echo \"@status $?\"";
     FILE* p = popen(cmd.c_str(), "r");
     Outcome r;
     if (!p) return r;
     char buf[4096];
     size_t n;
-    while ((n = fread(buf, 1, sizeof buf, p)) > 0) r.output.append(buf, n);
+    while ((n = fread(buf, 1, sizeof buf, p)) > 0)
+        r.output.append(buf, n);
     pclose(p);
     const size_t at = r.output.rfind("@status ");
     if (at == std::string::npos) return r;
     const int code = std::stoi(r.output.substr(at + 8));
     r.output.erase(at);
     // The shell reports a child killed by signal N as 128 + N; spillway itself exits 0, 1 or 2.
-    if (code > 128) r.signalled = true, r.signal = code - 128;
-    else r.status = code;
+    if (code > 128)
+        r.signalled = true, r.signal = code - 128;
+    else
+        r.status = code;
     return r;
 }
 
@@ -52,39 +55,46 @@ const char* const kTriangleObj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
 std::string garbage(size_t size, unsigned seed) {
     std::mt19937 rng(seed);
     std::string s(size, '\0');
-    for (char& c : s) c = char(rng() & 0xFF);
+    for (char& c : s)
+        c = char(rng() & 0xFF);
     return s;
 }
 
 // Layered textures 30 levels deep, each anchor used three times by the next: 3^30 leaves if
 // aliases were copied, 31 textures when they are shared.
 std::string aliasBomb(int levels) {
-    std::string s = "shaders:\n  - {type: Lambert, texture: &a0 {type: Constant, colour: [0.5, 0.5, 0.5]}}\n";
+    std::string s =
+        "shaders:\n  - {type: Lambert, texture: &a0 {type: Constant, colour: [0.5, 0.5, 0.5]}}\n";
     for (int i = 1; i <= levels; ++i) {
         const std::string prev = "*a" + std::to_string(i - 1);
-        s += "  - {type: Lambert, texture: &a" + std::to_string(i) + " {type: Layered, upper: " + prev +
-             ", lower: " + prev + ", mask: " + prev + "}}\n";
+        s += "  - {type: Lambert, texture: &a" + std::to_string(i) +
+             " {type: Layered, upper: " + prev + ", lower: " + prev + ", mask: " + prev + "}}\n";
     }
-    return s + "object: {filename: tri.obj, shader: " + std::to_string(levels) + "}\n"
-               "image: {width: 8, height: 8}\n";
+    return s + "object: {filename: tri.obj, shader: " + std::to_string(levels) +
+           "}\n"
+           "image: {width: 8, height: 8}\n";
 }
 
 std::string nested(int levels) {
     std::string s = "camera: ";
-    for (int i = 0; i < levels; ++i) s += "[";
-    for (int i = 0; i < levels; ++i) s += "]";
+    for (int i = 0; i < levels; ++i)
+        s += "[";
+    for (int i = 0; i < levels; ++i)
+        s += "]";
     return s + "\n";
 }
 
 std::string deepTexture(int levels) {
     std::string t = "{type: Constant}";
-    for (int i = 0; i < levels; ++i) t = "{type: Layered, upper: " + t + ", lower: {type: Constant}, mask: {type: Constant}}";
+    for (int i = 0; i < levels; ++i)
+        t = "{type: Layered, upper: " + t + ", lower: {type: Constant}, mask: {type: Constant}}";
     return "shader: {type: Lambert, texture: " + t + "}\n";
 }
 
 // A scene whose camera looks at the triangle from `eye` (set far away to break it).
 std::string lookingFrom(const std::string& eye) {
-    return "camera:\n  look at: {eye: " + eye + ", target: [0.3, 0.3, 0]}\nshader: {type: Lambert}\n"
+    return "camera:\n  look at: {eye: " + eye +
+           ", target: [0.3, 0.3, 0]}\nshader: {type: Lambert}\n"
            "object: {filename: tri.obj}\nimage: {width: 8, height: 8}\n";
 }
 
@@ -93,15 +103,18 @@ enum class Expect { SceneError, RuntimeError, Success };
 struct BadInput {
     const char* name;
     std::vector<std::pair<std::string, std::string>> files; // written beside scene.yaml
-    std::string scene;                                     // scene.yaml's text
-    std::string args;    // after "render"; {scene}, {out} (out/image.exr), {dir} and {cornell} are replaced
+    std::string scene;                                      // scene.yaml's text
+    std::string
+        args; // after "render"; {scene}, {out} (out/image.exr), {dir} and {cornell} are replaced
     Expect expect;
     std::string where;   // SceneError: the file (relative to the folder) and line, "scene.yaml:3"
     std::string mention; // a part of the message
     std::string prefix = ""; // shell words before the command (ulimit, environment)
 };
 
-void PrintTo(const BadInput& c, std::ostream* os) { *os << c.name; }
+void PrintTo(const BadInput& c, std::ostream* os) {
+    *os << c.name;
+}
 
 class BadInputs : public ::testing::TestWithParam<BadInput> {};
 
@@ -109,27 +122,32 @@ TEST_P(BadInputs, NeverCrashHangOrLeaveAFile) {
     const BadInput& c = GetParam();
     TempDir dir;
     dir.write("tri.obj", kTriangleObj);
-    for (const auto& [name, text] : c.files) dir.write(name, text);
+    for (const auto& [name, text] : c.files)
+        dir.write(name, text);
     const std::string scene = dir.write("scene.yaml", c.scene);
     fs::create_directories(dir.file("out"));
     // An image from before: a failed render must leave it as it was.
     const std::string before = "not an image, and must stay so\n";
     dir.write("out/keep.exr", before);
     std::string args = c.args.empty() ? "{scene} -o {out} --quiet" : c.args;
-    args = replaceAll(replaceAll(replaceAll(replaceAll(args, "{scene}", scene), "{out}", dir.file("out/image.exr")),
+    args = replaceAll(replaceAll(replaceAll(replaceAll(args, "{scene}", scene), "{out}",
+                                            dir.file("out/image.exr")),
                                  "{dir}", dir.path()),
                       "{cornell}", sourceDir() + "/scenes/cornell-box.yaml");
     const Outcome r = runLimited("render " + args, 120, replaceAll(c.prefix, "{dir}", dir.path()));
 
-    ASSERT_FALSE(r.signalled) << (r.signal == SIGKILL ? "hung (killed after 120 s)" : "killed by signal " +
-                                                                                         std::to_string(r.signal))
-                              << "\n" << r.output;
+    ASSERT_FALSE(r.signalled) << (r.signal == SIGKILL
+                                      ? "hung (killed after 120 s)"
+                                      : "killed by signal " + std::to_string(r.signal))
+                              << "\n"
+                              << r.output;
     EXPECT_EQ(readFile(dir.file("out/keep.exr")), before) << "an existing file was changed";
     switch (c.expect) {
     case Expect::SceneError: {
         EXPECT_EQ(r.status, 2) << r.output;
         const std::string where = (c.where.empty() ? dir.path() : dir.file(c.where)) + ":";
-        EXPECT_EQ(r.output.rfind(where, 0), 0u) << "expected the message to start with '" << where << "': " << r.output;
+        EXPECT_EQ(r.output.rfind(where, 0), 0u)
+            << "expected the message to start with '" << where << "': " << r.output;
         break;
     }
     case Expect::RuntimeError:
@@ -142,129 +160,366 @@ TEST_P(BadInputs, NeverCrashHangOrLeaveAFile) {
         EXPECT_EQ(r.output, "");
         break;
     }
-    EXPECT_NE(r.output.find(c.mention), std::string::npos) << "expected '" << c.mention << "' in: " << r.output;
+    EXPECT_NE(r.output.find(c.mention), std::string::npos)
+        << "expected '" << c.mention << "' in: " << r.output;
     if (c.expect != Expect::Success) {
         std::vector<std::string> left;
         for (const auto& e : fs::directory_iterator(dir.path()))
-            if (e.path().filename().string()[0] == '.') left.push_back(e.path().filename().string());
+            if (e.path().filename().string()[0] == '.')
+                left.push_back(e.path().filename().string());
         for (const auto& e : fs::directory_iterator(dir.file("out")))
-            if (e.path().filename() != "keep.exr") left.push_back("out/" + e.path().filename().string());
+            if (e.path().filename() != "keep.exr")
+                left.push_back("out/" + e.path().filename().string());
         EXPECT_TRUE(left.empty()) << "left behind: " << (left.empty() ? "" : left[0]);
     }
 }
 
-const std::string kTri = "shader: {type: Lambert}\nobject: {filename: tri.obj}\nimage: {width: 8, height: 8}\n";
+const std::string kTri =
+    "shader: {type: Lambert}\nobject: {filename: tri.obj}\nimage: {width: 8, height: 8}\n";
 std::string objScene(const std::string& obj) {
-    return "shader: {type: Lambert}\nobject: {filename: " + obj + "}\nimage: {width: 8, height: 8}\n";
+    return "shader: {type: Lambert}\nobject: {filename: " + obj +
+           "}\nimage: {width: 8, height: 8}\n";
 }
 
 const BadInput kBadInputs[] = {
     // 1. OBJ indices that name no element.
-    {"ObjFaceIndexPastInt", {{"m.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 2147483648\n"}}, objScene("m.obj"), "",
-     Expect::SceneError, "m.obj:4", "2147483648"},
-    {"ObjFaceIndexPastLastVertex", {{"m.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 2 4\n"}}, objScene("m.obj"), "",
-     Expect::SceneError, "m.obj:5", "index 4"},
-    {"ObjNegativeIndexBeforeFirstVertex", {{"m.obj", "v 0 0 0\nv 1 0 0\nf -1 -2 -3\nv 0 1 0\n"}}, objScene("m.obj"),
-     "", Expect::SceneError, "m.obj:3", "-3"},
-    {"ObjIndexZero", {{"m.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n"}}, objScene("m.obj"), "", Expect::SceneError,
-     "m.obj:4", "index 0"},
-    {"ObjTexcoordIndexOutOfRange", {{"m.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nf 1/1 2/2 3/1\n"}},
-     objScene("m.obj"), "", Expect::SceneError, "m.obj:5", "texture coordinate"},
-    {"ObjNormalIndexOutOfRange", {{"m.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nf 1//1 2//1 3//-2\n"}},
-     objScene("m.obj"), "", Expect::SceneError, "m.obj:5", "normal"},
-    {"ObjIndexNotANumber", {{"m.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 three\n"}}, objScene("m.obj"), "",
-     Expect::SceneError, "m.obj:4", "three"},
+    {"ObjFaceIndexPastInt",
+     {{"m.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 2147483648\n"}},
+     objScene("m.obj"),
+     "",
+     Expect::SceneError,
+     "m.obj:4",
+     "2147483648"},
+    {"ObjFaceIndexPastLastVertex",
+     {{"m.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 2 4\n"}},
+     objScene("m.obj"),
+     "",
+     Expect::SceneError,
+     "m.obj:5",
+     "index 4"},
+    {"ObjNegativeIndexBeforeFirstVertex",
+     {{"m.obj", "v 0 0 0\nv 1 0 0\nf -1 -2 -3\nv 0 1 0\n"}},
+     objScene("m.obj"),
+     "",
+     Expect::SceneError,
+     "m.obj:3",
+     "-3"},
+    {"ObjIndexZero",
+     {{"m.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n"}},
+     objScene("m.obj"),
+     "",
+     Expect::SceneError,
+     "m.obj:4",
+     "index 0"},
+    {"ObjTexcoordIndexOutOfRange",
+     {{"m.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nf 1/1 2/2 3/1\n"}},
+     objScene("m.obj"),
+     "",
+     Expect::SceneError,
+     "m.obj:5",
+     "texture coordinate"},
+    {"ObjNormalIndexOutOfRange",
+     {{"m.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nf 1//1 2//1 3//-2\n"}},
+     objScene("m.obj"),
+     "",
+     Expect::SceneError,
+     "m.obj:5",
+     "normal"},
+    {"ObjIndexNotANumber",
+     {{"m.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 three\n"}},
+     objScene("m.obj"),
+     "",
+     Expect::SceneError,
+     "m.obj:4",
+     "three"},
     // 2. Not an OBJ at all.
-    {"ObjBinaryGarbage", {{"m.obj", garbage(65536, 1)}}, objScene("m.obj"), "", Expect::SceneError, "m.obj:1",
+    {"ObjBinaryGarbage",
+     {{"m.obj", garbage(65536, 1)}},
+     objScene("m.obj"),
+     "",
+     Expect::SceneError,
+     "m.obj:1",
      "not an OBJ"},
-    {"ObjGarbageAfterValidLines", {{"m.obj", std::string(kTriangleObj) + "\x01\x02\x7f\n"}}, objScene("m.obj"), "",
-     Expect::SceneError, "m.obj:5", "not text"},
-    {"ObjUnknownStatement", {{"m.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nface 1 2 3\n"}}, objScene("m.obj"), "",
-     Expect::SceneError, "m.obj:4", "not an OBJ statement"},
-    {"ObjTextWithNoFace", {{"m.obj", "# only vertices\nv 0 0 0\nv 1 0 0\n"}}, objScene("m.obj"), "",
-     Expect::SceneError, "scene.yaml:2", "no face"},
-    {"ObjEmpty", {{"m.obj", ""}}, objScene("m.obj"), "", Expect::SceneError, "scene.yaml:2", "no face"},
-    {"ObjTwoVertexFace", {{"m.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 2\n"}}, objScene("m.obj"), "",
-     Expect::SceneError, "m.obj:5", "at least 3 vertices"},
-    {"ObjHexFloatVertex", {{"m.obj", "v 0 0 0\nv 0x1p0 0 0\nv 0 1 0\nf 1 2 3\n"}}, objScene("m.obj"), "",
-     Expect::SceneError, "m.obj:2", "0x1p0"},
+    {"ObjGarbageAfterValidLines",
+     {{"m.obj", std::string(kTriangleObj) + "\x01\x02\x7f\n"}},
+     objScene("m.obj"),
+     "",
+     Expect::SceneError,
+     "m.obj:5",
+     "not text"},
+    {"ObjUnknownStatement",
+     {{"m.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nface 1 2 3\n"}},
+     objScene("m.obj"),
+     "",
+     Expect::SceneError,
+     "m.obj:4",
+     "not an OBJ statement"},
+    {"ObjTextWithNoFace",
+     {{"m.obj", "# only vertices\nv 0 0 0\nv 1 0 0\n"}},
+     objScene("m.obj"),
+     "",
+     Expect::SceneError,
+     "scene.yaml:2",
+     "no face"},
+    {"ObjEmpty",
+     {{"m.obj", ""}},
+     objScene("m.obj"),
+     "",
+     Expect::SceneError,
+     "scene.yaml:2",
+     "no face"},
+    {"ObjTwoVertexFace",
+     {{"m.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 2\n"}},
+     objScene("m.obj"),
+     "",
+     Expect::SceneError,
+     "m.obj:5",
+     "at least 3 vertices"},
+    {"ObjHexFloatVertex",
+     {{"m.obj", "v 0 0 0\nv 0x1p0 0 0\nv 0 1 0\nf 1 2 3\n"}},
+     objScene("m.obj"),
+     "",
+     Expect::SceneError,
+     "m.obj:2",
+     "0x1p0"},
     // 3, 4. Texture trees: a cycle, an alias bomb (shared: renders), too deep.
-    {"LayeredTextureContainsItself", {},
-     "shader:\n  type: Lambert\n  texture: &t {type: Layered, upper: *t, lower: {type: Constant}, mask: {type: Constant}}\n",
-     "", Expect::SceneError, "scene.yaml:3", "contains itself"},
+    {"LayeredTextureContainsItself",
+     {},
+     "shader:\n  type: Lambert\n  texture: &t {type: Layered, upper: *t, lower: {type: Constant}, "
+     "mask: {type: Constant}}\n",
+     "",
+     Expect::SceneError,
+     "scene.yaml:3",
+     "contains itself"},
     {"LayeredAliasBombIsShared", {}, aliasBomb(30), "", Expect::Success, "", ""},
-    {"LayeredTextureTooDeep", {}, deepTexture(80), "", Expect::SceneError, "scene.yaml:1", "deeper than 64"},
-    {"YamlNestedTenThousandLevels", {}, nested(10000), "", Expect::SceneError, "scene.yaml:1", "nests deeper"},
+    {"LayeredTextureTooDeep",
+     {},
+     deepTexture(80),
+     "",
+     Expect::SceneError,
+     "scene.yaml:1",
+     "deeper than 64"},
+    {"YamlNestedTenThousandLevels",
+     {},
+     nested(10000),
+     "",
+     Expect::SceneError,
+     "scene.yaml:1",
+     "nests deeper"},
     // 5. What would hand Embree an invalid ray.
-    {"CameraFarFromTheScene", {}, lookingFrom("[1e20, 0, 5]"), "", Expect::SceneError, "scene.yaml:2",
+    {"CameraFarFromTheScene",
+     {},
+     lookingFrom("[1e20, 0, 5]"),
+     "",
+     Expect::SceneError,
+     "scene.yaml:2",
      "from the camera"},
-    {"EyeAt1e38", {}, lookingFrom("[1e38, 0, 5]"), "", Expect::SceneError, "scene.yaml:2", "from the camera"},
-    {"CameraTranslatedFar", {}, "camera: {translation: [0, 0, 1e20]}\n" + kTri, "", Expect::SceneError,
-     "tri.obj:1", "from the camera"},
-    {"ObjectTranslatedFar", {}, "shader: {type: Lambert}\nobject: {filename: tri.obj, translation: [0, -1e16, 0]}\n",
-     "", Expect::SceneError, "tri.obj:1", "from the camera"},
-    {"ThinLensApertureHuge", {}, "camera: {type: ThinLens, aperture radius: 1e20}\n" + kTri, "",
-     Expect::SceneError, "scene.yaml:1", "aperture radius"},
-    {"ThinLensFocalDistanceHuge", {}, "camera:\n  type: ThinLens\n  focal distance: 1e30\n" + kTri, "",
-     Expect::SceneError, "scene.yaml:3", "focal distance"},
-    {"ThinLensFocalPlaneFar", {}, "camera:\n  type: ThinLens\n  fov: 179\n  focal distance: 1e13\n" + kTri, "",
-     Expect::SceneError, "scene.yaml:4", "focal plane"},
-    {"FilmWidthOverFocalLengthWiderThan180Degrees", {},
-     "camera:\n  focal length: 1e-6\n  film width: 1e9\n" + kTri, "", Expect::SceneError, "scene.yaml:2",
+    {"EyeAt1e38",
+     {},
+     lookingFrom("[1e38, 0, 5]"),
+     "",
+     Expect::SceneError,
+     "scene.yaml:2",
+     "from the camera"},
+    {"CameraTranslatedFar",
+     {},
+     "camera: {translation: [0, 0, 1e20]}\n" + kTri,
+     "",
+     Expect::SceneError,
+     "tri.obj:1",
+     "from the camera"},
+    {"ObjectTranslatedFar",
+     {},
+     "shader: {type: Lambert}\nobject: {filename: tri.obj, translation: [0, -1e16, 0]}\n",
+     "",
+     Expect::SceneError,
+     "tri.obj:1",
+     "from the camera"},
+    {"ThinLensApertureHuge",
+     {},
+     "camera: {type: ThinLens, aperture radius: 1e20}\n" + kTri,
+     "",
+     Expect::SceneError,
+     "scene.yaml:1",
+     "aperture radius"},
+    {"ThinLensFocalDistanceHuge",
+     {},
+     "camera:\n  type: ThinLens\n  focal distance: 1e30\n" + kTri,
+     "",
+     Expect::SceneError,
+     "scene.yaml:3",
+     "focal distance"},
+    {"ThinLensFocalPlaneFar",
+     {},
+     "camera:\n  type: ThinLens\n  fov: 179\n  focal distance: 1e13\n" + kTri,
+     "",
+     Expect::SceneError,
+     "scene.yaml:4",
+     "focal plane"},
+    {"FilmWidthOverFocalLengthWiderThan180Degrees",
+     {},
+     "camera:\n  focal length: 1e-6\n  film width: 1e9\n" + kTri,
+     "",
+     Expect::SceneError,
+     "scene.yaml:2",
      "wider than 179.9"},
-    {"QuadLightWithPowerBeyondFloat", {},
-     kTri + "light: {type: Quad, translation: [0, 0, 1e9], rotation: [180, 0, 0], scale: [3e9, 3e9], intensity: 1e20}\n",
-     "", Expect::Success, "", ""},
-    {"QuadLightFar", {}, kTri + "light: {type: Quad, translation: [0, 0, -1e18]}\n", "", Expect::SceneError,
-     "scene.yaml:4", "quad light corner"},
+    {"QuadLightWithPowerBeyondFloat",
+     {},
+     kTri + "light: {type: Quad, translation: [0, 0, 1e9], rotation: [180, 0, 0], scale: [3e9, "
+            "3e9], intensity: 1e20}\n",
+     "",
+     Expect::Success,
+     "",
+     ""},
+    {"QuadLightFar",
+     {},
+     kTri + "light: {type: Quad, translation: [0, 0, -1e18]}\n",
+     "",
+     Expect::SceneError,
+     "scene.yaml:4",
+     "quad light corner"},
     // 6, 7. Radiance beyond float's headroom, or beyond the film.
-    {"LightPowerOverflowsFloat", {}, kTri + "light:\n  type: Quad\n  intensity: 1e20\n  colour: [1e19, 1, 1]\n", "",
-     Expect::SceneError, "scene.yaml:7", "exceeds 1e20"},
-    {"EmissionAboveTheRange", {}, "shader: {type: Lambert, emission: [1e30, 0, 0]}\nobject: {filename: tri.obj}\n",
-     "", Expect::SceneError, "scene.yaml:1", "emission"},
-    {"LightIntensityAboveTheRange", {}, kTri + "light: {type: Quad, intensity: 1e30}\n", "", Expect::SceneError,
-     "scene.yaml:4", "intensity"},
+    {"LightPowerOverflowsFloat",
+     {},
+     kTri + "light:\n  type: Quad\n  intensity: 1e20\n  colour: [1e19, 1, 1]\n",
+     "",
+     Expect::SceneError,
+     "scene.yaml:7",
+     "exceeds 1e20"},
+    {"EmissionAboveTheRange",
+     {},
+     "shader: {type: Lambert, emission: [1e30, 0, 0]}\nobject: {filename: tri.obj}\n",
+     "",
+     Expect::SceneError,
+     "scene.yaml:1",
+     "emission"},
+    {"LightIntensityAboveTheRange",
+     {},
+     kTri + "light: {type: Quad, intensity: 1e30}\n",
+     "",
+     Expect::SceneError,
+     "scene.yaml:4",
+     "intensity"},
     // 8. One depth limit for every backend.
-    {"MaxDepthBeyondTheRayRecord", {}, "settings: {max depth: 40000}\n" + kTri, "", Expect::SceneError,
-     "scene.yaml:1", "32767"},
+    {"MaxDepthBeyondTheRayRecord",
+     {},
+     "settings: {max depth: 40000}\n" + kTri,
+     "",
+     Expect::SceneError,
+     "scene.yaml:1",
+     "32767"},
     // 9. Scene errors that used to be runtime failures.
-    {"TextureNotAnImage", {{"t.png", "this is text, not a PNG\n"}},
-     "shader:\n  type: Lambert\n  texture: {type: Standard, filename: t.png}\nobject: {filename: tri.obj}\n", "",
-     Expect::SceneError, "scene.yaml:3", "not an image"},
+    {"TextureNotAnImage",
+     {{"t.png", "this is text, not a PNG\n"}},
+     "shader:\n  type: Lambert\n  texture: {type: Standard, filename: t.png}\nobject: {filename: "
+     "tri.obj}\n",
+     "",
+     Expect::SceneError,
+     "scene.yaml:3",
+     "not an image"},
     {"SceneIsAFolder", {}, kTri, "{dir} -o {out} --quiet", Expect::SceneError, "", "is a folder"},
-    {"SceneMissing", {}, kTri, "{dir}/nosuch.yaml -o {out} --quiet", Expect::SceneError, "nosuch.yaml",
+    {"SceneMissing",
+     {},
+     kTri,
+     "{dir}/nosuch.yaml -o {out} --quiet",
+     Expect::SceneError,
+     "nosuch.yaml",
      "cannot open the scene file"},
     // 10, 12. Outputs that cannot be written: found before rendering, nothing left behind.
-    {"OutputFolderMissing", {}, kTri, "{scene} -o {dir}/out/missing/image.exr --quiet --spp 16000000",
-     Expect::RuntimeError, "", "missing"},
-    {"StatsFolderMissing", {}, kTri, "{scene} -o {out} --stats {dir}/out/none/s.json --quiet --spp 16000000",
-     Expect::RuntimeError, "", "none"},
-    {"ErrorCsvFolderMissing", {}, kTri, "{scene} -o {out} --error-csv {dir}/out/none/e.csv --quiet --spp 16000000",
-     Expect::RuntimeError, "", "none"},
-    {"OutputIsAFolder", {}, kTri, "{scene} -o {dir}/d.exr --quiet --spp 16000000", Expect::RuntimeError, "",
-     "folder", "mkdir {dir}/d.exr && "},
-    {"PngToAFullDevice", {}, kTri, "{cornell} -o {dir}/full.png --quiet --spp 1", Expect::RuntimeError, "",
-     "No space left", "ln -s /dev/full {dir}/full.png && "},
-    {"ImageOverAFileSizeLimit", {}, kTri, "{cornell} -o {dir}/out/big.exr --quiet --spp 1", Expect::RuntimeError,
-     "", "too large", "ulimit -f 1; "},
-    {"PngOverAFileSizeLimit", {}, kTri, "{cornell} -o {dir}/out/big.png --quiet --spp 1", Expect::RuntimeError, "",
-     "too large", "ulimit -f 1; "},
-    // The image is small enough; the stats are not: neither appears, as all outputs commit together.
-    {"StatsOverAFileSizeLimit", {}, kTri, "{scene} -o {dir}/out/image.png --stats {dir}/out/s.json --quiet --spp 1",
-     Expect::RuntimeError, "", "s.json", "ulimit -f 1; "},
-    {"CsvOverAFileSizeLimit", {}, kTri,
+    {"OutputFolderMissing",
+     {},
+     kTri,
+     "{scene} -o {dir}/out/missing/image.exr --quiet --spp 16000000",
+     Expect::RuntimeError,
+     "",
+     "missing"},
+    {"StatsFolderMissing",
+     {},
+     kTri,
+     "{scene} -o {out} --stats {dir}/out/none/s.json --quiet --spp 16000000",
+     Expect::RuntimeError,
+     "",
+     "none"},
+    {"ErrorCsvFolderMissing",
+     {},
+     kTri,
+     "{scene} -o {out} --error-csv {dir}/out/none/e.csv --quiet --spp 16000000",
+     Expect::RuntimeError,
+     "",
+     "none"},
+    {"OutputIsAFolder",
+     {},
+     kTri,
+     "{scene} -o {dir}/d.exr --quiet --spp 16000000",
+     Expect::RuntimeError,
+     "",
+     "folder",
+     "mkdir {dir}/d.exr && "},
+    {"PngToAFullDevice",
+     {},
+     kTri,
+     "{cornell} -o {dir}/full.png --quiet --spp 1",
+     Expect::RuntimeError,
+     "",
+     "No space left",
+     "ln -s /dev/full {dir}/full.png && "},
+    {"ImageOverAFileSizeLimit",
+     {},
+     kTri,
+     "{cornell} -o {dir}/out/big.exr --quiet --spp 1",
+     Expect::RuntimeError,
+     "",
+     "too large",
+     "ulimit -f 1; "},
+    {"PngOverAFileSizeLimit",
+     {},
+     kTri,
+     "{cornell} -o {dir}/out/big.png --quiet --spp 1",
+     Expect::RuntimeError,
+     "",
+     "too large",
+     "ulimit -f 1; "},
+    // The image is small enough; the stats are not: neither appears, as all outputs commit
+    // together.
+    {"StatsOverAFileSizeLimit",
+     {},
+     kTri,
+     "{scene} -o {dir}/out/image.png --stats {dir}/out/s.json --quiet --spp 1",
+     Expect::RuntimeError,
+     "",
+     "s.json",
+     "ulimit -f 1; "},
+    {"CsvOverAFileSizeLimit",
+     {},
+     kTri,
      "{scene} -o {dir}/out/image.png --error-csv {dir}/out/e.csv --quiet --spp 10000 --backend cpu",
-     Expect::RuntimeError, "", "e.csv", "ulimit -f 1; "},
+     Expect::RuntimeError,
+     "",
+     "e.csv",
+     "ulimit -f 1; "},
     // 12. A spill folder that is missing matters only when a batch spills.
-    {"MissingTmpdirWithoutSpill", {}, kTri, "{scene} -o {dir}/out/fine.exr --quiet --spp 4 --backend cpu",
-     Expect::Success, "", "", "TMPDIR={dir}/missing "},
-    {"MissingTmpdirWithSpill", {}, objScene("tri.obj"),
-     "{scene} -o {out} --quiet --spp 16 --backend cpu --memory-budget 0.001 --bin-exponent 6", Expect::RuntimeError,
-     "", "spill file", "TMPDIR={dir}/missing "},
+    {"MissingTmpdirWithoutSpill",
+     {},
+     kTri,
+     "{scene} -o {dir}/out/fine.exr --quiet --spp 4 --backend cpu",
+     Expect::Success,
+     "",
+     "",
+     "TMPDIR={dir}/missing "},
+    {"MissingTmpdirWithSpill",
+     {},
+     objScene("tri.obj"),
+     "{scene} -o {out} --quiet --spp 16 --backend cpu --memory-budget 0.001 --bin-exponent 6",
+     Expect::RuntimeError,
+     "",
+     "spill file",
+     "TMPDIR={dir}/missing "},
 };
 
 INSTANTIATE_TEST_SUITE_P(Cli, BadInputs, ::testing::ValuesIn(kBadInputs),
-                         [](const ::testing::TestParamInfo<BadInput>& info) { return std::string(info.param.name); });
+                         [](const ::testing::TestParamInfo<BadInput>& info) {
+                             return std::string(info.param.name);
+                         });
 
 TEST(BadInputs, RenderHelpPrintsUsageAndExitsZero) {
     const Outcome r = runLimited("render --help", 30);
@@ -276,10 +531,12 @@ TEST(BadInputs, RenderHelpPrintsUsageAndExitsZero) {
 
 TEST(BadInputs, SceneMissingIsReportedWithoutALineNumber) {
     TempDir dir;
-    const Outcome r = runLimited("render " + dir.file("nosuch.yaml") + " -o " + dir.file("x.exr") + " --quiet", 30);
+    const Outcome r = runLimited(
+        "render " + dir.file("nosuch.yaml") + " -o " + dir.file("x.exr") + " --quiet", 30);
     ASSERT_FALSE(r.signalled);
     EXPECT_EQ(r.status, 2);
-    EXPECT_EQ(r.output.rfind(dir.file("nosuch.yaml") + ": cannot open the scene file", 0), 0u) << r.output;
+    EXPECT_EQ(r.output.rfind(dir.file("nosuch.yaml") + ": cannot open the scene file", 0), 0u)
+        << r.output;
 }
 
 } // namespace

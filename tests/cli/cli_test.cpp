@@ -16,9 +16,13 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string cornellBox() { return sourceDir() + "/scenes/cornell-box.yaml"; }
+std::string cornellBox() {
+    return sourceDir() + "/scenes/cornell-box.yaml";
+}
 
-bool contains(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
+bool contains(const std::string& s, const std::string& part) {
+    return s.find(part) != std::string::npos;
+}
 
 TEST(Cli, HelpPrintsUsage) {
     CommandResult r = runSpillway("--help");
@@ -53,7 +57,9 @@ struct BadUsage {
     const char* mention;
 };
 
-void PrintTo(const BadUsage& c, std::ostream* os) { *os << c.name; }
+void PrintTo(const BadUsage& c, std::ostream* os) {
+    *os << c.name;
+}
 
 class CliBadUsage : public ::testing::TestWithParam<BadUsage> {};
 
@@ -61,8 +67,9 @@ class CliBadUsage : public ::testing::TestWithParam<BadUsage> {};
 TEST_P(CliBadUsage, ExitsTwoAndWritesNothing) {
     const BadUsage& c = GetParam();
     TempDir dir;
-    std::string args = replaceAll(replaceAll(replaceAll(c.args, "{scene}", cornellBox()), "{out}", dir.file("out.exr")),
-                              "{dir}", dir.path());
+    std::string args = replaceAll(
+        replaceAll(replaceAll(c.args, "{scene}", cornellBox()), "{out}", dir.file("out.exr")),
+        "{dir}", dir.path());
     CommandResult r = runSpillway("render " + args);
     EXPECT_EQ(r.status, 2) << args << "\n" << r.output;
     EXPECT_TRUE(contains(r.output, c.mention)) << args << "\n" << r.output;
@@ -87,7 +94,9 @@ const BadUsage kBadUsages[] = {
 };
 
 INSTANTIATE_TEST_SUITE_P(Cli, CliBadUsage, ::testing::ValuesIn(kBadUsages),
-                         [](const ::testing::TestParamInfo<BadUsage>& info) { return std::string(info.param.name); });
+                         [](const ::testing::TestParamInfo<BadUsage>& info) {
+                             return std::string(info.param.name);
+                         });
 
 TEST(Cli, MissingSceneFileExitsTwo) {
     TempDir dir;
@@ -104,7 +113,8 @@ void expectCornellImage(const std::string& path) {
     EXPECT_EQ(img.width, 256);
     EXPECT_EQ(img.height, 256);
     ASSERT_EQ(img.rgb.size(), 256u * 256u * 3u);
-    for (float v : img.rgb) ASSERT_TRUE(std::isfinite(v)) << path;
+    for (float v : img.rgb)
+        ASSERT_TRUE(std::isfinite(v)) << path;
     EXPECT_GT(mean(img.rgb), 0.0) << path << " is black";
 }
 
@@ -127,13 +137,14 @@ TEST(Cli, RendersCornellBoxToPng) {
 TEST(Cli, StatsFileIsJsonWithTheDocumentedKeys) {
     TempDir dir;
     const std::string stats = dir.file("stats.json");
-    CommandResult r = runSpillway("render " + cornellBox() + " --spp 1 --quiet -o " + dir.file("c.exr") +
-                                  " --stats " + stats);
+    CommandResult r = runSpillway("render " + cornellBox() + " --spp 1 --quiet -o " +
+                                  dir.file("c.exr") + " --stats " + stats);
     ASSERT_EQ(r.status, 0) << r.output;
     std::ifstream in(stats);
     ASSERT_TRUE(in) << "no stats file";
     nlohmann::json j = nlohmann::json::parse(in); // throws (fails the test) on malformed JSON
-    for (const char* key : {"backend", "device", "width", "height", "spp", "wall_seconds", "rays", "stage_seconds"})
+    for (const char* key :
+         {"backend", "device", "width", "height", "spp", "wall_seconds", "rays", "stage_seconds"})
         EXPECT_TRUE(j.contains(key)) << "missing key " << key << " in " << j.dump(2);
     ASSERT_TRUE(j["backend"].is_string());
     EXPECT_FALSE(j["backend"].get<std::string>().empty());
@@ -160,9 +171,11 @@ TEST(Cli, StatsFileIsJsonWithTheDocumentedKeys) {
     }
 }
 
-std::vector<float> renderWithSeed(const TempDir& dir, const std::string& name, const std::string& seed) {
+std::vector<float> renderWithSeed(const TempDir& dir, const std::string& name,
+                                  const std::string& seed) {
     const std::string out = dir.file(name);
-    CommandResult r = runSpillway("render " + cornellBox() + " --spp 1 --quiet --seed " + seed + " -o " + out);
+    CommandResult r =
+        runSpillway("render " + cornellBox() + " --spp 1 --quiet --seed " + seed + " -o " + out);
     EXPECT_EQ(r.status, 0) << r.output;
     return readImage(out).rgb;
 }
@@ -175,8 +188,10 @@ TEST(Cli, SameSeedReproducesTheImageBitForBit) {
     ASSERT_EQ(a.size(), 256u * 256u * 3u);
     ASSERT_EQ(b.size(), a.size());
     ASSERT_EQ(c.size(), a.size());
-    EXPECT_EQ(std::memcmp(a.data(), b.data(), a.size() * sizeof(float)), 0) << "seed 7 twice gave different images";
-    EXPECT_NE(std::memcmp(a.data(), c.data(), a.size() * sizeof(float)), 0) << "seeds 7 and 8 gave the same image";
+    EXPECT_EQ(std::memcmp(a.data(), b.data(), a.size() * sizeof(float)), 0)
+        << "seed 7 twice gave different images";
+    EXPECT_NE(std::memcmp(a.data(), c.data(), a.size() * sizeof(float)), 0)
+        << "seeds 7 and 8 gave the same image";
 }
 
 } // namespace

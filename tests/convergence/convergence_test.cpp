@@ -38,7 +38,8 @@ const Reference& highSppReference(int size) {
     cfg.spp = size < 48 ? 16384 : 4096;
     cfg.seed = 12345; // independent of the test renders' random numbers
     auto result = render(scene, cfg);
-    return refs[size] = Reference{ImageRGB{size, size, result->film->image()}, result->film->halfBufferRelMse()};
+    return refs[size] = Reference{ImageRGB{size, size, result->film->image()},
+                                  result->film->halfBufferRelMse()};
 }
 
 // One render's error at five sample counts, each twice the last: the true relMSE (against the
@@ -62,7 +63,8 @@ Series convergence(const std::string& backend, std::uint32_t seed, int size, int
         const int spp = done * 4; // sample base 2
         if (k < 5 && spp == firstSpp << k) {
             s.spp[k] = spp;
-            s.trueRelMse[k] = compareImages({size, size, film.image()}, ref.image).relMse - ref.ownRelMse;
+            s.trueRelMse[k] =
+                compareImages({size, size, film.image()}, ref.image).relMse - ref.ownRelMse;
             s.estimate[k] = film.halfBufferRelMse();
             ++k;
         }
@@ -87,7 +89,8 @@ struct Sample {
 };
 Sample meanOf(const std::vector<double>& v) {
     double s = 0, s2 = 0;
-    for (double x : v) s += x, s2 += x * x;
+    for (double x : v)
+        s += x, s2 += x * x;
     const double n = double(v.size()), m = s / n;
     return {m, std::sqrt(std::max(0.0, (s2 / n - m * m) / (n - 1)))};
 }
@@ -102,21 +105,25 @@ Sample meanOf(const std::vector<double>& v) {
 TEST(Convergence, HalfBufferEstimateTracksTrueRelMse) {
     constexpr int kSeeds = 24;
     std::vector<Series> runs;
-    for (int seed = 1; seed <= kSeeds; ++seed) runs.push_back(convergence("reference", std::uint32_t(seed), 32, 64));
+    for (int seed = 1; seed <= kSeeds; ++seed)
+        runs.push_back(convergence("reference", std::uint32_t(seed), 32, 64));
     const int* spp = runs[0].spp;
     double est[5] = {}, tru[5] = {};
     std::vector<double> slopeDiff;
     for (const Series& r : runs) {
-        for (int k = 0; k < 5; ++k) est[k] += r.estimate[k] / kSeeds, tru[k] += r.trueRelMse[k] / kSeeds;
+        for (int k = 0; k < 5; ++k)
+            est[k] += r.estimate[k] / kSeeds, tru[k] += r.trueRelMse[k] / kSeeds;
         slopeDiff.push_back(logLogSlope(spp, r.estimate) - logLogSlope(spp, r.trueRelMse));
     }
     double pooled = 0;
     for (int k = 0; k < 5; ++k) {
         pooled += est[k] / tru[k] / 5;
         std::vector<double> ratios;
-        for (const Series& r : runs) ratios.push_back(r.estimate[k] / r.trueRelMse[k]);
+        for (const Series& r : runs)
+            ratios.push_back(r.estimate[k] / r.trueRelMse[k]);
         Sample per = meanOf(ratios);
-        std::printf("%4d spp: true relMSE %.6f, estimate %.6f, ratio of means %.3f (per seed %.3f +- %.3f)\n",
+        std::printf("%4d spp: true relMSE %.6f, estimate %.6f, ratio of means %.3f (per seed %.3f "
+                    "+- %.3f)\n",
                     spp[k], tru[k], est[k], est[k] / tru[k], per.mean, per.stderror);
         EXPECT_GT(est[k] / tru[k], 0.8) << spp[k] << " spp";
         EXPECT_LT(est[k] / tru[k], 1.2) << spp[k] << " spp";
@@ -126,8 +133,8 @@ TEST(Convergence, HalfBufferEstimateTracksTrueRelMse) {
     EXPECT_LT(pooled, 1.1);
     const double slopeEst = logLogSlope(spp, est), slopeTrue = logLogSlope(spp, tru);
     Sample d = meanOf(slopeDiff);
-    std::printf("log-log slope: estimate %.3f, true %.3f (per seed difference %.3f +- %.3f)\n", slopeEst, slopeTrue,
-                d.mean, d.stderror);
+    std::printf("log-log slope: estimate %.3f, true %.3f (per seed difference %.3f +- %.3f)\n",
+                slopeEst, slopeTrue, d.mean, d.stderror);
     EXPECT_NEAR(slopeEst, slopeTrue, 0.07);
 }
 
@@ -145,23 +152,28 @@ TEST(Convergence, EveryBackendIsUnbiasedAndRelMseFallsAsOneOverSpp) {
         std::vector<double> diff[3];
         for (int seed = 101; seed < 101 + kSeeds; ++seed) {
             Series s = convergence(backend, std::uint32_t(seed), 48, 16);
-            for (int k = 0; k < 5; ++k) tru[k] += s.trueRelMse[k] / kSeeds;
+            for (int k = 0; k < 5; ++k)
+                tru[k] += s.trueRelMse[k] / kSeeds;
             slopes.push_back(logLogSlope(s.spp, s.trueRelMse));
             std::copy(s.spp, s.spp + 5, spp);
-            for (size_t i = 0; i < s.image.size(); ++i) diff[i % 3].push_back(double(s.image[i]) - ref.rgb[i]);
+            for (size_t i = 0; i < s.image.size(); ++i)
+                diff[i % 3].push_back(double(s.image[i]) - ref.rgb[i]);
         }
         for (int c = 0; c < 3; ++c) {
             Sample d = meanOf(diff[c]);
             double refMean = 0;
-            for (size_t i = size_t(c); i < ref.rgb.size(); i += 3) refMean += ref.rgb[i] / double(ref.rgb.size() / 3);
-            std::printf("%s channel %d: mean %.5f, reference %.5f, difference %+.5f +- %.5f (%+.2f %%)\n",
-                        backend.c_str(), c, refMean + d.mean, refMean, d.mean, d.stderror, 100 * d.mean / refMean);
+            for (size_t i = size_t(c); i < ref.rgb.size(); i += 3)
+                refMean += ref.rgb[i] / double(ref.rgb.size() / 3);
+            std::printf(
+                "%s channel %d: mean %.5f, reference %.5f, difference %+.5f +- %.5f (%+.2f %%)\n",
+                backend.c_str(), c, refMean + d.mean, refMean, d.mean, d.stderror,
+                100 * d.mean / refMean);
             EXPECT_LT(std::fabs(d.mean), 4 * d.stderror) << backend << " channel " << c;
         }
         Sample sl = meanOf(slopes);
         const double slope = logLogSlope(spp, tru);
-        std::printf("%s: log-log slope of relMSE against spp %.3f (per seed %.3f +- %.3f)\n", backend.c_str(), slope,
-                    sl.mean, sl.stderror);
+        std::printf("%s: log-log slope of relMSE against spp %.3f (per seed %.3f +- %.3f)\n",
+                    backend.c_str(), slope, sl.mean, sl.stderror);
         EXPECT_LT(std::fabs(slope + 1.0), 4 * sl.stderror) << backend;
     }
 }
@@ -174,13 +186,15 @@ std::vector<std::map<std::string, std::string>> readCsv(const std::string& path)
     while (std::getline(in, line)) {
         std::vector<std::string> cells;
         std::stringstream ss(line);
-        for (std::string c; std::getline(ss, c, ',');) cells.push_back(c);
+        for (std::string c; std::getline(ss, c, ',');)
+            cells.push_back(c);
         if (header.empty()) {
             header = cells;
             continue;
         }
         std::map<std::string, std::string> row;
-        for (size_t i = 0; i < cells.size() && i < header.size(); ++i) row[header[i]] = cells[i];
+        for (size_t i = 0; i < cells.size() && i < header.size(); ++i)
+            row[header[i]] = cells[i];
         rows.push_back(row);
     }
     return rows;
@@ -189,10 +203,12 @@ std::vector<std::map<std::string, std::string>> readCsv(const std::string& path)
 TEST(ErrorCsv, OneRowPerIterationWithAndWithoutReference) {
     TempDir dir;
     const std::string scene = sourceDir() + "/scenes/cornell-box.yaml";
-    CommandResult ref = runSpillway("render " + scene + " --quiet --spp 16 -o " + dir.file("ref.exr"));
+    CommandResult ref =
+        runSpillway("render " + scene + " --quiet --spp 16 -o " + dir.file("ref.exr"));
     ASSERT_EQ(ref.status, 0) << ref.output;
-    CommandResult r = runSpillway("render " + scene + " --quiet --spp 8 -o " + dir.file("a.exr") + " --error-csv " +
-                                  dir.file("a.csv") + " --reference " + dir.file("ref.exr") + " --seed 3");
+    CommandResult r = runSpillway("render " + scene + " --quiet --spp 8 -o " + dir.file("a.exr") +
+                                  " --error-csv " + dir.file("a.csv") + " --reference " +
+                                  dir.file("ref.exr") + " --seed 3");
     ASSERT_EQ(r.status, 0) << r.output;
     auto rows = readCsv(dir.file("a.csv"));
     ASSERT_EQ(rows.size(), 2u); // sample base 2: 4 spp per iteration
@@ -210,17 +226,18 @@ TEST(ErrorCsv, OneRowPerIterationWithAndWithoutReference) {
     ImageMetrics m = compareImages(readImage(dir.file("a.exr")), readImage(dir.file("ref.exr")));
     EXPECT_NEAR(std::stod(rows.back()["relmse"]), m.relMse, 1e-6 * m.relMse);
 
-    CommandResult plain = runSpillway("render " + scene + " --quiet --spp 8 -o " + dir.file("b.exr") +
-                                      " --error-csv " + dir.file("b.csv"));
+    CommandResult plain = runSpillway("render " + scene + " --quiet --spp 8 -o " +
+                                      dir.file("b.exr") + " --error-csv " + dir.file("b.csv"));
     ASSERT_EQ(plain.status, 0) << plain.output;
     auto rowsB = readCsv(dir.file("b.csv"));
     ASSERT_EQ(rowsB.size(), 2u);
     EXPECT_EQ(rowsB[0].count("relmse"), 0u);
     EXPECT_GT(std::stod(rowsB[0]["relmse_estimate"]), 0.0);
 
-    CommandResult mismatch = runSpillway("render " + dir.write("small.yaml", "image: {width: 8, height: 8}\n") +
-                                         " --quiet -o " + dir.file("c.exr") + " --error-csv " + dir.file("c.csv") +
-                                         " --reference " + dir.file("ref.exr"));
+    CommandResult mismatch =
+        runSpillway("render " + dir.write("small.yaml", "image: {width: 8, height: 8}\n") +
+                    " --quiet -o " + dir.file("c.exr") + " --error-csv " + dir.file("c.csv") +
+                    " --reference " + dir.file("ref.exr"));
     EXPECT_EQ(mismatch.status, 2) << mismatch.output;
     EXPECT_NE(mismatch.output.find("ref.exr"), std::string::npos) << mismatch.output;
 }
@@ -228,8 +245,10 @@ TEST(ErrorCsv, OneRowPerIterationWithAndWithoutReference) {
 // --time-limit stops after the iteration that crosses it and still writes a valid image.
 TEST(TimeLimit, StopsAfterTheCrossingIterationWithAValidImage) {
     TempDir dir;
-    CommandResult r = runSpillway("render " + sourceDir() + "/scenes/cornell-box.yaml --quiet --spp 4096 --time-limit 0.001 -o " +
-                                  dir.file("t.exr") + " --stats " + dir.file("s.json"));
+    CommandResult r =
+        runSpillway("render " + sourceDir() +
+                    "/scenes/cornell-box.yaml --quiet --spp 4096 --time-limit 0.001 -o " +
+                    dir.file("t.exr") + " --stats " + dir.file("s.json"));
     ASSERT_EQ(r.status, 0) << r.output;
     nlohmann::json s = nlohmann::json::parse(std::ifstream(dir.file("s.json")));
     EXPECT_EQ(s["iterations"].get<int>(), 1);

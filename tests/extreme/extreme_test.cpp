@@ -14,9 +14,9 @@
 //     non-negative and never create energy.
 // Standard errors come from the renders' own samples: per pixel over iterations (PixelStats) or
 // over pixels when every pixel estimates the same value.
-#include "host/render/camera.h"
 #include "host/image/compare.h"
 #include "host/image/film.h"
+#include "host/render/camera.h"
 #include "test_util.h"
 
 #include <gtest/gtest.h>
@@ -30,7 +30,9 @@ namespace spw::test {
 namespace {
 
 // The backends every case runs on.
-std::vector<std::string> extremeBackends() { return backendsUnderTest(); }
+std::vector<std::string> extremeBackends() {
+    return backendsUnderTest();
+}
 
 // ---- statistics -------------------------------------------------------------------------
 
@@ -84,7 +86,8 @@ std::string fmt(const char* format, ...) {
 // cluster of dark pixels, a leak as a bright block). The renders share random numbers, so
 // their difference is far smaller than either's noise: the independent-sample errors used
 // here make the bound conservative in the direction of passing only agreeing images.
-void expectSameImage(const PixelStats& a, const PixelStats& b, int width, int height, const std::string& what) {
+void expectSameImage(const PixelStats& a, const PixelStats& b, int width, int height,
+                     const std::string& what) {
     ASSERT_EQ(a.pixels(), b.pixels());
     const MeanError ma = a.imageMean(), mb = b.imageMean();
     const double se = std::hypot(ma.stderror, mb.stderror);
@@ -96,8 +99,10 @@ void expectSameImage(const PixelStats& a, const PixelStats& b, int width, int he
     const double worstZ = worstBlockZ(
         width, height, [&](size_t i) { return a.mean(i) - b.mean(i); },
         [&](size_t i) { return std::max(a.meanVariance(i) + b.meanVariance(i), 1e-18); });
-    std::printf("  %-40s mean %.5f vs %.5f (se %.5f, z %+.2f), worst 8x8 block |z| %.2f, outlier pixels %zu/%zu\n",
-                what.c_str(), mb.mean, ma.mean, se, (mb.mean - ma.mean) / se, worstZ, outliers, a.pixels());
+    std::printf("  %-40s mean %.5f vs %.5f (se %.5f, z %+.2f), worst 8x8 block |z| %.2f, outlier "
+                "pixels %zu/%zu\n",
+                what.c_str(), mb.mean, ma.mean, se, (mb.mean - ma.mean) / se, worstZ, outliers,
+                a.pixels());
     EXPECT_NEAR(mb.mean, ma.mean, 4.0 * se) << what;
     EXPECT_LT(worstZ, 4.5) << what;
     EXPECT_LE(double(outliers), 0.005 * double(a.pixels())) << what;
@@ -106,17 +111,17 @@ void expectSameImage(const PixelStats& a, const PixelStats& b, int width, int he
 // ---- scenes -------------------------------------------------------------------------------
 
 // The Cornell box of scenes/cornell-box.yaml with every position p mapped to s p + t.
-std::string cornellYaml(double s, glm::dvec3 t, int size, int sampleBase, int iterations, const std::string& camera = "",
-                        double lightScale = 1.0) {
+std::string cornellYaml(double s, glm::dvec3 t, int size, int sampleBase, int iterations,
+                        const std::string& camera = "", double lightScale = 1.0) {
     const std::string box = sourceDir() + "/scenes/cornell-box/";
     auto p = [&](double x, double y, double z) {
         return fmt("[%.17g, %.17g, %.17g]", s * x + t.x, s * y + t.y, s * z + t.z);
     };
-    std::string y = fmt("image: {width: %d, height: %d, sample base: %d, iterations: %d}\n", size, size, sampleBase,
-                        iterations);
+    std::string y = fmt("image: {width: %d, height: %d, sample base: %d, iterations: %d}\n", size,
+                        size, sampleBase, iterations);
     y += "settings: {min depth: 3, max depth: 16}\n";
-    y += camera.empty() ? "camera: {look at: {eye: " + p(278, 273, -800) + ", target: " + p(278, 273, 0) +
-                              ", up: [0, 1, 0]}, fov: 39.3}\n"
+    y += camera.empty() ? "camera: {look at: {eye: " + p(278, 273, -800) +
+                              ", target: " + p(278, 273, 0) + ", up: [0, 1, 0]}, fov: 39.3}\n"
                         : camera;
     y += "sampler: {type: Stratified}\n";
     y += "shaders:\n"
@@ -126,12 +131,13 @@ std::string cornellYaml(double s, glm::dvec3 t, int size, int sampleBase, int it
     const char* objects[][2] = {{"white", "0"}, {"red", "1"}, {"green", "2"}, {"blocks", "0"}};
     y += "objects:\n";
     for (auto& o : objects)
-        y += fmt("  - {filename: %s%s.obj, shader: %s, scale: %.17g, translation: [%.17g, %.17g, %.17g]}\n", box.c_str(),
-                 o[0], o[1], s, t.x, t.y, t.z);
+        y += fmt("  - {filename: %s%s.obj, shader: %s, scale: %.17g, translation: [%.17g, %.17g, "
+                 "%.17g]}\n",
+                 box.c_str(), o[0], o[1], s, t.x, t.y, t.z);
     // Equal power: the light's area shrinks by lightScale^2, its radiance grows by the inverse.
     y += "light: {type: Quad, translation: " + p(278, 548.7, 279.5) + ", rotation: [90, 0, 0], " +
-         fmt("scale: [%.17g, %.17g], intensity: %.17g, colour: [17, 12, 4]}\n", 130 * s * lightScale,
-             105 * s * lightScale, 1.0 / (lightScale * lightScale));
+         fmt("scale: [%.17g, %.17g], intensity: %.17g, colour: [17, 12, 4]}\n",
+             130 * s * lightScale, 105 * s * lightScale, 1.0 / (lightScale * lightScale));
     return y;
 }
 
@@ -152,18 +158,22 @@ std::string planeObj(float h, std::optional<vec3> normal = {}) {
 
 // The white furnace: inside the cube [-1, 1]^3 whose walls emit radiance 1 and absorb
 // (Emissive = Null + emission), one object with the shader under test.
-std::string furnaceYaml(const std::string& object, const std::string& shader, const std::string& camera,
-                        int size, int sampleBase, int iterations, int maxDepth, const char* sampler = "Stratified") {
-    return fmt("image: {width: %d, height: %d, sample base: %d, iterations: %d}\n", size, size, sampleBase,
-               iterations) +
+std::string furnaceYaml(const std::string& object, const std::string& shader,
+                        const std::string& camera, int size, int sampleBase, int iterations,
+                        int maxDepth, const char* sampler = "Stratified") {
+    return fmt("image: {width: %d, height: %d, sample base: %d, iterations: %d}\n", size, size,
+               sampleBase, iterations) +
            fmt("settings: {max depth: %d, min depth: 3, threshold: 0.1}\n", maxDepth) + camera +
            fmt("sampler: {type: %s}\n", sampler) +
            "shaders:\n"
            "  - {type: Emissive, emission: [1, 1, 1]}\n"
-           "  - " + shader + "\n"
+           "  - " +
+           shader +
+           "\n"
            "objects:\n"
            "  - {filename: enclosure.obj, shader: 0}\n"
-           "  - " + object + "\n";
+           "  - " +
+           object + "\n";
 }
 
 // ---- scale and distance ---------------------------------------------------------------------
@@ -180,11 +190,13 @@ TEST(Extreme, CornellBoxIsTheSameAtAnyScaleAndDistance) {
                     {"moved 1e6 from the origin", 1.0, {d, d, d}}};
     TempDir dir;
     for (const std::string& backend : extremeBackends()) {
-        const Scene original = loadScene(dir.write("o.yaml", cornellYaml(1.0, {0, 0, 0}, kSize, 2, 24)));
+        const Scene original =
+            loadScene(dir.write("o.yaml", cornellYaml(1.0, {0, 0, 0}, kSize, 2, 24)));
         const Rendered ref = renderScene(original, backend);
         EXPECT_EQ(ref.counters.nonFiniteSamples, 0u);
         for (const Variant& v : variants) {
-            const Scene scene = loadScene(dir.write("v.yaml", cornellYaml(v.scale, v.translation, kSize, 2, 24)));
+            const Scene scene =
+                loadScene(dir.write("v.yaml", cornellYaml(v.scale, v.translation, kSize, 2, 24)));
             const Rendered r = renderScene(scene, backend);
             // Same seed: the scaled or moved box traces nearly the same paths, so the paired
             // difference (per iteration) is tiny and a bias far below either render's noise fails.
@@ -207,15 +219,18 @@ TEST(Extreme, ImageDoesNotDependOnWhereTheSceneSits) {
     constexpr int kSize = 32;
     TempDir dir;
     for (const std::string& backend : extremeBackends()) {
-        const Scene original = loadScene(dir.write("o.yaml", cornellYaml(1.0, {0, 0, 0}, kSize, 2, 4)));
+        const Scene original =
+            loadScene(dir.write("o.yaml", cornellYaml(1.0, {0, 0, 0}, kSize, 2, 4)));
         const Rendered ref = renderScene(original, backend);
         for (double t : {1e5, 1e6, 1e7}) {
-            const Scene moved = loadScene(dir.write("m.yaml", cornellYaml(1.0, {t, -t, t}, kSize, 2, 4)));
+            const Scene moved =
+                loadScene(dir.write("m.yaml", cornellYaml(1.0, {t, -t, t}, kSize, 2, 4)));
             EXPECT_NEAR(moved.origin.x - original.origin.x, t, 1e-9 * t);
             const Rendered r = renderScene(moved, backend);
             const double relMse =
                 compareImages({kSize, kSize, r.image}, {kSize, kSize, ref.image}).relMse;
-            std::printf("  %s, moved %g: relMSE %.3g against the untranslated render\n", backend.c_str(), t, relMse);
+            std::printf("  %s, moved %g: relMSE %.3g against the untranslated render\n",
+                        backend.c_str(), t, relMse);
             EXPECT_LE(relMse, 1e-7) << backend << " moved " << t;
             EXPECT_GT(mean(r.image), 0.0);
         }
@@ -242,8 +257,10 @@ TEST(Extreme, LightAtTheBrightestAllowedRadianceRendersWithoutSaturation) {
         EXPECT_EQ(hot.counters.nonFiniteSamples, 0u) << backend;
         double worst = 0;
         for (size_t i = 0; i < unit.image.size(); ++i)
-            worst = std::max(worst, std::fabs(hot.image[i] / k - unit.image[i]) / std::max(1e-3, double(unit.image[i])));
-        std::printf("  %s: worst relative difference %.3g between the image at 5e18 (scaled back) and at 1\n",
+            worst = std::max(worst, std::fabs(hot.image[i] / k - unit.image[i]) /
+                                        std::max(1e-3, double(unit.image[i])));
+        std::printf("  %s: worst relative difference %.3g between the image at 5e18 (scaled back) "
+                    "and at 1\n",
                     backend.c_str(), worst);
         EXPECT_LT(worst, 1e-4) << backend;
     }
@@ -263,23 +280,32 @@ TEST(Extreme, HugeTriangleThroughTheOriginHasNoAcne) {
     TempDir dir;
     auto plane = [&](double h) {
         // The plane z = 0.3 x + 0.2 y (tilted about two axes), corners at +-h.
-        auto v = [&](double x, double y) { return fmt("v %.9g %.9g %.9g\n", x, 0.3 * x + 0.2 * y, -y); };
+        auto v = [&](double x, double y) {
+            return fmt("v %.9g %.9g %.9g\n", x, 0.3 * x + 0.2 * y, -y);
+        };
         return v(-h, -h) + v(h, -h) + v(h, h) + v(-h, h) + "f 1 2 3 4\n";
     };
     dir.write("small.obj", plane(2.0));
     dir.write("huge.obj", plane(1e5));
     auto yaml = [&](const char* obj) {
-        return fmt("image: {width: %d, height: %d, sample base: 2, iterations: 16}\n", kSize, kSize) +
+        return fmt("image: {width: %d, height: %d, sample base: 2, iterations: 16}\n", kSize,
+                   kSize) +
                "settings: {max depth: 1}\n"
                "camera: {look at: {eye: [0.05, 1.0, 0.3], target: [0, 0, 0]}, fov: 40}\n"
                "shaders:\n  - {type: Lambert, reflectance: 0.8}\n"
-               "objects:\n  - {filename: " + std::string(obj) + ", shader: 0}\n"
-               "light: {type: Quad, translation: [0, 2, 0], rotation: [90, 0, 0], scale: [0.5, 0.5], intensity: 20}\n";
+               "objects:\n  - {filename: " +
+               std::string(obj) +
+               ", shader: 0}\n"
+               "light: {type: Quad, translation: [0, 2, 0], rotation: [90, 0, 0], scale: [0.5, "
+               "0.5], intensity: 20}\n";
     };
     for (const std::string& backend : extremeBackends()) {
-        const Rendered small = renderScene(loadScene(dir.write("s.yaml", yaml("small.obj"))), backend);
-        const Rendered huge = renderScene(loadScene(dir.write("h.yaml", yaml("huge.obj"))), backend);
-        expectSameImage(small.stats, huge.stats, kSize, kSize, backend + ": plane of half-size 1e5 vs 2");
+        const Rendered small =
+            renderScene(loadScene(dir.write("s.yaml", yaml("small.obj"))), backend);
+        const Rendered huge =
+            renderScene(loadScene(dir.write("h.yaml", yaml("huge.obj"))), backend);
+        expectSameImage(small.stats, huge.stats, kSize, kSize,
+                        backend + ": plane of half-size 1e5 vs 2");
     }
 }
 
@@ -301,13 +327,13 @@ TEST_P(StiffEnclosure, ReachesLeOverOneMinusAlbedo) {
     const double a = GetParam();
     TempDir dir;
     dir.write("cube.obj", insideCubeObj());
-    const Scene scene = loadScene(
-        dir.write("e.yaml", fmt("image: {width: 16, height: 16, sample base: 2, iterations: 1}\n"
-                                "settings: {max depth: 30000, min depth: 3, threshold: 0.1}\n"
-                                "camera: {look at: {eye: [0, 0, 0], target: [0.3, 0.2, -1]}, fov: 100}\n"
-                                "object: {filename: cube.obj, shader: 0}\n"
-                                "shader: {type: Lambert, reflectance: %.17g, emission: [1, 1, 1]}\n",
-                                a)));
+    const Scene scene = loadScene(dir.write(
+        "e.yaml", fmt("image: {width: 16, height: 16, sample base: 2, iterations: 1}\n"
+                      "settings: {max depth: 30000, min depth: 3, threshold: 0.1}\n"
+                      "camera: {look at: {eye: [0, 0, 0], target: [0.3, 0.2, -1]}, fov: 100}\n"
+                      "object: {filename: cube.obj, shader: 0}\n"
+                      "shader: {type: Lambert, reflectance: %.17g, emission: [1, 1, 1]}\n",
+                      a)));
     const double expected = 1.0 / (1.0 - a);
     const double k0 = std::ceil(std::log(0.1) / std::log(double(float(a))));
     const double expectedBounces = k0 + 1.0 / (1.0 - a);
@@ -315,13 +341,15 @@ TEST_P(StiffEnclosure, ReachesLeOverOneMinusAlbedo) {
         const Rendered r = renderScene(scene, backend);
         const MeanError m = meanAndError(r.image);
         const double bounces = double(r.counters.bounceRays) / double(r.counters.cameraRays);
-        std::printf("  %s, albedo %.3f: mean %.3f +- %.3f (expected %.1f, z %+.2f), %.0f bounces a path "
-                    "(expected about %.0f)\n",
-                    backend.c_str(), a, m.mean, m.stderror, expected, (m.mean - expected) / m.stderror, bounces,
-                    expectedBounces);
+        std::printf(
+            "  %s, albedo %.3f: mean %.3f +- %.3f (expected %.1f, z %+.2f), %.0f bounces a path "
+            "(expected about %.0f)\n",
+            backend.c_str(), a, m.mean, m.stderror, expected, (m.mean - expected) / m.stderror,
+            bounces, expectedBounces);
         EXPECT_NEAR(m.mean, expected, 4.0 * m.stderror) << backend;
         EXPECT_LT(m.stderror, 0.03 * expected) << backend;
-        const double bouncesError = std::sqrt(a) / (1.0 - a) / std::sqrt(double(r.counters.cameraRays));
+        const double bouncesError =
+            std::sqrt(a) / (1.0 - a) / std::sqrt(double(r.counters.cameraRays));
         std::printf("    path length %.1f +- %.1f, z %+.2f\n", bounces, bouncesError,
                     (bounces - expectedBounces) / bouncesError);
         EXPECT_NEAR(bounces, expectedBounces, 4.0 * bouncesError) << backend;
@@ -335,10 +363,12 @@ INSTANTIATE_TEST_SUITE_P(Extreme, StiffEnclosure, ::testing::Values(0.99, 0.999)
 // ---- pin-point light -------------------------------------------------------------------------
 
 // Irradiance at x from a uniformly emitting polygon (Lambert's formula), in double.
-double polygonIrradiance(glm::dvec3 x, glm::dvec3 n, const std::vector<glm::dvec3>& corners, double L) {
+double polygonIrradiance(glm::dvec3 x, glm::dvec3 n, const std::vector<glm::dvec3>& corners,
+                         double L) {
     double sum = 0;
     for (size_t i = 0; i < corners.size(); ++i) {
-        const glm::dvec3 a = glm::normalize(corners[i] - x), b = glm::normalize(corners[(i + 1) % corners.size()] - x);
+        const glm::dvec3 a = glm::normalize(corners[i] - x),
+                         b = glm::normalize(corners[(i + 1) % corners.size()] - x);
         const double theta = std::atan2(glm::length(glm::cross(a, b)), glm::dot(a, b));
         sum += theta * glm::dot(n, glm::normalize(glm::cross(a, b)));
     }
@@ -358,31 +388,40 @@ TEST(Extreme, PinPointLightMatchesClosedFormAtEqualPower) {
             const double shrink = k == 0 ? 1.0 : 1e-3;
             const double w = 130 * shrink, h = 105 * shrink, L = 17.0 / (shrink * shrink);
             const Scene scene = loadScene(dir.write(
-                "p.yaml", fmt("image: {width: %d, height: %d, sample base: 1, iterations: 256}\n", kSize, kSize) +
-                              "settings: {max depth: 1}\n"
-                              "camera: {look at: {eye: [0, 400, 0], target: [0, 0, 0], up: [0, 0, -1]}, fov: 90}\n"
-                              "sampler: {type: Grid}\n"
-                              "object: {filename: floor.obj, shader: 0}\n"
-                              "shader: {type: Lambert, reflectance: 0.5}\n" +
-                              fmt("light: {type: Quad, translation: [0, 548.7, 0], rotation: [90, 0, 0], "
-                                  "scale: [%.17g, %.17g], intensity: %.17g}\n",
-                                  w, h, L)));
+                "p.yaml",
+                fmt("image: {width: %d, height: %d, sample base: 1, iterations: 256}\n", kSize,
+                    kSize) +
+                    "settings: {max depth: 1}\n"
+                    "camera: {look at: {eye: [0, 400, 0], target: [0, 0, 0], up: [0, 0, -1]}, fov: "
+                    "90}\n"
+                    "sampler: {type: Grid}\n"
+                    "object: {filename: floor.obj, shader: 0}\n"
+                    "shader: {type: Lambert, reflectance: 0.5}\n" +
+                    fmt("light: {type: Quad, translation: [0, 548.7, 0], rotation: [90, 0, 0], "
+                        "scale: [%.17g, %.17g], intensity: %.17g}\n",
+                        w, h, L)));
             const Rendered r = renderScene(scene, backend);
-            const std::vector<glm::dvec3> corners = {{-w / 2, 548.7, -h / 2}, {w / 2, 548.7, -h / 2},
-                                                     {w / 2, 548.7, h / 2}, {-w / 2, 548.7, h / 2}};
+            const std::vector<glm::dvec3> corners = {{-w / 2, 548.7, -h / 2},
+                                                     {w / 2, 548.7, -h / 2},
+                                                     {w / 2, 548.7, h / 2},
+                                                     {-w / 2, 548.7, h / 2}};
             CameraModel cam(scene, 1);
             double worstZ = 0, sumZ = 0, exp = 0;
             for (int y = 0; y < kSize; ++y)
                 for (int x = 0; x < kSize; ++x) {
-                    const CameraRay cr = cam.generate(uint(x), uint(y), 0, 0, 0); // Grid: the pixel centre
-                    const glm::dvec3 o = scene.origin + glm::dvec3(cr.origin), dv(cr.dir); // camera-relative world
+                    const CameraRay cr =
+                        cam.generate(uint(x), uint(y), 0, 0, 0); // Grid: the pixel centre
+                    const glm::dvec3 o = scene.origin + glm::dvec3(cr.origin),
+                                     dv(cr.dir); // camera-relative world
                     const glm::dvec3 p = o + dv * (-o.y / dv.y);
-                    const double expected = 0.5 / M_PI * polygonIrradiance(p, {0, 1, 0}, corners, L);
+                    const double expected =
+                        0.5 / M_PI * polygonIrradiance(p, {0, 1, 0}, corners, L);
                     const size_t i = size_t(y * kSize + x);
                     // The pin-point light's pixels barely vary between iterations (Grid sampler, a
                     // light seen as a point): their standard error gets a floor of 1e-5 relative,
                     // the float precision of the render's own arithmetic.
-                    const double se = std::sqrt(r.stats.meanVariance(i) + 1e-10 * expected * expected);
+                    const double se =
+                        std::sqrt(r.stats.meanVariance(i) + 1e-10 * expected * expected);
                     const double z = (r.stats.mean(i) - expected) / se;
                     worstZ = std::max(worstZ, std::fabs(z));
                     sumZ += z;
@@ -390,7 +429,8 @@ TEST(Extreme, PinPointLightMatchesClosedFormAtEqualPower) {
                 }
             const MeanError m = r.stats.imageMean();
             means[k] = m.mean;
-            std::printf("  %s, light x%g: mean %.6f +- %.6f, closed form %.6f, worst pixel |z| %.2f, mean z %+.3f\n",
+            std::printf("  %s, light x%g: mean %.6f +- %.6f, closed form %.6f, worst pixel |z| "
+                        "%.2f, mean z %+.3f\n",
                         backend.c_str(), shrink, m.mean, m.stderror, exp / (kSize * kSize), worstZ,
                         sumZ / (kSize * kSize));
             EXPECT_LT(worstZ, 5.0) << backend << " x" << shrink;
@@ -398,7 +438,8 @@ TEST(Extreme, PinPointLightMatchesClosedFormAtEqualPower) {
             EXPECT_EQ(r.counters.nonFiniteSamples, 0u);
             EXPECT_TRUE(finiteAndNonNegative(r.image));
         }
-        std::printf("  %s: pin-point / full-size mean illumination %.5f\n", backend.c_str(), means[1] / means[0]);
+        std::printf("  %s: pin-point / full-size mean illumination %.5f\n", backend.c_str(),
+                    means[1] / means[0]);
     }
 }
 
@@ -412,23 +453,28 @@ TEST(Extreme, PinPointLightMatchesClosedFormAtEqualPower) {
 TEST(Extreme, PinPointLightInTheCornellBoxGivesTheSameMeanIllumination) {
     constexpr int kSize = 24;
     TempDir dir;
-    const std::string camera =
-        "camera: {look at: {eye: [278, 380, 279.5], target: [278, 0, 279.5], up: [0, 0, 1]}, fov: 90}\n";
+    const std::string camera = "camera: {look at: {eye: [278, 380, 279.5], target: [278, 0, "
+                               "279.5], up: [0, 0, 1]}, fov: 90}\n";
     for (const std::string& backend : extremeBackends()) {
-        const Rendered full =
-            renderScene(loadScene(dir.write("f.yaml", cornellYaml(1.0, {0, 0, 0}, kSize, 2, 32, camera))), backend);
+        const Rendered full = renderScene(
+            loadScene(dir.write("f.yaml", cornellYaml(1.0, {0, 0, 0}, kSize, 2, 32, camera))),
+            backend);
         const Rendered small = renderScene(
-            loadScene(dir.write("s.yaml", cornellYaml(1.0, {0, 0, 0}, kSize, 2, 32, camera, 1e-2))), backend);
+            loadScene(dir.write("s.yaml", cornellYaml(1.0, {0, 0, 0}, kSize, 2, 32, camera, 1e-2))),
+            backend);
         const Rendered pin = renderScene(
-            loadScene(dir.write("p.yaml", cornellYaml(1.0, {0, 0, 0}, kSize, 2, 32, camera, 1e-3))), backend);
-        const MeanError a = full.stats.imageMean(), s = small.stats.imageMean(), b = pin.stats.imageMean();
+            loadScene(dir.write("p.yaml", cornellYaml(1.0, {0, 0, 0}, kSize, 2, 32, camera, 1e-3))),
+            backend);
+        const MeanError a = full.stats.imageMean(), s = small.stats.imageMean(),
+                        b = pin.stats.imageMean();
         const double se = std::hypot(s.stderror, b.stderror);
         std::printf("  %s: light x1e-2 %.5f +- %.5f, x1e-3 (pin-point) %.5f +- %.5f (z %+.2f); "
                     "original x1 %.5f +- %.5f (pin-point / original %.4f)\n",
-                    backend.c_str(), s.mean, s.stderror, b.mean, b.stderror, (b.mean - s.mean) / se, a.mean, a.stderror,
-                    b.mean / a.mean);
+                    backend.c_str(), s.mean, s.stderror, b.mean, b.stderror, (b.mean - s.mean) / se,
+                    a.mean, a.stderror, b.mean / a.mean);
         EXPECT_NEAR(b.mean, s.mean, 4.0 * se) << backend;
-        expectSameImage(small.stats, pin.stats, kSize, kSize, backend + ": pin-point vs x1e-2, per pixel");
+        expectSameImage(small.stats, pin.stats, kSize, kSize,
+                        backend + ": pin-point vs x1e-2, per pixel");
         EXPECT_EQ(pin.counters.nonFiniteSamples, 0u) << backend;
         EXPECT_EQ(pin.counters.saturatedSamples, 0u) << backend;
         EXPECT_TRUE(finiteAndNonNegative(pin.image)) << backend;
@@ -440,9 +486,9 @@ TEST(Extreme, PinPointLightInTheCornellBoxGivesTheSameMeanIllumination) {
 // A conductor or glass floor under a small bright light and a large dim one, direct light only:
 // light sampling, BSDF sampling and MIS must agree for every roughness. (The small light is
 // kept large enough, 0.25 wide, for BSDF sampling alone to find it a few times per pixel: with a
-// rarer hit its estimate becomes heavy-tailed and its sample standard error meaningless.) A delta lobe gets no
-// shadow ray and no MIS weight (the emitter it hits counts in full under every strategy), so for
-// alpha = 0 the three strategies must give the same image bit for bit.
+// rarer hit its estimate becomes heavy-tailed and its sample standard error meaningless.) A delta
+// lobe gets no shadow ray and no MIS weight (the emitter it hits counts in full under every
+// strategy), so for alpha = 0 the three strategies must give the same image bit for bit.
 TEST(Extreme, MisStrategiesAgreeOnGlossyAndDeltaLobes) {
     TempDir dir;
     dir.write("floor.obj", floorObj(1.0f));
@@ -450,48 +496,59 @@ TEST(Extreme, MisStrategiesAgreeOnGlossyAndDeltaLobes) {
         const char* name;
         const char* shader;
         bool delta;
-    } cases[] = {{"mirror", "{type: Conductor, colour: [0.9, 0.8, 0.7], alpha: 0}", true},
-                 {"conductor alpha 0.02", "{type: Conductor, colour: [0.9, 0.8, 0.7], alpha: 0.02}", false},
-                 {"conductor alpha 0.3", "{type: Conductor, colour: [0.9, 0.8, 0.7], alpha: 0.3}", false},
-                 {"glass", "{type: Dielectric, ior: 1.5, alpha: 0}", true},
-                 {"rough glass alpha 0.1", "{type: Dielectric, ior: 1.5, alpha: 0.1}", false}};
+    } cases[] = {
+        {"mirror", "{type: Conductor, colour: [0.9, 0.8, 0.7], alpha: 0}", true},
+        {"conductor alpha 0.02", "{type: Conductor, colour: [0.9, 0.8, 0.7], alpha: 0.02}", false},
+        {"conductor alpha 0.3", "{type: Conductor, colour: [0.9, 0.8, 0.7], alpha: 0.3}", false},
+        {"glass", "{type: Dielectric, ior: 1.5, alpha: 0}", true},
+        {"rough glass alpha 0.1", "{type: Dielectric, ior: 1.5, alpha: 0.1}", false}};
     for (const std::string& backend : extremeBackends())
         for (const Case& c : cases) {
             const Scene scene = loadScene(dir.write(
-                "m.yaml", std::string("image: {width: 16, height: 16, sample base: 1, iterations: 64}\n"
-                                      "settings: {max depth: 1}\n"
-                                      "camera: {look at: {eye: [0, 0.8, -0.6], target: [0, 0, 0.2]}, fov: 70}\n"
-                                      "object: {filename: floor.obj, shader: 0}\n"
-                                      "shader: ") +
-                              c.shader +
-                              "\nlights:\n"
-                              "  - {type: Quad, translation: [0, 1, 0.3], rotation: [90, 0, 0], scale: [0.25, 0.25], "
-                              "intensity: 16}\n"
-                              "  - {type: Quad, translation: [0, 0.6, 1], rotation: [180, 0, 0], scale: [2, 1.2], "
-                              "intensity: 0.5}\n"));
+                "m.yaml",
+                std::string(
+                    "image: {width: 16, height: 16, sample base: 1, iterations: 64}\n"
+                    "settings: {max depth: 1}\n"
+                    "camera: {look at: {eye: [0, 0.8, -0.6], target: [0, 0, 0.2]}, fov: 70}\n"
+                    "object: {filename: floor.obj, shader: 0}\n"
+                    "shader: ") +
+                    c.shader +
+                    "\nlights:\n"
+                    "  - {type: Quad, translation: [0, 1, 0.3], rotation: [90, 0, 0], scale: "
+                    "[0.25, 0.25], "
+                    "intensity: 16}\n"
+                    "  - {type: Quad, translation: [0, 0.6, 1], rotation: [180, 0, 0], scale: [2, "
+                    "1.2], "
+                    "intensity: 0.5}\n"));
             PixelStats stats[3];
             std::vector<float> images[3];
             for (uint strategy : {kStrategyMis, kStrategyLight, kStrategyBsdf}) {
                 RenderConfig cfg;
                 cfg.backend = parseBackend(backend);
                 cfg.strategy = strategy;
-                auto result = render(scene, cfg, [&](int, int, const Film& f) { stats[strategy].add(f.lastIterationImage()); });
+                auto result = render(scene, cfg, [&](int, int, const Film& f) {
+                    stats[strategy].add(f.lastIterationImage());
+                });
                 images[strategy] = result->film->image();
                 EXPECT_EQ(result->stats.nonFiniteSamples, 0u);
             }
             const MeanError mis = stats[kStrategyMis].imageMean();
             const MeanError light = stats[kStrategyLight].imageMean();
             const MeanError bsdf = stats[kStrategyBsdf].imageMean();
-            std::printf("  %s, %-22s MIS %.5f +- %.5f, light %.5f +- %.5f, BSDF %.5f +- %.5f\n", backend.c_str(), c.name,
-                        mis.mean, mis.stderror, light.mean, light.stderror, bsdf.mean, bsdf.stderror);
+            std::printf("  %s, %-22s MIS %.5f +- %.5f, light %.5f +- %.5f, BSDF %.5f +- %.5f\n",
+                        backend.c_str(), c.name, mis.mean, mis.stderror, light.mean, light.stderror,
+                        bsdf.mean, bsdf.stderror);
             EXPECT_GT(mis.mean, 0.0) << c.name;
             if (c.delta) {
-                EXPECT_EQ(images[kStrategyMis], images[kStrategyLight]) << backend << ", " << c.name;
+                EXPECT_EQ(images[kStrategyMis], images[kStrategyLight])
+                    << backend << ", " << c.name;
                 EXPECT_EQ(images[kStrategyMis], images[kStrategyBsdf]) << backend << ", " << c.name;
                 continue;
             }
-            EXPECT_NEAR(mis.mean, light.mean, 4.0 * std::hypot(mis.stderror, light.stderror)) << backend << ", " << c.name;
-            EXPECT_NEAR(mis.mean, bsdf.mean, 4.0 * std::hypot(mis.stderror, bsdf.stderror)) << backend << ", " << c.name;
+            EXPECT_NEAR(mis.mean, light.mean, 4.0 * std::hypot(mis.stderror, light.stderror))
+                << backend << ", " << c.name;
+            EXPECT_NEAR(mis.mean, bsdf.mean, 4.0 * std::hypot(mis.stderror, bsdf.stderror))
+                << backend << ", " << c.name;
         }
 }
 
@@ -503,31 +560,35 @@ TEST(Extreme, WhiteFurnaceRendersOneForEveryLosslessModel) {
     TempDir dir;
     dir.write("enclosure.obj", insideCubeObj());
     dir.write("cube.obj", outsideCubeObj(0.35f));
-    const std::string camera = "camera: {look at: {eye: [0.2, 0.3, 0.95], target: [0, 0, 0]}, fov: 60}\n";
+    const std::string camera =
+        "camera: {look at: {eye: [0.2, 0.3, 0.95], target: [0, 0, 0]}, fov: 60}\n";
     const std::string object = "{filename: cube.obj, shader: 1, rotation: [25, 35, 0]}";
     struct Case {
         const char* name;
         const char* shader;
         bool deltaOnly;
-    } cases[] = {{"Lambert, reflectance 1", "{type: Lambert, reflectance: 1}", false},
-                 {"smooth conductor, F0 = 1", "{type: Conductor, colour: [1, 1, 1], alpha: 0}", true},
-                 {"smooth dielectric, ior 1.5", "{type: Dielectric, ior: 1.5, alpha: 0}", true}};
+    } cases[] = {
+        {"Lambert, reflectance 1", "{type: Lambert, reflectance: 1}", false},
+        {"smooth conductor, F0 = 1", "{type: Conductor, colour: [1, 1, 1], alpha: 0}", true},
+        {"smooth dielectric, ior 1.5", "{type: Dielectric, ior: 1.5, alpha: 0}", true}};
     for (const std::string& backend : extremeBackends())
         for (const Case& c : cases) {
-            const Scene scene = loadScene(dir.write("w.yaml", furnaceYaml(object, c.shader, camera, 24, 2, 8, 1000)));
+            const Scene scene = loadScene(
+                dir.write("w.yaml", furnaceYaml(object, c.shader, camera, 24, 2, 8, 1000)));
             const Rendered r = renderScene(scene, backend);
             const MeanError m = meanAndError(r.image);
             double worst = 0;
-            for (float v : r.image) worst = std::max(worst, std::fabs(double(v) - 1.0));
-            std::printf("  %s, %-28s mean %.6f +- %.6f, worst pixel |v - 1| %.2e\n", backend.c_str(), c.name, m.mean,
-                        m.stderror, worst);
+            for (float v : r.image)
+                worst = std::max(worst, std::fabs(double(v) - 1.0));
+            std::printf("  %s, %-28s mean %.6f +- %.6f, worst pixel |v - 1| %.2e\n",
+                        backend.c_str(), c.name, m.mean, m.stderror, worst);
             EXPECT_NEAR(m.mean, 1.0, std::max(4.0 * m.stderror, 1e-5)) << backend << ", " << c.name;
             EXPECT_EQ(r.counters.nonFiniteSamples, 0u) << backend << ", " << c.name;
             if (c.deltaOnly) {
                 // Delta lobes only: every path is deterministic but for the Fresnel choice, and
-                // every one that escapes carries exactly 1 (entering glass 1 / eta^2, leaving eta^2).
-                // The sorted pipeline's compact rays round the throughput to bfloat16 at each
-                // bounce (stochastically, so the mean stays exact): a few 2^-8 per path there.
+                // every one that escapes carries exactly 1 (entering glass 1 / eta^2, leaving
+                // eta^2). The sorted pipeline's compact rays round the throughput to bfloat16 at
+                // each bounce (stochastically, so the mean stays exact): a few 2^-8 per path there.
                 EXPECT_LT(worst, backend == "reference" ? 1e-4 : 2e-2) << backend << ", " << c.name;
             }
         }
@@ -583,12 +644,14 @@ TEST(Extreme, RoughConductorLosesOnlySingleScatteringEnergy) {
     TempDir dir;
     dir.write("enclosure.obj", insideCubeObj());
     dir.write("plane.obj", planeObj(0.9f));
-    const std::string camera = "camera: {look at: {eye: [0, 0.6, 0.6], target: [0, 0, 0]}, fov: 20}\n";
+    const std::string camera =
+        "camera: {look at: {eye: [0, 0.6, 0.6], target: [0, 0, 0]}, fov: 20}\n";
     const float alphas[] = {0.05f, 0.1f, 0.25f, 0.5f, 0.75f, 1.0f};
     auto sceneFor = [&](float alpha) {
-        return loadScene(dir.write("r.yaml", furnaceYaml("{filename: plane.obj, shader: 1}",
-                                                         fmt("{type: Conductor, colour: [1, 1, 1], alpha: %g}", alpha),
-                                                         camera, kSize, 1, 96, 16, "Grid")));
+        return loadScene(dir.write(
+            "r.yaml", furnaceYaml("{filename: plane.obj, shader: 1}",
+                                  fmt("{type: Conductor, colour: [1, 1, 1], alpha: %g}", alpha),
+                                  camera, kSize, 1, 96, 16, "Grid")));
     };
     // The expected value of every pixel: the albedo for its (centre) camera ray.
     std::vector<std::vector<double>> expected;
@@ -597,12 +660,13 @@ TEST(Extreme, RoughConductorLosesOnlySingleScatteringEnergy) {
         CameraModel cam(scene, 1);
         std::vector<double> e;
         for (int y = 0; y < kSize; ++y)
-            for (int x = 0; x < kSize; ++x) e.push_back(ggxAlbedo(alpha, -cam.generate(uint(x), uint(y), 0, 0, 0).dir.y));
+            for (int x = 0; x < kSize; ++x)
+                e.push_back(ggxAlbedo(alpha, -cam.generate(uint(x), uint(y), 0, 0, 0).dir.y));
         expected.push_back(e);
     }
     std::printf("  single-scattering GGX, F0 = 1: energy loss 1 - E against alpha\n");
-    std::printf("  %-10s %6s | %-18s %-12s | %-10s %-10s %-10s\n", "backend", "alpha", "render (~45 deg)",
-                "quadrature", "1-E(0)", "1-E(60)", "1-E(85)");
+    std::printf("  %-10s %6s | %-18s %-12s | %-10s %-10s %-10s\n", "backend", "alpha",
+                "render (~45 deg)", "quadrature", "1-E(0)", "1-E(60)", "1-E(85)");
     for (const std::string& backend : extremeBackends()) {
         double previousLoss = 0;
         for (size_t k = 0; k < std::size(alphas); ++k) {
@@ -610,13 +674,15 @@ TEST(Extreme, RoughConductorLosesOnlySingleScatteringEnergy) {
             const Rendered r = renderScene(sceneFor(alpha), backend);
             double mean = 0, worstZ = 0;
             for (size_t i = 0; i < r.stats.pixels(); ++i) {
-                worstZ = std::max(worstZ, std::fabs(r.stats.mean(i) - expected[k][i]) / std::sqrt(r.stats.meanVariance(i)));
+                worstZ = std::max(worstZ, std::fabs(r.stats.mean(i) - expected[k][i]) /
+                                              std::sqrt(r.stats.meanVariance(i)));
                 mean += expected[k][i] / double(r.stats.pixels());
             }
             const MeanError m = r.stats.imageMean();
             const double loss = 1.0 - m.mean;
-            std::printf("  %-10s %6.2f | %.5f +- %.5f | %.5f      | %.4f     %.4f     %.4f\n", backend.c_str(), alpha,
-                        loss, m.stderror, 1.0 - mean, 1.0 - ggxAlbedo(alpha, 1.0), 1.0 - ggxAlbedo(alpha, 0.5),
+            std::printf("  %-10s %6.2f | %.5f +- %.5f | %.5f      | %.4f     %.4f     %.4f\n",
+                        backend.c_str(), alpha, loss, m.stderror, 1.0 - mean,
+                        1.0 - ggxAlbedo(alpha, 1.0), 1.0 - ggxAlbedo(alpha, 0.5),
                         1.0 - ggxAlbedo(alpha, std::cos(85.0 * M_PI / 180.0)));
             EXPECT_NEAR(m.mean, mean, 4.0 * m.stderror) << backend << ", alpha " << alpha;
             EXPECT_LT(worstZ, 5.0) << backend << ", alpha " << alpha;
@@ -633,34 +699,40 @@ TEST(Extreme, RoughConductorLosesOnlySingleScatteringEnergy) {
 
 // ---- grazing and back-facing -------------------------------------------------------------------
 
-const char* kAllModels[][2] = {{"Lambert", "{type: Lambert, reflectance: 1}"},
-                               {"mirror", "{type: Conductor, colour: [1, 1, 1], alpha: 0}"},
-                               {"rough conductor", "{type: Conductor, colour: [1, 1, 1], alpha: 0.3}"},
-                               {"glass", "{type: Dielectric, ior: 1.5, alpha: 0}"},
-                               {"rough glass", "{type: Dielectric, ior: 1.5, alpha: 0.3}"}};
+const char* kAllModels[][2] = {
+    {"Lambert", "{type: Lambert, reflectance: 1}"},
+    {"mirror", "{type: Conductor, colour: [1, 1, 1], alpha: 0}"},
+    {"rough conductor", "{type: Conductor, colour: [1, 1, 1], alpha: 0.3}"},
+    {"glass", "{type: Dielectric, ior: 1.5, alpha: 0}"},
+    {"rough glass", "{type: Dielectric, ior: 1.5, alpha: 0.3}"}};
 
 // Renders `object` with each model in the furnace: finite, non-negative, no energy created
 // (mean <= 1 + 4 standard errors: every model here is passive), and lossless models at 1.
 // `roughConductorAlbedo`: what the alpha 0.3 conductor must give, where every pixel sees the
 // object at the same angle.
-void expectPassiveInFurnace(TempDir& dir, const std::string& object, const std::string& camera, const std::string& what,
-                            bool losslessAtOne, std::optional<double> roughConductorAlbedo = {}) {
+void expectPassiveInFurnace(TempDir& dir, const std::string& object, const std::string& camera,
+                            const std::string& what, bool losslessAtOne,
+                            std::optional<double> roughConductorAlbedo = {}) {
     for (const std::string& backend : extremeBackends())
         for (auto& model : kAllModels) {
-            const Scene scene = loadScene(dir.write("g.yaml", furnaceYaml(object, model[1], camera, 16, 2, 8, 64)));
+            const Scene scene =
+                loadScene(dir.write("g.yaml", furnaceYaml(object, model[1], camera, 16, 2, 8, 64)));
             const Rendered r = renderScene(scene, backend);
             const MeanError m = meanAndError(r.image);
-            std::printf("  %s, %s, %-16s mean %.5f +- %.5f\n", backend.c_str(), what.c_str(), model[0], m.mean,
-                        m.stderror);
+            std::printf("  %s, %s, %-16s mean %.5f +- %.5f\n", backend.c_str(), what.c_str(),
+                        model[0], m.mean, m.stderror);
             EXPECT_TRUE(finiteAndNonNegative(r.image)) << backend << ", " << model[0];
             EXPECT_EQ(r.counters.nonFiniteSamples, 0u) << backend << ", " << model[0];
-            EXPECT_LE(m.mean, 1.0 + std::max(4.0 * m.stderror, 1e-5)) << backend << ", " << model[0];
+            EXPECT_LE(m.mean, 1.0 + std::max(4.0 * m.stderror, 1e-5))
+                << backend << ", " << model[0];
             const std::string name = model[0];
             if (losslessAtOne && (name == "Lambert" || name == "mirror")) {
-                EXPECT_NEAR(m.mean, 1.0, std::max(4.0 * m.stderror, 1e-5)) << backend << ", " << model[0];
+                EXPECT_NEAR(m.mean, 1.0, std::max(4.0 * m.stderror, 1e-5))
+                    << backend << ", " << model[0];
             }
             if (roughConductorAlbedo && name == "rough conductor") {
-                EXPECT_NEAR(m.mean, *roughConductorAlbedo, 4.0 * m.stderror) << backend << ", " << model[0];
+                EXPECT_NEAR(m.mean, *roughConductorAlbedo, 4.0 * m.stderror)
+                    << backend << ", " << model[0];
             }
         }
 }
@@ -675,18 +747,21 @@ TEST(Extreme, CameraAtGrazingAngleToAPlane) {
     dir.write("enclosure.obj", insideCubeObj());
     dir.write("plane.obj", planeObj(0.99f));
     const double drop = std::tan(0.1 * M_PI / 180.0);
-    const std::string camera = fmt("camera: {look at: {eye: [-0.9, 0.001, 0], target: [0.1, %.9g, 0]}, fov: 0.05}\n",
-                                   0.001 - drop);
+    const std::string camera =
+        fmt("camera: {look at: {eye: [-0.9, 0.001, 0], target: [0.1, %.9g, 0]}, fov: 0.05}\n",
+            0.001 - drop);
     const double e = ggxAlbedo(0.3, std::cos(89.9 * M_PI / 180.0), 1200, 360);
     std::printf("  single-scattering albedo at 89.9 degrees, alpha 0.3: %.5f\n", e);
     expectPassiveInFurnace(dir, "{filename: plane.obj, shader: 1}", camera, "89.9 degrees", true);
     for (const std::string& backend : extremeBackends()) {
-        const Scene scene = loadScene(dir.write("c.yaml", furnaceYaml("{filename: plane.obj, shader: 1}",
-                                                                      "{type: Conductor, colour: [1, 1, 1], alpha: 0.3}",
-                                                                      camera, 16, 8, 48, 64)));
+        const Scene scene = loadScene(
+            dir.write("c.yaml", furnaceYaml("{filename: plane.obj, shader: 1}",
+                                            "{type: Conductor, colour: [1, 1, 1], alpha: 0.3}",
+                                            camera, 16, 8, 48, 64)));
         const Rendered r = renderScene(scene, backend);
         const MeanError m = r.stats.imageMean();
-        std::printf("  %s: alpha 0.3 conductor at 89.9 degrees, 3072 spp: %.5f +- %.5f (loss %.5f, expected %.5f)\n",
+        std::printf("  %s: alpha 0.3 conductor at 89.9 degrees, 3072 spp: %.5f +- %.5f (loss %.5f, "
+                    "expected %.5f)\n",
                     backend.c_str(), m.mean, m.stderror, 1.0 - m.mean, 1.0 - e);
         EXPECT_LT(4.0 * m.stderror, 0.5 * (1.0 - e)) << "too few samples to see the loss";
         EXPECT_NEAR(m.mean, e, 4.0 * m.stderror) << backend;
@@ -705,32 +780,45 @@ TEST(Extreme, CameraAtGrazingAngleToAPlane) {
 TEST(Extreme, ShadingNormalsPointingAwayFromTheGeometricNormal) {
     TempDir dir;
     dir.write("enclosure.obj", insideCubeObj());
-    const std::string camera = "camera: {look at: {eye: [0.3, 0.7, 0.5], target: [0, 0, 0]}, fov: 50}\n";
+    const std::string camera =
+        "camera: {look at: {eye: [0.3, 0.7, 0.5], target: [0, 0, 0]}, fov: 50}\n";
     dir.write("plain.obj", planeObj(0.9f));
     dir.write("behind.obj", planeObj(0.9f, glm::normalize(vec3(0.8f, -0.6f, 0.0f))));
-    expectPassiveInFurnace(dir, "{filename: behind.obj, shader: 1}", camera, "ns 127 deg off ng", false);
+    expectPassiveInFurnace(dir, "{filename: behind.obj, shader: 1}", camera, "ns 127 deg off ng",
+                           false);
     const vec3 ns = glm::normalize(vec3(0.0f, 0.1f, -0.995f));
     dir.write("edge.obj", planeObj(0.9f, ns));
-    expectPassiveInFurnace(dir, "{filename: edge.obj, shader: 1}", camera, "ns 84 deg off ng", false);
+    expectPassiveInFurnace(dir, "{filename: edge.obj, shader: 1}", camera, "ns 84 deg off ng",
+                           false);
 
     constexpr int kSize = 16;
     for (const std::string& backend : extremeBackends()) {
         for (auto& model : kAllModels) {
-            const Scene plain = loadScene(dir.write("p.yaml", furnaceYaml("{filename: plain.obj, shader: 1}", model[1], camera, kSize, 2, 4, 64)));
-            const Scene behind = loadScene(dir.write("b.yaml", furnaceYaml("{filename: behind.obj, shader: 1}", model[1], camera, kSize, 2, 4, 64)));
+            const Scene plain =
+                loadScene(dir.write("p.yaml", furnaceYaml("{filename: plain.obj, shader: 1}",
+                                                          model[1], camera, kSize, 2, 4, 64)));
+            const Scene behind =
+                loadScene(dir.write("b.yaml", furnaceYaml("{filename: behind.obj, shader: 1}",
+                                                          model[1], camera, kSize, 2, 4, 64)));
             EXPECT_EQ(renderScene(plain, backend).image, renderScene(behind, backend).image)
                 << backend << ", " << model[0] << ": ns behind the surface must be ng";
         }
-        const std::string lambert = "{type: Lambert, reflectance: 1}", mirror = "{type: Conductor, colour: [1, 1, 1], alpha: 0}";
-        const Scene lam = loadScene(dir.write("l.yaml", furnaceYaml("{filename: edge.obj, shader: 1}", lambert, camera, kSize, 1, 256, 64, "Grid")));
-        const Scene mir = loadScene(dir.write("m.yaml", furnaceYaml("{filename: edge.obj, shader: 1}", mirror, camera, kSize, 1, 1, 64, "Grid")));
+        const std::string lambert = "{type: Lambert, reflectance: 1}",
+                          mirror = "{type: Conductor, colour: [1, 1, 1], alpha: 0}";
+        const Scene lam =
+            loadScene(dir.write("l.yaml", furnaceYaml("{filename: edge.obj, shader: 1}", lambert,
+                                                      camera, kSize, 1, 256, 64, "Grid")));
+        const Scene mir =
+            loadScene(dir.write("m.yaml", furnaceYaml("{filename: edge.obj, shader: 1}", mirror,
+                                                      camera, kSize, 1, 1, 64, "Grid")));
         const Rendered l = renderScene(lam, backend), m = renderScene(mir, backend);
         CameraModel cam(lam, 1);
         double worstZ = 0, sumZ = 0;
         int onPlane = 0, mirrorLit = 0;
         for (int y = 0; y < kSize; ++y)
             for (int x = 0; x < kSize; ++x) {
-                const CameraRay r = cam.generate(uint(x), uint(y), 0, 0, 0); // Grid: the pixel centre
+                const CameraRay r =
+                    cam.generate(uint(x), uint(y), 0, 0, 0); // Grid: the pixel centre
                 const glm::dvec3 o = lam.origin + glm::dvec3(r.origin), d(r.dir);
                 const glm::dvec3 p = o + d * (-o.y / d.y);
                 const size_t i = size_t(y * kSize + x);
@@ -744,18 +832,22 @@ TEST(Extreme, ShadingNormalsPointingAwayFromTheGeometricNormal) {
                     mirrorExpected = on > 0 && (2.0 * on * n - wo).y > 0 ? 1.0 : 0.0;
                     mirrorLit += int(mirrorExpected);
                 }
-                const double z = (l.stats.mean(i) - lambertExpected) / std::max(l.stats.stderror(i), 1e-12);
+                const double z =
+                    (l.stats.mean(i) - lambertExpected) / std::max(l.stats.stderror(i), 1e-12);
                 worstZ = std::max(worstZ, std::fabs(z));
                 sumZ += z;
-                EXPECT_NEAR(m.stats.mean(i), mirrorExpected, 1e-6) << backend << ", mirror, pixel " << x << ", " << y;
+                EXPECT_NEAR(m.stats.mean(i), mirrorExpected, 1e-6)
+                    << backend << ", mirror, pixel " << x << ", " << y;
             }
         const double meanZ = sumZ / (kSize * kSize);
-        std::printf("  %s, ns 84 deg off: Lambert against (1 + ns.ng)/2 = %.4f on %d plane pixels: worst |z| %.2f, "
+        std::printf("  %s, ns 84 deg off: Lambert against (1 + ns.ng)/2 = %.4f on %d plane pixels: "
+                    "worst |z| %.2f, "
                     "mean z %+.3f; mirror lit on %d of them\n",
                     backend.c_str(), 0.5 * (1.0 + ns.y), onPlane, worstZ, meanZ, mirrorLit);
         EXPECT_GT(onPlane, kSize * kSize / 2);
         EXPECT_LT(worstZ, 5.0) << backend;
-        EXPECT_LT(std::fabs(meanZ), 4.0 / kSize) << backend; // 256 pixels: the mean z's error is 1/16
+        EXPECT_LT(std::fabs(meanZ), 4.0 / kSize)
+            << backend; // 256 pixels: the mean z's error is 1/16
     }
 }
 

@@ -1,8 +1,8 @@
 #include "fuzz_targets.h"
 
 #include "host/image/image_io.h"
-#include "host/scene/obj_mesh.h"
 #include "host/render/render.h"
+#include "host/scene/obj_mesh.h"
 #include "host/scene/scene.h"
 
 #include <cstdlib>
@@ -62,7 +62,8 @@ Outcome scene(const std::uint8_t* data, std::size_t size, std::string* detail) {
     const std::string marker = "#@obj\n";
     const size_t at = text.find(marker);
     const std::string yaml = text.substr(0, at);
-    const std::string objText = at == std::string::npos ? std::string() : text.substr(at + marker.size());
+    const std::string objText =
+        at == std::string::npos ? std::string() : text.substr(at + marker.size());
     folder().write("mesh.obj", objText.data(), objText.size());
     const std::string path = folder().write("scene.yaml", yaml.data(), yaml.size());
     return guarded(
@@ -83,7 +84,8 @@ Outcome scene(const std::uint8_t* data, std::size_t size, std::string* detail) {
 
 Outcome obj(const std::uint8_t* data, std::size_t size, std::string* detail) {
     const std::string path = folder().write("alone.obj", reinterpret_cast<const char*>(data), size);
-    return guarded([&] { loadObjMesh(path, glm::dmat4(1.0), glm::dvec3(0.0), "fuzz.yaml", 1); }, detail);
+    return guarded([&] { loadObjMesh(path, glm::dmat4(1.0), glm::dvec3(0.0), "fuzz.yaml", 1); },
+                   detail);
 }
 
 } // namespace spw::fuzz

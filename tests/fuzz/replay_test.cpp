@@ -17,7 +17,8 @@ std::vector<std::string> filesIn(const std::string& dir) {
     std::vector<std::string> out;
     std::error_code ec;
     for (const auto& e : fs::directory_iterator(sourceDir() + "/tests/fuzz/" + dir, ec))
-        if (e.is_regular_file() && e.path().filename().string()[0] != '.') out.push_back(e.path().string());
+        if (e.is_regular_file() && e.path().filename().string()[0] != '.')
+            out.push_back(e.path().string());
     std::sort(out.begin(), out.end());
     return out;
 }
@@ -30,7 +31,8 @@ fuzz::Outcome replay(Target target, const std::string& path, std::string* detail
 }
 
 TEST(FuzzCorpus, SeedsLoadAndRender) {
-    const std::pair<const char*, Target> kinds[] = {{"seeds/scene", fuzz::scene}, {"seeds/obj", fuzz::obj}};
+    const std::pair<const char*, Target> kinds[] = {{"seeds/scene", fuzz::scene},
+                                                    {"seeds/obj", fuzz::obj}};
     for (const auto& [dir, target] : kinds) {
         const std::vector<std::string> files = filesIn(dir);
         EXPECT_GE(files.size(), 3u) << dir;
@@ -42,7 +44,8 @@ TEST(FuzzCorpus, SeedsLoadAndRender) {
 }
 
 TEST(FuzzCorpus, EveryCrasherFoundIsNowRejectedCleanly) {
-    const std::pair<const char*, Target> kinds[] = {{"crashers/scene", fuzz::scene}, {"crashers/obj", fuzz::obj}};
+    const std::pair<const char*, Target> kinds[] = {{"crashers/scene", fuzz::scene},
+                                                    {"crashers/obj", fuzz::obj}};
     for (const auto& [dir, target] : kinds)
         for (const std::string& f : filesIn(dir)) {
             std::string detail;

@@ -1,4 +1,5 @@
-// libFuzzer harness: scene files (YAML, and the OBJ they reference). scripts/fuzz.sh builds and runs it.
+// libFuzzer harness: scene files (YAML, and the OBJ they reference). scripts/fuzz.sh builds and
+// runs it.
 #include "fuzz_targets.h"
 
 #include <cstdio>

@@ -35,7 +35,8 @@ std::vector<KeyIndex> keysOf(const std::vector<Hit>& hits) {
     std::vector<KeyIndex> keys(hits.size());
     for (size_t i = 0; i < hits.size(); ++i) {
         const Hit& h = hits[i];
-        keys[i] = {h.miss ? kMissKey : hitSortKey(h.shader, h.object, h.primitive), std::uint32_t(i)};
+        keys[i] = {h.miss ? kMissKey : hitSortKey(h.shader, h.object, h.primitive),
+                   std::uint32_t(i)};
     }
     return keys;
 }
@@ -57,12 +58,15 @@ TEST(HitSort, KeysSortIntoOneContiguousRunPerShaderWithMissesLast) {
             }
         }
         const std::vector<KeyIndex> original = keysOf(hits);
-        for (const KeyIndex& k : keys) ASSERT_EQ(k.key, original[k.index].key);
+        for (const KeyIndex& k : keys)
+            ASSERT_EQ(k.key, original[k.index].key);
 
         // Misses last; the runs cover every hit, one per shader that was hit, each holding
         // exactly that shader's hits.
-        const size_t hitCount = size_t(std::count_if(hits.begin(), hits.end(), [](const Hit& h) { return !h.miss; }));
-        for (size_t i = hitCount; i < keys.size(); ++i) ASSERT_EQ(keys[i].key, kMissKey);
+        const size_t hitCount =
+            size_t(std::count_if(hits.begin(), hits.end(), [](const Hit& h) { return !h.miss; }));
+        for (size_t i = hitCount; i < keys.size(); ++i)
+            ASSERT_EQ(keys[i].key, kMissKey);
         std::set<uint> shadersHit;
         std::vector<size_t> perShader(shaders, 0);
         for (const Hit& h : hits)

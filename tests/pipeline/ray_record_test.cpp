@@ -48,10 +48,12 @@ TEST(CompactRay, DirectionWithinTheOctahedralGridBound) {
     std::mt19937 rng(7);
     std::normal_distribution<float> g;
     double worst = 0;
-    std::vector<vec3> dirs = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1},
-                              {1, 1, 0}, {1, -1, 0}, {0, 1, -1}, {-1, 0, -1}, {1, 1, 1}, {-1, -1, -1},
+    std::vector<vec3> dirs = {{1, 0, 0},      {-1, 0, 0},     {0, 1, 0},           {0, -1, 0},
+                              {0, 0, 1},      {0, 0, -1},     {1, 1, 0},           {1, -1, 0},
+                              {0, 1, -1},     {-1, 0, -1},    {1, 1, 1},           {-1, -1, -1},
                               {1e-7f, 0, -1}, {0, 1e-7f, -1}, {0.5f, 0.5f, -1e-7f}};
-    for (int i = 0; i < 1000000; ++i) dirs.push_back(vec3(g(rng), g(rng), g(rng)));
+    for (int i = 0; i < 1000000; ++i)
+        dirs.push_back(vec3(g(rng), g(rng), g(rng)));
     for (vec3 d : dirs) {
         d = glm::normalize(d);
         const RayState out = roundTrip(someRay(d, vec3(1)), RayFormat::Compact, uvec4(0));
@@ -72,16 +74,20 @@ TEST(CompactRay, ThroughputRoundingIsUnbiased) {
         float lo = INFINITY, hi = 0;
         constexpr int kN = 1000000;
         for (int i = 0; i < kN; ++i) {
-            const float v = roundTrip(someRay(vec3(0, 0, 1), vec3(x)), RayFormat::Compact, uvec4(rng(), 0, 0, 0)).path.beta.x;
+            const float v = roundTrip(someRay(vec3(0, 0, 1), vec3(x)), RayFormat::Compact,
+                                      uvec4(rng(), 0, 0, 0))
+                                .path.beta.x;
             sum += v;
             lo = std::min(lo, v), hi = std::max(hi, v);
         }
         EXPECT_LE(lo, x);
         EXPECT_GE(hi, x);
-        EXPECT_LE(double(hi - lo), std::ldexp(double(x), -7)) << x << ": more than one bfloat16 step";
+        EXPECT_LE(double(hi - lo), std::ldexp(double(x), -7))
+            << x << ": more than one bfloat16 step";
         const double p = hi > lo ? (double(x) - lo) / (double(hi) - lo) : 0.0;
         const double se = (double(hi) - lo) * std::sqrt(p * (1 - p) / kN);
-        std::printf("%.6g: mean %.9g (lower %.9g, upper %.9g, standard error %.3g)\n", x, sum / kN, lo, hi, se);
+        std::printf("%.6g: mean %.9g (lower %.9g, upper %.9g, standard error %.3g)\n", x, sum / kN,
+                    lo, hi, se);
         EXPECT_NEAR(sum / kN, double(x), 4 * se + 1e-12 * x) << x;
     }
 }
@@ -94,7 +100,8 @@ TEST(CompactRay, ThroughputRoundingKeepsTheChannelsInOrder) {
     for (int i = 0; i < 200000; ++i) {
         const vec3 beta(u(rng), u(rng), u(rng));
         const vec3 out = roundTrip(someRay(vec3(0, 1, 0), beta), RayFormat::Compact,
-                                   uvec4(rng(), rng(), rng(), rng())).path.beta;
+                                   uvec4(rng(), rng(), rng(), rng()))
+                             .path.beta;
         for (int a = 0; a < 3; ++a)
             for (int b = 0; b < 3; ++b)
                 if (beta[a] >= beta[b]) {
@@ -102,7 +109,9 @@ TEST(CompactRay, ThroughputRoundingKeepsTheChannelsInOrder) {
                 }
     }
     // Equal channels stay equal: the largest is then exactly as unbiased as each.
-    const vec3 out = roundTrip(someRay(vec3(0, 1, 0), vec3(0.1f)), RayFormat::Compact, uvec4(0x8000u, 1, 0xFFFFu, 0)).path.beta;
+    const vec3 out = roundTrip(someRay(vec3(0, 1, 0), vec3(0.1f)), RayFormat::Compact,
+                               uvec4(0x8000u, 1, 0xFFFFu, 0))
+                         .path.beta;
     EXPECT_EQ(out.x, out.y);
     EXPECT_EQ(out.y, out.z);
 }
@@ -120,7 +129,8 @@ TEST(CompactRay, MisPdfIsStoredExactlySoTheWeightsSumToOne) {
         r.path.prevPdf = bsdfPdf;
         const float stored = roundTrip(r, RayFormat::Compact, uvec4(rng())).path.prevPdf;
         ASSERT_EQ(std::memcmp(&stored, &bsdfPdf, 4), 0) << bsdfPdf;
-        const double sum = double(powerHeuristic(lightPdf, quantizePdf(bsdfPdf))) + powerHeuristic(stored, lightPdf);
+        const double sum = double(powerHeuristic(lightPdf, quantizePdf(bsdfPdf))) +
+                           powerHeuristic(stored, lightPdf);
         worst = std::max(worst, std::fabs(sum - 1.0));
     }
     std::printf("worst |light weight + BSDF weight - 1| %.3g\n", worst);

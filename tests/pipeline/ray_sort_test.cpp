@@ -20,7 +20,8 @@ std::vector<RayState> randomRays(size_t n, unsigned seed) {
     for (size_t i = 0; i < n; ++i) {
         RayState& r = rays[i];
         r.origin = vec3(10.0f * u(rng), 4.0f * u(rng), u(rng));
-        const float z = 2.0f * u(rng) - 1.0f, phi = 6.2831853f * u(rng), s = std::sqrt(std::max(0.0f, 1 - z * z));
+        const float z = 2.0f * u(rng) - 1.0f, phi = 6.2831853f * u(rng),
+                    s = std::sqrt(std::max(0.0f, 1 - z * z));
         r.dir = vec3(s * std::cos(phi), s * std::sin(phi), z);
         r.path = PathState{};
         r.path.pathId = uint(i);
@@ -30,7 +31,8 @@ std::vector<RayState> randomRays(size_t n, unsigned seed) {
 
 std::vector<uint> sortedIds(const std::vector<RayState>& rays) {
     std::vector<uint> ids;
-    for (const RayState& r : rays) ids.push_back(r.path.pathId);
+    for (const RayState& r : rays)
+        ids.push_back(r.path.pathId);
     std::sort(ids.begin(), ids.end());
     return ids;
 }
@@ -64,7 +66,8 @@ TEST(RaySort, MortonIsAStablePermutationOrderedByItsKey) {
     }
     // The keys must order something: an input in id order is far from key order.
     size_t moved = 0;
-    for (size_t i = 0; i < rays.size(); ++i) moved += rays[i].path.pathId != i;
+    for (size_t i = 0; i < rays.size(); ++i)
+        moved += rays[i].path.pathId != i;
     EXPECT_GT(moved, rays.size() * 9 / 10);
     std::printf("%zu ties among %zu keys\n", ties, rays.size());
 }
@@ -88,15 +91,19 @@ template <class Get>
 void expectMedianSplit(const RayState* r, size_t n, size_t leaf, Get get, int& nodes) {
     if (n <= leaf) return;
     vec3 lo(HUGE_VALF), hi(-HUGE_VALF);
-    for (size_t i = 0; i < n; ++i) lo = glm::min(lo, get(r[i])), hi = glm::max(hi, get(r[i]));
+    for (size_t i = 0; i < n; ++i)
+        lo = glm::min(lo, get(r[i])), hi = glm::max(hi, get(r[i]));
     const vec3 e = hi - lo;
     const int axis = e.x >= e.y && e.x >= e.z ? 0 : (e.y >= e.z ? 1 : 2);
     if (hi[axis] <= lo[axis]) return;
     const size_t mid = n / 2;
     float below = -HUGE_VALF, above = HUGE_VALF;
-    for (size_t i = 0; i < mid; ++i) below = std::max(below, get(r[i])[axis]);
-    for (size_t i = mid; i < n; ++i) above = std::min(above, get(r[i])[axis]);
-    ASSERT_LE(below, above) << "a node of " << n << " rays is not split at its median along axis " << axis;
+    for (size_t i = 0; i < mid; ++i)
+        below = std::max(below, get(r[i])[axis]);
+    for (size_t i = mid; i < n; ++i)
+        above = std::min(above, get(r[i])[axis]);
+    ASSERT_LE(below, above) << "a node of " << n << " rays is not split at its median along axis "
+                            << axis;
     ++nodes;
     expectMedianSplit(r, mid, leaf, get, nodes);
     expectMedianSplit(r + mid, n - mid, leaf, get, nodes);
@@ -108,10 +115,12 @@ TEST(RaySort, MedianSplitsAtTheMedianOfOriginsThenOfDirections) {
     sortRaysMedian(rays);
     expectPermutation(in, rays);
     int originNodes = 0, directionNodes = 0;
-    expectMedianSplit(rays.data(), rays.size(), 4096, [](const RayState& s) { return s.origin; }, originNodes);
+    expectMedianSplit(
+        rays.data(), rays.size(), 4096, [](const RayState& s) { return s.origin; }, originNodes);
     EXPECT_EQ(originNodes, 1 + 2 + 4); // 32768 -> 8 leaves of 4096
     for (size_t at = 0; at < rays.size(); at += 4096)
-        expectMedianSplit(rays.data() + at, 4096, 64, [](const RayState& s) { return s.dir; }, directionNodes);
+        expectMedianSplit(
+            rays.data() + at, 4096, 64, [](const RayState& s) { return s.dir; }, directionNodes);
     EXPECT_EQ(directionNodes, 8 * 63); // each 4096-ray leaf -> 64 groups of 64
 }
 

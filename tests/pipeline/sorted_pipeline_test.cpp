@@ -26,7 +26,9 @@ Scene smallCornell(int size) {
     return scene;
 }
 
-std::vector<float> renderImage(const Scene& scene, RenderConfig cfg) { return render(scene, cfg)->film->image(); }
+std::vector<float> renderImage(const Scene& scene, RenderConfig cfg) {
+    return render(scene, cfg)->film->image();
+}
 
 bool sameBits(const std::vector<float>& a, const std::vector<float>& b) {
     return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(float)) == 0;
@@ -41,26 +43,36 @@ TEST(SortedPipeline, FullPrecisionRaysGiveTheReferenceImageBitForBit) {
     dir.write("tex.ppm", "P3\n2 2\n255\n255 0 0  0 255 0\n0 0 255  255 255 255\n");
     const std::string box = sourceDir() + "/scenes/cornell-box/";
     const Scene everyModel = loadScene(dir.write(
-        "models.yaml",
-        "image: {width: 24, height: 24, sample base: 2, iterations: 2}\n"
-        "settings: {min depth: 2, max depth: 12}\n"
-        "camera: {type: ThinLens, look at: {eye: [278, 273, -800], target: [278, 273, 0]}, fov: 39.3,\n"
-        "         aperture radius: 5, focal distance: 1000}\n"
-        "filter: {type: Gaussian, width: 1.5}\n"
-        "shaders:\n"
-        "  - type: Lambert\n"
-        "    texture: {type: Layered, upper: {type: Standard, string: tex.ppm}, lower: {type: Constant, colour: [0.7, 0.7, 0.7]},\n"
-        "              mask: {type: Constant, colour: [0.5, 0.5, 0.5]}}\n"
-        "  - {type: Conductor, colour: [0.95, 0.64, 0.54], alpha: 0.3}\n"
-        "  - {type: Conductor, colour: [0.9, 0.9, 0.9]}\n"
-        "  - {type: Dielectric, ior: 1.5, alpha: 0.2}\n"
-        "  - {type: Dielectric, ior: 1.33}\n"
-        "objects:\n"
-        "  - {filename: " + box + "white.obj, shader: 0}\n"
-        "  - {filename: " + box + "red.obj, shader: 1}\n"
-        "  - {filename: " + box + "green.obj, shader: 2}\n"
-        "  - {filename: " + box + "blocks.obj, shader: 3}\n"
-        "light: {type: Quad, translation: [278, 548.7, 279.5], rotation: [90, 0, 0], scale: [130, 105], colour: [17, 12, 4]}\n"));
+        "models.yaml", "image: {width: 24, height: 24, sample base: 2, iterations: 2}\n"
+                       "settings: {min depth: 2, max depth: 12}\n"
+                       "camera: {type: ThinLens, look at: {eye: [278, 273, -800], target: [278, "
+                       "273, 0]}, fov: 39.3,\n"
+                       "         aperture radius: 5, focal distance: 1000}\n"
+                       "filter: {type: Gaussian, width: 1.5}\n"
+                       "shaders:\n"
+                       "  - type: Lambert\n"
+                       "    texture: {type: Layered, upper: {type: Standard, string: tex.ppm}, "
+                       "lower: {type: Constant, colour: [0.7, 0.7, 0.7]},\n"
+                       "              mask: {type: Constant, colour: [0.5, 0.5, 0.5]}}\n"
+                       "  - {type: Conductor, colour: [0.95, 0.64, 0.54], alpha: 0.3}\n"
+                       "  - {type: Conductor, colour: [0.9, 0.9, 0.9]}\n"
+                       "  - {type: Dielectric, ior: 1.5, alpha: 0.2}\n"
+                       "  - {type: Dielectric, ior: 1.33}\n"
+                       "objects:\n"
+                       "  - {filename: " +
+                           box +
+                           "white.obj, shader: 0}\n"
+                           "  - {filename: " +
+                           box +
+                           "red.obj, shader: 1}\n"
+                           "  - {filename: " +
+                           box +
+                           "green.obj, shader: 2}\n"
+                           "  - {filename: " +
+                           box +
+                           "blocks.obj, shader: 3}\n"
+                           "light: {type: Quad, translation: [278, 548.7, 279.5], rotation: [90, "
+                           "0, 0], scale: [130, 105], colour: [17, 12, 4]}\n"));
     // A 16384 x 4 strip at 4 spp: a sample whose offset in its pixel is within half an ulp of
     // 1 rounds to the next pixel's edge (float(x) + offset == x + 1) about 2^-24 x of the time,
     // some fifty times here; the reference once splatted those into the next pixel.
@@ -93,8 +105,9 @@ void expectAgreesWithReference(const Scene& scene, int iterations, const std::st
     RenderConfig cpu = ref;
     cpu.backend = BackendKind::Cpu;
     cpu.pipeline.binExponent = 10;
-    expectNoPairedDifference(pairedDifference(iterationImages(scene, cpu), iterationImages(scene, ref)),
-                             scene.image.width, scene.image.height, what);
+    expectNoPairedDifference(
+        pairedDifference(iterationImages(scene, cpu), iterationImages(scene, ref)),
+        scene.image.width, scene.image.height, what);
 }
 
 TEST(SortedPipeline, CompactRaysAgreeWithReferenceOnCornellBox) {
@@ -106,12 +119,12 @@ TEST(SortedPipeline, CompactRaysAgreeWithReferenceOnCornellBox) {
 TEST(SortedPipeline, CompactRaysAgreeWithReferenceOnClosedEnclosure) {
     TempDir dir;
     dir.write("cube.obj", insideCubeObj());
-    Scene scene = loadScene(dir.write("e.yaml",
-                                      "image: {width: 16, height: 16, sample base: 1, iterations: 1}\n"
-                                      "settings: {max depth: 300}\n"
-                                      "camera: {look at: {eye: [0, 0, 0], target: [0.3, 0.2, -1]}, fov: 100}\n"
-                                      "object: {filename: cube.obj, shader: 0}\n"
-                                      "shader: {type: Lambert, reflectance: 0.8, emission: [1, 1, 1]}\n"));
+    Scene scene = loadScene(dir.write(
+        "e.yaml", "image: {width: 16, height: 16, sample base: 1, iterations: 1}\n"
+                  "settings: {max depth: 300}\n"
+                  "camera: {look at: {eye: [0, 0, 0], target: [0.3, 0.2, -1]}, fov: 100}\n"
+                  "object: {filename: cube.obj, shader: 0}\n"
+                  "shader: {type: Lambert, reflectance: 0.8, emission: [1, 1, 1]}\n"));
     expectAgreesWithReference(scene, 32, "closed enclosure");
     // And the cpu backend alone against the closed form Le / (1 - a) = 5.
     RenderConfig cpu;
@@ -144,8 +157,11 @@ TEST(SortedPipeline, ImageIsIndependentOfBatchingSortingBudgetAndThreads) {
     variant("bin exponent 16", [](RenderConfig& c) { c.pipeline.binExponent = 16; });
     variant("2 threads", [](RenderConfig& c) { c.threads = 2; });
     // 64 KiB: less than six 2^12-ray batches (768 KiB), so every batch goes through the disk.
-    EXPECT_GT(variant("64 KiB budget", [](RenderConfig& c) { c.pipeline.memoryBudgetMiB = 1.0 / 16; }), 0);
-    EXPECT_EQ(variant("1 GiB budget", [](RenderConfig& c) { c.pipeline.memoryBudgetMiB = 1024.0; }), 0);
+    EXPECT_GT(
+        variant("64 KiB budget", [](RenderConfig& c) { c.pipeline.memoryBudgetMiB = 1.0 / 16; }),
+        0);
+    EXPECT_EQ(variant("1 GiB budget", [](RenderConfig& c) { c.pipeline.memoryBudgetMiB = 1024.0; }),
+              0);
     EXPECT_GT(variant("64 KiB budget, 2 threads, exponent 8",
                       [](RenderConfig& c) {
                           c.pipeline.memoryBudgetMiB = 1.0 / 16;
@@ -184,8 +200,10 @@ struct ChildResult {
     std::string output;
 };
 
-ChildResult runChild(const std::vector<std::string>& args, const std::function<void(pid_t)>& whileRunning = {}) {
-    std::string log = std::filesystem::temp_directory_path() / ("spillway-child-" + std::to_string(getpid()) + ".log");
+ChildResult runChild(const std::vector<std::string>& args,
+                     const std::function<void(pid_t)>& whileRunning = {}) {
+    std::string log = std::filesystem::temp_directory_path() /
+                      ("spillway-child-" + std::to_string(getpid()) + ".log");
     pid_t pid = fork();
     if (pid == 0) {
         FILE* f = std::freopen(log.c_str(), "w", stderr);
@@ -195,7 +213,8 @@ ChildResult runChild(const std::vector<std::string>& args, const std::function<v
         std::string bin = binary();
         argv.push_back(bin.data());
         std::vector<std::string> copy = args;
-        for (std::string& a : copy) argv.push_back(a.data());
+        for (std::string& a : copy)
+            argv.push_back(a.data());
         argv.push_back(nullptr);
         execv(bin.c_str(), argv.data());
         _exit(127);
@@ -212,7 +231,8 @@ ChildResult runChild(const std::vector<std::string>& args, const std::function<v
 
 size_t filesIn(const std::string& dir) {
     size_t n = 0;
-    for ([[maybe_unused]] const auto& e : std::filesystem::directory_iterator(dir)) ++n;
+    for ([[maybe_unused]] const auto& e : std::filesystem::directory_iterator(dir))
+        ++n;
     return n;
 }
 
@@ -220,14 +240,20 @@ size_t filesIn(const std::string& dir) {
 // records: far more than a 1 MiB budget. max depth 0 keeps the test fast (no shading work).
 std::string heavyScene(const TempDir& dir) {
     const std::string box = sourceDir() + "/scenes/cornell-box/";
-    return dir.write("heavy.yaml",
-                     "image: {width: 256, height: 256, sample base: 8, iterations: 1}\n"
-                     "settings: {max depth: 0, bin exponent: 12}\n"
-                     "camera: {look at: {eye: [278, 273, -800], target: [278, 273, 0]}, fov: 39.3}\n"
-                     "shader: {type: Lambert}\n"
-                     "object: {filename: " + box + "white.obj, shader: 0}\n"
-                     "object: {filename: " + box + "blocks.obj, shader: 0}\n"
-                     "light: {type: Quad, translation: [278, 548.7, 279.5], rotation: [90, 0, 0], scale: [130, 105], intensity: 10}\n");
+    return dir.write(
+        "heavy.yaml",
+        "image: {width: 256, height: 256, sample base: 8, iterations: 1}\n"
+        "settings: {max depth: 0, bin exponent: 12}\n"
+        "camera: {look at: {eye: [278, 273, -800], target: [278, 273, 0]}, fov: 39.3}\n"
+        "shader: {type: Lambert}\n"
+        "object: {filename: " +
+            box +
+            "white.obj, shader: 0}\n"
+            "object: {filename: " +
+            box +
+            "blocks.obj, shader: 0}\n"
+            "light: {type: Quad, translation: [278, 548.7, 279.5], rotation: [90, 0, 0], scale: "
+            "[130, 105], intensity: 10}\n");
 }
 
 TEST(Spill, SmallBudgetSpillsReadsBackAndBoundsMemory) {
@@ -236,12 +262,12 @@ TEST(Spill, SmallBudgetSpillsReadsBackAndBoundsMemory) {
     // --backend cpu in all three: `auto` probes Vulkan, and the suite runs it under the validation
     // layer, whose memory varies from run to run by more than this test's margins.
     auto run = [&](const char* budget, const std::string& stats) {
-        return runChild({"render", scene, "-o", dir.file("o.exr"), "--quiet", "--backend", "cpu", "--memory-budget",
-                         budget, "--spill-dir", spill.path(), "--stats", stats});
+        return runChild({"render", scene, "-o", dir.file("o.exr"), "--quiet", "--backend", "cpu",
+                         "--memory-budget", budget, "--spill-dir", spill.path(), "--stats", stats});
     };
     // The process's own baseline (libraries, Embree and TBB start-up): an 8 x 8 pixel render.
-    ChildResult tiny = runChild({"render", dir.write("tiny.yaml", "image: {width: 8, height: 8}\n"), "-o",
-                                 dir.file("t.exr"), "--quiet", "--backend", "cpu"});
+    ChildResult tiny = runChild({"render", dir.write("tiny.yaml", "image: {width: 8, height: 8}\n"),
+                                 "-o", dir.file("t.exr"), "--quiet", "--backend", "cpu"});
     ASSERT_EQ(tiny.status, 0) << tiny.output;
     ChildResult big = run("1024", dir.file("big.json"));
     ChildResult small = run("1", dir.file("small.json"));
@@ -271,7 +297,8 @@ TEST(Spill, SmallBudgetSpillsReadsBackAndBoundsMemory) {
 TEST(Spill, NoFileLeftAfterNormalRunErrorOrAnySignal) {
     TempDir dir, spill;
     const std::string scene = heavyScene(dir);
-    std::vector<std::string> args = {"render", scene, "--quiet", "--memory-budget", "1", "--spill-dir", spill.path()};
+    std::vector<std::string> args = {"render", scene,         "--quiet",   "--memory-budget",
+                                     "1",      "--spill-dir", spill.path()};
 
     std::vector<std::string> ok = args;
     ok.insert(ok.end(), {"-o", dir.file("ok.exr")});
@@ -285,7 +312,8 @@ TEST(Spill, NoFileLeftAfterNormalRunErrorOrAnySignal) {
     ChildResult err = runChild(bad);
     EXPECT_EQ(err.status, 1) << err.output;
     EXPECT_NE(err.output.find("full.exr"), std::string::npos) << err.output;
-    EXPECT_FALSE(std::filesystem::exists(dir.file("full.json"))) << "stats written for a failed render";
+    EXPECT_FALSE(std::filesystem::exists(dir.file("full.json")))
+        << "stats written for a failed render";
     EXPECT_EQ(filesIn(spill.path()), 0u);
 
     // SIGINT, SIGTERM and SIGKILL while batches are on disk: wait until the process holds an
@@ -302,7 +330,8 @@ TEST(Spill, NoFileLeftAfterNormalRunErrorOrAnySignal) {
         ChildResult sig = runChild(slow, [&](pid_t pid) {
             for (int i = 0; i < 400 && !sawSpill; ++i) {
                 std::error_code ec;
-                for (const auto& e : std::filesystem::directory_iterator("/proc/" + std::to_string(pid) + "/fd", ec)) {
+                for (const auto& e : std::filesystem::directory_iterator(
+                         "/proc/" + std::to_string(pid) + "/fd", ec)) {
                     std::string target = std::filesystem::read_symlink(e.path(), ec).string();
                     if (target.rfind(spill.path(), 0) == 0) sawSpill = true;
                 }
@@ -324,8 +353,8 @@ TEST(Spill, UnwritableSpillFolderExitsOneNamingIt) {
     TempDir dir;
     const std::string scene = heavyScene(dir);
     const std::string missing = dir.file("no-such-folder");
-    ChildResult r = runChild({"render", scene, "--quiet", "--memory-budget", "1", "--spill-dir", missing, "-o",
-                              dir.file("x.exr")});
+    ChildResult r = runChild({"render", scene, "--quiet", "--memory-budget", "1", "--spill-dir",
+                              missing, "-o", dir.file("x.exr")});
     EXPECT_EQ(r.status, 1) << r.output;
     EXPECT_NE(r.output.find(missing), std::string::npos) << r.output;
     EXPECT_FALSE(std::filesystem::exists(dir.file("x.exr")));
@@ -337,29 +366,38 @@ TEST(Spill, UnwritableSpillFolderExitsOneNamingIt) {
 TEST(Spill, PeakRaysInRamStayWithinTheBudgetOrSixBatches) {
     TempDir dir, spill;
     const std::string box = sourceDir() + "/scenes/cornell-box";
-    const std::string scene = dir.write("b.yaml", "image: {width: 64, height: 64, sample base: 2, iterations: 1}\n"
-                                                  "settings: {max depth: 3}\n"
-                                                  "camera: {look at: {eye: [278, 273, -800], target: [278, 273, 0]}, fov: 39.3}\n"
-                                                  "shader: {type: Lambert}\n"
-                                                  "object: {filename: " + box + "/white.obj}\n"
-                                                  "object: {filename: " + box + "/blocks.obj}\n"
-                                                  "light: {type: Quad, translation: [278, 548.7, 279.5], rotation: [90, 0, 0], scale: [130, 105], intensity: 10}\n");
+    const std::string scene = dir.write(
+        "b.yaml", "image: {width: 64, height: 64, sample base: 2, iterations: 1}\n"
+                  "settings: {max depth: 3}\n"
+                  "camera: {look at: {eye: [278, 273, -800], target: [278, 273, 0]}, fov: 39.3}\n"
+                  "shader: {type: Lambert}\n"
+                  "object: {filename: " +
+                      box +
+                      "/white.obj}\n"
+                      "object: {filename: " +
+                      box +
+                      "/blocks.obj}\n"
+                      "light: {type: Quad, translation: [278, 548.7, 279.5], rotation: [90, 0, 0], "
+                      "scale: [130, 105], intensity: 10}\n");
     struct Case {
         const char* budgetMiB;
         int exponent;
     } cases[] = {{"0.1", 8}, {"0.1", 10}, {"0.25", 6}, {"1", 12}};
     for (const Case& c : cases) {
         const std::string stats = dir.file("s.json");
-        ChildResult r = runChild({"render", scene, "-o", dir.file("o.exr"), "--quiet", "--backend", "cpu",
-                                  "--memory-budget", c.budgetMiB, "--bin-exponent", std::to_string(c.exponent),
-                                  "--spill-dir", spill.path(), "--stats", stats});
+        ChildResult r =
+            runChild({"render", scene, "-o", dir.file("o.exr"), "--quiet", "--backend", "cpu",
+                      "--memory-budget", c.budgetMiB, "--bin-exponent", std::to_string(c.exponent),
+                      "--spill-dir", spill.path(), "--stats", stats});
         ASSERT_EQ(r.status, 0) << r.output;
         nlohmann::json j = nlohmann::json::parse(std::ifstream(stats));
         const long budget = long(std::stod(c.budgetMiB) * 1024 * 1024);
         const long sixBatches = 6L * (1L << c.exponent) * 32;
         const long peak = j["peak_ray_bytes_in_ram"].get<long>();
-        std::printf("budget %s MiB, 2^%d-ray batches: peak %ld bytes, bound %ld, %ld batches spilled\n", c.budgetMiB,
-                    c.exponent, peak, std::max(budget, sixBatches), j["batches_spilled"].get<long>());
+        std::printf(
+            "budget %s MiB, 2^%d-ray batches: peak %ld bytes, bound %ld, %ld batches spilled\n",
+            c.budgetMiB, c.exponent, peak, std::max(budget, sixBatches),
+            j["batches_spilled"].get<long>());
         EXPECT_LE(peak, std::max(budget, sixBatches)) << c.budgetMiB << " MiB, 2^" << c.exponent;
         EXPECT_GT(j["batches_spilled"].get<long>(), 0) << c.budgetMiB << " MiB, 2^" << c.exponent;
         if (sixBatches >= budget) {
@@ -373,14 +411,16 @@ TEST(Spill, PeakRaysInRamStayWithinTheBudgetOrSixBatches) {
 TEST(Spill, FullDiskExitsOneNamingTheFolder) {
     TempDir dir, spill;
     const std::string scene = heavyScene(dir);
-    std::string cmd = "bash -c 'ulimit -f 4096; exec " + binary() + " render " + scene + " --quiet --memory-budget 1 --spill-dir " +
-                      spill.path() + " -o " + dir.file("x.exr") + "' 2>&1";
+    std::string cmd = "bash -c 'ulimit -f 4096; exec " + binary() + " render " + scene +
+                      " --quiet --memory-budget 1 --spill-dir " + spill.path() + " -o " +
+                      dir.file("x.exr") + "' 2>&1";
     FILE* p = popen(cmd.c_str(), "r");
     ASSERT_NE(p, nullptr);
     std::string out;
     char buf[512];
     size_t n;
-    while ((n = fread(buf, 1, sizeof buf, p)) > 0) out.append(buf, n);
+    while ((n = fread(buf, 1, sizeof buf, p)) > 0)
+        out.append(buf, n);
     int st = pclose(p);
     EXPECT_TRUE(WIFEXITED(st) && WEXITSTATUS(st) == 1) << out;
     EXPECT_NE(out.find(spill.path()), std::string::npos) << out;

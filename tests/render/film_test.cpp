@@ -12,7 +12,8 @@ namespace {
 
 TEST(Film, NonFiniteSamplesAreCountedAndDropped) {
     Film film(2, 1, Filter{}, 1.0f);
-    const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
+    const float nan = std::numeric_limits<float>::quiet_NaN(),
+                inf = std::numeric_limits<float>::infinity();
     film.addSample(vec2(0.5f, 0.5f), 0);
     film.addSample(vec2(1.5f, 0.5f), 0);
     film.splat(vec2(0.5f, 0.5f), 0, vec3(0.25f, 0.5f, 1.0f), 1u);
@@ -25,7 +26,8 @@ TEST(Film, NonFiniteSamplesAreCountedAndDropped) {
     EXPECT_FLOAT_EQ(img[0], 0.25f);
     EXPECT_FLOAT_EQ(img[1], 0.5f);
     EXPECT_FLOAT_EQ(img[2], 1.0f);
-    for (int c = 3; c < 6; ++c) EXPECT_EQ(img[size_t(c)], 0.0f) << "the second pixel saw only a non-finite sample";
+    for (int c = 3; c < 6; ++c)
+        EXPECT_EQ(img[size_t(c)], 0.0f) << "the second pixel saw only a non-finite sample";
 }
 
 // The stochastic rounding to the fixed-point grid is unbiased over iterations even for a value
@@ -62,7 +64,8 @@ TEST(Film, NoAccumulatorWrapsAtTheMostSamplesAFilterGathers) {
     film.endIteration();
     EXPECT_EQ(film.saturatedSamples(), 0u);
     const std::vector<float> img = film.image();
-    for (float v : img) EXPECT_NEAR(v, 8.0f, 8e-6f);
+    for (float v : img)
+        EXPECT_NEAR(v, 8.0f, 8e-6f);
 }
 
 // The usual film keeps its brightest emitter's sample at 2^40 (a box filter, up to 64 samples

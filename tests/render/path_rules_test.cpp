@@ -20,11 +20,12 @@ Counts countRays(const Scene& scene, const std::string& backend) {
     RenderConfig cfg;
     cfg.backend = parseBackend(backend);
     auto r = render(scene, cfg);
-    return {double(r->stats.cameraRays.load()), double(r->stats.bounceRays.load()), double(r->stats.shadowRays.load()),
-            r->film->image()};
+    return {double(r->stats.cameraRays.load()), double(r->stats.bounceRays.load()),
+            double(r->stats.shadowRays.load()), r->film->image()};
 }
 
-std::string enclosureYaml(double albedo, int minDepth, double threshold, const std::string& extra = "") {
+std::string enclosureYaml(double albedo, int minDepth, double threshold,
+                          const std::string& extra = "") {
     char buf[512];
     std::snprintf(buf, sizeof buf,
                   "image: {width: 32, height: 32, sample base: 2, iterations: 4}\n"
@@ -54,8 +55,9 @@ TEST(PathRules, RussianRouletteStartsAtMinDepth) {
         for (const std::string& backend : backendsUnderTest()) {
             const Counts c = countRays(scene, backend);
             const double n = c.bounce / c.camera, se = std::sqrt(var / c.camera);
-            std::printf("%s, min depth %d: %.4f bounce rays a path, expected %.4f +- %.4f (z %+.2f)\n", backend.c_str(),
-                        m, n, mean, se, (n - mean) / se);
+            std::printf(
+                "%s, min depth %d: %.4f bounce rays a path, expected %.4f +- %.4f (z %+.2f)\n",
+                backend.c_str(), m, n, mean, se, (n - mean) / se);
             EXPECT_NEAR(n, mean, 4 * se) << backend << ", min depth " << m;
         }
     }
@@ -66,7 +68,10 @@ TEST(PathRules, NoShadowRaysWithoutEmitters) {
     TempDir dir;
     dir.write("cube.obj", insideCubeObj());
     const Scene dark = loadScene(dir.write("d.yaml", enclosureYaml(0.5, 3, 0.1)));
-    const Scene lit = loadScene(dir.write("l.yaml", enclosureYaml(0.5, 3, 0.1, "light: {type: Quad, translation: [0, 0.9, 0], rotation: [90, 0, 0], scale: [0.5, 0.5]}\n")));
+    const Scene lit =
+        loadScene(dir.write("l.yaml", enclosureYaml(0.5, 3, 0.1,
+                                                    "light: {type: Quad, translation: [0, 0.9, 0], "
+                                                    "rotation: [90, 0, 0], scale: [0.5, 0.5]}\n")));
     for (const std::string& backend : backendsUnderTest()) {
         const Counts d = countRays(dark, backend);
         EXPECT_EQ(d.shadow, 0.0) << backend;
@@ -87,23 +92,32 @@ TEST(PathRules, DielectricAtBothEndsOfItsIorRange) {
     for (double ior : {1.01, 10.0})
         for (double alpha : {0.0, 0.3}) {
             char shader[128];
-            std::snprintf(shader, sizeof shader, "{type: Dielectric, ior: %g, alpha: %g}", ior, alpha);
+            std::snprintf(shader, sizeof shader, "{type: Dielectric, ior: %g, alpha: %g}", ior,
+                          alpha);
             const Scene scene = loadScene(dir.write(
-                "g.yaml", std::string("image: {width: 16, height: 16, sample base: 2, iterations: 16}\n"
-                                      "settings: {max depth: 64, min depth: 3, threshold: 0.1}\n"
-                                      "camera: {look at: {eye: [0.3, 0.7, 0.5], target: [0, 0, 0]}, fov: 50}\n"
-                                      "shaders:\n  - {type: Emissive, emission: [1, 1, 1]}\n  - ") +
-                              shader + "\nobjects:\n  - {filename: enclosure.obj, shader: 0}\n  - {filename: plane.obj, shader: 1}\n"));
+                "g.yaml",
+                std::string(
+                    "image: {width: 16, height: 16, sample base: 2, iterations: 16}\n"
+                    "settings: {max depth: 64, min depth: 3, threshold: 0.1}\n"
+                    "camera: {look at: {eye: [0.3, 0.7, 0.5], target: [0, 0, 0]}, fov: 50}\n"
+                    "shaders:\n  - {type: Emissive, emission: [1, 1, 1]}\n  - ") +
+                    shader +
+                    "\nobjects:\n  - {filename: enclosure.obj, shader: 0}\n  - {filename: "
+                    "plane.obj, shader: 1}\n"));
             for (const std::string& backend : backendsUnderTest()) {
                 RenderConfig cfg;
                 cfg.backend = parseBackend(backend);
                 PixelStats s;
-                auto r = render(scene, cfg, [&](int, int, const Film& f) { s.add(f.lastIterationImage()); });
+                auto r = render(scene, cfg,
+                                [&](int, int, const Film& f) { s.add(f.lastIterationImage()); });
                 const MeanError m = s.imageMean();
-                std::printf("%s, ior %g, alpha %g: mean %.4f +- %.4f\n", backend.c_str(), ior, alpha, m.mean, m.stderror);
+                std::printf("%s, ior %g, alpha %g: mean %.4f +- %.4f\n", backend.c_str(), ior,
+                            alpha, m.mean, m.stderror);
                 EXPECT_EQ(r->stats.nonFiniteSamples, 0u) << backend << ", ior " << ior;
-                for (float v : r->film->image()) ASSERT_TRUE(std::isfinite(v) && v >= 0.0f) << backend << ", ior " << ior;
-                EXPECT_LE(m.mean, 1.0 + 4 * m.stderror) << backend << ", ior " << ior << ", alpha " << alpha;
+                for (float v : r->film->image())
+                    ASSERT_TRUE(std::isfinite(v) && v >= 0.0f) << backend << ", ior " << ior;
+                EXPECT_LE(m.mean, 1.0 + 4 * m.stderror)
+                    << backend << ", ior " << ior << ", alpha " << alpha;
                 EXPECT_GT(m.mean, 0.0) << backend;
             }
         }

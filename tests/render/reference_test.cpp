@@ -18,7 +18,8 @@ RenderConfig referenceConfig() {
     return cfg;
 }
 
-std::unique_ptr<RenderResult> renderWithStats(const Scene& scene, const RenderConfig& cfg, PixelStats* stats) {
+std::unique_ptr<RenderResult> renderWithStats(const Scene& scene, const RenderConfig& cfg,
+                                              PixelStats* stats) {
     return render(scene, cfg, [&](int, int, const Film& film) {
         if (stats) stats->add(film.lastIterationImage());
     });
@@ -48,7 +49,8 @@ TEST_P(ClosedEnclosure, MeanMatchesLeOverOneMinusAlbedo) {
     auto result = render(scene, referenceConfig());
     MeanError m = meanAndError(result->film->image());
     const double expected = 1.0 / (1.0 - a);
-    std::printf("albedo %.3f: mean %.5f, expected %.5f, standard error %.5f\n", a, m.mean, expected, m.stderror);
+    std::printf("albedo %.3f: mean %.5f, expected %.5f, standard error %.5f\n", a, m.mean, expected,
+                m.stderror);
     EXPECT_GT(m.stderror, 0.0);
     EXPECT_NEAR(m.mean, expected, 4.0 * m.stderror) << "standard error " << m.stderror;
     EXPECT_EQ(result->stats.nonFiniteSamples, 0u);
@@ -74,24 +76,27 @@ double polygonIrradiance(vec3 x, vec3 n, const std::vector<vec3>& corners, doubl
 TEST(QuadLight, PixelsMatchPolygonIrradiance) {
     TempDir dir;
     dir.write("floor.obj", floorObj(4.0f));
-    const std::string path = dir.write("quad.yaml",
-                                       "image: {width: 16, height: 16, sample base: 1, iterations: 256}\n"
-                                       "settings: {max depth: 1}\n"
-                                       "camera: {look at: {eye: [0.2, 0.6, 0.1], target: [0.2, 0, 0.1], up: [0, 0, -1]}, fov: 90}\n"
-                                       "sampler: {type: Grid}\n"
-                                       "object: {filename: floor.obj, shader: 0}\n"
-                                       "shader: {type: Lambert, reflectance: 0.5}\n"
-                                       "light: {type: Quad, translation: [0, 1, 0], rotation: [90, 0, 0], scale: [1, 0.5], intensity: 3}\n");
+    const std::string path =
+        dir.write("quad.yaml", "image: {width: 16, height: 16, sample base: 1, iterations: 256}\n"
+                               "settings: {max depth: 1}\n"
+                               "camera: {look at: {eye: [0.2, 0.6, 0.1], target: [0.2, 0, 0.1], "
+                               "up: [0, 0, -1]}, fov: 90}\n"
+                               "sampler: {type: Grid}\n"
+                               "object: {filename: floor.obj, shader: 0}\n"
+                               "shader: {type: Lambert, reflectance: 0.5}\n"
+                               "light: {type: Quad, translation: [0, 1, 0], rotation: [90, 0, 0], "
+                               "scale: [1, 0.5], intensity: 3}\n");
     Scene scene = loadScene(path);
     PixelStats ps;
     auto result = renderWithStats(scene, referenceConfig(), &ps);
-    const std::vector<vec3> corners = {{-0.5f, 1, -0.25f}, {0.5f, 1, -0.25f}, {0.5f, 1, 0.25f}, {-0.5f, 1, 0.25f}};
+    const std::vector<vec3> corners = {
+        {-0.5f, 1, -0.25f}, {0.5f, 1, -0.25f}, {0.5f, 1, 0.25f}, {-0.5f, 1, 0.25f}};
     CameraModel cam(scene, 1);
     double worstZ = 0, sumZ = 0;
     for (int y = 0; y < 16; ++y)
         for (int x = 0; x < 16; ++x) {
             CameraRay r = cam.generate(uint(x), uint(y), 0, 0, 0); // Grid: the pixel centre
-            const vec3 o = vec3(scene.origin) + r.origin; // the world is camera-relative
+            const vec3 o = vec3(scene.origin) + r.origin;          // the world is camera-relative
             vec3 p = o + r.dir * (-o.y / r.dir.y);
             double expected = 0.5 / kPi * polygonIrradiance(p, vec3(0, 1, 0), corners, 3.0);
             size_t i = size_t(y * 16 + x);
@@ -117,19 +122,24 @@ TEST(QuadLight, PixelsMatchPolygonIrradiance) {
 TEST(Mis, StrategiesAgreeWithTheClosedFormAndMisHasLowestVariance) {
     TempDir dir;
     dir.write("floor.obj", floorObj(1.0f));
-    const std::string yaml = "settings: {max depth: 1}\n"
-                             "camera: {look at: {eye: [0, 0.8, -0.2], target: [0, 0, -0.2], up: [0, 0, -1]}, fov: 100}\n"
-                             "sampler: {type: Grid}\n"
-                             "object: {filename: floor.obj, shader: 0}\n"
-                             "shader: {type: Lambert, reflectance: 0.8}\n"
-                             "lights:\n"
-                             "  - {type: Quad, translation: [0, 1, 0], rotation: [90, 0, 0], scale: [0.04, 0.04], intensity: 600}\n"
-                             "  - {type: Quad, translation: [0, 1, -1], scale: [2, 2], intensity: 0.4}\n";
-    const Scene scene = loadScene(dir.write("mis.yaml", "image: {width: 16, height: 16, sample base: 1, iterations: 800}\n" + yaml));
-    const Scene longer = loadScene(dir.write("bsdf.yaml", "image: {width: 16, height: 16, sample base: 1, iterations: 16000}\n" + yaml));
+    const std::string yaml =
+        "settings: {max depth: 1}\n"
+        "camera: {look at: {eye: [0, 0.8, -0.2], target: [0, 0, -0.2], up: [0, 0, -1]}, fov: 100}\n"
+        "sampler: {type: Grid}\n"
+        "object: {filename: floor.obj, shader: 0}\n"
+        "shader: {type: Lambert, reflectance: 0.8}\n"
+        "lights:\n"
+        "  - {type: Quad, translation: [0, 1, 0], rotation: [90, 0, 0], scale: [0.04, 0.04], "
+        "intensity: 600}\n"
+        "  - {type: Quad, translation: [0, 1, -1], scale: [2, 2], intensity: 0.4}\n";
+    const Scene scene = loadScene(dir.write(
+        "mis.yaml", "image: {width: 16, height: 16, sample base: 1, iterations: 800}\n" + yaml));
+    const Scene longer = loadScene(dir.write(
+        "bsdf.yaml", "image: {width: 16, height: 16, sample base: 1, iterations: 16000}\n" + yaml));
 
     // The closed form at each pixel centre (the Grid sampler puts every sample there).
-    const std::vector<vec3> tiny = {{-0.02f, 1, -0.02f}, {0.02f, 1, -0.02f}, {0.02f, 1, 0.02f}, {-0.02f, 1, 0.02f}};
+    const std::vector<vec3> tiny = {
+        {-0.02f, 1, -0.02f}, {0.02f, 1, -0.02f}, {0.02f, 1, 0.02f}, {-0.02f, 1, 0.02f}};
     const std::vector<vec3> wall = {{-1, 0, -1}, {1, 0, -1}, {1, 2, -1}, {-1, 2, -1}};
     CameraModel cam(scene, 1);
     std::vector<double> expected(256);
@@ -146,8 +156,9 @@ TEST(Mis, StrategiesAgreeWithTheClosedFormAndMisHasLowestVariance) {
             if (tWall > 0 && tWall < tFloor && std::fabs(q.x) <= 1 && q.y >= 0 && q.y <= 2) {
                 e = 0.4, ++wallPixels, seesWall[size_t(y * 16 + x)] = true;
             } else if (std::fabs(p.x) <= 1 && std::fabs(p.z) <= 1) {
-                e = 0.8 / kPi * (polygonIrradiance(p, vec3(0, 1, 0), tiny, 600.0) +
-                                 polygonIrradiance(p, vec3(0, 1, 0), wall, 0.4));
+                e = 0.8 / kPi *
+                    (polygonIrradiance(p, vec3(0, 1, 0), tiny, 600.0) +
+                     polygonIrradiance(p, vec3(0, 1, 0), wall, 0.4));
             }
             expected[size_t(y * 16 + x)] = e;
             expectedMean += e / 256.0;
@@ -161,8 +172,10 @@ TEST(Mis, StrategiesAgreeWithTheClosedFormAndMisHasLowestVariance) {
         cfg.strategy = s;
         renderWithStats(s == kStrategyBsdf ? longer : scene, cfg, &stats[s]);
         const MeanError m = stats[s].imageMean();
-        std::printf("strategy %u: mean %.5f +- %.5f (closed form %.5f, z %+.2f), mean pixel variance %.5f\n", s, m.mean,
-                    m.stderror, expectedMean, (m.mean - expectedMean) / m.stderror, stats[s].averageVariance());
+        std::printf("strategy %u: mean %.5f +- %.5f (closed form %.5f, z %+.2f), mean pixel "
+                    "variance %.5f\n",
+                    s, m.mean, m.stderror, expectedMean, (m.mean - expectedMean) / m.stderror,
+                    stats[s].averageVariance());
         EXPECT_NEAR(m.mean, expectedMean, 4.0 * m.stderror) << "strategy " << s;
         EXPECT_LT(m.stderror, 0.05 * expectedMean) << "too few samples to test strategy " << s;
         if (s != kStrategyMis) continue;
@@ -172,7 +185,8 @@ TEST(Mis, StrategiesAgreeWithTheClosedFormAndMisHasLowestVariance) {
                 EXPECT_NEAR(stats[s].mean(i), 0.4, 1e-6) << "strategy " << s << ", pixel " << i;
                 continue;
             }
-            const double z = (stats[s].mean(i) - expected[i]) / std::max(stats[s].stderror(i), 1e-9);
+            const double z =
+                (stats[s].mean(i) - expected[i]) / std::max(stats[s].stderror(i), 1e-9);
             worstZ = std::max(worstZ, std::fabs(z));
             sumZ += z;
         }
@@ -183,7 +197,8 @@ TEST(Mis, StrategiesAgreeWithTheClosedFormAndMisHasLowestVariance) {
     }
     // Per-iteration variance, the BSDF strategy's from its longer render (the same estimator).
     for (uint s : {kStrategyLight, kStrategyBsdf})
-        EXPECT_LT(stats[kStrategyMis].averageVariance(), stats[s].averageVariance()) << "strategy " << s;
+        EXPECT_LT(stats[kStrategyMis].averageVariance(), stats[s].averageVariance())
+            << "strategy " << s;
 }
 
 std::vector<float> renderCornell(int threads) {
@@ -206,21 +221,23 @@ TEST(Determinism, ReferenceImageIsTheSameBitForBitWithOneAndTwoThreads) {
 TEST(MaxDepth, ZeroShowsOnlyEmitters) {
     TempDir dir;
     dir.write("floor.obj", floorObj(4.0f));
-    Scene scene = loadScene(dir.write("d0.yaml",
-                                      "image: {width: 8, height: 8}\n"
-                                      "settings: {max depth: 0}\n"
-                                      "camera: {look at: {eye: [0, 2, 0], target: [0, 0, 0], up: [0, 0, -1]}, fov: 60}\n"
-                                      "object: {filename: floor.obj, shader: 0}\n"
-                                      "shader: {type: Lambert}\n"
-                                      "light: {type: Quad, translation: [0, 3, 0], rotation: [90, 0, 0], intensity: 5}\n"));
+    Scene scene = loadScene(dir.write(
+        "d0.yaml",
+        "image: {width: 8, height: 8}\n"
+        "settings: {max depth: 0}\n"
+        "camera: {look at: {eye: [0, 2, 0], target: [0, 0, 0], up: [0, 0, -1]}, fov: 60}\n"
+        "object: {filename: floor.obj, shader: 0}\n"
+        "shader: {type: Lambert}\n"
+        "light: {type: Quad, translation: [0, 3, 0], rotation: [90, 0, 0], intensity: 5}\n"));
     EXPECT_EQ(mean(render(scene, referenceConfig())->film->image()), 0.0);
     // The same floor emitting itself is seen at exactly its radiance.
-    Scene lit = loadScene(dir.write("d0e.yaml",
-                                    "image: {width: 8, height: 8}\n"
-                                    "settings: {max depth: 0}\n"
-                                    "camera: {look at: {eye: [0, 2, 0], target: [0, 0, 0], up: [0, 0, -1]}, fov: 60}\n"
-                                    "object: {filename: floor.obj, shader: 0}\n"
-                                    "shader: {type: Emissive, emission: [0.25, 0.5, 2]}\n"));
+    Scene lit = loadScene(dir.write(
+        "d0e.yaml",
+        "image: {width: 8, height: 8}\n"
+        "settings: {max depth: 0}\n"
+        "camera: {look at: {eye: [0, 2, 0], target: [0, 0, 0], up: [0, 0, -1]}, fov: 60}\n"
+        "object: {filename: floor.obj, shader: 0}\n"
+        "shader: {type: Emissive, emission: [0.25, 0.5, 2]}\n"));
     std::vector<float> img = render(lit, referenceConfig())->film->image();
     for (size_t i = 0; i < img.size(); i += 3) {
         ASSERT_FLOAT_EQ(img[i], 0.25f);

@@ -31,8 +31,12 @@ template <class F> void writeImage(const std::string& path, F f) {
     ASSERT_TRUE(out->close()) << out->geterror();
 }
 
-vec3 upper(int c, int r) { return vec3(0.1f + 0.1f * c, 0.9f - 0.1f * r, 0.05f * float((c + r) % 4)); }
-vec3 mask(int c, int r) { return vec3(float(c + kTexels * r) / float(kTexels * kTexels - 1)); }
+vec3 upper(int c, int r) {
+    return vec3(0.1f + 0.1f * c, 0.9f - 0.1f * r, 0.05f * float((c + r) % 4));
+}
+vec3 mask(int c, int r) {
+    return vec3(float(c + kTexels * r) / float(kTexels * kTexels - 1));
+}
 const vec3 kLower(0.2f, 0.4f, 0.6f);
 
 // A square of half-size 0.5 at y = -0.5 facing +Y, u along +x and v along +z (OBJ's v grows
@@ -49,22 +53,23 @@ TEST(Textures, LayeredImageOverConstantByImageMaskOnEveryBackend) {
     writeImage(dir.file("mask.exr"), mask);
     // The camera 1 above the plane sees exactly its square (fov 53.13: tan = 0.5), so the 8 x 8
     // pixel centres land on the 8 x 8 texel centres.
-    const Scene scene = loadScene(dir.write(
-        "t.yaml", "image: {width: 8, height: 8, sample base: 1, iterations: 4}\n"
-                  "settings: {max depth: 1}\n"
-                  "sampler: {type: Grid}\n"
-                  "camera: {look at: {eye: [0, 0.5, 0], target: [0, -0.5, 0], up: [0, 0, -1]}, fov: 53.130102354}\n"
-                  "shaders:\n"
-                  "  - {type: Emissive, emission: [1, 1, 1]}\n"
-                  "  - type: Lambert\n"
-                  "    texture:\n"
-                  "      type: Layered\n"
-                  "      upper: {type: Standard, string: upper.exr}\n"
-                  "      lower: {type: Constant, colour: [0.2, 0.4, 0.6]}\n"
-                  "      mask: {type: Standard, string: mask.exr}\n"
-                  "objects:\n"
-                  "  - {filename: enclosure.obj, shader: 0}\n"
-                  "  - {filename: plane.obj, shader: 1}\n"));
+    const Scene scene = loadScene(
+        dir.write("t.yaml", "image: {width: 8, height: 8, sample base: 1, iterations: 4}\n"
+                            "settings: {max depth: 1}\n"
+                            "sampler: {type: Grid}\n"
+                            "camera: {look at: {eye: [0, 0.5, 0], target: [0, -0.5, 0], up: [0, 0, "
+                            "-1]}, fov: 53.130102354}\n"
+                            "shaders:\n"
+                            "  - {type: Emissive, emission: [1, 1, 1]}\n"
+                            "  - type: Lambert\n"
+                            "    texture:\n"
+                            "      type: Layered\n"
+                            "      upper: {type: Standard, string: upper.exr}\n"
+                            "      lower: {type: Constant, colour: [0.2, 0.4, 0.6]}\n"
+                            "      mask: {type: Standard, string: mask.exr}\n"
+                            "objects:\n"
+                            "  - {filename: enclosure.obj, shader: 0}\n"
+                            "  - {filename: plane.obj, shader: 1}\n"));
     for (const std::string& backend : backendsUnderTest()) {
         RenderConfig cfg;
         cfg.backend = parseBackend(backend);
@@ -83,7 +88,8 @@ TEST(Textures, LayeredImageOverConstantByImageMaskOnEveryBackend) {
                 for (int k = 0; k < 3; ++k) {
                     const double got = img[size_t(y * 8 + x) * 3 + size_t(k)];
                     worst = std::max(worst, std::fabs(got - expected[k]));
-                    EXPECT_NEAR(got, expected[k], 1e-6) << backend << ", pixel " << x << ", " << y << ", channel " << k;
+                    EXPECT_NEAR(got, expected[k], 1e-6)
+                        << backend << ", pixel " << x << ", " << y << ", channel " << k;
                 }
             }
         std::printf("%s: worst |albedo - expected| %.3g\n", backend.c_str(), worst);
@@ -98,12 +104,14 @@ TEST(Textures, NoTextureSystemWithoutImageTextures) {
     const std::string head = "shader:\n  type: Lambert\n  texture:\n";
     const Scene constant = loadScene(dir.write(
         "c.yaml", head + "    type: Layered\n    upper: {type: Constant, colour: [1, 0, 0]}\n"
-                         "    lower: {type: Constant, colour: [0, 1, 0]}\n    mask: {type: Constant, colour: [0.25, 0.5, 1]}\n"));
+                         "    lower: {type: Constant, colour: [0, 1, 0]}\n    mask: {type: "
+                         "Constant, colour: [0.25, 0.5, 1]}\n"));
     TextureResolver none(constant);
     EXPECT_FALSE(none.active());
     const vec3 a = none.albedo(constant.shaders[0], vec2(0.3f, 0.7f));
     EXPECT_EQ(a, vec3(0.25f, 0.5f, 0.0f));
-    const Scene image = loadScene(dir.write("i.yaml", head + "    {type: Standard, string: a.exr}\n"));
+    const Scene image =
+        loadScene(dir.write("i.yaml", head + "    {type: Standard, string: a.exr}\n"));
     EXPECT_TRUE(TextureResolver(image).active());
 }
 

@@ -95,7 +95,8 @@ light:
 
 vec3 centroid(const Mesh& m) {
     vec3 c(0.0f);
-    for (vec3 p : m.positions) c += p;
+    for (vec3 p : m.positions)
+        c += p;
     return c / float(m.positions.size());
 }
 
@@ -105,7 +106,8 @@ void expectNear(vec3 actual, vec3 expected, float tolerance, const std::string& 
 }
 
 bool endsWith(const std::string& s, const std::string& suffix) {
-    return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
+    return s.size() >= suffix.size() &&
+           s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
 }
 
 TEST(Loader, AppendixBExampleLoads) {
@@ -128,7 +130,8 @@ TEST(Loader, AppendixBExampleLoads) {
     EXPECT_FLOAT_EQ(scene.camera.focalLength, 150.0f);
     // The world is camera-relative: the camera's position is the scene's origin.
     expectNear(vec3(scene.origin), vec3(0, 120, 1000), 1e-4f, "camera position");
-    expectNear(vec3(scene.camera.cameraToWorld[3]), vec3(0.0f), 0.0f, "camera position in the rendered world");
+    expectNear(vec3(scene.camera.cameraToWorld[3]), vec3(0.0f), 0.0f,
+               "camera position in the rendered world");
     EXPECT_EQ(scene.filter.type, FilterType::Tent);
     EXPECT_EQ(scene.sampler, SamplerType::Stratified);
 
@@ -140,8 +143,10 @@ TEST(Loader, AppendixBExampleLoads) {
     EXPECT_EQ(scene.meshes[0].triangles.size(), 2u);
     EXPECT_EQ(scene.meshes[0].uvs.size(), scene.meshes[0].positions.size());
     EXPECT_EQ(scene.meshes[0].shader, 0);
-    expectNear(vec3(scene.origin) + centroid(scene.meshes[1]), vec3(100, 100, 35), 1e-3f, "first light");
-    expectNear(vec3(scene.origin) + centroid(scene.meshes[2]), vec3(-120, 120, 50), 1e-3f, "second light");
+    expectNear(vec3(scene.origin) + centroid(scene.meshes[1]), vec3(100, 100, 35), 1e-3f,
+               "first light");
+    expectNear(vec3(scene.origin) + centroid(scene.meshes[2]), vec3(-120, 120, 50), 1e-3f,
+               "second light");
     expectNear(scene.shaders[size_t(scene.meshes[1].shader)].params.emission, vec3(25.0f), 0.0f,
                "first light emission");
     expectNear(scene.shaders[size_t(scene.meshes[2].shader)].params.emission, vec3(1.0f), 0.0f,
@@ -173,7 +178,8 @@ TEST(Loader, AppendixBExampleLoads) {
     auto result = render(scene, config);
     std::vector<float> image = result->film->image();
     ASSERT_EQ(image.size(), 32u * 16u * 3u);
-    for (float v : image) ASSERT_TRUE(std::isfinite(v));
+    for (float v : image)
+        ASSERT_TRUE(std::isfinite(v));
     EXPECT_EQ(result->stats.nonFiniteSamples, 0u);
 }
 
@@ -210,7 +216,8 @@ TEST(Loader, EmptyFileTakesTheDocumentedDefaults) {
     auto result = render(scene, config);
     std::vector<float> image = result->film->image();
     ASSERT_EQ(image.size(), 16u * 16u * 3u);
-    for (float v : image) ASSERT_EQ(v, 0.0f);
+    for (float v : image)
+        ASSERT_EQ(v, 0.0f);
 }
 
 TEST(Loader, CommentOnlyFileIsAnEmptyScene) {
@@ -274,9 +281,10 @@ lights:
 TEST(Loader, ObjectTransformScalesThenRotatesZYXThenTranslates) {
     TempDir dir;
     dir.write("tri.obj", kTriangleObj);
-    Scene scene = loadScene(dir.write(
-        "xf.yaml", "shader: {type: Lambert}\n"
-                   "object: {filename: tri.obj, scale: [2, 3, 4], rotation: [90, 90, 90], translation: [1, 2, 3]}\n"));
+    Scene scene =
+        loadScene(dir.write("xf.yaml", "shader: {type: Lambert}\n"
+                                       "object: {filename: tri.obj, scale: [2, 3, 4], rotation: "
+                                       "[90, 90, 90], translation: [1, 2, 3]}\n"));
     ASSERT_EQ(scene.objectCount, 1);
     const Mesh& m = scene.meshes[0];
     ASSERT_EQ(m.triangles.size(), 1u);
@@ -289,8 +297,8 @@ TEST(Loader, ObjectTransformScalesThenRotatesZYXThenTranslates) {
 TEST(Loader, UniformScaleIsANumber) {
     TempDir dir;
     dir.write("tri.obj", kTriangleObj);
-    Scene scene = loadScene(dir.write(
-        "xf.yaml", "shader: {type: Lambert}\nobject: {filename: tri.obj, scale: 3, translation: [0, 0, -1]}\n"));
+    Scene scene = loadScene(dir.write("xf.yaml", "shader: {type: Lambert}\nobject: {filename: "
+                                                 "tri.obj, scale: 3, translation: [0, 0, -1]}\n"));
     const Mesh& m = scene.meshes[0];
     const uvec3 t = m.triangles[0];
     expectNear(m.positions[t.x], vec3(3, 0, -1), 1e-5f, "corner (1,0,0)");
@@ -303,9 +311,11 @@ TEST(Loader, UniformScaleIsANumber) {
 // YAML reads a plain `Null` as the null value: the format's Null shader must load all the same.
 TEST(Loader, NullShaderTypeIsReadAsTheNullShader) {
     TempDir dir;
-    const Scene scene = loadScene(dir.write("n.yaml", "shaders:\n  - {type: Null, emission: [2, 2, 2]}\n  - type: Null\n"));
+    const Scene scene = loadScene(
+        dir.write("n.yaml", "shaders:\n  - {type: Null, emission: [2, 2, 2]}\n  - type: Null\n"));
     ASSERT_EQ(scene.shaders.size(), 2u);
-    for (const Shader& s : scene.shaders) EXPECT_EQ(s.params.model, kModelNull);
+    for (const Shader& s : scene.shaders)
+        EXPECT_EQ(s.params.model, kModelNull);
     EXPECT_EQ(scene.shaders[0].params.emission, vec3(2.0f));
 }
 
@@ -313,11 +323,12 @@ TEST(Loader, NullShaderTypeIsReadAsTheNullShader) {
 // level below three times load as 31 textures (3^30 leaves if aliases were copied).
 TEST(Loader, TextureAliasesAreSharedNotCopied) {
     TempDir dir;
-    std::string y = "shaders:\n  - {type: Lambert, texture: &a0 {type: Constant, colour: [0.5, 0.5, 0.5]}}\n";
+    std::string y =
+        "shaders:\n  - {type: Lambert, texture: &a0 {type: Constant, colour: [0.5, 0.5, 0.5]}}\n";
     for (int i = 1; i <= 30; ++i) {
         const std::string prev = "*a" + std::to_string(i - 1);
-        y += "  - {type: Lambert, texture: &a" + std::to_string(i) + " {type: Layered, upper: " + prev + ", lower: " +
-             prev + ", mask: " + prev + "}}\n";
+        y += "  - {type: Lambert, texture: &a" + std::to_string(i) +
+             " {type: Layered, upper: " + prev + ", lower: " + prev + ", mask: " + prev + "}}\n";
     }
     const Scene scene = loadScene(dir.write("bomb.yaml", y));
     EXPECT_EQ(scene.textures.size(), 31u);
@@ -329,11 +340,13 @@ TEST(Loader, TextureAliasesAreSharedNotCopied) {
 
 TEST(Loader, ConductorAndDielectricTakeTheirKeysAndDefaults) {
     TempDir dir;
-    Scene scene = loadScene(dir.write("metal.yaml", "shaders:\n"
-                                                    "  - {type: Conductor}\n"
-                                                    "  - {type: Conductor, colour: [0.9, 0.6, 0.2], alpha: 0.3, two sided: true}\n"
-                                                    "  - {type: Dielectric}\n"
-                                                    "  - {type: Dielectric, ior: 2.4, alpha: 0.05, emission: [1, 2, 3]}\n"));
+    Scene scene = loadScene(
+        dir.write("metal.yaml",
+                  "shaders:\n"
+                  "  - {type: Conductor}\n"
+                  "  - {type: Conductor, colour: [0.9, 0.6, 0.2], alpha: 0.3, two sided: true}\n"
+                  "  - {type: Dielectric}\n"
+                  "  - {type: Dielectric, ior: 2.4, alpha: 0.05, emission: [1, 2, 3]}\n"));
     ASSERT_EQ(scene.shaders.size(), 4u);
     const ShaderParams& c0 = scene.shaders[0].params;
     EXPECT_EQ(c0.model, kModelConductor);
@@ -358,7 +371,8 @@ TEST(Loader, DegenerateTrianglesAreDroppedWithOneWarning) {
     TempDir dir;
     const std::string obj = dir.write("degenerate.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 2 0 0\n"
                                                         "f 1 2 3\nf 1 2 4\nf 1 1 3\n");
-    Scene scene = loadScene(dir.write("d.yaml", "shader: {type: Lambert}\nobject: {filename: degenerate.obj}\n"));
+    Scene scene = loadScene(
+        dir.write("d.yaml", "shader: {type: Lambert}\nobject: {filename: degenerate.obj}\n"));
     ASSERT_EQ(scene.meshes.size(), 1u);
     EXPECT_EQ(scene.meshes[0].triangles.size(), 1u);
     EXPECT_EQ(scene.meshes[0].droppedTriangles, 2);
@@ -369,7 +383,8 @@ TEST(Loader, DegenerateTrianglesAreDroppedWithOneWarning) {
     const size_t at = r.output.find(warning);
     EXPECT_NE(at, std::string::npos) << r.output;
     EXPECT_EQ(r.output.find(warning, at + 1), std::string::npos) << "warned twice: " << r.output;
-    EXPECT_NE(r.output.find(obj), std::string::npos) << "the warning must name the file: " << r.output;
+    EXPECT_NE(r.output.find(obj), std::string::npos)
+        << "the warning must name the file: " << r.output;
 }
 
 // Absurd --spp values are refused before anything is loaded or allocated.
@@ -377,7 +392,8 @@ TEST(Loader, AbsurdSppIsAUsageError) {
     TempDir dir;
     const std::string scene = dir.write("s.yaml", "image: {width: 4, height: 4}\n");
     for (const char* spp : {"0", "-3", "100000000000", "1e9"}) {
-        CommandResult r = runSpillway("render " + scene + " -o " + dir.file("s.exr") + " --quiet --spp " + spp);
+        CommandResult r =
+            runSpillway("render " + scene + " -o " + dir.file("s.exr") + " --quiet --spp " + spp);
         EXPECT_EQ(r.status, 2) << spp << ": " << r.output;
         EXPECT_NE(r.output.find("--spp"), std::string::npos) << r.output;
     }
@@ -387,17 +403,20 @@ TEST(Loader, AbsurdSppIsAUsageError) {
 // plane y = 5, spans 4 in X and 2 in Z, and its front (local +Z) faces -Y.
 TEST(Loader, QuadLightRotatedNinetyAboutXFacesDown) {
     TempDir dir;
-    Scene scene = loadScene(
-        dir.write("light.yaml", "light: {type: Quad, translation: [1, 5, -3], rotation: [90, 0, 0], scale: [4, 2]}\n"));
+    Scene scene = loadScene(dir.write(
+        "light.yaml",
+        "light: {type: Quad, translation: [1, 5, -3], rotation: [90, 0, 0], scale: [4, 2]}\n"));
     ASSERT_EQ(scene.quadLightCount, 1);
     const Mesh& m = scene.meshes[size_t(scene.objectCount)];
     ASSERT_EQ(m.triangles.size(), 2u);
     for (const uvec3& t : m.triangles) {
-        vec3 n = glm::cross(m.positions[t.y] - m.positions[t.x], m.positions[t.z] - m.positions[t.x]);
+        vec3 n =
+            glm::cross(m.positions[t.y] - m.positions[t.x], m.positions[t.z] - m.positions[t.x]);
         expectNear(glm::normalize(n), vec3(0, -1, 0), 1e-5f, "triangle normal");
     }
     vec3 lo(HUGE_VALF), hi(-HUGE_VALF);
-    for (vec3 p : m.positions) lo = glm::min(lo, p), hi = glm::max(hi, p);
+    for (vec3 p : m.positions)
+        lo = glm::min(lo, p), hi = glm::max(hi, p);
     expectNear(lo, vec3(-1, 5, -4), 1e-5f, "lower corner");
     expectNear(hi, vec3(3, 5, -2), 1e-5f, "upper corner");
 }
@@ -407,7 +426,8 @@ TEST(Loader, QuadLightRotatedNinetyAboutXFacesDown) {
 TEST(Loader, ShaderAndObjectCountsStayWithinTheHitKey) {
     TempDir dir;
     std::string shaders = "shaders:\n";
-    for (int i = 0; i < kMaxShaders - 1; ++i) shaders += "  - {type: Lambert}\n";
+    for (int i = 0; i < kMaxShaders - 1; ++i)
+        shaders += "  - {type: Lambert}\n";
     const std::string light = "lights:\n  - {type: Quad}\n  - {type: Quad}\n";
     // kMaxShaders - 1 shaders and one light fit; a second light does not.
     const std::string full = dir.write("full.yaml", shaders + "lights:\n  - {type: Quad}\n");
@@ -418,7 +438,8 @@ TEST(Loader, ShaderAndObjectCountsStayWithinTheHitKey) {
         ADD_FAILURE() << "loaded " << kMaxShaders + 1 << " shaders";
     } catch (const SceneError& e) {
         EXPECT_EQ(e.line(), kMaxShaders + 3) << e.what();
-        EXPECT_NE(std::string(e.what()).find("more than 4095 shaders"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("more than 4095 shaders"), std::string::npos)
+            << e.what();
     }
     const std::string lightsFirst = dir.write("first.yaml", light + shaders);
     try {
@@ -439,7 +460,9 @@ struct ErrorCase {
     bool inObj = false;  // the error is in an OBJ file, not in the scene file
 };
 
-void PrintTo(const ErrorCase& c, std::ostream* os) { *os << c.name; }
+void PrintTo(const ErrorCase& c, std::ostream* os) {
+    *os << c.name;
+}
 
 class LoaderError : public ::testing::TestWithParam<ErrorCase> {};
 
@@ -458,7 +481,8 @@ TEST_P(LoaderError, ExitsTwoNamingFileAndLine) {
     EXPECT_EQ(r.status, 2) << r.output;
     const std::string file = c.inObj ? dir.file(c.message) : scenePath;
     const std::string where = file + ":" + std::to_string(c.line) + ":";
-    EXPECT_EQ(r.output.rfind(where, 0), 0u) << "expected output to start with '" << where << "', got: " << r.output;
+    EXPECT_EQ(r.output.rfind(where, 0), 0u)
+        << "expected output to start with '" << where << "', got: " << r.output;
     if (!c.inObj) {
         EXPECT_NE(r.output.find(c.message, where.size()), std::string::npos) << r.output;
     }
@@ -466,15 +490,18 @@ TEST_P(LoaderError, ExitsTwoNamingFileAndLine) {
 }
 
 const ErrorCase kErrorCases[] = {
-    {"UnknownTopLevelKey", "image: {width: 8, height: 8}\nmaterials: {type: Lambert}\n", 2, "materials"},
+    {"UnknownTopLevelKey", "image: {width: 8, height: 8}\nmaterials: {type: Lambert}\n", 2,
+     "materials"},
     {"UnknownCameraKey", "camera:\n  type: PinHole\n  zoom: 3\n", 3, "zoom"},
-    {"UnknownKeyInObject", "shader: {type: Lambert}\nobject:\n  filename: tri.obj\n  colour: [1, 0, 0]\n", 4,
-     "colour"},
+    {"UnknownKeyInObject",
+     "shader: {type: Lambert}\nobject:\n  filename: tri.obj\n  colour: [1, 0, 0]\n", 4, "colour"},
     {"WidthNotAnInteger", "image:\n  height: 8\n  width: abc\n", 3, "width"},
     {"WidthNotWhole", "image:\n  width: 8.5\n", 2, "width"},
-    {"StringWhereListExpected", "camera:\n  type: PinHole\n  translation: far away\n", 3, "translation"},
+    {"StringWhereListExpected", "camera:\n  type: PinHole\n  translation: far away\n", 3,
+     "translation"},
     {"ListWithTooFewNumbers", "light:\n  type: Quad\n  colour: [1, 1]\n", 3, "colour"},
-    {"MapWhereNumberExpected", "shader:\n  type: Lambert\n  reflectance: {a: 1}\n", 3, "reflectance"},
+    {"MapWhereNumberExpected", "shader:\n  type: Lambert\n  reflectance: {a: 1}\n", 3,
+     "reflectance"},
     {"NegativeWidth", "settings: {max depth: 4}\nimage:\n  width: -5\n", 3, "width"},
     {"ZeroHeight", "image: {width: 8,\n  height: 0}\n", 2, "height"},
     {"NegativeLightScale", "light:\n  type: Quad\n  scale: [1, -2]\n", 3, "scale"},
@@ -484,30 +511,36 @@ const ErrorCase kErrorCases[] = {
     {"NanIntensity", "light:\n  type: Quad\n  intensity: .nan\n", 3, "intensity"},
     {"InfTranslation", "camera:\n  translation: [0, .inf, 0]\n", 2, "translation"},
     {"NegativeInfFocalLength", "camera:\n  focal length: -.inf\n", 2, "focal length"},
-    {"NanInObjectScale", "shader: {type: Lambert}\nobject:\n  filename: tri.obj\n  scale: [1, .NaN, 1]\n", 4,
-     "scale"},
+    {"NanInObjectScale",
+     "shader: {type: Lambert}\nobject:\n  filename: tri.obj\n  scale: [1, .NaN, 1]\n", 4, "scale"},
     {"ShaderIndexMissingFlow",
-     "shader: {type: Lambert}\nobject: {type: Polygon, filename: tri.obj, shader: 1}\n", 2, "shader 1"},
+     "shader: {type: Lambert}\nobject: {type: Polygon, filename: tri.obj, shader: 1}\n", 2,
+     "shader 1"},
     {"ShaderIndexMissingBlock",
-     "shader: {type: Lambert}\nobject:\n  type: Polygon\n  filename: tri.obj\n  shader: 3\n", 5, "shader 3"},
+     "shader: {type: Lambert}\nobject:\n  type: Polygon\n  filename: tri.obj\n  shader: 3\n", 5,
+     "shader 3"},
     {"NoShadersAtAll", "object: {type: Polygon, filename: tri.obj}\n", 1, "shader 0"},
-    {"MissingObjFile", "shader: {type: Lambert}\nobject:\n  type: Polygon\n  filename: nowhere.obj\n", 4,
+    {"MissingObjFile",
+     "shader: {type: Lambert}\nobject:\n  type: Polygon\n  filename: nowhere.obj\n", 4,
      "nowhere.obj"},
     {"MissingTextureFile",
-     "shader:\n  type: Lambert\n  texture:\n    type: Layered\n    upper: {type: Standard, string: textures/ok.tx}\n"
-     "    lower:\n      type: Standard\n      string: textures/none.tx\n    mask: {type: Constant}\n",
+     "shader:\n  type: Lambert\n  texture:\n    type: Layered\n    upper: {type: Standard, string: "
+     "textures/ok.tx}\n"
+     "    lower:\n      type: Standard\n      string: textures/none.tx\n    mask: {type: "
+     "Constant}\n",
      8, "none.tx"},
-    {"ConductorAlphaAboveOne", "image: {width: 4, height: 4}\nshader:\n  type: Conductor\n  alpha: 1.5\n", 4,
-     "alpha"},
+    {"ConductorAlphaAboveOne",
+     "image: {width: 4, height: 4}\nshader:\n  type: Conductor\n  alpha: 1.5\n", 4, "alpha"},
     {"ConductorColourAboveOne", "shader:\n  type: Conductor\n  colour: [1, 1.2, 1]\n", 3, "colour"},
     {"ConductorTakesNoIor", "shader:\n  type: Conductor\n  ior: 1.5\n", 3, "ior"},
     {"IorBelowRange", "shader:\n  type: Dielectric\n  ior: 1.0\n", 3, "ior"},
     {"IorAboveRange", "shader:\n  type: Dielectric\n  ior: 10.5\n", 3, "ior"},
-    {"DielectricIorBelowOne", "shaders:\n  - {type: Lambert}\n  - {type: Dielectric, ior: 0.8}\n", 3, "ior"},
+    {"DielectricIorBelowOne", "shaders:\n  - {type: Lambert}\n  - {type: Dielectric, ior: 0.8}\n",
+     3, "ior"},
     {"DielectricNegativeAlpha", "shader:\n  type: Dielectric\n  alpha: -0.1\n", 3, "alpha"},
     {"DielectricTakesNoColour", "shader:\n  type: Dielectric\n  colour: [1, 1, 1]\n", 3, "colour"},
-    {"PointLightNotSupported", "light: {type: Quad}\nlight:\n  type: Point\n  position: [0, 1, 0]\n", 3,
-     "not supported yet"},
+    {"PointLightNotSupported",
+     "light: {type: Quad}\nlight:\n  type: Point\n  position: [0, 1, 0]\n", 3, "not supported yet"},
     {"EnvironmentLightNotSupported", "lights:\n  - {type: Environment, colour: [1, 1, 1]}\n", 2,
      "not supported yet"},
     {"UnknownShaderType", "shader:\n  type: Phong\n", 2, "Phong"},
@@ -515,18 +548,24 @@ const ErrorCase kErrorCases[] = {
     {"ImageTwice", "image: {width: 8}\ncamera: {fov: 40}\nimage: {height: 8}\n", 3, "image"},
     {"ObjectsNotAList", "shader: {type: Lambert}\nobjects: {filename: tri.obj}\n", 2, "list"},
     {"ObjNanVertex", "shader: {type: Lambert}\nobject: {filename: bad.obj}\n", 4, "bad.obj", true},
-    {"ObjInfVertex", "shader: {type: Lambert}\nobject: {filename: bad_inf.obj}\n", 2, "bad_inf.obj", true},
-    {"ObjVertexInfiniteAfterTransform", "shader: {type: Lambert}\nobject: {filename: big.obj, scale: 1e30}\n", 2,
-     "big.obj", true},
-    {"ObjTriangleTooLargeForFloat", "shader: {type: Lambert}\nobject:\n  filename: big.obj\n", 3, "too large"},
-    {"QuadLightWithoutAreaInFloat", "light:\n  type: Quad\n  scale: [1e-30, 1e-30]\n", 2, "no area"},
-    {"MoreSamplesPerPixelThan2To32", "image:\n  sample base: 256\n  iterations: 16777216\n", 2, "2^32"},
+    {"ObjInfVertex", "shader: {type: Lambert}\nobject: {filename: bad_inf.obj}\n", 2, "bad_inf.obj",
+     true},
+    {"ObjVertexInfiniteAfterTransform",
+     "shader: {type: Lambert}\nobject: {filename: big.obj, scale: 1e30}\n", 2, "big.obj", true},
+    {"ObjTriangleTooLargeForFloat", "shader: {type: Lambert}\nobject:\n  filename: big.obj\n", 3,
+     "too large"},
+    {"QuadLightWithoutAreaInFloat", "light:\n  type: Quad\n  scale: [1e-30, 1e-30]\n", 2,
+     "no area"},
+    {"MoreSamplesPerPixelThan2To32", "image:\n  sample base: 256\n  iterations: 16777216\n", 2,
+     "2^32"},
     {"AbsurdImageSize", "image:\n  width: 32768\n  height: 32768\n", 2, "larger than"},
     {"AbsurdWidth", "image:\n  width: 1000000000\n", 2, "width"},
 };
 
 INSTANTIATE_TEST_SUITE_P(Loader, LoaderError, ::testing::ValuesIn(kErrorCases),
-                         [](const ::testing::TestParamInfo<ErrorCase>& info) { return std::string(info.param.name); });
+                         [](const ::testing::TestParamInfo<ErrorCase>& info) {
+                             return std::string(info.param.name);
+                         });
 
 } // namespace
 } // namespace spw::test

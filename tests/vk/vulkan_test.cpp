@@ -72,8 +72,9 @@ RenderConfig validatedVulkan(int spp) {
 // Renders with validation on and fails the test on any message the layer printed, counted
 // after the render returned (the instance, and the layer's leak checks, are gone by then).
 // With `iterations`, each iteration's image is appended to it.
-std::unique_ptr<RenderResult> renderValidated(const Scene& scene, const RenderConfig& cfg,
-                                              std::vector<std::vector<float>>* iterations = nullptr) {
+std::unique_ptr<RenderResult>
+renderValidated(const Scene& scene, const RenderConfig& cfg,
+                std::vector<std::vector<float>>* iterations = nullptr) {
     const std::uint64_t before = vk::validationMessageCount();
     auto result = render(scene, cfg, [&](int, int, const Film& film) {
         if (iterations) iterations->push_back(film.lastIterationImage());
@@ -130,18 +131,22 @@ Difference difference(const std::vector<float>& a, const std::vector<float>& b) 
 //    errors, which are far below either render's noise (see expectNoPairedDifference), allowing
 //    `rounding` x the image mean per pixel for consistent rounding.
 void expectSameUpToRounding(const char* what, const std::vector<std::vector<float>>& vulkan,
-                            const std::vector<std::vector<float>>& cpu, int width, int height, double rounding) {
+                            const std::vector<std::vector<float>>& cpu, int width, int height,
+                            double rounding) {
     ASSERT_EQ(vulkan.size(), cpu.size());
     std::vector<float> v(vulkan[0].size(), 0.0f), c(cpu[0].size(), 0.0f);
     for (size_t k = 0; k < vulkan.size(); ++k)
-        for (size_t i = 0; i < v.size(); ++i) v[i] += vulkan[k][i] / float(vulkan.size()), c[i] += cpu[k][i] / float(cpu.size());
+        for (size_t i = 0; i < v.size(); ++i)
+            v[i] += vulkan[k][i] / float(vulkan.size()), c[i] += cpu[k][i] / float(cpu.size());
     const Difference d = difference(v, c);
-    std::printf("%s: %zu of %zu values differ at all; relative difference: 99.9th percentile %.2e, max %.2e; "
+    std::printf("%s: %zu of %zu values differ at all; relative difference: 99.9th percentile %.2e, "
+                "max %.2e; "
                 "%zu beyond %.0e (paths that diverged)\n",
                 what, d.unequal, d.values, d.p999, d.maxRel, d.diverged, kDiverged);
     EXPECT_LE(d.p999, rounding) << what;
     EXPECT_LE(double(d.diverged), 1e-3 * double(d.values)) << what;
-    expectNoPairedDifference(pairedDifference(vulkan, cpu), width, height, what, rounding * mean(c));
+    expectNoPairedDifference(pairedDifference(vulkan, cpu), width, height, what,
+                             rounding * mean(c));
 }
 
 // --- the device ----------------------------------------------------------------------------
@@ -203,7 +208,8 @@ TEST(VulkanVsCpu, CornellBoxAgreesUpToFloatRounding) {
     cpuCfg.backend = BackendKind::Cpu;
     std::vector<std::vector<float>> v, c;
     auto result = renderValidated(scene, vkCfg, &v);
-    render(scene, cpuCfg, [&](int, int, const Film& film) { c.push_back(film.lastIterationImage()); });
+    render(scene, cpuCfg,
+           [&](int, int, const Film& film) { c.push_back(film.lastIterationImage()); });
     expectSameUpToRounding("Cornell box", v, c, 32, 32, 1e-5);
     // The scene's models: its Lambert walls and blocks, and the quad light's Null shader.
     EXPECT_EQ(result->stats.extra["vulkan"]["pipelines"], nlohmann::json({"null", "lambert"}));
@@ -221,7 +227,8 @@ TEST(VulkanVsCpu, ClosedEnclosureAgreesUpToFloatRounding) {
     cpuCfg.backend = BackendKind::Cpu;
     std::vector<std::vector<float>> v, c;
     auto result = renderValidated(scene, vkCfg, &v);
-    render(scene, cpuCfg, [&](int, int, const Film& film) { c.push_back(film.lastIterationImage()); });
+    render(scene, cpuCfg,
+           [&](int, int, const Film& film) { c.push_back(film.lastIterationImage()); });
     expectSameUpToRounding("closed enclosure", v, c, scene.image.width, scene.image.height, 5e-4);
     // And against the closed form Le / (1 - a) = 5.
     const MeanError m = meanAndError(result->film->image());
@@ -329,7 +336,8 @@ PerHit shadeSameHits(ShadingMode mode) {
             float u = unit(rng), v = unit(rng);
             if (u + v > 1.0f) u = 1.0f - u, v = 1.0f - v;
             ShadeInput& in = inputs[i];
-            in.hit = embree.setUpHit(HitRecord{mesh, prim, u, v, 10.0f + 1000.0f * unit(rng)}, textures);
+            in.hit =
+                embree.setUpHit(HitRecord{mesh, prim, u, v, 10.0f + 1000.0f * unit(rng)}, textures);
             vec3 d = glm::normalize(vec3(unit(rng) - 0.5f, unit(rng) - 0.5f, unit(rng) - 0.5f));
             if (rng() % 8 != 0 && glm::dot(d, in.hit.ng) > 0.0f)
                 d = -d; // mostly the front, some backs
@@ -465,7 +473,8 @@ TEST(VulkanMegakernel, MatchesCpuAndBuildsOnlyTheUberShader) {
     cpuCfg.backend = BackendKind::Cpu;
     std::vector<std::vector<float>> vi, ci;
     auto v = renderValidated(scene, vkCfg, &vi);
-    render(scene, cpuCfg, [&](int, int, const Film& film) { ci.push_back(film.lastIterationImage()); });
+    render(scene, cpuCfg,
+           [&](int, int, const Film& film) { ci.push_back(film.lastIterationImage()); });
     expectSameUpToRounding("megakernel Cornell box", vi, ci, 24, 24, 3e-5); // measured 3.5e-6
     EXPECT_EQ(v->stats.extra["vulkan"]["pipelines"], nlohmann::json({"megakernel"}));
     EXPECT_EQ(v->stats.extra["shading"], "megakernel");
