@@ -4,7 +4,7 @@
 // arithmetic is shared/path.h's shadeSurface(), the same function the sorted backends run.
 #pragma once
 
-#include "host/render/backend.h"
+#include "host/backend/backend.h"
 
 namespace spw {
 

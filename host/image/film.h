@@ -18,7 +18,8 @@
 // difference estimates the image's own error without a reference (halfBufferRelMse).
 #pragma once
 
-#include "host/scene/scene.h"
+#include "host/image/filter.h"
+#include "shared/types.h"
 
 #include <atomic>
 #include <cstdint>

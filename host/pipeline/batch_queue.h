@@ -9,8 +9,8 @@
 // fallocate(PUNCH_HOLE) so the file's disk use stays at what is still queued.
 #pragma once
 
+#include "host/backend/stats.h"
 #include "host/pipeline/ray_record.h"
-#include "host/render/stats.h"
 
 #include <cstdint>
 #include <deque>

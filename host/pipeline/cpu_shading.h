@@ -3,8 +3,8 @@
 // is nothing to overlap).
 #pragma once
 
+#include "host/backend/backend.h"
 #include "host/pipeline/shading_engine.h"
-#include "host/render/backend.h"
 
 #include <memory>
 

@@ -30,7 +30,7 @@
 // bounce | flags << 16.
 #pragma once
 
-#include "host/render/render_config.h"
+#include "host/backend/render_config.h"
 #include "shared/types.h"
 
 #include <cstddef>

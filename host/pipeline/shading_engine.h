@@ -3,7 +3,7 @@
 // implement it: C++ in TBB tasks (cpu_shading.h) and Vulkan compute (host/vk/vulkan_shading.h).
 #pragma once
 
-#include "host/render/stats.h"
+#include "host/backend/stats.h"
 #include "shared/shade_io.h"
 
 #include <cstddef>

@@ -3,10 +3,10 @@
 // where the shading engine has two slots.
 #pragma once
 
+#include "host/backend/backend.h"
 #include "host/pipeline/batch_queue.h"
 #include "host/pipeline/ray_sort.h"
 #include "host/pipeline/shading_engine.h"
-#include "host/render/backend.h"
 
 #include <memory>
 

@@ -17,11 +17,11 @@
 #pragma once
 
 #include "embree_backend/batch_traversal.h"
+#include "host/backend/backend.h"
 #include "host/pipeline/batch_queue.h"
 #include "host/pipeline/hit_sort.h"
 #include "host/pipeline/ray_record.h"
 #include "host/pipeline/shading_engine.h"
-#include "host/render/backend.h"
 
 #include <cstdint>
 #include <vector>

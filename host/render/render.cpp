@@ -2,10 +2,10 @@
 
 #include "embree_backend/embree_scene.h"
 #include "embree_backend/reference_renderer.h"
+#include "host/backend/backend.h"
 #include "host/pipeline/cpu_shading.h"
 #include "host/pipeline/sorted_renderer.h"
-#include "host/render/backend.h"
-#include "host/render/camera.h"
+#include "host/scene/camera.h"
 #include "host/scene/textures.h"
 #include "host/vk/context.h"
 #include "host/vk/vulkan_shading.h"

@@ -2,9 +2,9 @@
 // iterations into the film and fills in the stats. The CLI and the tests both call this.
 #pragma once
 
+#include "host/backend/render_config.h"
+#include "host/backend/stats.h"
 #include "host/image/film.h"
-#include "host/render/render_config.h"
-#include "host/render/stats.h"
 #include "host/scene/scene.h"
 
 #include <functional>

@@ -2,6 +2,7 @@
 // loaded. Backends read it; nothing writes it after loadScene() returns.
 #pragma once
 
+#include "host/image/filter.h"
 #include "shared/types.h"
 
 #include <glm/vec3.hpp>
@@ -84,12 +85,6 @@ struct Camera {
     float focalDistance = 1.0f;
     // tan(horizontal half angle)
     float tanHalfFovX() const;
-};
-
-enum class FilterType { Box, Tent, Gaussian };
-struct Filter {
-    FilterType type = FilterType::Box;
-    float radius = 0.5f; // pixels; Box always covers its own pixel only
 };
 
 enum class SamplerType { Independent, Grid, Stratified };

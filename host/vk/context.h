@@ -4,7 +4,7 @@
 // prints and counts every warning or error it reports (the tests fail on any).
 #pragma once
 
-#include "host/render/render_config.h"
+#include "host/backend/render_config.h"
 
 #include <vulkan/vulkan.h>
 

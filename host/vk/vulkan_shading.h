@@ -13,8 +13,8 @@
 // emission and next-event estimation without emitters, and the per-hit albedo without textures.
 #pragma once
 
+#include "host/backend/backend.h"
 #include "host/pipeline/shading_engine.h"
-#include "host/render/backend.h"
 
 #include <memory>
 

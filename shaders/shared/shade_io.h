@@ -2,7 +2,7 @@
 // per-hit input record, and the push constants of one dispatch. (The per-hit output is
 // ShadeResult in types.h: the shadow ray with its pending contribution and the continuation ray,
 // which the host traces and bins. Rays themselves never cross: Embree traces them on the host.)
-// The C++ layout is pinned in host/render/shared_layout.cpp; kernels read these through
+// The C++ layout is pinned in host/vk/shared_layout.cpp; kernels read these through
 // GL_EXT_scalar_block_layout, which packs them exactly as C++ over glm does (vec3 = 12 bytes,
 // 4-byte alignment), so no field needs hand padding beyond what is written here.
 #ifndef SPILLWAY_SHARED_SHADE_IO_H

@@ -1,5 +1,5 @@
 // Structs that every backend's shading step reads and writes. Declared once, here; the C++
-// side checks their layout in host/render/shared_layout.cpp so that a GLSL scalar-block-layout view
+// side checks their layout in host/vk/shared_layout.cpp so that a GLSL scalar-block-layout view
 // of the same bytes stays in step.
 #ifndef SPILLWAY_SHARED_TYPES_H
 #define SPILLWAY_SHARED_TYPES_H

@@ -4,7 +4,7 @@
 // pipelines a scene needs, and fail or fall back cleanly when no driver is visible.
 #include "embree_backend/embree_scene.h"
 #include "host/pipeline/cpu_shading.h"
-#include "host/render/camera.h"
+#include "host/scene/camera.h"
 #include "host/scene/surface_models.h"
 #include "host/scene/textures.h"
 #include "host/vk/check.h"

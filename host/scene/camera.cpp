@@ -1,4 +1,4 @@
-#include "host/render/camera.h"
+#include "host/scene/camera.h"
 
 #include "shared/rng.h"
 #include "shared/sampling.h"

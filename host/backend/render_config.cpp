@@ -1,4 +1,4 @@
-#include "host/render/render_config.h"
+#include "host/backend/render_config.h"
 
 #include <stdexcept>
 

@@ -2,10 +2,10 @@
 // Virtual calls happen per iteration, never per ray.
 #pragma once
 
+#include "host/backend/render_config.h"
+#include "host/backend/stats.h"
 #include "host/image/film.h"
-#include "host/render/camera.h"
-#include "host/render/render_config.h"
-#include "host/render/stats.h"
+#include "host/scene/camera.h"
 #include "host/scene/lights.h"
 #include "host/scene/scene.h"
 #include "host/scene/textures.h"

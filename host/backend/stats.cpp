@@ -1,4 +1,4 @@
-#include "host/render/stats.h"
+#include "host/backend/stats.h"
 
 namespace spw {
 

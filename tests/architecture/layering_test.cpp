@@ -1,0 +1,91 @@
+// The architecture as docs/design.md draws it, checked on the sources: every #include goes down
+// the layers, never up or sideways, and Embree stays inside embree_backend/.
+//
+//   app -> render -> {pipeline -> embree_backend, vk -> pipeline's shading-engine interface}
+//       -> backend (what every backend is handed) -> scene -> image -> shaders/shared
+#include "test_util.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <regex>
+#include <set>
+#include <string>
+
+namespace spw::test {
+namespace {
+
+namespace fs = std::filesystem;
+
+// The folder a source or an include path belongs to: host/<folder>/..., embree_backend, shared.
+std::string layerOf(const std::string& path) {
+    static const std::regex host("^host/([a-z_]+)/");
+    std::smatch m;
+    if (std::regex_search(path, m, host)) return m[1];
+    if (path.rfind("embree_backend/", 0) == 0) return "embree_backend";
+    if (path.rfind("shared/", 0) == 0 || path.rfind("shaders/shared/", 0) == 0) return "shared";
+    return "";
+}
+
+// What each layer may include besides itself.
+const std::map<std::string, std::set<std::string>> kMayInclude = {
+    {"shared", {}},
+    {"image", {"shared"}},
+    {"scene", {"image", "shared"}},
+    {"backend", {"scene", "image", "shared"}},
+    {"embree_backend", {"backend", "scene", "image", "shared"}},
+    {"pipeline", {"embree_backend", "backend", "scene", "image", "shared"}},
+    {"vk", {"pipeline", "backend", "scene", "image", "shared"}},
+    {"render", {"pipeline", "vk", "embree_backend", "backend", "scene", "image", "shared"}},
+    {"app", {"render", "pipeline", "vk", "embree_backend", "backend", "scene", "image", "shared"}},
+};
+
+std::vector<std::string> sources() {
+    std::vector<std::string> out;
+    for (const char* dir : {"host", "embree_backend", "shaders/shared"})
+        for (const auto& e : fs::recursive_directory_iterator(sourceDir() + "/" + dir)) {
+            const std::string ext = e.path().extension().string();
+            if (e.is_regular_file() && (ext == ".h" || ext == ".cpp"))
+                out.push_back(fs::relative(e.path(), sourceDir()).generic_string());
+        }
+    return out;
+}
+
+TEST(Architecture, EveryIncludeGoesDownTheLayers) {
+    const std::vector<std::string> files = sources();
+    ASSERT_GT(files.size(), 50u);
+    static const std::regex include("^#include \"([^\"]+)\"");
+    size_t checked = 0;
+    for (const std::string& file : files) {
+        const std::string from = layerOf(file);
+        ASSERT_TRUE(kMayInclude.count(from)) << file << ": a folder the layering does not know";
+        std::ifstream in(sourceDir() + "/" + file);
+        std::string line;
+        for (int n = 1; std::getline(in, line); ++n) {
+            std::smatch m;
+            if (!std::regex_search(line, m, include)) continue;
+            const std::string to = layerOf(m[1]);
+            if (to.empty() || to == from) continue; // same folder, or a sibling file of shared/
+            ++checked;
+            EXPECT_TRUE(kMayInclude.at(from).count(to))
+                << file << ":" << n << ": " << from << " includes " << m[1] << " (" << to << ")";
+        }
+    }
+    EXPECT_GT(checked, 50u);
+}
+
+TEST(Architecture, NoEmbreeTypeOutsideEmbreeBackend) {
+    static const std::regex embree("embree3/|\\bRTC[A-Z][A-Za-z]*\\b|\\brtc[A-Z][A-Za-z0-9]*\\(");
+    for (const std::string& file : sources()) {
+        if (layerOf(file) == "embree_backend") continue;
+        std::ifstream in(sourceDir() + "/" + file);
+        std::string line;
+        for (int n = 1; std::getline(in, line); ++n)
+            EXPECT_FALSE(std::regex_search(line, embree)) << file << ":" << n << ": " << line;
+    }
+}
+
+} // namespace
+} // namespace spw::test
