@@ -6,8 +6,7 @@
 //     kModelCount in shaders/shared/types.h).
 // The BSDF dispatch itself is bsdf.h's, shared by every backend.
 //
-// Adding a model: its constant in types.h, its header in shaders/shared/ dispatched from bsdf.h,
-// one line here, its kernel shaders/<file>.comp (four lines: see lambert.comp), and its test.
+// Adding a model: docs/adding-a-surface-model.md lists every file and what checks each.
 //
 // X(Name, model constant, kernel file stem) — keep each entry on one line: CMake parses them.
 #pragma once
