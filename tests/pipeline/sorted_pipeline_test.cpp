@@ -39,40 +39,9 @@ bool sameBits(const std::vector<float>& a, const std::vector<float>& b) {
 // are identical, not merely close. The Cornell box (Lambert, Stratified, Box filter) and a
 // scene with every surface model, a Layered image texture, a Gaussian filter and a thin lens.
 TEST(SortedPipeline, FullPrecisionRaysGiveTheReferenceImageBitForBit) {
-    TempDir dir;
-    dir.write("tex.ppm", "P3\n2 2\n255\n255 0 0  0 255 0\n0 0 255  255 255 255\n");
-    const std::string box = sourceDir() + "/scenes/cornell-box/";
-    const Scene everyModel = loadScene(dir.write(
-        "models.yaml", "image: {width: 24, height: 24, sample base: 2, iterations: 2}\n"
-                       "settings: {min depth: 2, max depth: 12}\n"
-                       "camera: {type: ThinLens, look at: {eye: [278, 273, -800], target: [278, "
-                       "273, 0]}, fov: 39.3,\n"
-                       "         aperture radius: 5, focal distance: 1000}\n"
-                       "filter: {type: Gaussian, width: 1.5}\n"
-                       "shaders:\n"
-                       "  - type: Lambert\n"
-                       "    texture: {type: Layered, upper: {type: Standard, string: tex.ppm}, "
-                       "lower: {type: Constant, colour: [0.7, 0.7, 0.7]},\n"
-                       "              mask: {type: Constant, colour: [0.5, 0.5, 0.5]}}\n"
-                       "  - {type: Conductor, colour: [0.95, 0.64, 0.54], alpha: 0.3}\n"
-                       "  - {type: Conductor, colour: [0.9, 0.9, 0.9]}\n"
-                       "  - {type: Dielectric, ior: 1.5, alpha: 0.2}\n"
-                       "  - {type: Dielectric, ior: 1.33}\n"
-                       "objects:\n"
-                       "  - {filename: " +
-                           box +
-                           "white.obj, shader: 0}\n"
-                           "  - {filename: " +
-                           box +
-                           "red.obj, shader: 1}\n"
-                           "  - {filename: " +
-                           box +
-                           "green.obj, shader: 2}\n"
-                           "  - {filename: " +
-                           box +
-                           "blocks.obj, shader: 3}\n"
-                           "light: {type: Quad, translation: [278, 548.7, 279.5], rotation: [90, "
-                           "0, 0], scale: [130, 105], colour: [17, 12, 4]}\n"));
+    // scenes/every-model.yaml at 24 x 24 (8 spp below).
+    Scene everyModel = loadScene(sourceDir() + "/scenes/every-model.yaml");
+    everyModel.image.width = everyModel.image.height = 24;
     // A 16384 x 4 strip at 4 spp: a sample whose offset in its pixel is within half an ulp of
     // 1 rounds to the next pixel's edge (float(x) + offset == x + 1) about 2^-24 x of the time,
     // some fifty times here; the reference once splatted those into the next pixel.
