@@ -2,6 +2,7 @@
 // range where it is read, and every error names the file and line of the offending node.
 #include "host/scene/obj_mesh.h"
 #include "host/scene/scene.h"
+#include "host/scene/surface_models.h"
 
 #include <OpenImageIO/imageio.h>
 #include <glm/gtc/matrix_transform.hpp>
@@ -43,12 +44,12 @@ class Reader {
 
     // A map node whose keys are all in `allowed`; returns (key, value) pairs in file order.
     void checkKeys(const YAML::Node& map, const std::string& what,
-                   std::initializer_list<const char*> allowed) const {
+                   const std::vector<std::string>& allowed) const {
         if (!map.IsMap()) fail(map, what + " must be a map of keys to values");
         for (auto it = map.begin(); it != map.end(); ++it) {
             std::string key = it->first.as<std::string>();
             bool known = false;
-            for (const char* a : allowed)
+            for (const std::string& a : allowed)
                 known = known || key == a;
             if (!known) fail(it->first, "unknown key '" + key + "' in " + what);
         }
@@ -347,7 +348,7 @@ class TextureReader {
         std::string t = rd.string(n["type"], "texture type");
         Texture tex;
         tex.line = n.Mark().line + 1;
-        auto only = [&](std::initializer_list<const char*> keys) {
+        auto only = [&](const std::vector<std::string>& keys) {
             rd.checkKeys(n, t + " texture", keys);
         };
         if (t == "Constant") {
@@ -404,53 +405,55 @@ class TextureReader {
     std::map<std::size_t, std::vector<Seen>> seen_;
 };
 
+// A shader: `type` names a registered surface model (host/scene/surface_models.h), or Emissive
+// (the Null model with emission required). Every model takes `emission` and `two sided`; the
+// other keys are the ones its registry line names, each read here with its one range.
 void readShader(const Reader& rd, const YAML::Node& n, TextureReader& textures, Scene& scene) {
-    const char* kTypes = "(Null, Lambert, Emissive, Conductor or Dielectric)";
-    if (!n.IsMap() || !n["type"]) rd.fail(n, std::string("shader needs a type ") + kTypes);
+    std::string types = "Emissive";
+    for (const SurfaceModelInfo& m : kSurfaceModels)
+        types += std::string(", ") + m.name;
+    types = "(" + types + ")";
+    if (!n.IsMap() || !n["type"]) rd.fail(n, "shader needs a type " + types);
     // YAML reads a plain `Null` (like `null` and `~`) as the null value, not as a string: the
     // format's shader type Null is written that way, so a null type means Null.
     std::string t = n["type"].IsNull() ? "Null" : rd.string(n["type"], "shader type");
+    const SurfaceModelInfo* model = t == "Emissive" ? surfaceModel(kModelNull) : nullptr;
+    for (const SurfaceModelInfo& m : kSurfaceModels)
+        if (t == m.name) model = &m;
+    if (!model) rd.fail(n["type"], "unknown shader type '" + t + "' " + types);
+
+    std::vector<std::string> keys = {"type", "emission", "two sided"};
+    const uint takes = model->params;
+    for (auto [bit, key] : {std::pair{kTakesReflectance, "reflectance"},
+                            {kTakesColour, "colour"},
+                            {kTakesTexture, "texture"},
+                            {kTakesAlpha, "alpha"},
+                            {kTakesIor, "ior"}})
+        if (takes & bit) keys.push_back(key);
+    rd.checkKeys(n, t + " shader", keys);
+    if (t == "Emissive" && !n["emission"]) rd.fail(n, "Emissive shader needs 'emission'");
+
     Shader s;
     s.typeName = t;
     s.line = n.Mark().line + 1;
     ShaderParams& p = s.params;
-    p.model = kModelNull;
+    p.model = model->model;
     p.colour = vec3(1.0f);
     p.reflectance = 1.0f;
     p.emission = vec3(0.0f);
     p.ior = 1.5f;
     p.alpha = 0.0f;
-    if (t == "Null" || t == "Emissive") {
-        rd.checkKeys(n, t + " shader", {"type", "emission", "two sided"});
-        if (t == "Emissive" && !n["emission"]) rd.fail(n, "Emissive shader needs 'emission'");
-    } else if (t == "Lambert") {
-        rd.checkKeys(n, "Lambert shader",
-                     {"type", "emission", "two sided", "reflectance", "colour", "texture"});
-        p.model = kModelLambert;
-        if (n["reflectance"])
-            p.reflectance = float(rd.number(n["reflectance"], "reflectance", 0.0, 1.0));
-        if (n["colour"] && n["texture"])
-            rd.fail(n["texture"], "Lambert takes colour or texture, not both");
-        if (n["colour"]) p.colour = rd.vec<3>(n["colour"], "colour", 0.0, 1.0);
-        if (n["texture"]) {
-            s.texture = textures.read(n["texture"]);
-            p.flags |= kShaderTextured;
-        }
-    } else if (t == "Conductor") {
-        // colour is F0 (Schlick); alpha the GGX width, 0 a mirror (shared/conductor.h).
-        rd.checkKeys(n, "Conductor shader", {"type", "emission", "two sided", "colour", "alpha"});
-        p.model = kModelConductor;
-        if (n["colour"]) p.colour = rd.vec<3>(n["colour"], "colour", 0.0, 1.0);
-        if (n["alpha"]) p.alpha = float(rd.number(n["alpha"], "alpha", 0.0, 1.0));
-    } else if (t == "Dielectric") {
-        // ior behind the surface, vacuum in front; alpha 0 is smooth glass (shared/dielectric.h).
-        rd.checkKeys(n, "Dielectric shader", {"type", "emission", "two sided", "ior", "alpha"});
-        p.model = kModelDielectric;
-        if (n["ior"]) p.ior = float(rd.number(n["ior"], "ior", 1.01, 10.0));
-        if (n["alpha"]) p.alpha = float(rd.number(n["alpha"], "alpha", 0.0, 1.0));
-    } else {
-        rd.fail(n["type"], "unknown shader type '" + t + "' " + kTypes);
+    if (n["reflectance"])
+        p.reflectance = float(rd.number(n["reflectance"], "reflectance", 0.0, 1.0));
+    if (n["colour"] && n["texture"])
+        rd.fail(n["texture"], t + " takes colour or texture, not both");
+    if (n["colour"]) p.colour = rd.vec<3>(n["colour"], "colour", 0.0, 1.0);
+    if (n["texture"]) {
+        s.texture = textures.read(n["texture"]);
+        p.flags |= kShaderTextured;
     }
+    if (n["ior"]) p.ior = float(rd.number(n["ior"], "ior", 1.01, 10.0));
+    if (n["alpha"]) p.alpha = float(rd.number(n["alpha"], "alpha", 0.0, 1.0));
     if (n["emission"]) p.emission = rd.vec<3>(n["emission"], "emission", 0.0, kMaxRadiance);
     if (n["two sided"] && rd.boolean(n["two sided"], "two sided")) p.flags |= kShaderTwoSided;
     scene.shaders.push_back(s);

@@ -1,38 +1,42 @@
-// The registry of surface models: one line per model. From this list come
-//   * the shader list of the build: CMakeLists.txt reads the lines below and compiles
-//     shaders/<file>.comp for each (configuring fails if a registered model has no kernel);
-//   * the Vulkan pipeline table (host/vk/pipelines.cpp): one pipeline per model the scene uses;
-//   * the checks of tests/vk/vulkan_test.cpp (every model has its kernel, the count matches
-//     kModelCount in shaders/shared/types.h).
-// The BSDF dispatch itself is bsdf.h's, shared by every backend.
+// The C++ view of the surface-model registry (shaders/shared/surface_models.h): each model's
+// name as the scene format spells it, its kModel* constant, its kernel (shaders/<stem>.comp,
+// embedded as SPIR-V under that name) and the scene keys it takes. Read by the loader (which
+// accepts `type: <Name>` and parses the keys), the Vulkan pipeline table (one pipeline per model
+// the scene uses) and the tests that check every model is complete.
 //
-// Adding a model: docs/adding-a-surface-model.md lists every file and what checks each.
-//
-// X(Name, model constant, kernel file stem) — keep each entry on one line: CMake parses them.
+// Adding a model: docs/adding-a-surface-model.md.
 #pragma once
 
 #include "shared/types.h"
 
 #include <cstddef>
 
-#define SPW_SURFACE_MODELS(X)                                                                      \
-    X(Null, kModelNull, "null")                                                                    \
-    X(Lambert, kModelLambert, "lambert")                                                           \
-    X(Conductor, kModelConductor, "conductor")                                                     \
-    X(Dielectric, kModelDielectric, "dielectric")
-
 namespace spw {
+
+// The keys a shader of a model may set beyond `type`, `emission` and `two sided` (which every
+// model takes). Each key has one range, checked in one place (scene_loader.cpp's readShader):
+enum SurfaceParam : uint {
+    kNoParams = 0,
+    kTakesReflectance = 1u << 0, // reflectance: albedo scale in [0, 1] (default 1)
+    kTakesColour = 1u << 1,      // colour: [r, g, b] in [0, 1] (default [1, 1, 1])
+    kTakesTexture = 1u << 2,     // texture: a texture tree for the colour, instead of colour
+    kTakesAlpha = 1u << 3,       // alpha: GGX width in [0, 1] (default 0: smooth)
+    kTakesIor = 1u << 4,         // ior: index of refraction behind the surface, [1.01, 10] (1.5)
+};
 
 struct SurfaceModelInfo {
     const char* name;   // as the scene format spells it
     uint model;         // kModel*
     const char* kernel; // shaders/<kernel>.comp, embedded as SPIR-V under this name
+    uint params;        // SurfaceParam bits
 };
 
-#define SPW_SURFACE_MODEL_ENTRY(Name, Constant, File) SurfaceModelInfo{#Name, Constant, File},
+#define SPW_SURFACE_MODEL_ENTRY(Name, id, stem, params)                                            \
+    SurfaceModelInfo{#Name, kModel##Name, #stem, uint(params)},
 inline constexpr SurfaceModelInfo kSurfaceModels[] = {SPW_SURFACE_MODELS(SPW_SURFACE_MODEL_ENTRY)};
 #undef SPW_SURFACE_MODEL_ENTRY
 inline constexpr size_t kSurfaceModelCount = sizeof(kSurfaceModels) / sizeof(kSurfaceModels[0]);
+static_assert(kSurfaceModelCount == kModelCount);
 
 // The uber-shader of --shading megakernel: every model, switched per hit.
 inline constexpr const char* kMegakernel = "megakernel";

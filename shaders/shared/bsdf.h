@@ -1,19 +1,21 @@
 // The BSDF interface every surface model implements, and the dispatch over models. Directions
 // point away from the surface; `fcos` means f(wo, wi) * |cos(ns, wi)|.
 //
-// Models (one file each, registered in host/scene/surface_models.h):
-//   Null       — no response: absorbs everything (emitter-only geometry)
-//   Lambert    — lambert.h
-//   Conductor  — conductor.h (GGX, Schlick Fresnel; alpha 0: mirror)
-//   Dielectric — dielectric.h (GGX, exact Fresnel, refraction; alpha 0: smooth glass)
+// The models are the registry's (shared/surface_models.h); each one's header <stem>.h defines
+// the three functions dispatched to below, with these signatures:
+//   bool <stem>BsdfIsDelta(ShaderParams sh)
+//   vec3 <stem>BsdfEval(ShaderParams sh, vec3 albedo, vec3 ng, vec3 ns, vec3 wo, vec3 wi,
+//                       OUT(float) pdf)
+//   bool <stem>BsdfSample(ShaderParams sh, vec3 albedo, vec3 ng, vec3 ns, vec3 wo, vec3 u,
+//                         OUT(vec3) wi, OUT(vec3) weight, OUT(float) pdf, OUT(bool) specular)
+// The headers are included through generated/surface_model_headers.h, which CMake writes from
+// the registry.
 //
 // Delta lobes (smooth Conductor and Dielectric): bsdfEval gives 0 for them, bsdfSample returns
 // them with `specular` set, pdf 0 and weight = the lobe's fcos / its discrete probability.
 #ifndef SPILLWAY_SHARED_BSDF_H
 #define SPILLWAY_SHARED_BSDF_H
-#include "conductor.h"
-#include "dielectric.h"
-#include "lambert.h"
+#include "surface_model_headers.h"
 #include "types.h"
 
 SHARED_BEGIN
@@ -21,7 +23,11 @@ SHARED_BEGIN
 // True when the shader's BSDF is nothing but delta lobes: light sampling can never hit them,
 // so next-event estimation is skipped.
 SHARED_FN bool bsdfIsDelta(ShaderParams sh) {
-    return (sh.model == kModelConductor || sh.model == kModelDielectric) && ggxIsSmooth(sh.alpha);
+#define SPW_BSDF_IS_DELTA(Name, id, stem, params)                                                  \
+    if (sh.model == kModel##Name) return stem##BsdfIsDelta(sh);
+    SPW_SURFACE_MODELS(SPW_BSDF_IS_DELTA)
+#undef SPW_BSDF_IS_DELTA
+    return false;
 }
 
 // f * |cos| and the solid-angle pdf of sampling wi. `albedo`: the hit's reflectance x texture
@@ -29,9 +35,10 @@ SHARED_FN bool bsdfIsDelta(ShaderParams sh) {
 SHARED_FN vec3 bsdfEval(ShaderParams sh, vec3 albedo, vec3 ng, vec3 ns, vec3 wo, vec3 wi,
                         OUT(float) pdf) {
     pdf = 0.0f;
-    if (sh.model == kModelLambert) return lambertEval(albedo, ng, ns, wo, wi, pdf);
-    if (sh.model == kModelConductor) return conductorEval(albedo, sh.alpha, ng, ns, wo, wi, pdf);
-    if (sh.model == kModelDielectric) return dielectricEval(sh.ior, sh.alpha, ng, ns, wo, wi, pdf);
+#define SPW_BSDF_EVAL(Name, id, stem, params)                                                      \
+    if (sh.model == kModel##Name) return stem##BsdfEval(sh, albedo, ng, ns, wo, wi, pdf);
+    SPW_SURFACE_MODELS(SPW_BSDF_EVAL)
+#undef SPW_BSDF_EVAL
     return vec3(0.0f);
 }
 
@@ -43,13 +50,11 @@ SHARED_FN bool bsdfSample(ShaderParams sh, vec3 albedo, vec3 ng, vec3 ns, vec3 w
     pdf = 0.0f;
     weight = vec3(0.0f);
     wi = vec3(0.0f);
-    if (sh.model == kModelLambert)
-        return lambertSample(albedo, ng, ns, wo, vec2(u.x, u.y), wi, weight, pdf);
-    if (sh.model == kModelConductor)
-        return conductorSample(albedo, sh.alpha, ng, ns, wo, vec2(u.x, u.y), wi, weight, pdf,
-                               specular);
-    if (sh.model == kModelDielectric)
-        return dielectricSample(sh.ior, sh.alpha, ng, ns, wo, u, wi, weight, pdf, specular);
+#define SPW_BSDF_SAMPLE(Name, id, stem, params)                                                    \
+    if (sh.model == kModel##Name)                                                                  \
+        return stem##BsdfSample(sh, albedo, ng, ns, wo, u, wi, weight, pdf, specular);
+    SPW_SURFACE_MODELS(SPW_BSDF_SAMPLE)
+#undef SPW_BSDF_SAMPLE
     return false;
 }
 

@@ -11,6 +11,7 @@
 //   * no references, pointers, templates or constructors: parameters are `in`, `OUT(T)` or
 //     `INOUT(T)`, and structs are filled field by field;
 //   * functions are declared `SHARED_FN` (inline in C++, nothing in GLSL);
+//   * a parameter an interface requires but a function does not read is marked `UNUSED(p);`;
 //   * buffer reads go through the accessor macros of the file that declares the buffer.
 #ifndef SPILLWAY_SHARED_COMPAT_H
 #define SPILLWAY_SHARED_COMPAT_H
@@ -58,12 +59,14 @@ using std::sqrt;
 #define INOUT(T) T&
 #define SHARED_BEGIN namespace spw {
 #define SHARED_END }
+#define UNUSED(x) (void)(x)
 #else
 #define SHARED_FN
 #define OUT(T) out T
 #define INOUT(T) inout T
 #define SHARED_BEGIN
 #define SHARED_END
+#define UNUSED(x)
 #endif
 
 SHARED_BEGIN

@@ -12,6 +12,7 @@
 #ifndef SPILLWAY_SHARED_CONDUCTOR_H
 #define SPILLWAY_SHARED_CONDUCTOR_H
 #include "ggx.h"
+#include "types.h"
 
 SHARED_BEGIN
 
@@ -68,6 +69,20 @@ SHARED_FN bool conductorSample(vec3 f0, float alpha, vec3 ng, vec3 ns, vec3 wo, 
     weight = schlickFresnel(f0, oh) * (li.z * (lo.z + ao) / denom);
     specular = false;
     return pdf > 0.0f;
+}
+
+// The registry's interface (shared/bsdf.h dispatches here).
+SHARED_FN bool conductorBsdfIsDelta(ShaderParams sh) {
+    return ggxIsSmooth(sh.alpha);
+}
+SHARED_FN vec3 conductorBsdfEval(ShaderParams sh, vec3 albedo, vec3 ng, vec3 ns, vec3 wo, vec3 wi,
+                                 OUT(float) pdf) {
+    return conductorEval(albedo, sh.alpha, ng, ns, wo, wi, pdf);
+}
+SHARED_FN bool conductorBsdfSample(ShaderParams sh, vec3 albedo, vec3 ng, vec3 ns, vec3 wo, vec3 u,
+                                   OUT(vec3) wi, OUT(vec3) weight, OUT(float) pdf,
+                                   OUT(bool) specular) {
+    return conductorSample(albedo, sh.alpha, ng, ns, wo, vec2(u.x, u.y), wi, weight, pdf, specular);
 }
 
 SHARED_END

@@ -18,6 +18,7 @@
 #ifndef SPILLWAY_SHARED_DIELECTRIC_H
 #define SPILLWAY_SHARED_DIELECTRIC_H
 #include "ggx.h"
+#include "types.h"
 
 SHARED_BEGIN
 
@@ -129,6 +130,22 @@ SHARED_FN bool dielectricSample(float ior, float alpha, vec3 ng, vec3 ns, vec3 w
     weight = vec3(abs(li.z) * (lo.z + ao) / denomG * etaScale);
     specular = false;
     return pdf > 0.0f && denomG > 0.0f;
+}
+
+// The registry's interface (shared/bsdf.h dispatches here). No colour: albedo is not read.
+SHARED_FN bool dielectricBsdfIsDelta(ShaderParams sh) {
+    return ggxIsSmooth(sh.alpha);
+}
+SHARED_FN vec3 dielectricBsdfEval(ShaderParams sh, vec3 albedo, vec3 ng, vec3 ns, vec3 wo, vec3 wi,
+                                  OUT(float) pdf) {
+    UNUSED(albedo);
+    return dielectricEval(sh.ior, sh.alpha, ng, ns, wo, wi, pdf);
+}
+SHARED_FN bool dielectricBsdfSample(ShaderParams sh, vec3 albedo, vec3 ng, vec3 ns, vec3 wo, vec3 u,
+                                    OUT(vec3) wi, OUT(vec3) weight, OUT(float) pdf,
+                                    OUT(bool) specular) {
+    UNUSED(albedo);
+    return dielectricSample(sh.ior, sh.alpha, ng, ns, wo, u, wi, weight, pdf, specular);
 }
 
 SHARED_END

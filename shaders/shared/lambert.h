@@ -5,6 +5,7 @@
 #ifndef SPILLWAY_SHARED_LAMBERT_H
 #define SPILLWAY_SHARED_LAMBERT_H
 #include "sampling.h"
+#include "types.h"
 
 SHARED_BEGIN
 
@@ -29,6 +30,24 @@ SHARED_FN bool lambertSample(vec3 albedo, vec3 ng, vec3 ns, vec3 wo, vec2 u, OUT
     pdf = local.z * kInvPi;
     weight = albedo;
     return true;
+}
+
+// The registry's interface (shared/bsdf.h dispatches here).
+SHARED_FN bool lambertBsdfIsDelta(ShaderParams sh) {
+    UNUSED(sh);
+    return false;
+}
+SHARED_FN vec3 lambertBsdfEval(ShaderParams sh, vec3 albedo, vec3 ng, vec3 ns, vec3 wo, vec3 wi,
+                               OUT(float) pdf) {
+    UNUSED(sh);
+    return lambertEval(albedo, ng, ns, wo, wi, pdf);
+}
+SHARED_FN bool lambertBsdfSample(ShaderParams sh, vec3 albedo, vec3 ng, vec3 ns, vec3 wo, vec3 u,
+                                 OUT(vec3) wi, OUT(vec3) weight, OUT(float) pdf,
+                                 OUT(bool) specular) {
+    UNUSED(sh);
+    UNUSED(specular); // never a delta lobe: bsdfSample has cleared it
+    return lambertSample(albedo, ng, ns, wo, vec2(u.x, u.y), wi, weight, pdf);
 }
 
 SHARED_END

@@ -4,15 +4,18 @@
 #ifndef SPILLWAY_SHARED_TYPES_H
 #define SPILLWAY_SHARED_TYPES_H
 #include "compat.h"
+#include "surface_models.h"
 
 SHARED_BEGIN
 
-// Surface models. The registry (host/scene/surface_models.h) maps each to its name and code.
-const uint kModelNull = 0u;
-const uint kModelLambert = 1u;
-const uint kModelConductor = 2u;
-const uint kModelDielectric = 3u;
-const uint kModelCount = 4u;
+// Surface models: kModel<Name> for every line of the registry (shared/surface_models.h), and
+// their count.
+#define SPW_MODEL_CONSTANT(Name, id, stem, params) const uint kModel##Name = id;
+SPW_SURFACE_MODELS(SPW_MODEL_CONSTANT)
+#undef SPW_MODEL_CONSTANT
+#define SPW_MODEL_ONE(Name, id, stem, params) +1u
+const uint kModelCount = 0u SPW_SURFACE_MODELS(SPW_MODEL_ONE);
+#undef SPW_MODEL_ONE
 
 const uint kShaderTwoSided = 1u; // emits from both faces
 const uint kShaderTextured = 2u; // albedo comes from a texture tree, resolved on the host

@@ -1,7 +1,10 @@
-// A surface model is complete only with every piece docs/adding-a-surface-model.md lists: this
-// test walks the registry (host/scene/surface_models.h) and fails for a registered model that
-// lacks its shared header (dispatched from bsdf.h), its BSDF test, or a scene name the loader
-// accepts. Its kernel and the kModel* count are checked in tests/vk (SurfaceModels.*).
+// A surface model is one registry line (shaders/shared/surface_models.h), its shared header, its
+// kernel and its test: docs/adding-a-surface-model.md. Everything else is derived from the
+// registry, and this test checks both halves: it fails for a registered model that lacks its
+// header, its kernel or its TEST(<Name>, ...), and for a loader that does not take exactly the
+// scene keys the registry line names. (That the kernels are embedded and the kModel* constants
+// follow the registry's order is checked in tests/vk,
+// SurfaceModels.EveryRegisteredModelHasItsKernel.)
 #include "host/scene/scene.h"
 #include "host/scene/surface_models.h"
 #include "test_util.h"
@@ -14,33 +17,51 @@
 namespace spw::test {
 namespace {
 
-TEST(SurfaceModels, EveryRegisteredModelHasItsHeaderItsTestAndItsSceneName) {
-    const std::string bsdf = readFile(sourceDir() + "/shaders/shared/bsdf.h");
-    ASSERT_FALSE(bsdf.empty());
-    TempDir dir;
-    const std::string box = sourceDir() + "/scenes/cornell-box/";
-    for (size_t i = 0; i < kSurfaceModelCount; ++i) {
-        const SurfaceModelInfo& m = kSurfaceModels[i];
+std::string shaderScene(const std::string& shader) {
+    return "image: {width: 4, height: 4}\n"
+           "camera: {type: PinHole, look at: {eye: [278, 273, -800], target: [278, 273, 0]}, "
+           "fov: 39.3}\n"
+           "shaders:\n  - {" +
+           shader + "}\nobjects:\n  - {filename: " + sourceDir() +
+           "/scenes/cornell-box/white.obj, shader: 0}\n";
+}
+
+TEST(SurfaceModels, EveryRegisteredModelHasItsHeaderItsKernelAndItsTest) {
+    for (const SurfaceModelInfo& m : kSurfaceModels) {
         const std::string stem = m.kernel, name = m.name;
         EXPECT_TRUE(std::filesystem::exists(sourceDir() + "/shaders/" + stem + ".comp"))
             << name << ": no shaders/" << stem << ".comp";
-        // The loader takes the registry's name and gives the registry's model constant.
-        const Scene scene = loadScene(dir.write(
-            stem + ".yaml", "image: {width: 4, height: 4}\n"
-                            "camera: {type: PinHole, look at: {eye: [278, 273, -800], target: "
-                            "[278, 273, 0]}, fov: 39.3}\n"
-                            "shaders:\n  - {type: " +
-                                name + "}\nobjects:\n  - {filename: " + box + "white.obj, shader: 0}\n"));
-        ASSERT_EQ(scene.shaders.size(), 1u) << name;
-        EXPECT_EQ(scene.shaders[0].params.model, m.model) << name;
-        if (m.model == kModelNull) continue; // no response: no BSDF of its own to test
         EXPECT_TRUE(std::filesystem::exists(sourceDir() + "/shaders/shared/" + stem + ".h"))
             << name << ": no shaders/shared/" << stem << ".h";
-        EXPECT_NE(bsdf.find("#include \"" + stem + ".h\""), std::string::npos)
-            << name << ": bsdf.h does not include " << stem << ".h";
         const std::string test = readFile(sourceDir() + "/tests/bsdf/" + stem + "_test.cpp");
         EXPECT_NE(test.find("TEST(" + name + ","), std::string::npos)
             << name << ": no TEST(" << name << ", ...) in tests/bsdf/" << stem << "_test.cpp";
+    }
+}
+
+// The loader takes `type: <Name>`, gives the registry's constant, and takes each optional key
+// exactly when the registry line names it.
+TEST(SurfaceModels, TheLoaderTakesEachModelWithExactlyItsRegisteredKeys) {
+    const std::pair<SurfaceParam, std::string> keys[] = {
+        {kTakesReflectance, "reflectance: 0.5"},
+        {kTakesColour, "colour: [0.5, 0.5, 0.5]"},
+        {kTakesTexture, "texture: {type: Constant, colour: [0.5, 0.5, 0.5]}"},
+        {kTakesAlpha, "alpha: 0.5"},
+        {kTakesIor, "ior: 1.33"}};
+    TempDir dir;
+    for (const SurfaceModelInfo& m : kSurfaceModels) {
+        const std::string type = std::string("type: ") + m.name;
+        const Scene scene = loadScene(dir.write("plain.yaml", shaderScene(type)));
+        ASSERT_EQ(scene.shaders.size(), 1u) << m.name;
+        EXPECT_EQ(scene.shaders[0].params.model, m.model) << m.name;
+        for (const auto& [bit, key] : keys) {
+            const std::string path = dir.write("keyed.yaml", shaderScene(type + ", " + key));
+            if (m.params & bit) {
+                EXPECT_NO_THROW(loadScene(path)) << m.name << " should take " << key;
+            } else {
+                EXPECT_THROW(loadScene(path), SceneError) << m.name << " should refuse " << key;
+            }
+        }
     }
 }
 

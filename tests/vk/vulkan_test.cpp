@@ -519,8 +519,6 @@ TEST(VulkanBuffers, StagingTwoDimensionalAndWindowedDispatchesGiveTheSameImage) 
 // --- the registry --------------------------------------------------------------------------
 
 TEST(SurfaceModels, EveryRegisteredModelHasItsKernel) {
-    EXPECT_EQ(kSurfaceModelCount, size_t(kModelCount))
-        << "a kModel* constant is missing from host/scene/surface_models.h";
     std::set<std::string> registered;
     for (size_t i = 0; i < kSurfaceModelCount; ++i) {
         const SurfaceModelInfo& m = kSurfaceModels[i];
