@@ -101,7 +101,11 @@ std::string binary() {
 }
 
 CommandResult runSpillway(const std::string& args) {
-    std::string cmd = binary() + " " + args + " 2>&1";
+    return runShell(binary() + " " + args);
+}
+
+CommandResult runShell(const std::string& command) {
+    const std::string cmd = command + " 2>&1";
     FILE* p = popen(cmd.c_str(), "r");
     if (!p) return {-1, "popen failed"};
     std::string out;

@@ -57,6 +57,8 @@ struct CommandResult {
     std::string output; // stdout and stderr together
 };
 CommandResult runSpillway(const std::string& args);
+// Runs a shell command line, stdout and stderr captured together; status -1 unless it exited.
+CommandResult runShell(const std::string& command);
 
 // Mean of the channel average over all pixels.
 double mean(const std::vector<float>& rgb);

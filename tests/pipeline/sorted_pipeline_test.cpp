@@ -380,18 +380,11 @@ TEST(Spill, PeakRaysInRamStayWithinTheBudgetOrSixBatches) {
 TEST(Spill, FullDiskExitsOneNamingTheFolder) {
     TempDir dir, spill;
     const std::string scene = heavyScene(dir);
-    std::string cmd = "bash -c 'ulimit -f 4096; exec " + binary() + " render " + scene +
-                      " --quiet --memory-budget 1 --spill-dir " + spill.path() + " -o " +
-                      dir.file("x.exr") + "' 2>&1";
-    FILE* p = popen(cmd.c_str(), "r");
-    ASSERT_NE(p, nullptr);
-    std::string out;
-    char buf[512];
-    size_t n;
-    while ((n = fread(buf, 1, sizeof buf, p)) > 0)
-        out.append(buf, n);
-    int st = pclose(p);
-    EXPECT_TRUE(WIFEXITED(st) && WEXITSTATUS(st) == 1) << out;
+    const CommandResult r = runShell("bash -c 'ulimit -f 4096; exec " + binary() + " render " +
+                                     scene + " --quiet --memory-budget 1 --spill-dir " +
+                                     spill.path() + " -o " + dir.file("x.exr") + "'");
+    const std::string& out = r.output;
+    EXPECT_EQ(r.status, 1) << out;
     EXPECT_NE(out.find(spill.path()), std::string::npos) << out;
     EXPECT_EQ(filesIn(spill.path()), 0u);
 }

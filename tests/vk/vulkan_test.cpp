@@ -541,16 +541,7 @@ TEST(SurfaceModels, EveryRegisteredModelHasItsKernel) {
 
 // Runs the binary with extra environment variables, output and status captured.
 CommandResult runWithEnv(const std::string& env, const std::string& args) {
-    const std::string cmd = "env " + env + " " + binary() + " " + args + " 2>&1";
-    FILE* p = popen(cmd.c_str(), "r");
-    if (!p) return {-1, "popen failed"};
-    std::string out;
-    char buf[4096];
-    size_t n;
-    while ((n = fread(buf, 1, sizeof buf, p)) > 0)
-        out.append(buf, n);
-    const int st = pclose(p);
-    return {WIFEXITED(st) ? WEXITSTATUS(st) : -1, out};
+    return runShell("env " + env + " " + binary() + " " + args);
 }
 
 bool contains(const std::string& s, const std::string& part) {
