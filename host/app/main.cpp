@@ -54,6 +54,8 @@ render options:
                         two half buffers, and with --reference the compare metrics
   --reference REF.exr   the reference image for --error-csv
   --time-limit SECONDS  stop after the iteration that crosses this render time
+  --texture-cache MiB   the texture system's tile cache (settings: texture cache; default
+                        1024): image textures beyond it are read from disk again as needed
 
 sorted pipeline options (cpu and vulkan backends):
   --bin-exponent E      a directional bin becomes a batch at 2^E rays (settings: bin exponent)
@@ -173,6 +175,8 @@ int renderCommand(const std::vector<std::string>& args) {
             referencePath = value();
         else if (a == "--time-limit")
             config.timeLimitSeconds = parseNumber(a, value(), 1e-3, 1e9);
+        else if (a == "--texture-cache")
+            config.textureCacheMiB = parseNumber(a, value(), 1.0, 1 << 20);
         else if (a == "--bin-exponent")
             config.pipeline.binExponent = int(parseInteger(a, value(), 4, 24));
         else if (a == "--memory-budget")

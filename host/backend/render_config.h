@@ -75,6 +75,7 @@ struct RenderConfig {
     PipelineConfig pipeline;                // the sorted backends' knobs
     VulkanConfig vulkan;                    // the vulkan backend's knobs
     std::optional<double> timeLimitSeconds; // stop after the iteration that crosses it
+    std::optional<double> textureCacheMiB;  // overrides settings: texture cache
 };
 
 } // namespace spw

@@ -32,6 +32,24 @@ std::string cpuName() {
     return "unknown CPU";
 }
 
+// --stats' `textures`: the texture system's counters, and the traffic per traced ray.
+nlohmann::json textureStatistics(const TextureResolver& textures, const RenderStats& stats) {
+    const TextureStatistics t = textures.statistics();
+    const double rays = double(stats.cameraRays + stats.bounceRays + stats.shadowRays);
+    auto perRay = [&](std::uint64_t n) { return rays > 0 ? double(n) / rays : 0.0; };
+    return {{"lookups", t.lookups},
+            {"tiles_read", t.tilesRead},
+            {"bytes_read", t.bytesRead},
+            {"files_opened", t.filesOpened},
+            {"files_reopened", t.filesReopened},
+            {"cache_misses", t.cacheMisses},
+            {"peak_cache_bytes", t.peakCacheBytes},
+            {"per_ray",
+             {{"lookups", perRay(t.lookups)},
+              {"tiles_read", perRay(t.tilesRead)},
+              {"bytes_read", perRay(t.bytesRead)}}}};
+}
+
 } // namespace
 
 SamplingPlan planSampling(const ImageSettings& image, std::optional<int> spp) {
@@ -95,7 +113,7 @@ std::unique_ptr<RenderResult> renderWithProgress(const Scene& scene, const Rende
         StageTimer t(stats.stages, "build bvh");
         embree = std::make_unique<EmbreeScene>(scene, lights);
     }
-    TextureResolver textures(scene);
+    TextureResolver textures(scene, config.textureCacheMiB.value_or(scene.settings.textureCacheMiB));
     CameraModel camera(scene, plan.sampleBase);
 
     RenderParams params{};
@@ -130,6 +148,7 @@ std::unique_ptr<RenderResult> renderWithProgress(const Scene& scene, const Rende
         }
         embree->checkError("tracing");
         textures.checkErrors();
+        textures.noteCacheUse();
         renderSeconds +=
             std::chrono::duration<double>(std::chrono::steady_clock::now() - iterationStart)
                 .count();
@@ -142,6 +161,7 @@ std::unique_ptr<RenderResult> renderWithProgress(const Scene& scene, const Rende
     stats.iterations = done;
     stats.spp = done * plan.sampleBase * plan.sampleBase;
     stats.extra["render_seconds"] = renderSeconds;
+    if (textures.active()) stats.extra["textures"] = textureStatistics(textures, stats);
     stats.nonFiniteSamples = result->film->nonFiniteSamples();
     stats.saturatedSamples = result->film->saturatedSamples();
     stats.wallSeconds =

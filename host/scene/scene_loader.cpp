@@ -194,7 +194,7 @@ void readImage(const Reader& rd, const YAML::Node& n, ImageSettings& img) {
 void readSettings(const Reader& rd, const YAML::Node& n, Settings& s) {
     rd.checkKeys(n, "settings",
                  {"min depth", "max depth", "threshold", "bucket size", "shading size",
-                  "bin exponent", "memory budget", "seed"});
+                  "bin exponent", "memory budget", "texture cache", "seed"});
     if (n["min depth"]) s.minDepth = int(rd.integer(n["min depth"], "min depth", 0, kMaxDepth));
     if (n["max depth"]) s.maxDepth = int(rd.integer(n["max depth"], "max depth", 0, kMaxDepth));
     if (n["threshold"]) s.threshold = float(rd.number(n["threshold"], "threshold", 0.0, 1e30));
@@ -205,6 +205,8 @@ void readSettings(const Reader& rd, const YAML::Node& n, Settings& s) {
         s.binExponent = int(rd.integer(n["bin exponent"], "bin exponent", 4, 24));
     if (n["memory budget"])
         s.memoryBudgetMiB = rd.number(n["memory budget"], "memory budget", 1.0 / 1024, 1 << 20);
+    if (n["texture cache"])
+        s.textureCacheMiB = rd.number(n["texture cache"], "texture cache", 1.0, 1 << 20);
     if (n["seed"]) s.seed = std::uint32_t(rd.integer(n["seed"], "seed", 0, 0xFFFFFFFFLL));
 }
 

@@ -24,6 +24,7 @@ struct TextureResolver::Impl {
     std::mutex errorMutex;
     int failedTexture = -1;
     std::string error;
+    mutable std::atomic<std::uint64_t> peakCacheBytes{0};
     ~Impl() {
         if (system) OIIO::TextureSystem::destroy(system);
     }
@@ -44,7 +45,7 @@ void visit(const Scene& scene, int t, std::vector<int>& slotOf, std::vector<int>
 
 } // namespace
 
-TextureResolver::TextureResolver(const Scene& scene) : scene_(scene) {
+TextureResolver::TextureResolver(const Scene& scene, double cacheMiB) : scene_(scene) {
     programs_.resize(scene.textures.size());
     for (const Shader& sh : scene.shaders) {
         if (sh.texture < 0 || !programs_[size_t(sh.texture)].empty()) continue;
@@ -67,7 +68,7 @@ TextureResolver::TextureResolver(const Scene& scene) : scene_(scene) {
     if (!any) return;
     impl_ = std::make_unique<Impl>();
     impl_->system = OIIO::TextureSystem::create(false);
-    impl_->system->attribute("max_memory_MB", 256.0f);
+    impl_->system->attribute("max_memory_MB", float(cacheMiB));
     impl_->images.resize(scene.textures.size());
     for (size_t i = 0; i < scene.textures.size(); ++i) {
         const Texture& t = scene.textures[i];
@@ -118,6 +119,40 @@ void TextureResolver::checkErrors() const {
     while (!why.empty() && (why.back() == '\n' || why.back() == '\r'))
         why.pop_back();
     throw SceneError(scene_.file, t.line, "texture file '" + t.path + "' cannot be read: " + why);
+}
+
+void TextureResolver::noteCacheUse() const {
+    if (!impl_) return;
+    long long used = 0;
+    impl_->system->getattribute("stat:cache_memory_used", OIIO::TypeDesc::INT64, &used);
+    std::uint64_t seen = impl_->peakCacheBytes.load();
+    while (std::uint64_t(used) > seen && !impl_->peakCacheBytes.compare_exchange_weak(seen, used)) {
+    }
+}
+
+TextureStatistics TextureResolver::statistics() const {
+    TextureStatistics s;
+    if (!impl_) return s;
+    noteCacheUse();
+    OIIO::TextureSystem& ts = *impl_->system;
+    // OpenImageIO answers a counter only when asked in its own type, int64 for some, int for
+    // others (and the choice has moved between versions): ask in both.
+    auto count = [&](const char* name) {
+        long long wide = 0;
+        if (ts.getattribute(name, OIIO::TypeDesc::INT64, &wide)) return std::uint64_t(wide);
+        int narrow = 0;
+        if (ts.getattribute(name, OIIO::TypeDesc::INT, &narrow)) return std::uint64_t(narrow);
+        return std::uint64_t(0);
+    };
+    s.lookups = count("stat:texture_queries");
+    s.tilesRead = count("stat:tiles_created");
+    s.bytesRead = count("stat:bytes_read");
+    s.filesOpened = count("stat:open_files_created");
+    const std::uint64_t unique = count("stat:unique_files");
+    s.filesReopened = s.filesOpened > unique ? s.filesOpened - unique : 0;
+    s.cacheMisses = count("stat:find_tile_cache_misses");
+    s.peakCacheBytes = impl_->peakCacheBytes.load();
+    return s;
 }
 
 vec3 TextureResolver::albedo(const Shader& shader, vec2 uv) const {

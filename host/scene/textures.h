@@ -10,14 +10,27 @@
 
 #include "host/scene/scene.h"
 
+#include <cstdint>
 #include <memory>
 #include <vector>
 
 namespace spw {
 
+// What the texture system did during a render (OpenImageIO's own counters).
+struct TextureStatistics {
+    std::uint64_t lookups = 0;        // texture queries (one per Standard node per hit set up)
+    std::uint64_t tilesRead = 0;      // tiles read into the cache, re-reads after eviction too
+    std::uint64_t bytesRead = 0;      // pixel bytes those tiles held (uncompressed)
+    std::uint64_t filesOpened = 0;    // file opens, re-opens after closing included
+    std::uint64_t filesReopened = 0;  // opens beyond the first of each file
+    std::uint64_t cacheMisses = 0;    // tile lookups that missed the cache
+    std::uint64_t peakCacheBytes = 0; // the tile cache's largest size seen (noteCacheUse)
+};
+
 class TextureResolver {
   public:
-    explicit TextureResolver(const Scene& scene);
+    // cacheMiB: the tile cache's size (settings: texture cache, or --texture-cache).
+    TextureResolver(const Scene& scene, double cacheMiB);
     ~TextureResolver();
     TextureResolver(const TextureResolver&) = delete;
     TextureResolver& operator=(const TextureResolver&) = delete;
@@ -29,6 +42,10 @@ class TextureResolver {
     // Throws SceneError (the texture's file and scene line) if an image lookup failed since the
     // scene loaded: a file that was readable when loaded but whose pixels are not.
     void checkErrors() const;
+    // Samples the tile cache's size for peakCacheBytes (the renderer calls it per iteration).
+    void noteCacheUse() const;
+    // OpenImageIO's counters since the resolver was made; all zero when !active().
+    TextureStatistics statistics() const;
 
   private:
     // One node of a flattened tree: its operands are slots of earlier nodes.

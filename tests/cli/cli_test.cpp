@@ -78,6 +78,7 @@ TEST_P(CliBadUsage, ExitsTwoAndWritesNothing) {
 
 const BadUsage kBadUsages[] = {
     {"UnknownOption", "{scene} -o {out} --quiet --frobnicate", "--frobnicate"},
+    {"TextureCacheBelowOneMiB", "{scene} -o {out} --quiet --texture-cache 0.5", "--texture-cache"},
     {"MissingValueAtEnd", "{scene} --quiet -o {out} --spp", "--spp"},
     {"MissingOutputValue", "{scene} --quiet --spp 1 -o", "-o"},
     {"SppNotAnInteger", "{scene} -o {out} --quiet --spp abc", "abc"},

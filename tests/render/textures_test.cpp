@@ -77,7 +77,20 @@ TEST(Textures, LayeredImageOverConstantByImageMaskOnEveryBackend) {
         // Full-precision rays: the compact record would round the albedo (now the throughput)
         // to bfloat16, unbiased but 2^-8 apart (CompactRay.* test that on its own).
         cfg.pipeline.rayFormat = RayFormat::Full;
-        const std::vector<float> img = render(scene, cfg)->film->image();
+        const auto result = render(scene, cfg);
+        const std::vector<float> img = result->film->image();
+        // --stats' texture counters: 256 camera hits on the plane, two image nodes each (the
+        // bounces find the untextured enclosure); each 8 x 8 float image is one tile, read once.
+        const nlohmann::json& t = result->stats.extra["textures"];
+        EXPECT_EQ(t["lookups"], 256 * 2) << backend;
+        EXPECT_EQ(t["files_opened"], 2) << backend;
+        EXPECT_EQ(t["files_reopened"], 0) << backend;
+        EXPECT_EQ(t["tiles_read"], 2) << backend;
+        EXPECT_EQ(t["bytes_read"], 2 * 8 * 8 * 3 * 4) << backend;
+        EXPECT_GE(t["peak_cache_bytes"].get<double>(), 2 * 8 * 8 * 3 * 4) << backend;
+        const double rays = double(result->stats.cameraRays + result->stats.bounceRays +
+                                   result->stats.shadowRays);
+        EXPECT_DOUBLE_EQ(t["per_ray"]["lookups"].get<double>(), 512 / rays) << backend;
         double worst = 0;
         for (int y = 0; y < 8; ++y)
             for (int x = 0; x < 8; ++x) {
@@ -106,13 +119,22 @@ TEST(Textures, NoTextureSystemWithoutImageTextures) {
         "c.yaml", head + "    type: Layered\n    upper: {type: Constant, colour: [1, 0, 0]}\n"
                          "    lower: {type: Constant, colour: [0, 1, 0]}\n    mask: {type: "
                          "Constant, colour: [0.25, 0.5, 1]}\n"));
-    TextureResolver none(constant);
+    TextureResolver none(constant, 64.0);
     EXPECT_FALSE(none.active());
     const vec3 a = none.albedo(constant.shaders[0], vec2(0.3f, 0.7f));
     EXPECT_EQ(a, vec3(0.25f, 0.5f, 0.0f));
     const Scene image =
         loadScene(dir.write("i.yaml", head + "    {type: Standard, string: a.exr}\n"));
-    EXPECT_TRUE(TextureResolver(image).active());
+    EXPECT_TRUE(TextureResolver(image, 64.0).active());
+    EXPECT_EQ(none.statistics().lookups, 0u);
+}
+
+// --stats has no `textures` object (not even zeros) for a scene without image textures.
+TEST(Textures, NoTextureStatisticsWithoutImageTextures) {
+    const Scene box = loadScene(sourceDir() + "/scenes/cornell-box.yaml");
+    RenderConfig cfg;
+    cfg.spp = 1;
+    EXPECT_FALSE(render(box, cfg)->stats.extra.contains("textures"));
 }
 
 } // namespace

@@ -197,6 +197,7 @@ TEST(Loader, EmptyFileTakesTheDocumentedDefaults) {
     EXPECT_EQ(scene.settings.shadingSize, 4096);
     EXPECT_EQ(scene.settings.binExponent, 15);
     EXPECT_DOUBLE_EQ(scene.settings.memoryBudgetMiB, 512.0);
+    EXPECT_DOUBLE_EQ(scene.settings.textureCacheMiB, 1024.0);
     EXPECT_EQ(scene.settings.seed, 0u);
     EXPECT_EQ(scene.camera.type, CameraType::PinHole);
     EXPECT_FLOAT_EQ(scene.camera.focalLength, 35.0f);
@@ -506,6 +507,7 @@ const ErrorCase kErrorCases[] = {
     {"ZeroHeight", "image: {width: 8,\n  height: 0}\n", 2, "height"},
     {"NegativeLightScale", "light:\n  type: Quad\n  scale: [1, -2]\n", 3, "scale"},
     {"NegativeLightIntensity", "light:\n  type: Quad\n  intensity: -1\n", 3, "intensity"},
+    {"TextureCacheBelowOneMiB", "settings:\n  texture cache: 0.5\n", 2, "texture cache"},
     {"ReflectanceAboveOne", "shader:\n  type: Lambert\n  reflectance: 1.5\n", 3, "reflectance"},
     {"NegativeMaxDepth", "settings:\n  min depth: 2\n  max depth: -1\n", 3, "max depth"},
     {"NanIntensity", "light:\n  type: Quad\n  intensity: .nan\n", 3, "intensity"},

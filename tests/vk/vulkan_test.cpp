@@ -300,7 +300,7 @@ PerHit shadeSameHits(ShadingMode mode) {
     Scene scene = everyModelScene(dir);
     SceneLights lights(scene);
     EmbreeScene embree(scene, lights);
-    TextureResolver textures(scene);
+    TextureResolver textures(scene, scene.settings.textureCacheMiB);
     CameraModel camera(scene, 1);
     RenderStats stats;
     RenderConfig cfg;
