@@ -1,7 +1,8 @@
 // Conductor: a metal, rough or polished.
-//   parameters: colour [r, g, b] ([1, 1, 1]): F0, the reflectance at normal incidence, through
-//   Schlick's Fresnel approximation (Schlick 1994, "An Inexpensive BRDF Model for Physically-based
-//   Rendering"); alpha (0): GGX width. alpha < kGgxSmoothAlpha (1e-4) is a perfect mirror.
+//   parameters: colour [r, g, b] ([1, 1, 1]) or texture: F0, the reflectance at normal incidence,
+//   through Schlick's Fresnel approximation (Schlick 1994, "An Inexpensive BRDF Model for
+//   Physically-based Rendering"); alpha (0): GGX width. alpha < kGgxSmoothAlpha (1e-4) is a
+//   perfect mirror.
 //   Rough: f = D G2 F / (4 |co| |ci|) (Walter et al. 2007) with GGX D and the height-correlated
 //   Smith G2 (ggx.h); sampled through the visible normals (Heitz 2018): pdf = D G1(wo) / (4 co),
 //   weight = F G2 / G1(wo). Single scattering only: light that would bounce between microfacets

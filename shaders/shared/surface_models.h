@@ -21,7 +21,7 @@
 #define SPW_SURFACE_MODELS(X)                                                                      \
     X(Null, 0u, null, kNoParams)                                                                   \
     X(Lambert, 1u, lambert, kTakesReflectance | kTakesColour | kTakesTexture)                      \
-    X(Conductor, 2u, conductor, kTakesColour | kTakesAlpha)                                        \
+    X(Conductor, 2u, conductor, kTakesColour | kTakesTexture | kTakesAlpha)                        \
     X(Dielectric, 3u, dielectric, kTakesIor | kTakesAlpha)
 
 #endif
