@@ -6,13 +6,23 @@ are noisy; ratios travel, absolute seconds do not).
   scripts/bench.py reference   Cornell box 256x256, 64 spp, reference backend: seconds, rays/s
   scripts/bench.py pipeline    cpu vs reference on the Cornell box and the 1M-triangle scene,
                                each ray sort and hit sort setting, peak RSS, spill traffic
-  scripts/bench.py all         both (default)
+  scripts/bench.py production  the thesis' Table 6.1 on this machine: the generated production
+                               scene (scripts/make_production_scene.py, in out/production) with a
+                               texture cache of 1/4 of its texture bytes; cpu at bin exponents
+                               8, 11, 14, 17 and the reference, at max depth 1, 2, 3; vulkan at
+                               2^17; the in-core control (Constant colours). Wall, user and system
+                               seconds, peak RSS, texture tiles and bytes read, ratio to the
+                               reference at the same depth. Writes out/production/bench.json.
+  scripts/bench.py all         reference and pipeline (default)
 
-Options: --repeat N (best of N, default 3), --spillway PATH (default build/spillway).
+Options: --repeat N (best of N, default 3; production: 1), --spillway PATH (default
+build/spillway), --depths 1,2,3 and --exponents 8,11,14,17 (production), --scene-args "..."
+(production: options for make_production_scene.py).
 """
 import argparse
 import json
 import os
+import re
 import subprocess
 import sys
 import tempfile
@@ -21,7 +31,8 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
 
 def run(spillway, scene, args, repeat):
-    """Best-of-N render; returns (stats json, peak RSS MiB)."""
+    """Best-of-N render; returns (stats json, peak RSS MiB). The stats get "user_seconds" and
+    "system_seconds" of the best run."""
     best, rss = None, 0
     with tempfile.TemporaryDirectory() as tmp:
         for _ in range(repeat):
@@ -32,6 +43,7 @@ def run(spillway, scene, args, repeat):
             if status != 0:
                 return None, 0
             s = json.load(open(stats))
+            s["user_seconds"], s["system_seconds"] = ru.ru_utime, ru.ru_stime
             rss = max(rss, ru.ru_maxrss / 1024)
             if best is None or s["wall_seconds"] < best["wall_seconds"]:
                 best = s
@@ -88,12 +100,84 @@ def bench_pipeline(spillway, repeat):
                     s["batches_processed"], s["batches_ray_sorted"], s["device"]))
 
 
+def with_depth(scene, depth):
+    """A copy of a generated scene file beside it (its files are relative) with max depth set."""
+    text = open(scene).read()
+    text = re.sub(r"max depth: \d+", "max depth: %d" % depth, text)
+    text = re.sub(r"min depth: \d+", "min depth: %d" % min(depth, 3), text)
+    out = scene.replace(".yaml", "-d%d.yaml" % depth)
+    with open(out, "w") as f:
+        f.write(text)
+    return out
+
+
+def bench_production(spillway, repeat, depths, exponents, scene_args):
+    folder = os.path.join(ROOT, "out", "production")
+    made = subprocess.check_output([sys.executable, os.path.join(ROOT, "scripts", "make_production_scene.py"),
+                                    folder] + scene_args, text=True).strip()
+    print(made)
+    texture_bytes = sum(os.path.getsize(os.path.join(folder, f)) for f in os.listdir(folder) if f.endswith(".tx"))
+    geometry_bytes = sum(os.path.getsize(os.path.join(folder, f)) for f in os.listdir(folder) if f.endswith(".obj"))
+    cache = texture_bytes / 4 / 2**20
+    common = ["--texture-cache", "%.1f" % cache]
+    print("textures %.0f MiB on disk, cache %.0f MiB (1/4); geometry %.0f MiB of OBJ text" % (
+        texture_bytes / 2**20, cache, geometry_bytes / 2**20))
+    header = "  %-26s %8s %8s %7s %7s %8s %9s %10s %10s %9s" % (
+        "config", "wall s", "core s", "user s", "sys s", "vs ref", "RSS MiB", "tiles", "MB read", "B/ray")
+    rows = []
+    for depth in depths:
+        scene = with_depth(os.path.join(folder, "scene.yaml"), depth)
+        control = with_depth(os.path.join(folder, "control.yaml"), depth)
+        configs = [("reference", scene, ["--backend", "reference"])]
+        configs += [("cpu 2^%d" % e, scene, ["--backend", "cpu", "--bin-exponent", str(e)]) for e in exponents]
+        configs += [("vulkan 2^%d" % max(exponents), scene, ["--backend", "vulkan", "--bin-exponent",
+                                                            str(max(exponents))]),
+                    ("control: reference", control, ["--backend", "reference"]),
+                    ("control: cpu 2^%d" % max(exponents), control, ["--backend", "cpu", "--bin-exponent",
+                                                                    str(max(exponents))])]
+        print("\nmax depth %d\n%s" % (depth, header))
+        ref = None
+        for name, path, args in configs:
+            s, rss = run(spillway, path, args + common, repeat)
+            if s is None:
+                print("  %-26s (could not run here)" % name)
+                continue
+            core = core_seconds(s)
+            if name == "reference":
+                ref = core
+            t = s.get("textures", {})
+            rays = s["rays"]["total"]
+            print("  %-26s %8.2f %8.2f %7.1f %7.1f %7.2fx %9.0f %10d %10.1f %9.1f" % (
+                name, s["wall_seconds"], core, s["user_seconds"], s["system_seconds"], core / ref, rss,
+                t.get("tiles_read", 0), t.get("bytes_read", 0) / 1e6, t.get("bytes_read", 0) / rays), flush=True)
+            if name.startswith("cpu") or name.startswith("vulkan"):
+                print("    stages: " + ", ".join("%s %.2f" % (k, v) for k, v in s["stage_seconds"].items()))
+            rows.append({"depth": depth, "config": name, "wall_seconds": s["wall_seconds"], "core_seconds": core,
+                         "user_seconds": s["user_seconds"], "system_seconds": s["system_seconds"],
+                         "vs_reference": core / ref, "peak_rss_mib": rss, "rays": rays, "textures": t,
+                         "stage_seconds": s["stage_seconds"]})
+    bound = 512 + cache + geometry_bytes / 2**20 + 200
+    print("\npeak RSS bound: memory budget 512 + cache %.0f + geometry %.0f + 200 = %.0f MiB" % (
+        cache, geometry_bytes / 2**20, bound))
+    with open(os.path.join(folder, "bench.json"), "w") as f:
+        json.dump({"texture_bytes": texture_bytes, "geometry_bytes": geometry_bytes, "cache_mib": cache,
+                   "rss_bound_mib": bound, "rows": rows}, f, indent=1)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("what", nargs="?", default="all", choices=["reference", "pipeline", "all"])
-    ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("what", nargs="?", default="all", choices=["reference", "pipeline", "production", "all"])
+    ap.add_argument("--repeat", type=int)
+    ap.add_argument("--depths", default="1,2,3")
+    ap.add_argument("--exponents", default="8,11,14,17")
+    ap.add_argument("--scene-args", default="")
     ap.add_argument("--spillway", default=os.path.join(ROOT, "build", "spillway"))
     a = ap.parse_args()
+    if a.what == "production":
+        bench_production(a.spillway, a.repeat or 1, [int(d) for d in a.depths.split(",")],
+                         [int(e) for e in a.exponents.split(",")], a.scene_args.split())
+        return
+    a.repeat = a.repeat or 3
     if a.what in ("reference", "all"):
         bench_reference(a.spillway, a.repeat)
     if a.what in ("pipeline", "all"):
