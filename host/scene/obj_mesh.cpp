@@ -88,9 +88,10 @@ class ObjChecker {
         for (int line = 1; at < t.size(); ++line) {
             size_t eol = t.find('\n', at);
             if (eol == std::string::npos) eol = t.size();
-            const size_t hash = t.find('#', at);
-            if (hash < eol)
-                std::fill(t.begin() + std::ptrdiff_t(hash), t.begin() + std::ptrdiff_t(eol), ' ');
+            // A comment runs to the end of its line; look for it on this line only (a search
+            // to the end of the file from every line made reading quadratic in its size).
+            const auto end = t.begin() + std::ptrdiff_t(eol);
+            std::fill(std::find(t.begin() + std::ptrdiff_t(at), end, '#'), end, ' ');
             statement(line, tokens(t, at, eol));
             at = eol + 1;
         }
