@@ -1,9 +1,12 @@
 #include "embree_backend/embree_scene.h"
 
+#include "shared/cone.h"
 #include "shared/offset.h"
 
 #include <embree3/rtcore.h>
 
+#include <algorithm>
+#include <cmath>
 #include <stdexcept>
 
 namespace spw {
@@ -79,10 +82,33 @@ void EmbreeScene::surfaceHit(uint geomID, uint primID, float u, float v, float t
     hit.offset = surfaceOffset(hit.p, p0, p1, p2, hit.ng);
 }
 
-SurfaceHit EmbreeScene::setUpHit(const HitRecord& h, const TextureResolver& textures) const {
+SurfaceHit EmbreeScene::setUpHit(const HitRecord& h, vec3 dir, uint cone,
+                                 const TextureResolver& textures) const {
     SurfaceHit hit;
     surfaceHit(h.mesh, h.prim, h.u, h.v, h.t, hit);
-    hit.albedo = textures.albedo(src_.shaders[hit.shader], uvAt(h.mesh, h.prim, h.u, h.v));
+    const Shader& shader = src_.shaders[hit.shader];
+    if (shader.texture < 0) {
+        hit.albedo = textures.albedo(shader, vec2(0.0f), 0.0f);
+        return hit;
+    }
+    // The filter width in texture space: the cone's width at the hit, stretched by the
+    // incidence (1/|cos|, at most 1000x at grazing angles) and scaled by the triangle's texture
+    // area over its world area (Akenine-Moller et al. 2019, eq. 20.x's Delta_0).
+    const Mesh& mesh = src_.meshes[h.mesh];
+    float footprint = 0.0f;
+    if (!mesh.uvs.empty()) {
+        const uvec3 tri = mesh.triangles[h.prim];
+        const vec3 p0 = mesh.positions[tri.x];
+        const vec2 t0 = mesh.uvs[tri.x];
+        const float worldArea =
+            glm::length(glm::cross(mesh.positions[tri.y] - p0, mesh.positions[tri.z] - p0));
+        const vec2 a = mesh.uvs[tri.y] - t0, b = mesh.uvs[tri.z] - t0;
+        const float uvArea = std::fabs(a.x * b.y - a.y * b.x);
+        const float cosine = std::max(std::fabs(glm::dot(dir, hit.ng)), 1e-3f);
+        if (worldArea > 0.0f)
+            footprint = coneWidthAt(cone, h.t) / cosine * std::sqrt(uvArea / worldArea);
+    }
+    hit.albedo = textures.albedo(shader, uvAt(h.mesh, h.prim, h.u, h.v), footprint);
     return hit;
 }
 

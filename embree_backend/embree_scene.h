@@ -40,7 +40,10 @@ class EmbreeScene {
 
     // Hit setup, the same on every backend: the world-space hit (position, normals, self-
     // intersection offset, shader, emitter) and the albedo the shader's texture gives there.
-    SurfaceHit setUpHit(const HitRecord& h, const TextureResolver& textures) const;
+    // `dir` and `cone`: the ray's unit direction and packed cone (shared/cone.h), for the
+    // texture filter width.
+    SurfaceHit setUpHit(const HitRecord& h, vec3 dir, uint cone,
+                        const TextureResolver& textures) const;
     // Throws if Embree reported an error since the last check.
     void checkError(const char* what) const;
 

@@ -30,13 +30,13 @@ void ReferenceRenderer::renderIteration(uint iteration, Film& film) {
                         CameraRay cr =
                             ctx_.camera.generate(uint(x), uint(y), s, sampleIndex, rp.seed);
                         film.addSample(cr.filmPos, sampleIndex);
-                        PathState st = cameraPath(rp, pixel, s);
+                        PathState st = cameraPath(rp, pixel, s, ctx_.camera.pixelSpread());
                         vec3 org = cr.origin, dir = cr.dir;
                         ++camera;
                         for (;;) {
                             const HitRecord h = intersectOne(embree, org, dir);
                             if (h.mesh == kNoHit) break;
-                            const SurfaceHit hit = embree.setUpHit(h, ctx_.textures);
+                            const SurfaceHit hit = embree.setUpHit(h, dir, st.cone, ctx_.textures);
                             ShadeResult res;
                             shadeSurface(view, rp, hit, dir, st, res);
                             if (res.flags & kShadeEmitted)

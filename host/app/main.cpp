@@ -56,6 +56,8 @@ render options:
   --time-limit SECONDS  stop after the iteration that crosses this render time
   --texture-cache MiB   the texture system's tile cache (settings: texture cache; default
                         1024): image textures beyond it are read from disk again as needed
+  --texture-filter F    cone (default: lookups read the MIP levels each hit's ray-cone
+                        footprint needs, trilinear) or finest (always the finest level)
 
 sorted pipeline options (cpu and vulkan backends):
   --bin-exponent E      a directional bin becomes a batch at 2^E rays (settings: bin exponent)
@@ -67,7 +69,7 @@ sorted pipeline options (cpu and vulkan backends):
   --hit-sort on|off     sort hits by (shader, object, primitive) before shading
   --shading MODE        sorted (default: one dispatch per shader range, one kernel per surface
                         model) or megakernel (unsorted hits, one uber-shader switching per hit)
-  --ray-format F        compact (32-byte rays, default) or full (48 bytes, every bit kept)
+  --ray-format F        compact (34-byte rays, default) or full (50 bytes, every bit kept)
 
 exit status: 0 done; 1 runtime failure (disk, device, an output that cannot be written);
 2 bad usage or scene error (printed as FILE:LINE: message). On any failure no output file
@@ -175,6 +177,8 @@ int renderCommand(const std::vector<std::string>& args) {
             referencePath = value();
         else if (a == "--time-limit")
             config.timeLimitSeconds = parseNumber(a, value(), 1e-3, 1e9);
+        else if (a == "--texture-filter")
+            config.textureFilter = choice(a, value(), spw::parseTextureFilter);
         else if (a == "--texture-cache")
             config.textureCacheMiB = parseNumber(a, value(), 1.0, 1 << 20);
         else if (a == "--bin-exponent")

@@ -35,6 +35,8 @@ constexpr std::pair<const char*, RaySortMode> kRaySorts[] = {{"auto", RaySortMod
                                                              {"off", RaySortMode::Off}};
 constexpr std::pair<const char*, ShadingMode> kShadings[] = {
     {"sorted", ShadingMode::Sorted}, {"megakernel", ShadingMode::Megakernel}};
+constexpr std::pair<const char*, TextureFilter> kTextureFilters[] = {
+    {"cone", TextureFilter::Cone}, {"finest", TextureFilter::Finest}};
 
 } // namespace
 
@@ -61,6 +63,9 @@ ShadingMode parseShadingMode(const std::string& name) {
 }
 const char* shadingModeName(ShadingMode mode) {
     return nameOf(mode, kShadings);
+}
+TextureFilter parseTextureFilter(const std::string& name) {
+    return parseChoice("texture filter", name, kTextureFilters);
 }
 
 } // namespace spw

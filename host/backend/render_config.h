@@ -17,8 +17,8 @@ enum class BackendKind { Auto, Vulkan, Cpu, Reference };
 BackendKind parseBackend(const std::string& name); // auto | vulkan | cpu | reference
 const char* backendName(BackendKind kind);
 
-// How rays wait between bounces (host/pipeline/ray_record.h): 32-byte compact records, or
-// 48-byte full ones that keep every bit.
+// How rays wait between bounces (host/pipeline/ray_record.h): 34-byte compact records, or
+// 50-byte full ones that keep every bit.
 enum class RayFormat { Compact, Full };
 RayFormat parseRayFormat(const std::string& name); // compact | full
 const char* rayFormatName(RayFormat format);
@@ -36,6 +36,12 @@ enum class ShadingMode { Sorted, Megakernel };
 ShadingMode
 parseShadingMode(const std::string& name); // "sorted" | "megakernel"; throws invalid_argument
 const char* shadingModeName(ShadingMode mode);
+
+// Which MIP levels image-texture lookups read. Cone (the default): the level the ray cone's
+// footprint needs (shared/cone.h), trilinear. Finest (the ablation): always the finest level,
+// as a renderer without filtering does, and as the thesis' experiment measured.
+enum class TextureFilter { Cone, Finest };
+TextureFilter parseTextureFilter(const std::string& name); // "cone" | "finest"
 
 // What the scene's settings do not say about the pipeline: the ablation knobs.
 struct PipelineConfig {
@@ -76,6 +82,7 @@ struct RenderConfig {
     VulkanConfig vulkan;                    // the vulkan backend's knobs
     std::optional<double> timeLimitSeconds; // stop after the iteration that crosses it
     std::optional<double> textureCacheMiB;  // overrides settings: texture cache
+    TextureFilter textureFilter = TextureFilter::Cone;
 };
 
 } // namespace spw

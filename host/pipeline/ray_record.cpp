@@ -90,6 +90,7 @@ void encodeRay(const RayState& r, RayFormat format, uvec4 rounding, std::uint8_t
             put<float>(p, r.path.beta[i]);
         put<float>(p, r.path.prevPdf);
         put<std::uint32_t>(p, r.path.bounce | r.path.flags << 16);
+        put<std::uint16_t>(p, std::uint16_t(r.path.cone));
         return;
     }
     uint u, v;
@@ -105,6 +106,7 @@ void encodeRay(const RayState& r, RayFormat format, uvec4 rounding, std::uint8_t
     put<std::uint16_t>(p, std::uint16_t(floatBitsToUint(r.path.prevPdf) >> 16));
     put<std::uint16_t>(p, std::uint16_t(std::min(r.path.bounce, kMaxCompactBounce) |
                                         ((r.path.flags & kPathSpecular) ? 0x8000u : 0u)));
+    put<std::uint16_t>(p, std::uint16_t(r.path.cone));
 }
 
 void decodeRay(const std::uint8_t* in, RayFormat format, RayState& r) {
@@ -112,7 +114,6 @@ void decodeRay(const std::uint8_t* in, RayFormat format, RayState& r) {
     for (int i = 0; i < 3; ++i)
         r.origin[i] = get<float>(p);
     r.path.pathId = get<std::uint32_t>(p);
-    r.path.pad0 = 0;
     if (format == RayFormat::Full) {
         for (int i = 0; i < 3; ++i)
             r.dir[i] = get<float>(p);
@@ -122,6 +123,7 @@ void decodeRay(const std::uint8_t* in, RayFormat format, RayState& r) {
         std::uint32_t bf = get<std::uint32_t>(p);
         r.path.bounce = bf & 0xFFFFu;
         r.path.flags = bf >> 16;
+        r.path.cone = get<std::uint16_t>(p);
         return;
     }
     r.dir = octDecode(get24(p), get24(p + 3));
@@ -133,6 +135,7 @@ void decodeRay(const std::uint8_t* in, RayFormat format, RayState& r) {
     std::uint16_t bf = get<std::uint16_t>(p);
     r.path.bounce = bf & 0x7FFFu;
     r.path.flags = (bf & 0x8000u) ? kPathSpecular : 0u;
+    r.path.cone = get<std::uint16_t>(p);
 }
 
 } // namespace spw

@@ -4,7 +4,7 @@
 // records; `compact` is the default, `full` keeps every bit and exists to prove that compaction
 // does not change the image (a test renders both).
 //
-// Compact record, 32 bytes:
+// Compact record, 34 bytes:
 //   origin      3 x float32  12 B  exact: the origin decides self-intersection, so it keeps
 //                                  every bit.
 //   pathId      uint32        4 B  exact: pixel * samples per iteration + sample. The iteration
@@ -25,9 +25,12 @@
 //   prevPdf     bfloat16      2 B  exact: shadeSurface() already quantises it, and MIS uses the
 //                                  same quantised value on both sides (shared/sampling.h).
 //   bounce      15 bits      2 B  exact up to 32767 bounces; the top bit is the specular flag.
+//   cone        2 x 8 bits   2 B  exact: the ray cone's width and spread, which shadeSurface()
+//                                  already quantises to a byte each on a log2 scale
+//                                  (shared/cone.h), for the texture filter width at the next hit.
 //
-// Full record, 48 bytes: float32 origin, direction, throughput, prevPdf; uint32 pathId and
-// bounce | flags << 16.
+// Full record, 50 bytes: float32 origin, direction, throughput, prevPdf; uint32 pathId and
+// bounce | flags << 16; the 16-bit cone.
 #pragma once
 
 #include "host/backend/render_config.h"
@@ -45,8 +48,8 @@ struct RayState {
     PathState path;
 };
 
-constexpr size_t kCompactRayBytes = 32;
-constexpr size_t kFullRayBytes = 48;
+constexpr size_t kCompactRayBytes = 34;
+constexpr size_t kFullRayBytes = 50;
 constexpr uint kMaxCompactBounce = 0x7FFF;
 
 inline size_t rayRecordBytes(RayFormat f) {

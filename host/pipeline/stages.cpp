@@ -43,6 +43,7 @@ void generateCameraRays(const RenderContext& ctx, uint iteration, RayFormat form
     const int width = scene.image.width, height = scene.image.height,
               tile = scene.settings.bucketSize;
     const uint spi = rp.samplesPerIteration;
+    const float spread = ctx.camera.pixelSpread();
     const int tilesX = (width + tile - 1) / tile, tilesY = (height + tile - 1) / tile;
     tbb::parallel_for(0, tilesX * tilesY, [&](int t) {
         const int x0 = (t % tilesX) * tile, y0 = (t / tilesX) * tile;
@@ -56,7 +57,7 @@ void generateCameraRays(const RenderContext& ctx, uint iteration, RayFormat form
                     RayState r;
                     r.origin = cr.origin;
                     r.dir = cr.dir;
-                    r.path = cameraPath(rp, uint(y * width + x), s);
+                    r.path = cameraPath(rp, uint(y * width + x), s, spread);
                     buffer.push(r, format, roundingBits(rp, r.path));
                 }
         ctx.stats.cameraRays += buffer.count;
@@ -121,7 +122,7 @@ void setUpHits(const RenderContext& ctx, const std::vector<RayState>& rays,
             for (size_t i = r.begin(); i < r.end(); ++i) {
                 const std::uint32_t k = order[i].index;
                 ShadeInput in; // assembled here, stored whole: one sequential write into the slot
-                in.hit = ctx.embree.setUpHit(hits[k], ctx.textures);
+                in.hit = ctx.embree.setUpHit(hits[k], rays[k].dir, rays[k].path.cone, ctx.textures);
                 in.path = rays[k].path;
                 in.rayDir = rays[k].dir;
                 in.pad0 = 0.0f;

@@ -4,7 +4,7 @@
 //
 //   generate      camera tiles -> thread-local ray buffers -> six directional bins
 //   load          the next batch from RAM or the spill file      BatchQueue::pop (batch_queue.h)
-//   decompress    32- or 48-byte records -> RayState
+//   decompress    34- or 50-byte records -> RayState
 //   sort rays     Morton radix sort, median split, or none        ray_sort.h; RaySortPolicy decides
 //   traverse      closest hits of the whole batch                 intersectBatch (embree_backend/)
 //   sort hits     by (shader, object, primitive), misses last

@@ -113,7 +113,8 @@ std::unique_ptr<RenderResult> renderWithProgress(const Scene& scene, const Rende
         StageTimer t(stats.stages, "build bvh");
         embree = std::make_unique<EmbreeScene>(scene, lights);
     }
-    TextureResolver textures(scene, config.textureCacheMiB.value_or(scene.settings.textureCacheMiB));
+    TextureResolver textures(scene, config.textureCacheMiB.value_or(scene.settings.textureCacheMiB),
+                             config.textureFilter == TextureFilter::Cone);
     CameraModel camera(scene, plan.sampleBase);
 
     RenderParams params{};

@@ -23,6 +23,9 @@ class CameraModel {
     // `sampleIndex` the render-wide one that keys the random numbers.
     CameraRay generate(uint x, uint y, uint sample, uint sampleIndex, uint seed) const;
     vec2 filmPosition(uint x, uint y, uint sample, uint sampleIndex, uint seed) const;
+    // The angle (radians) one pixel subtends at the image centre: camera rays' cone spread
+    // (shared/cone.h).
+    float pixelSpread() const { return 2.0f * tanX_ / float(width_); }
 
   private:
     Camera cam_;

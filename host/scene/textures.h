@@ -29,14 +29,17 @@ struct TextureStatistics {
 
 class TextureResolver {
   public:
-    // cacheMiB: the tile cache's size (settings: texture cache, or --texture-cache).
-    TextureResolver(const Scene& scene, double cacheMiB);
+    // cacheMiB: the tile cache's size (settings: texture cache, or --texture-cache). filtered:
+    // lookups take their footprint (MIP levels, trilinear); otherwise the finest level always.
+    TextureResolver(const Scene& scene, double cacheMiB, bool filtered = true);
     ~TextureResolver();
     TextureResolver(const TextureResolver&) = delete;
     TextureResolver& operator=(const TextureResolver&) = delete;
 
-    // reflectance x (texture colour at uv, or the constant colour). Thread-safe.
-    vec3 albedo(const Shader& shader, vec2 uv) const;
+    // reflectance x (texture colour at uv, or the constant colour). `footprint`: the filter
+    // width in texture space (uv units), from the ray cone; it picks the MIP levels (trilinear).
+    // Thread-safe.
+    vec3 albedo(const Shader& shader, vec2 uv, float footprint) const;
     // True when the scene has image textures (OpenImageIO is in use).
     bool active() const { return impl_ != nullptr; }
     // Throws SceneError (the texture's file and scene line) if an image lookup failed since the
@@ -54,11 +57,12 @@ class TextureResolver {
         int texture;            // index into Scene::textures
         int upper, lower, mask; // Layered: operand slots
     };
-    vec3 lookup(int texture, vec2 uv) const;
+    vec3 lookup(int texture, vec2 uv, float footprint) const;
     struct Impl;
     const Scene& scene_;
     std::vector<std::vector<Op>> programs_; // per Scene::textures root used by a shader
     std::unique_ptr<Impl> impl_;
+    bool filtered_;
 };
 
 } // namespace spw

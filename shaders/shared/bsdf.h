@@ -4,6 +4,8 @@
 // The models are the registry's (shared/surface_models.h); each one's header <stem>.h defines
 // the three functions dispatched to below, with these signatures:
 //   bool <stem>BsdfIsDelta(ShaderParams sh)
+//   float <stem>BsdfConeSpread(ShaderParams sh)  the angle (radians) its lobe adds to a ray
+//                                                cone's spread (shared/cone.h)
 //   vec3 <stem>BsdfEval(ShaderParams sh, vec3 albedo, vec3 ng, vec3 ns, vec3 wo, vec3 wi,
 //                       OUT(float) pdf)
 //   bool <stem>BsdfSample(ShaderParams sh, vec3 albedo, vec3 ng, vec3 ns, vec3 wo, vec3 u,
@@ -28,6 +30,17 @@ SHARED_FN bool bsdfIsDelta(ShaderParams sh) {
     SPW_SURFACE_MODELS(SPW_BSDF_IS_DELTA)
 #undef SPW_BSDF_IS_DELTA
     return false;
+}
+
+// What a bounce adds to the ray cone's spread angle: nothing for a delta lobe (`specular`),
+// the model's lobe width otherwise (shared/cone.h).
+SHARED_FN float bsdfConeSpread(ShaderParams sh, bool specular) {
+    if (specular) return 0.0f;
+#define SPW_BSDF_CONE_SPREAD(Name, id, stem, params)                                               \
+    if (sh.model == kModel##Name) return stem##BsdfConeSpread(sh);
+    SPW_SURFACE_MODELS(SPW_BSDF_CONE_SPREAD)
+#undef SPW_BSDF_CONE_SPREAD
+    return 0.0f;
 }
 
 // f * |cos| and the solid-angle pdf of sampling wi. `albedo`: the hit's reflectance x texture

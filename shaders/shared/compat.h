@@ -12,6 +12,8 @@
 //     `INOUT(T)`, and structs are filled field by field;
 //   * functions are declared `SHARED_FN` (inline in C++, nothing in GLSL);
 //   * a parameter an interface requires but a function does not read is marked `UNUSED(p);`;
+//   * GLSL's `out` parameters are not copied in, and a callee's unwritten `out` overwrites the
+//     caller's variable with an undefined value: a function writes every `out` it promises;
 //   * buffer reads go through the accessor macros of the file that declares the buffer.
 #ifndef SPILLWAY_SHARED_COMPAT_H
 #define SPILLWAY_SHARED_COMPAT_H

@@ -76,6 +76,11 @@ SHARED_FN bool conductorSample(vec3 f0, float alpha, vec3 ng, vec3 ns, vec3 wo, 
 SHARED_FN bool conductorBsdfIsDelta(ShaderParams sh) {
     return ggxIsSmooth(sh.alpha);
 }
+// GGX's alpha is the tangent of the lobe's angular width: a rough reflection spreads the cone
+// by about alpha radians (a mirror, sampled as a delta lobe, by 0: bsdfConeSpread).
+SHARED_FN float conductorBsdfConeSpread(ShaderParams sh) {
+    return sh.alpha;
+}
 SHARED_FN vec3 conductorBsdfEval(ShaderParams sh, vec3 albedo, vec3 ng, vec3 ns, vec3 wo, vec3 wi,
                                  OUT(float) pdf) {
     return conductorEval(albedo, sh.alpha, ng, ns, wo, wi, pdf);

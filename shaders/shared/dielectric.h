@@ -136,6 +136,10 @@ SHARED_FN bool dielectricSample(float ior, float alpha, vec3 ng, vec3 ns, vec3 w
 SHARED_FN bool dielectricBsdfIsDelta(ShaderParams sh) {
     return ggxIsSmooth(sh.alpha);
 }
+// As the conductor's: about alpha radians for a rough interface.
+SHARED_FN float dielectricBsdfConeSpread(ShaderParams sh) {
+    return sh.alpha;
+}
 SHARED_FN vec3 dielectricBsdfEval(ShaderParams sh, vec3 albedo, vec3 ng, vec3 ns, vec3 wo, vec3 wi,
                                   OUT(float) pdf) {
     UNUSED(albedo);

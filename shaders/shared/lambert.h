@@ -33,6 +33,11 @@ SHARED_FN bool lambertSample(vec3 albedo, vec3 ng, vec3 ns, vec3 wo, vec2 u, OUT
 }
 
 // The registry's interface (shared/bsdf.h dispatches here).
+// The cosine lobe is about a radian wide (its half-power angle is 60 degrees).
+SHARED_FN float lambertBsdfConeSpread(ShaderParams sh) {
+    UNUSED(sh);
+    return 1.0f;
+}
 SHARED_FN bool lambertBsdfIsDelta(ShaderParams sh) {
     UNUSED(sh);
     return false;
@@ -46,7 +51,7 @@ SHARED_FN bool lambertBsdfSample(ShaderParams sh, vec3 albedo, vec3 ng, vec3 ns,
                                  OUT(vec3) wi, OUT(vec3) weight, OUT(float) pdf,
                                  OUT(bool) specular) {
     UNUSED(sh);
-    UNUSED(specular); // never a delta lobe: bsdfSample has cleared it
+    specular = false; // never a delta lobe (GLSL's `out` is not copied in: set it here)
     return lambertSample(albedo, ng, ns, wo, vec2(u.x, u.y), wi, weight, pdf);
 }
 

@@ -8,6 +8,10 @@
 SHARED_BEGIN
 
 // The registry's interface (shared/bsdf.h dispatches here).
+SHARED_FN float nullBsdfConeSpread(ShaderParams sh) {
+    UNUSED(sh);
+    return 0.0f;
+}
 SHARED_FN bool nullBsdfIsDelta(ShaderParams sh) {
     UNUSED(sh);
     return false;
@@ -31,10 +35,11 @@ SHARED_FN bool nullBsdfSample(ShaderParams sh, vec3 albedo, vec3 ng, vec3 ns, ve
     UNUSED(ns);
     UNUSED(wo);
     UNUSED(u);
-    UNUSED(wi);
-    UNUSED(weight);
-    UNUSED(pdf);
-    UNUSED(specular); // bsdfSample has cleared every output
+    // GLSL's `out` parameters are not copied in: write every one.
+    wi = vec3(0.0f);
+    weight = vec3(0.0f);
+    pdf = 0.0f;
+    specular = false;
     return false;
 }
 

@@ -7,6 +7,7 @@
 #ifndef SPILLWAY_SHARED_PATH_H
 #define SPILLWAY_SHARED_PATH_H
 #include "bsdf.h"
+#include "cone.h"
 #include "lights.h"
 #include "offset.h"
 #include "rng.h"
@@ -22,14 +23,15 @@ SHARED_FN uint pathSample(RenderParams rp, uint pathId) {
 }
 
 // A camera path's state before its first bounce: throughput 1, sample `s` of `pixel`.
-SHARED_FN PathState cameraPath(RenderParams rp, uint pixel, uint s) {
+// pixelSpread: the angle one pixel subtends (CameraModel::pixelSpread), the cone's spread.
+SHARED_FN PathState cameraPath(RenderParams rp, uint pixel, uint s, float pixelSpread) {
     PathState st;
     st.beta = vec3(1.0f);
     st.prevPdf = 0.0f;
     st.pathId = pixel * rp.samplesPerIteration + s;
     st.bounce = 0u;
     st.flags = 0u;
-    st.pad0 = 0u;
+    st.cone = packCone(0.0f, pixelSpread);
     return st;
 }
 
@@ -123,6 +125,8 @@ SHARED_FN void shadeSurface(SCENE_PARAM RenderParams rp, SurfaceHit hit, vec3 ra
     r.next.prevPdf = quantizePdf(pdf);
     r.next.bounce = st.bounce + 1u;
     r.next.flags = specular ? kPathSpecular : 0u;
+    r.next.cone =
+        packCone(coneWidthAt(st.cone, hit.t), coneSpread(st.cone) + bsdfConeSpread(sh, specular));
     r.flags |= kShadeContinue;
 }
 

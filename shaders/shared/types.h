@@ -68,7 +68,7 @@ struct PathState {
     uint pathId;   // pixel * samplesPerIteration + sample within the iteration
     uint bounce;   // 0 for camera rays
     uint flags;    // kPath*
-    uint pad0;
+    uint cone;     // the ray's cone, packed (shared/cone.h)
 };
 
 const uint kStrategyMis = 0u;   // light and BSDF sampling, power heuristic

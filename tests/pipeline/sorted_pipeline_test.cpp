@@ -1,5 +1,6 @@
 // The sorted deferred pipeline (--backend cpu): it must render the reference's image, whatever
 // its batching, sorting, memory budget and thread count, and it must clean up after itself.
+#include "host/pipeline/ray_record.h"
 #include "test_util.h"
 
 #include <gtest/gtest.h>
@@ -361,7 +362,7 @@ TEST(Spill, PeakRaysInRamStayWithinTheBudgetOrSixBatches) {
         ASSERT_EQ(r.status, 0) << r.output;
         nlohmann::json j = nlohmann::json::parse(std::ifstream(stats));
         const long budget = long(std::stod(c.budgetMiB) * 1024 * 1024);
-        const long sixBatches = 6L * (1L << c.exponent) * 32;
+        const long sixBatches = 6L * (1L << c.exponent) * long(kCompactRayBytes);
         const long peak = j["peak_ray_bytes_in_ram"].get<long>();
         std::printf(
             "budget %s MiB, 2^%d-ray batches: peak %ld bytes, bound %ld, %ld batches spilled\n",

@@ -121,7 +121,7 @@ TEST(Textures, NoTextureSystemWithoutImageTextures) {
                          "Constant, colour: [0.25, 0.5, 1]}\n"));
     TextureResolver none(constant, 64.0);
     EXPECT_FALSE(none.active());
-    const vec3 a = none.albedo(constant.shaders[0], vec2(0.3f, 0.7f));
+    const vec3 a = none.albedo(constant.shaders[0], vec2(0.3f, 0.7f), 0.0f);
     EXPECT_EQ(a, vec3(0.25f, 0.5f, 0.0f));
     const Scene image =
         loadScene(dir.write("i.yaml", head + "    {type: Standard, string: a.exr}\n"));

@@ -337,7 +337,8 @@ PerHit shadeSameHits(ShadingMode mode) {
             if (u + v > 1.0f) u = 1.0f - u, v = 1.0f - v;
             ShadeInput& in = inputs[i];
             in.hit =
-                embree.setUpHit(HitRecord{mesh, prim, u, v, 10.0f + 1000.0f * unit(rng)}, textures);
+                embree.setUpHit(HitRecord{mesh, prim, u, v, 10.0f + 1000.0f * unit(rng)},
+                               vec3(0.0f, 0.0f, 1.0f), 0u, textures);
             vec3 d = glm::normalize(vec3(unit(rng) - 0.5f, unit(rng) - 0.5f, unit(rng) - 0.5f));
             if (rng() % 8 != 0 && glm::dot(d, in.hit.ng) > 0.0f)
                 d = -d; // mostly the front, some backs
@@ -348,6 +349,7 @@ PerHit shadeSameHits(ShadingMode mode) {
             in.path.pathId = uint(rng() % (64 * 64 * 4));
             in.path.bounce = uint(rng() % 12);
             in.path.flags = rng() % 5 == 0 ? kPathSpecular : 0u;
+            in.path.cone = uint(rng() & 0xFFFFu);
         }
         // One range per shader (sorted shading), or all at once (megakernel).
         std::stable_sort(
@@ -380,7 +382,8 @@ PerHit shadeSameHits(ShadingMode mode) {
                 continue;
             }
             if (a.flags != b.flags || a.next.bounce != b.next.bounce ||
-                a.next.pathId != b.next.pathId || a.next.flags != b.next.flags) {
+                a.next.pathId != b.next.pathId || a.next.flags != b.next.flags ||
+                ((a.flags & kShadeContinue) && a.next.cone != b.next.cone)) {
                 ++out.flagMismatches;
                 continue;
             }
