@@ -66,7 +66,7 @@ sorted pipeline options (cpu and vulkan backends):
                         budget, or within six batches (2^E rays each) if that is larger
   --spill-dir DIR       where spilled batches go (default: the system temp folder)
   --ray-sort MODE       auto (sort only where it measures faster), morton, median or off
-  --hit-sort on|off     sort hits by (shader, object, primitive) before shading
+  --hit-sort on|off     sort hits by (shader, object, texture order) before shading
   --shading MODE        sorted (default: one dispatch per shader range, one kernel per surface
                         model) or megakernel (unsorted hits, one uber-shader switching per hit)
   --ray-format F        compact (34-byte rays, default) or full (50 bytes, every bit kept)

@@ -28,7 +28,7 @@ enum class RaySortMode { Auto, Morton, Median, Off };
 RaySortMode parseRaySortMode(const std::string& name); // auto | morton | median | off
 const char* raySortName(RaySortMode mode);
 
-// How hits are shaded. Sorted: hits sorted by (shader, object, primitive), one homogeneous
+// How hits are shaded. Sorted: hits sorted by (shader, object, texture order), one homogeneous
 // dispatch per shader range, each with its model's own kernel. Megakernel (the ablation): the
 // hits stay unsorted and one uber-shader switches on the model per hit. Unsorted hits (also
 // --hit-sort off) always take the megakernel: they have no homogeneous ranges.

@@ -97,9 +97,13 @@ size_t sortHits(const Scene& scene, const std::vector<HitRecord>& hits, bool byS
             for (size_t i = r.begin(); i < r.end(); ++i) {
                 const HitRecord& h = hits[i];
                 std::uint64_t key = kMissKey;
-                if (h.mesh != kNoHit)
-                    key = byShader ? hitSortKey(uint(scene.meshes[h.mesh].shader), h.mesh, h.prim)
-                                   : 0;
+                if (h.mesh != kNoHit && byShader) {
+                    const Mesh& mesh = scene.meshes[h.mesh];
+                    key =
+                        hitSortKey(uint(mesh.shader), h.mesh, textureOrder(mesh, h.prim, h.u, h.v));
+                } else if (h.mesh != kNoHit) {
+                    key = 0;
+                }
                 order[i] = {key, std::uint32_t(i)};
             }
         });

@@ -7,7 +7,7 @@
 //   decompress    34- or 50-byte records -> RayState
 //   sort rays     Morton radix sort, median split, or none        ray_sort.h; RaySortPolicy decides
 //   traverse      closest hits of the whole batch                 intersectBatch (embree_backend/)
-//   sort hits     by (shader, object, primitive), misses last
+//   sort hits     by (shader, object, texture order), misses last
 //   hit setup     world-space hit and texture albedo, in sorted order, into the engine's inputs
 //   shade         one pass per shader range                       ShadingEngine (shading_engine.h)
 //   shade wait    until the engine's results are complete
@@ -40,7 +40,7 @@ size_t decompressRays(RayBatch& batch, std::vector<RayState>& rays);
 void traverse(const EmbreeScene& embree, const std::vector<RayState>& rays, bool coherent,
               std::vector<HitRecord>& hits);
 
-// sort hits: one SortedHit per ray, the hits first (by shader, object, primitive when
+// sort hits: one SortedHit per ray, the hits first (by shader, object, texture order when
 // `byShader`, else in traversal order), the misses after them. Returns the number of hits.
 size_t sortHits(const Scene& scene, const std::vector<HitRecord>& hits, bool byShader,
                 std::vector<SortedHit>& order, std::vector<SortedHit>& scratch);

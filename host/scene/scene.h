@@ -46,7 +46,7 @@ constexpr int kMaxDepth = 0x7FFF;
 // Layered textures: levels from the root to a leaf, and textures in all (aliases shared).
 constexpr int kMaxTextureDepth = 64;
 constexpr int kMaxTextures = 1 << 16;
-// The sorted pipeline's hit key packs (shader, object, primitive) into 12 + 20 + 32 bits, the
+// The sorted pipeline's hit key packs (shader, object, texture order) into 12 + 20 + 32 bits, the
 // all-ones key meaning a miss: at most 4095 shaders (one per light included) and 2^20 objects
 // (one per light included).
 constexpr int kMaxShaders = (1 << 12) - 1;

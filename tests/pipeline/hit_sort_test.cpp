@@ -100,5 +100,24 @@ TEST(HitSort, KeyOrdersByShaderThenObjectThenPrimitive) {
     EXPECT_EQ(shaderOfKey(hitSortKey(maxShader - 1, 0, 0)), maxShader - 1);
 }
 
+// Within an object, hits order by the Morton code of their texture coordinates (wrapped), and
+// by primitive where the mesh has none.
+TEST(HitSort, TextureOrderIsTheMortonCodeOfTheWrappedTextureCoordinates) {
+    Mesh mesh;
+    mesh.positions = {vec3(0), vec3(1, 0, 0), vec3(0, 1, 0)};
+    mesh.triangles = {uvec3(0, 1, 2), uvec3(0, 1, 2)};
+    EXPECT_EQ(textureOrder(mesh, 1, 0.3f, 0.3f), 1u) << "no texture coordinates: the primitive";
+    // Vertex 0 at uv (0.5, 0.25) + 3 (wrapped), vertex 1 at (1.5, 0.25): u = 0.5 + b1.
+    mesh.uvs = {vec2(3.5f, 3.25f), vec2(4.5f, 3.25f), vec2(3.5f, 4.25f)};
+    // u = 0.5 is bit 15 of x, spread to bit 30; v = 0.25 is bit 14 of y, spread to bit 29.
+    EXPECT_EQ(textureOrder(mesh, 0, 0.0f, 0.0f), (1u << 30) | (1u << 29));
+    // u = 0.75 (bits 15 and 14 of x: bits 30 and 28); v = 0.25.
+    EXPECT_EQ(textureOrder(mesh, 0, 0.25f, 0.0f), (1u << 30) | (1u << 28) | (1u << 29));
+    // The next cell in u is the next key; the next in v, two on.
+    const uint a = textureOrder(mesh, 0, 0.0f, 0.0f);
+    EXPECT_EQ(textureOrder(mesh, 0, 1.5f / 65536, 0.0f), a + 1);
+    EXPECT_EQ(textureOrder(mesh, 0, 0.0f, 1.5f / 65536), a + 2);
+}
+
 } // namespace
 } // namespace spw
