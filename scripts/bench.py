@@ -12,7 +12,10 @@ are noisy; ratios travel, absolute seconds do not).
                                8, 11, 14, 17 and the reference, at max depth 1, 2, 3; vulkan at
                                2^17; the in-core control (Constant colours). Wall, user and system
                                seconds, peak RSS, texture tiles and bytes read, ratio to the
-                               reference at the same depth. Writes out/production/bench.json.
+                               reference at the same depth; all of it twice, with
+                               --texture-filter finest (the thesis' regime: every lookup at the
+                               finest level) and cone (the default). Writes
+                               out/production/bench.json.
   scripts/bench.py all         reference and pipeline (default)
 
 Options: --repeat N (best of N, default 3; production: 1), --spillway PATH (default
@@ -125,37 +128,40 @@ def bench_production(spillway, repeat, depths, exponents, scene_args):
     header = "  %-26s %8s %8s %7s %7s %8s %9s %10s %10s %9s" % (
         "config", "wall s", "core s", "user s", "sys s", "vs ref", "RSS MiB", "tiles", "MB read", "B/ray")
     rows = []
-    for depth in depths:
-        scene = with_depth(os.path.join(folder, "scene.yaml"), depth)
-        control = with_depth(os.path.join(folder, "control.yaml"), depth)
-        configs = [("reference", scene, ["--backend", "reference"])]
-        configs += [("cpu 2^%d" % e, scene, ["--backend", "cpu", "--bin-exponent", str(e)]) for e in exponents]
-        configs += [("vulkan 2^%d" % max(exponents), scene, ["--backend", "vulkan", "--bin-exponent",
-                                                            str(max(exponents))]),
-                    ("control: reference", control, ["--backend", "reference"]),
-                    ("control: cpu 2^%d" % max(exponents), control, ["--backend", "cpu", "--bin-exponent",
-                                                                    str(max(exponents))])]
-        print("\nmax depth %d\n%s" % (depth, header))
-        ref = None
-        for name, path, args in configs:
-            s, rss = run(spillway, path, args + common, repeat)
-            if s is None:
-                print("  %-26s (could not run here)" % name)
-                continue
-            core = core_seconds(s)
-            if name == "reference":
-                ref = core
-            t = s.get("textures", {})
-            rays = s["rays"]["total"]
-            print("  %-26s %8.2f %8.2f %7.1f %7.1f %7.2fx %9.0f %10d %10.1f %9.1f" % (
-                name, s["wall_seconds"], core, s["user_seconds"], s["system_seconds"], core / ref, rss,
-                t.get("tiles_read", 0), t.get("bytes_read", 0) / 1e6, t.get("bytes_read", 0) / rays), flush=True)
-            if name.startswith("cpu") or name.startswith("vulkan"):
-                print("    stages: " + ", ".join("%s %.2f" % (k, v) for k, v in s["stage_seconds"].items()))
-            rows.append({"depth": depth, "config": name, "wall_seconds": s["wall_seconds"], "core_seconds": core,
-                         "user_seconds": s["user_seconds"], "system_seconds": s["system_seconds"],
-                         "vs_reference": core / ref, "peak_rss_mib": rss, "rays": rays, "textures": t,
-                         "stage_seconds": s["stage_seconds"]})
+    for texture_filter in ("finest", "cone"):
+        print("\n== --texture-filter %s ==" % texture_filter)
+        for depth in depths:
+            scene = with_depth(os.path.join(folder, "scene.yaml"), depth)
+            control = with_depth(os.path.join(folder, "control.yaml"), depth)
+            top = str(max(exponents))
+            configs = [("reference", scene, ["--backend", "reference"])]
+            configs += [("cpu 2^%d" % e, scene, ["--backend", "cpu", "--bin-exponent", str(e)]) for e in exponents]
+            configs += [("vulkan 2^" + top, scene, ["--backend", "vulkan", "--bin-exponent", top]),
+                        ("control: reference", control, ["--backend", "reference"]),
+                        ("control: cpu 2^" + top, control, ["--backend", "cpu", "--bin-exponent", top])]
+            print("\nmax depth %d\n%s" % (depth, header))
+            ref = None
+            for name, path, args in configs:
+                s, rss = run(spillway, path, args + common + ["--texture-filter", texture_filter], repeat)
+                if s is None:
+                    print("  %-26s (could not run here)" % name)
+                    continue
+                core = core_seconds(s)
+                if name == "reference":
+                    ref = core
+                t = s.get("textures", {})
+                rays = s["rays"]["total"]
+                print("  %-26s %8.2f %8.2f %7.1f %7.1f %7.2fx %9.0f %10d %10.1f %9.1f" % (
+                    name, s["wall_seconds"], core, s["user_seconds"], s["system_seconds"], core / ref, rss,
+                    t.get("tiles_read", 0), t.get("bytes_read", 0) / 1e6, t.get("bytes_read", 0) / rays),
+                    flush=True)
+                if name.startswith("cpu") or name.startswith("vulkan"):
+                    print("    stages: " + ", ".join("%s %.2f" % (k, v) for k, v in s["stage_seconds"].items()))
+                rows.append({"filter": texture_filter, "depth": depth, "config": name,
+                             "wall_seconds": s["wall_seconds"], "core_seconds": core,
+                             "user_seconds": s["user_seconds"], "system_seconds": s["system_seconds"],
+                             "vs_reference": core / ref, "peak_rss_mib": rss, "rays": rays, "textures": t,
+                             "stage_seconds": s["stage_seconds"]})
     bound = 512 + cache + geometry_bytes / 2**20 + 200
     print("\npeak RSS bound: memory budget 512 + cache %.0f + geometry %.0f + 200 = %.0f MiB" % (
         cache, geometry_bytes / 2**20, bound))
