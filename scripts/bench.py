@@ -168,6 +168,35 @@ def bench_production(spillway, repeat, depths, exponents, scene_args):
     with open(os.path.join(folder, "bench.json"), "w") as f:
         json.dump({"texture_bytes": texture_bytes, "geometry_bytes": geometry_bytes, "cache_mib": cache,
                    "rss_bound_mib": bound, "rows": rows}, f, indent=1)
+    plot_production(rows, os.path.join(folder, "production.png"))
+
+
+def plot_production(rows, path):
+    """Run time against bin exponent per max depth, one panel per texture filter, the reference
+    as a dashed line at its depth (as the thesis' figures 6.5 and 6.6)."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    filters = sorted({r["filter"] for r in rows}, key=["finest", "cone"].index)
+    fig, axes = plt.subplots(1, len(filters), figsize=(5.5 * len(filters), 4), sharey=True)
+    for ax, f in zip(axes if len(filters) > 1 else [axes], filters):
+        for i, depth in enumerate(sorted({r["depth"] for r in rows})):
+            colour = "C%d" % i
+            pts = sorted((int(r["config"].split("^")[1]), r["core_seconds"]) for r in rows
+                         if r["filter"] == f and r["depth"] == depth and r["config"].startswith("cpu"))
+            ax.plot([p[0] for p in pts], [p[1] for p in pts], "o-", color=colour, label="cpu, depth %d" % depth)
+            for r in rows:
+                if r["filter"] == f and r["depth"] == depth and r["config"] == "reference":
+                    ax.axhline(r["core_seconds"], color=colour, ls="--", lw=1,
+                               label="reference, depth %d" % depth)
+        ax.set_title("--texture-filter %s" % f)
+        ax.set_xlabel("bin exponent (batch = 2^E rays)")
+        ax.grid(alpha=0.3)
+    (axes[0] if len(filters) > 1 else axes).set_ylabel("render seconds")
+    (axes[0] if len(filters) > 1 else axes).legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=100)
+    print("plot: " + path)
 
 
 def main():
