@@ -62,10 +62,11 @@ def sphere_mesh(path, centre, radius, seed, nu, nv):
     upper = np.stack([a, c, b], axis=-1)[1:]  # the north pole row would be degenerate
     lower = np.stack([b, c, d], axis=-1)[:-1]  # and so would the south pole's
     faces = np.concatenate([upper.reshape(-1, 3), lower.reshape(-1, 3)])
-    with open(path, "w") as f:
+    with open(path + ".part", "w") as f:
         f.write("".join("v %.5f %.5f %.5f\n" % tuple(p) for p in verts))
         f.write("".join("vt %.5f %.5f\n" % tuple(t) for t in uvs))
         f.write("".join("f %d/%d %d/%d %d/%d\n" % (p, p, q, q, s, s) for p, q, s in faces))
+    os.replace(path + ".part", path)
     return len(faces)
 
 
@@ -143,10 +144,13 @@ def main():
     spacing = 2.4
     triangles, geometry_bytes = 0, 0
     # What is already in OUT_DIR is kept when it was made with the same options.
+    # The record is removed until this run completes, so that files left by an interrupted run
+    # are never taken as made with these options.
     made = {}
     stamp_path = os.path.join(a.out, "generated.json")
     if os.path.exists(stamp_path):
         made = json.load(open(stamp_path))
+        os.remove(stamp_path)
     fresh_geometry = made.get("mesh") != [nu, nv, a.models]
     if made.get("texture_res") != a.texture_res:
         for f in os.listdir(a.out):
