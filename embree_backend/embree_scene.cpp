@@ -93,7 +93,7 @@ SurfaceHit EmbreeScene::setUpHit(const HitRecord& h, vec3 dir, uint cone,
     }
     // The filter width in texture space: the cone's width at the hit, stretched by the
     // incidence (1/|cos|, at most 1000x at grazing angles) and scaled by the triangle's texture
-    // area over its world area (Akenine-Moller et al. 2019, eq. 20.x's Delta_0).
+    // area over its world area (the Delta_0 term of Akenine-Moller et al. 2019's ray-cone LOD).
     const Mesh& mesh = src_.meshes[h.mesh];
     float footprint = 0.0f;
     if (!mesh.uvs.empty()) {
