@@ -65,19 +65,27 @@ void intersectBatch(const EmbreeScene& scene, const RayStream& rays, bool cohere
     });
 }
 
+void occludedRange(const EmbreeScene& scene, const ShadowRay* rays, size_t count, bool coherent,
+                   std::uint8_t* occluded) {
+    RTCIntersectContext ctx = context(coherent);
+    RTCRay buf[kGroup];
+    for (size_t begin = 0; begin < count; begin += kGroup) {
+        const size_t n = std::min(count - begin, kGroup);
+        for (size_t i = 0; i < n; ++i)
+            fillRay(buf[i], rays[begin + i].origin, rays[begin + i].dir, rays[begin + i].tmax);
+        rtcOccluded1M(scene.handle(), &ctx, buf, unsigned(n), sizeof(RTCRay));
+        for (size_t i = 0; i < n; ++i)
+            occluded[begin + i] = buf[i].tfar < 0.0f ? 1 : 0;
+    }
+}
+
 void occludedBatch(const EmbreeScene& scene, const std::vector<ShadowRay>& rays, bool coherent,
                    std::vector<std::uint8_t>& occluded) {
     occluded.assign(rays.size(), 0);
     const size_t groups = (rays.size() + kGroup - 1) / kGroup;
     tbb::parallel_for(size_t(0), groups, [&](size_t g) {
         const size_t begin = g * kGroup, end = std::min(rays.size(), begin + kGroup);
-        RTCRay buf[kGroup];
-        for (size_t i = begin; i < end; ++i)
-            fillRay(buf[i - begin], rays[i].origin, rays[i].dir, rays[i].tmax);
-        RTCIntersectContext ctx = context(coherent);
-        rtcOccluded1M(scene.handle(), &ctx, buf, unsigned(end - begin), sizeof(RTCRay));
-        for (size_t i = begin; i < end; ++i)
-            occluded[i] = buf[i - begin].tfar < 0.0f ? 1 : 0;
+        occludedRange(scene, &rays[begin], end - begin, coherent, &occluded[begin]);
     });
 }
 

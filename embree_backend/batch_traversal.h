@@ -47,6 +47,9 @@ struct ShadowRay {
 // occluded[i] = 1 when something blocks ray i before its tmax.
 void occludedBatch(const EmbreeScene& scene, const std::vector<ShadowRay>& rays, bool coherent,
                    std::vector<std::uint8_t>& occluded);
+// The same for `count` rays on the calling thread (a fused chunk's shadow rays).
+void occludedRange(const EmbreeScene& scene, const ShadowRay* rays, size_t count, bool coherent,
+                   std::uint8_t* occluded);
 
 // One ray, for the depth-first reference: the closest hit, and whether a shadow ray is blocked.
 HitRecord intersectOne(const EmbreeScene& scene, vec3 origin, vec3 dir);

@@ -83,9 +83,10 @@ void EmbreeScene::surfaceHit(uint geomID, uint primID, float u, float v, float t
 }
 
 SurfaceHit EmbreeScene::setUpHit(const HitRecord& h, vec3 dir, uint cone,
-                                 const TextureResolver& textures) const {
+                                 const TextureResolver& textures, bool albedo) const {
     SurfaceHit hit;
     surfaceHit(h.mesh, h.prim, h.u, h.v, h.t, hit);
+    if (!albedo) return hit;
     const Shader& shader = src_.shaders[hit.shader];
     if (shader.texture < 0) {
         hit.albedo = textures.albedo(shader, vec2(0.0f), 0.0f);

@@ -36,7 +36,8 @@ void ReferenceRenderer::renderIteration(uint iteration, Film& film) {
                         for (;;) {
                             const HitRecord h = intersectOne(embree, org, dir);
                             if (h.mesh == kNoHit) break;
-                            const SurfaceHit hit = embree.setUpHit(h, dir, st.cone, ctx_.textures);
+                            const SurfaceHit hit = embree.setUpHit(h, dir, st.cone, ctx_.textures,
+                                                                   st.bounce < rp.maxDepth);
                             ShadeResult res;
                             shadeSurface(view, rp, hit, dir, st, res);
                             if (res.flags & kShadeEmitted)

@@ -70,6 +70,9 @@ sorted pipeline options (cpu and vulkan backends):
   --shading MODE        sorted (default: one dispatch per shader range, one kernel per surface
                         model) or megakernel (unsorted hits, one uber-shader switching per hit)
   --ray-format F        compact (34-byte rays, default) or full (50 bytes, every bit kept)
+  --stages MODE         fused (default; cpu: hit setup, shade, shadow, accumulate and bin run
+                        chunk by chunk of 128 hits, in cache) or separate (each stage over the
+                        whole batch in turn, as the vulkan backend runs them)
 
 exit status: 0 done; 1 runtime failure (disk, device, an output that cannot be written);
 2 bad usage or scene error (printed as FILE:LINE: message). On any failure no output file
@@ -196,6 +199,11 @@ int renderCommand(const std::vector<std::string>& args) {
             if (v != "on" && v != "off")
                 throw UsageError("--hit-sort takes on or off, not '" + v + "'");
             config.pipeline.hitSort = v == "on";
+        } else if (a == "--stages") {
+            std::string v = value();
+            if (v != "fused" && v != "separate")
+                throw UsageError("--stages takes fused or separate, not '" + v + "'");
+            config.pipeline.fuseStages = v == "fused";
         } else if (!a.empty() && a[0] == '-')
             throw UsageError("unknown option '" + a + "'");
         else if (scenePath.empty())

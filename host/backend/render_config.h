@@ -54,6 +54,9 @@ struct PipelineConfig {
     std::optional<int> binExponent;        // overrides settings: bin exponent
     std::optional<double> memoryBudgetMiB; // overrides settings: memory budget
     std::string spillDir;                  // empty: the system temp folder
+    // The cpu engine's per-hit stages fused chunk by chunk (stages.h: shadeFused); false runs
+    // them one whole batch after another, as the Vulkan engine must (the ablation).
+    bool fuseStages = true;
 };
 
 // Every parse* throws std::invalid_argument naming the value and the choices.

@@ -3,6 +3,7 @@
 #include "host/image/compare.h"
 #include "shared/rng.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace spw {
@@ -30,7 +31,7 @@ uint roundingKey(uint key, uint sampleIndex) {
 Film::Film(int width, int height, const Filter& filter, float brightestRadiance,
            int samplesPerIteration)
     : width_(width), height_(height), samplesPerIteration_(uint(samplesPerIteration)),
-      filter_(filter), acc_(new std::atomic<std::int64_t>[size_t(width) * height * 8]),
+      filter_(filter), acc_(new PixelSums[size_t(width) * height]),
       sum_(size_t(width) * height * 8, 0.0), lastIteration_(size_t(width) * height * 3, 0.0f) {
     // No clamp on e: the scale is a double, and every emission the loader accepts (up to
     // kMaxRadiance, down to the smallest float) keeps its brightest sample at 2^40.
@@ -49,12 +50,13 @@ Film::Film(int width, int height, const Filter& filter, float brightestRadiance,
 }
 
 void Film::beginIteration() {
-    for (size_t i = 0; i < size_t(width_) * height_ * 8; ++i)
-        acc_[i].store(0, std::memory_order_relaxed);
+    for (size_t i = 0; i < size_t(width_) * height_; ++i)
+        for (std::atomic<std::int64_t>& v : acc_[i].v)
+            v.store(0, std::memory_order_relaxed);
 }
 
 void Film::add(int px, int py, int half, vec3 value, float weight, uint key) {
-    std::atomic<std::int64_t>* a = &acc_[(size_t(py) * width_ + px) * 8 + size_t(half) * 4];
+    std::atomic<std::int64_t>* a = &acc_[size_t(py) * width_ + size_t(px)].v[half * 4];
     uvec4 h = pcg4d(uvec4(key, uint(py * width_ + px), 0x5157u, 0x9E3779B9u));
     const double in[4] = {value.x * scale_, value.y * scale_, value.z * scale_,
                           weight * weightScale_};
@@ -83,6 +85,12 @@ void Film::splat(vec2 filmPos, uint sampleIndex, vec3 radiance, uint key) {
 
 void Film::addSample(vec2 filmPos, uint sampleIndex) {
     filtered(filmPos, halfOf(sampleIndex), vec3(0.0f), 1.0f, roundingKey(0u, sampleIndex));
+}
+
+void Film::prefetch(vec2 filmPos) const {
+    const int px = std::clamp(int(filmPos.x), 0, width_ - 1);
+    const int py = std::clamp(int(filmPos.y), 0, height_ - 1);
+    __builtin_prefetch(&acc_[size_t(py) * width_ + size_t(px)], 1);
 }
 
 int Film::halfOf(uint sampleIndex) const {
@@ -117,8 +125,7 @@ void Film::endIteration() {
         for (int h = 0; h < 2; ++h) {
             double v[4];
             for (int c = 0; c < 4; ++c)
-                v[c] = double(acc_[i * 8 + size_t(h) * 4 + size_t(c)].load(
-                           std::memory_order_relaxed)) /
+                v[c] = double(acc_[i].v[h * 4 + c].load(std::memory_order_relaxed)) /
                        (c < 3 ? scale_ : weightScale_);
             for (int c = 0; c < 4; ++c) {
                 sum_[i * 8 + size_t(h) * 4 + size_t(c)] += v[c];

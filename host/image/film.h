@@ -49,6 +49,11 @@ class Film {
     // Thread-safe. Any number of times per sample: adds radiance it carried to the camera.
     // `key` makes the stochastic rounding deterministic (filmKey()).
     void splat(vec2 filmPos, uint sampleIndex, vec3 radiance, uint key);
+    // A hint, thread-safe: starts bringing the accumulators that a splat at `filmPos` adds to
+    // into this core's cache. The sorted pipeline's splats land in no pixel order, and an atomic
+    // add to a line not in cache stalls the core until it arrives; prefetching a chunk's splats
+    // before adding them overlaps those misses.
+    void prefetch(vec2 filmPos) const;
     void endIteration();
 
     // The render so far: sum of weighted radiance / sum of weights, RGB, row-major.
@@ -73,11 +78,15 @@ class Film {
     int width_, height_;
     uint samplesPerIteration_;
     Filter filter_;
-    double scale_;                                     // radiance units -> fixed-point units
-    double weightScale_;                               // filter weight -> fixed-point units
-    double maxAdd_;                                    // the clamp of one add, in fixed-point units
-    std::unique_ptr<std::atomic<std::int64_t>[]> acc_; // 8 per pixel: (r, g, b, weight) x 2 halves
-    std::vector<double> sum_;                          // 8 per pixel, whole render
+    double scale_;       // radiance units -> fixed-point units
+    double weightScale_; // filter weight -> fixed-point units
+    double maxAdd_;      // the clamp of one add, in fixed-point units
+    // (r, g, b, weight) x 2 halves: one cache line per pixel, so that a splat is one line.
+    struct alignas(64) PixelSums {
+        std::atomic<std::int64_t> v[8];
+    };
+    std::unique_ptr<PixelSums[]> acc_;
+    std::vector<double> sum_; // 8 per pixel, whole render
     std::vector<float> lastIteration_;
     std::atomic<std::uint64_t> nonFinite_{0}, saturated_{0};
 };

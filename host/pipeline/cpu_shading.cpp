@@ -13,6 +13,7 @@ class CpuShading : public ShadingEngine {
     CpuShading(SceneView view, RenderParams params, size_t chunk)
         : view_(view), params_(params), chunk_(chunk) {}
     void beginIteration(uint iteration) override { params_.iteration = iteration; }
+    bool shadesOnHostThreads() const override { return true; }
     ShadeSlot reserve(int /*slot*/, size_t count) override {
         inputs_.resize(count);
         results_.resize(count);

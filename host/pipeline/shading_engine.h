@@ -35,6 +35,10 @@ class ShadingEngine {
     // Batches that may be in flight at once. With 2 the renderer traverses and sets up batch k+1
     // while batch k is being shaded (double buffering); with 1 each batch is shaded in turn.
     virtual int slots() const { return 1; }
+    // True when shading runs on the host's own threads (cpu): the renderer may then call
+    // shadeSurface() itself, chunk by chunk between the other per-hit stages (stages.h:
+    // shadeFused), and the engine's reserve/submit/finish go unused.
+    virtual bool shadesOnHostThreads() const { return false; }
     // Storage for `count` hits in `slot` (0 <= slot < slots()); the slot's previous batch must be
     // finished. Valid until the slot's next reserve().
     virtual ShadeSlot reserve(int slot, size_t count) = 0;

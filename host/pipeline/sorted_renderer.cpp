@@ -36,7 +36,8 @@ double since(Clock::time_point t) {
 SortedRenderer::SortedRenderer(const RenderContext& ctx, const PipelineConfig& config,
                                std::unique_ptr<ShadingEngine> shading)
     : ctx_(ctx), config_(config), shading_(std::move(shading)), policy_(config.raySort),
-      scratch_(std::make_unique<Scratch>()) {
+      scratch_(std::make_unique<Scratch>()),
+      fused_(config.fuseStages && shading_->shadesOnHostThreads()) {
     const double budgetMiB = config.memoryBudgetMiB.value_or(ctx.scene.settings.memoryBudgetMiB);
     const uint exponent = uint(config.binExponent.value_or(ctx.scene.settings.binExponent));
     // The budget covers every ray waiting in RAM: the six bins fill up to one batch each, and
@@ -76,6 +77,10 @@ void SortedRenderer::renderIteration(uint iteration, Film& film) {
             if (!bins_->flushLargest()) break; // queue and bins empty: the iteration is done
             continue;
         }
+        if (fused_) {
+            runFusedBatch(*batch, iteration, film);
+            continue;
+        }
         startBatch(*batch, next);
         if (pending >= 0) finishBatch(pending, iteration, film);
         if (overlap) {
@@ -88,12 +93,10 @@ void SortedRenderer::renderIteration(uint iteration, Film& film) {
     publishStats();
 }
 
-void SortedRenderer::startBatch(RayBatch& batch, int slot) {
+size_t SortedRenderer::traceBatch(RayBatch& batch) {
     Scratch& s = *scratch_;
-    Scratch::InFlight& flight = s.inFlight[slot];
     StageTimes& times = ctx_.stats.stages;
     const size_t n = batch.count;
-    const bool byShader = config_.sortsHits();
     ++batchesProcessed_;
 
     size_t cameraRays = 0;
@@ -116,10 +119,21 @@ void SortedRenderer::startBatch(RayBatch& batch, int slot) {
     }
     if (cameraRays * 2 < n) policy_.record(mode != RaySortMode::Off, since(sortStart), n);
     ctx_.stats.bounceRays += n - cameraRays;
-    {
-        StageTimer t(times, "sort hits");
-        flight.hitCount = sortHits(ctx_.scene, s.hits, byShader, s.order, s.keyTmp);
-    }
+    StageTimer t(times, "sort hits");
+    return sortHits(ctx_.scene, s.hits, config_.sortsHits(), s.order, s.keyTmp);
+}
+
+void SortedRenderer::runFusedBatch(RayBatch& batch, uint iteration, Film& film) {
+    Scratch& s = *scratch_;
+    const size_t hitCount = traceBatch(batch);
+    shadeFused(ctx_, iteration, config_.rayFormat, s.rays, s.hits, s.order, hitCount, film, *bins_);
+}
+
+void SortedRenderer::startBatch(RayBatch& batch, int slot) {
+    Scratch& s = *scratch_;
+    Scratch::InFlight& flight = s.inFlight[slot];
+    StageTimes& times = ctx_.stats.stages;
+    flight.hitCount = traceBatch(batch);
     {
         StageTimer t(times, "hit setup");
         flight.shading = shading_->reserve(slot, flight.hitCount);
@@ -129,7 +143,7 @@ void SortedRenderer::startBatch(RayBatch& batch, int slot) {
     }
     {
         StageTimer t(times, "shade");
-        shadeRanges(ctx_.scene, s.order, flight.hitCount, byShader, s.ranges);
+        shadeRanges(ctx_.scene, s.order, flight.hitCount, config_.sortsHits(), s.ranges);
         shading_->submit(slot, s.ranges);
     }
 }
@@ -177,6 +191,7 @@ void SortedRenderer::publishStats() {
         shadingModeName(config_.sortsHits() ? ShadingMode::Sorted : ShadingMode::Megakernel);
     x["batches_ray_sorted"] = policy_.sortedBatches();
     x["batches_ray_unsorted_measured"] = policy_.unsortedBatches();
+    x["stages"] = fused_ ? "fused" : "separate";
     shading_->publishStats(ctx_.stats);
 }
 

@@ -1,6 +1,7 @@
 // The sorted deferred pipeline as a backend: it runs the stages of host/pipeline/stages.h over
 // every batch of an iteration, overlapping a batch's shading with the next batch's traversal
-// where the shading engine has two slots.
+// where the shading engine has two slots, and fusing the per-hit stages chunk by chunk where the
+// engine shades on the host's threads.
 #pragma once
 
 #include "host/backend/backend.h"
@@ -25,6 +26,10 @@ class SortedRenderer : public Backend {
     // decompress .. hit setup, then submit its shading to `slot`; then wait for it, trace its
     // shadow rays, accumulate and bin its continuation rays.
     void startBatch(RayBatch& batch, int slot);
+    // decompress .. sort hits: the batch's hits in shading order in the scratch; their count.
+    size_t traceBatch(RayBatch& batch);
+    // The whole batch with the per-hit stages fused (stages.h: shadeFused), for the cpu engine.
+    void runFusedBatch(RayBatch& batch, uint iteration, Film& film);
     void finishBatch(int slot, uint iteration, Film& film);
     void publishStats();
 
@@ -35,6 +40,7 @@ class SortedRenderer : public Backend {
     std::unique_ptr<DirectionalBins> bins_;
     RaySortPolicy policy_;
     std::unique_ptr<Scratch> scratch_;
+    bool fused_;
     std::uint64_t batchesProcessed_ = 0;
 };
 

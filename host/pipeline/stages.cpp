@@ -8,6 +8,9 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <memory>
 
 namespace spw {
 namespace {
@@ -118,22 +121,33 @@ size_t sortHits(const Scene& scene, const std::vector<HitRecord>& hits, bool byS
     return hitCount;
 }
 
+namespace {
+// One hit as the shade stage receives it. Hits that end their path (max depth) skip the albedo:
+// shading never reads it there.
+ShadeInput setUpOne(const RenderContext& ctx, const RayState& ray, const HitRecord& hit) {
+    ShadeInput in;
+    in.hit = ctx.embree.setUpHit(hit, ray.dir, ray.path.cone, ctx.textures,
+                                 ray.path.bounce < ctx.params.maxDepth);
+    in.path = ray.path;
+    in.rayDir = ray.dir;
+    in.pad0 = 0.0f;
+    return in;
+}
+} // namespace
+
 void setUpHits(const RenderContext& ctx, const std::vector<RayState>& rays,
                const std::vector<HitRecord>& hits, const std::vector<SortedHit>& order,
                size_t hitCount, ShadeInput* inputs, uvec2* paths) {
-    tbb::parallel_for(
-        tbb::blocked_range<size_t>(0, hitCount, 1024), [&](const tbb::blocked_range<size_t>& r) {
-            for (size_t i = r.begin(); i < r.end(); ++i) {
-                const std::uint32_t k = order[i].index;
-                ShadeInput in; // assembled here, stored whole: one sequential write into the slot
-                in.hit = ctx.embree.setUpHit(hits[k], rays[k].dir, rays[k].path.cone, ctx.textures);
-                in.path = rays[k].path;
-                in.rayDir = rays[k].dir;
-                in.pad0 = 0.0f;
-                inputs[i] = in;
-                paths[i] = uvec2(in.path.pathId, in.path.bounce);
-            }
-        });
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, hitCount, 1024),
+                      [&](const tbb::blocked_range<size_t>& r) {
+                          for (size_t i = r.begin(); i < r.end(); ++i) {
+                              const std::uint32_t k = order[i].index;
+                              // assembled, then stored whole: one sequential write into the slot
+                              const ShadeInput in = setUpOne(ctx, rays[k], hits[k]);
+                              inputs[i] = in;
+                              paths[i] = uvec2(in.path.pathId, in.path.bounce);
+                          }
+                      });
 }
 
 void shadeRanges(const Scene& scene, const std::vector<SortedHit>& order, size_t hitCount,
@@ -162,6 +176,37 @@ void gatherShadowRays(const ShadeResult* results, size_t hitCount,
                       });
 }
 
+namespace {
+// One contribution for the film: where, which sample, what, and its rounding key.
+struct Splat {
+    vec2 pos;
+    uint sample;
+    uint key;
+    vec3 value;
+};
+Splat emittedSplat(const RenderContext& ctx, const RenderParams& rp, const ShadeResult& res,
+                   uvec2 path) {
+    return {filmPosition(ctx, rp, path.x), pathSample(rp, path.x), filmKey(path.x, path.y, false),
+            res.emitted};
+}
+Splat shadowSplat(const RenderContext& ctx, const RenderParams& rp, const ShadeResult& res,
+                  uvec2 path) {
+    return {filmPosition(ctx, rp, path.x), pathSample(rp, path.x), filmKey(path.x, path.y, true),
+            res.shadowContribution};
+}
+void add(Film& film, const Splat& s) {
+    film.splat(s.pos, s.sample, s.value, s.key);
+}
+void binOne(const RenderParams& rp, RayFormat format, const ShadeResult& res, RayBuffer& buffer) {
+    if (!(res.flags & kShadeContinue)) return;
+    RayState ray;
+    ray.origin = res.nextOrigin;
+    ray.dir = res.nextDir;
+    ray.path = res.next;
+    buffer.push(ray, format, roundingBits(rp, ray.path));
+}
+} // namespace
+
 void accumulate(const RenderContext& ctx, uint iteration, const ShadeResult* results,
                 const uvec2* paths, size_t hitCount, const std::vector<std::uint32_t>& shadowOwner,
                 const std::vector<std::uint8_t>& occluded, Film& film) {
@@ -169,23 +214,16 @@ void accumulate(const RenderContext& ctx, uint iteration, const ShadeResult* res
     tbb::parallel_for(tbb::blocked_range<size_t>(0, hitCount, 1024),
                       [&](const tbb::blocked_range<size_t>& r) {
                           for (size_t i = r.begin(); i < r.end(); ++i)
-                              if (results[i].flags & kShadeEmitted) {
-                                  const uvec2 p = paths[i]; // (pathId, bounce)
-                                  film.splat(filmPosition(ctx, rp, p.x), pathSample(rp, p.x),
-                                             results[i].emitted, filmKey(p.x, p.y, false));
-                              }
+                              if (results[i].flags & kShadeEmitted)
+                                  add(film, emittedSplat(ctx, rp, results[i], paths[i]));
                       });
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, shadowOwner.size(), 1024),
-                      [&](const tbb::blocked_range<size_t>& r) {
-                          for (size_t j = r.begin(); j < r.end(); ++j)
-                              if (!occluded[j]) {
-                                  const size_t i = shadowOwner[j];
-                                  const uvec2 p = paths[i]; // (pathId, bounce)
-                                  film.splat(filmPosition(ctx, rp, p.x), pathSample(rp, p.x),
-                                             results[i].shadowContribution,
-                                             filmKey(p.x, p.y, true));
-                              }
-                      });
+    tbb::parallel_for(
+        tbb::blocked_range<size_t>(0, shadowOwner.size(), 1024),
+        [&](const tbb::blocked_range<size_t>& r) {
+            for (size_t j = r.begin(); j < r.end(); ++j)
+                if (!occluded[j])
+                    add(film, shadowSplat(ctx, rp, results[shadowOwner[j]], paths[shadowOwner[j]]));
+        });
 }
 
 void binContinuations(const RenderContext& ctx, uint iteration, RayFormat format,
@@ -195,17 +233,111 @@ void binContinuations(const RenderContext& ctx, uint iteration, RayFormat format
     tbb::parallel_for(tbb::blocked_range<size_t>(0, hitCount, chunk),
                       [&](const tbb::blocked_range<size_t>& r) {
                           RayBuffer buffer;
-                          for (size_t i = r.begin(); i < r.end(); ++i) {
-                              const ShadeResult& res = results[i];
-                              if (!(res.flags & kShadeContinue)) continue;
-                              RayState ray;
-                              ray.origin = res.nextOrigin;
-                              ray.dir = res.nextDir;
-                              ray.path = res.next;
-                              buffer.push(ray, format, roundingBits(rp, ray.path));
-                          }
+                          for (size_t i = r.begin(); i < r.end(); ++i)
+                              binOne(rp, format, results[i], buffer);
                           bins.add(buffer);
                       });
+}
+
+namespace {
+// The fused stages' working set: one chunk of hits through every per-hit stage. 128 hits keep
+// the inputs and results (28 KiB) within L1/L2 between stages.
+constexpr size_t kFusedChunk = 128;
+struct FusedChunk {
+    ShadeInput in[kFusedChunk];
+    ShadeResult out[kFusedChunk];
+    ShadowRay shadows[kFusedChunk];
+    std::uint8_t owner[kFusedChunk];
+    std::uint8_t occluded[kFusedChunk];
+    Splat splats[2 * kFusedChunk]; // at most one emitted and one shadow splat per hit
+};
+uvec2 pathOf(const ShadeInput& in) {
+    return uvec2(in.path.pathId, in.path.bounce);
+}
+static_assert(kFusedChunk <= 256, "owner indices are bytes");
+
+enum FusedStage { kSetUp, kShade, kShadow, kAccumulate, kBin, kFusedStages };
+const char* const kFusedStageNames[kFusedStages] = {"hit setup", "shade", "shadow", "accumulate",
+                                                    "bin"};
+} // namespace
+
+void shadeFused(const RenderContext& ctx, uint iteration, RayFormat format,
+                const std::vector<RayState>& rays, const std::vector<HitRecord>& hits,
+                const std::vector<SortedHit>& order, size_t hitCount, Film& film,
+                DirectionalBins& bins) {
+    using Clock = std::chrono::steady_clock;
+    const RenderParams rp = paramsAt(ctx, iteration);
+    const SceneView view = ctx.lights.view();
+    const auto wallStart = Clock::now();
+    std::atomic<std::int64_t> threadNs[kFusedStages] = {};
+    std::atomic<std::uint64_t> shadowRays{0};
+    tbb::parallel_for(
+        tbb::blocked_range<size_t>(0, hitCount, size_t(ctx.scene.settings.shadingSize)),
+        [&](const tbb::blocked_range<size_t>& r) {
+            std::int64_t ns[kFusedStages] = {};
+            auto t = Clock::now();
+            auto lap = [&](FusedStage stage) {
+                const auto now = Clock::now();
+                ns[stage] += std::chrono::duration_cast<std::chrono::nanoseconds>(now - t).count();
+                t = now;
+            };
+            std::unique_ptr<FusedChunk> c = std::make_unique<FusedChunk>();
+            RayBuffer buffer;
+            std::uint64_t shadowCount = 0;
+            for (size_t begin = r.begin(); begin < r.end(); begin += kFusedChunk) {
+                const size_t n = std::min(kFusedChunk, r.end() - begin);
+                for (size_t i = 0; i < n; ++i) {
+                    const std::uint32_t k = order[begin + i].index;
+                    c->in[i] = setUpOne(ctx, rays[k], hits[k]);
+                }
+                lap(kSetUp);
+                for (size_t i = 0; i < n; ++i)
+                    shadeSurface(view, rp, c->in[i].hit, c->in[i].rayDir, c->in[i].path, c->out[i]);
+                lap(kShade);
+                size_t m = 0;
+                for (size_t i = 0; i < n; ++i)
+                    if (c->out[i].flags & kShadeShadow) {
+                        const ShadeResult& res = c->out[i];
+                        c->owner[m] = std::uint8_t(i);
+                        c->shadows[m++] = {res.shadowOrigin, res.shadowDir, res.shadowTmax};
+                    }
+                occludedRange(ctx.embree, c->shadows, m, false, c->occluded);
+                shadowCount += m;
+                lap(kShadow);
+                // Every splat's place first, its film line prefetched; then the adds.
+                size_t splats = 0;
+                for (size_t i = 0; i < n; ++i)
+                    if (c->out[i].flags & kShadeEmitted)
+                        c->splats[splats++] = emittedSplat(ctx, rp, c->out[i], pathOf(c->in[i]));
+                for (size_t j = 0; j < m; ++j)
+                    if (!c->occluded[j]) {
+                        const size_t i = c->owner[j];
+                        c->splats[splats++] = shadowSplat(ctx, rp, c->out[i], pathOf(c->in[i]));
+                    }
+                for (size_t k = 0; k < splats; ++k)
+                    film.prefetch(c->splats[k].pos);
+                for (size_t k = 0; k < splats; ++k)
+                    add(film, c->splats[k]);
+                lap(kAccumulate);
+                for (size_t i = 0; i < n; ++i)
+                    binOne(rp, format, c->out[i], buffer);
+                lap(kBin);
+            }
+            bins.add(buffer);
+            lap(kBin);
+            for (int s = 0; s < kFusedStages; ++s)
+                threadNs[s] += ns[s];
+            shadowRays += shadowCount;
+        });
+    ctx.stats.shadowRays += shadowRays.load();
+    // The loop's wall time, shared among the stages in proportion to their thread time.
+    const double wall = std::chrono::duration<double>(Clock::now() - wallStart).count();
+    double total = 0.0;
+    for (const auto& ns : threadNs)
+        total += double(ns.load());
+    for (int s = 0; s < kFusedStages; ++s)
+        ctx.stats.stages.add(kFusedStageNames[s],
+                             total > 0.0 ? wall * double(threadNs[s].load()) / total : 0.0);
 }
 
 } // namespace spw

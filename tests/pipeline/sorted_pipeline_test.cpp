@@ -103,7 +103,8 @@ TEST(SortedPipeline, CompactRaysAgreeWithReferenceOnClosedEnclosure) {
     EXPECT_NEAR(m.mean, 5.0, 4.0 * m.stderror);
 }
 
-// The film must not depend on how rays were batched, sorted, spilled or scheduled. The Cornell
+// The film must not depend on how rays were batched, sorted, spilled or scheduled, nor on
+// whether the per-hit stages ran fused or one after another. The Cornell
 // box at max depth 16: bounce rays go through the bins, the queue and (with a small budget) the
 // spill file and back many times, so a read-back that corrupted one bit would change the image.
 TEST(SortedPipeline, ImageIsIndependentOfBatchingSortingBudgetAndThreads) {
@@ -143,6 +144,13 @@ TEST(SortedPipeline, ImageIsIndependentOfBatchingSortingBudgetAndThreads) {
     variant("median ray sort", [](RenderConfig& c) { c.pipeline.raySort = RaySortMode::Median; });
     variant("no ray sort", [](RenderConfig& c) { c.pipeline.raySort = RaySortMode::Off; });
     variant("no hit sort", [](RenderConfig& c) { c.pipeline.hitSort = false; });
+    // The per-hit stages one whole batch after another instead of fused chunk by chunk.
+    variant("separate stages", [](RenderConfig& c) { c.pipeline.fuseStages = false; });
+    variant("separate stages, 2 threads, no hit sort", [](RenderConfig& c) {
+        c.pipeline.fuseStages = false;
+        c.threads = 2;
+        c.pipeline.hitSort = false;
+    });
 }
 
 // The thesis's known crash: a tile's buffer (64 x 64 pixels x 64 samples = 262144 rays) far

@@ -71,10 +71,12 @@ TEST_F(ProductionScene, EveryBackendAgreesWithinStandardErrors) {
 // tiles. Read at the finest level (the thesis' regime, --texture-filter finest) the preset's
 // textures are far larger than the cache, and the sorted pipeline reads fewer tiles than the
 // same pipeline unsorted or the depth-first reference. Full-precision rays trace the reference's
-// paths exactly, so all three make the same lookups. Measured (one thread): sorted 2598 tiles,
-// unsorted 3732 (0.70), reference 3743 (0.69); at 64 x 64 pixels the reference's 32-pixel buckets
-// are coherent themselves. With ray cones (the default) every backend reads a few hundred tiles:
-// the levels the pixels need fit the cache, whatever the order (the next test).
+// paths exactly, so all three make the same lookups. Measured (one thread): sorted 1946 tiles,
+// unsorted 2697 (0.72), reference 2402 (0.81); at 64 x 64 pixels the reference's 32-pixel buckets
+// are coherent themselves. (Hits that end their path look nothing up: before that rule the
+// figures were 2598, 3732 and 3743, the difference being those hits' scattered lookups.) With ray
+// cones (the default) every backend reads a few hundred tiles: the levels the pixels need fit the
+// cache, whatever the order (the next test).
 TEST_F(ProductionScene, SortedBatchesReadFewerTilesThanUnsorted) {
     RenderConfig ref;
     ref.backend = BackendKind::Reference;
@@ -88,8 +90,8 @@ TEST_F(ProductionScene, SortedBatchesReadFewerTilesThanUnsorted) {
     const nlohmann::json r = textureStats(ref), s = textureStats(sorted),
                          u = textureStats(unsorted);
     std::printf("tiles read: sorted %d, unsorted %d, reference %d; lookups %d\n",
-                s["tiles_read"].get<int>(), u["tiles_read"].get<int>(),
-                r["tiles_read"].get<int>(), s["lookups"].get<int>());
+                s["tiles_read"].get<int>(), u["tiles_read"].get<int>(), r["tiles_read"].get<int>(),
+                s["lookups"].get<int>());
     EXPECT_EQ(s["lookups"], r["lookups"]);
     EXPECT_EQ(u["lookups"], r["lookups"]);
     EXPECT_GT(s["lookups"].get<double>(), 10000);
@@ -98,13 +100,13 @@ TEST_F(ProductionScene, SortedBatchesReadFewerTilesThanUnsorted) {
         EXPECT_LE((*t)["peak_cache_bytes"].get<double>(), 1.1 * 1024 * 1024);
         EXPECT_EQ((*t)["files_opened"], 28);
     }
-    EXPECT_LE(s["tiles_read"].get<double>(), 0.8 * u["tiles_read"].get<double>());
-    EXPECT_LE(s["tiles_read"].get<double>(), 0.8 * r["tiles_read"].get<double>());
-    EXPECT_LE(s["bytes_read"].get<double>(), 0.8 * r["bytes_read"].get<double>());
+    EXPECT_LE(s["tiles_read"].get<double>(), 0.75 * u["tiles_read"].get<double>());
+    EXPECT_LE(s["tiles_read"].get<double>(), 0.9 * r["tiles_read"].get<double>());
+    EXPECT_LE(s["bytes_read"].get<double>(), 0.9 * r["bytes_read"].get<double>());
 }
 
-// Ray cones read the levels the pixels need: the same lookups, a sixth of the tiles (measured:
-// 417 against 2598 sorted, 746 against 3743 for the reference).
+// Ray cones read the levels the pixels need: the same lookups, a fraction of the tiles (measured:
+// 392 against 1949 sorted, 695 against 2375 for the reference).
 TEST_F(ProductionScene, RayConesReadAFractionOfTheFinestLevelsTiles) {
     for (BackendKind backend : {BackendKind::Reference, BackendKind::Cpu}) {
         RenderConfig cone;
@@ -113,9 +115,11 @@ TEST_F(ProductionScene, RayConesReadAFractionOfTheFinestLevelsTiles) {
         RenderConfig finest = cone;
         finest.textureFilter = TextureFilter::Finest;
         const nlohmann::json c = textureStats(cone), f = textureStats(finest);
+        std::printf("%s: tiles read with cones %d, finest %d\n", backendName(backend),
+                    c["tiles_read"].get<int>(), f["tiles_read"].get<int>());
         EXPECT_EQ(c["lookups"], f["lookups"]);
-        EXPECT_LE(c["tiles_read"].get<double>(), 0.25 * f["tiles_read"].get<double>());
-        EXPECT_LE(c["bytes_read"].get<double>(), 0.25 * f["bytes_read"].get<double>());
+        EXPECT_LE(c["tiles_read"].get<double>(), f["tiles_read"].get<double>() / 3);
+        EXPECT_LE(c["bytes_read"].get<double>(), f["bytes_read"].get<double>() / 3);
     }
 }
 
