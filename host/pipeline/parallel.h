@@ -4,6 +4,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
+#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <cstdint>
@@ -12,6 +13,14 @@
 namespace spw {
 
 constexpr size_t kParallelGrain = 4096;
+
+// A grain for n items of a batch stage: at most `largest`, at least `smallest`, and otherwise
+// small enough for eight tasks per thread, so that a small batch (2^12 rays) still keeps every
+// core busy instead of running as one task.
+inline size_t batchGrain(size_t n, size_t smallest, size_t largest) {
+    const size_t threads = size_t(std::max(1, tbb::this_task_arena::max_concurrency()));
+    return std::clamp(n / (8 * threads), smallest, std::max(smallest, largest));
+}
 
 // Number of i in [0, n) with pred(i).
 template <class Pred> size_t parallelCount(size_t n, Pred pred) {

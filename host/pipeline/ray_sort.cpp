@@ -1,5 +1,7 @@
 #include "host/pipeline/ray_sort.h"
 
+#include "host/pipeline/parallel.h"
+
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_invoke.h>
 #include <tbb/parallel_reduce.h>
@@ -116,14 +118,14 @@ void sortRaysMorton(std::vector<RayState>& rays, std::vector<KeyIndex>& keys,
     if (n < 2) return;
     const MortonFrame frame = MortonFrame::of(rays);
     keys.resize(n);
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 4096),
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, n, batchGrain(n, 512, 4096)),
                       [&](const tbb::blocked_range<size_t>& range) {
                           for (size_t i = range.begin(); i < range.end(); ++i)
                               keys[i] = {frame.key(rays[i]), std::uint32_t(i)};
                       });
     radixSort(keys, scratch);
     tmp.resize(n);
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 4096),
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, n, batchGrain(n, 512, 4096)),
                       [&](const tbb::blocked_range<size_t>& range) {
                           for (size_t i = range.begin(); i < range.end(); ++i)
                               tmp[i] = rays[keys[i].index];

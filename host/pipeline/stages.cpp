@@ -72,7 +72,7 @@ size_t decompressRays(RayBatch& batch, std::vector<RayState>& rays) {
     const size_t n = batch.count;
     const size_t recordBytes = rayRecordBytes(batch.format);
     rays.resize(n);
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 4096),
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, n, batchGrain(n, 256, 4096)),
                       [&](const tbb::blocked_range<size_t>& r) {
                           for (size_t i = r.begin(); i < r.end(); ++i)
                               decodeRay(&batch.bytes[i * recordBytes], batch.format, rays[i]);
@@ -95,21 +95,21 @@ size_t sortHits(const Scene& scene, const std::vector<HitRecord>& hits, bool byS
                 std::vector<SortedHit>& order, std::vector<SortedHit>& scratch) {
     const size_t n = hits.size();
     order.resize(n);
-    tbb::parallel_for(
-        tbb::blocked_range<size_t>(0, n, kParallelGrain), [&](const tbb::blocked_range<size_t>& r) {
-            for (size_t i = r.begin(); i < r.end(); ++i) {
-                const HitRecord& h = hits[i];
-                std::uint64_t key = kMissKey;
-                if (h.mesh != kNoHit && byShader) {
-                    const Mesh& mesh = scene.meshes[h.mesh];
-                    key =
-                        hitSortKey(uint(mesh.shader), h.mesh, textureOrder(mesh, h.prim, h.u, h.v));
-                } else if (h.mesh != kNoHit) {
-                    key = 0;
-                }
-                order[i] = {key, std::uint32_t(i)};
-            }
-        });
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, n, batchGrain(n, 1024, kParallelGrain)),
+                      [&](const tbb::blocked_range<size_t>& r) {
+                          for (size_t i = r.begin(); i < r.end(); ++i) {
+                              const HitRecord& h = hits[i];
+                              std::uint64_t key = kMissKey;
+                              if (h.mesh != kNoHit && byShader) {
+                                  const Mesh& mesh = scene.meshes[h.mesh];
+                                  key = hitSortKey(uint(mesh.shader), h.mesh,
+                                                   textureOrder(mesh, h.prim, h.u, h.v));
+                              } else if (h.mesh != kNoHit) {
+                                  key = 0;
+                              }
+                              order[i] = {key, std::uint32_t(i)};
+                          }
+                      });
     const size_t hitCount = parallelCount(n, [&](size_t i) { return order[i].key != kMissKey; });
     if (byShader) {
         radixSort(order, scratch);
@@ -229,7 +229,7 @@ void accumulate(const RenderContext& ctx, uint iteration, const ShadeResult* res
 void binContinuations(const RenderContext& ctx, uint iteration, RayFormat format,
                       const ShadeResult* results, size_t hitCount, DirectionalBins& bins) {
     const RenderParams rp = paramsAt(ctx, iteration);
-    const size_t chunk = size_t(ctx.scene.settings.shadingSize);
+    const size_t chunk = batchGrain(hitCount, 256, size_t(ctx.scene.settings.shadingSize));
     tbb::parallel_for(tbb::blocked_range<size_t>(0, hitCount, chunk),
                       [&](const tbb::blocked_range<size_t>& r) {
                           RayBuffer buffer;
@@ -271,9 +271,10 @@ void shadeFused(const RenderContext& ctx, uint iteration, RayFormat format,
     const auto wallStart = Clock::now();
     std::atomic<std::int64_t> threadNs[kFusedStages] = {};
     std::atomic<std::uint64_t> shadowRays{0};
+    // Tasks of up to `shading size` hits, each handing its continuation rays to the bins once.
+    const size_t grain = batchGrain(hitCount, kFusedChunk, size_t(ctx.scene.settings.shadingSize));
     tbb::parallel_for(
-        tbb::blocked_range<size_t>(0, hitCount, size_t(ctx.scene.settings.shadingSize)),
-        [&](const tbb::blocked_range<size_t>& r) {
+        tbb::blocked_range<size_t>(0, hitCount, grain), [&](const tbb::blocked_range<size_t>& r) {
             std::int64_t ns[kFusedStages] = {};
             auto t = Clock::now();
             auto lap = [&](FusedStage stage) {
