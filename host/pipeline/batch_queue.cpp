@@ -236,10 +236,12 @@ size_t DirectionalBins::raysWaiting() {
 
 void RayBuffer::push(const RayState& ray, RayFormat format, uvec4 rounding) {
     std::vector<std::uint8_t>& dst = perBin[cardinalBin(ray.dir)];
-    const size_t at = dst.size();
-    if (dst.capacity() == at) dst.reserve(std::max<size_t>(at * 2, 256 * kFullRayBytes));
-    dst.resize(at + rayRecordBytes(format));
-    encodeRay(ray, format, rounding, dst.data() + at);
+    const size_t at = dst.size(), bytes = rayRecordBytes(format);
+    if (dst.capacity() < at + bytes) dst.reserve(std::max<size_t>(at * 2, 256 * kFullRayBytes));
+    // Encoded in place of a stack record, then appended: no zero-fill of the new bytes.
+    std::uint8_t record[kFullRayBytes];
+    encodeRay(ray, format, rounding, record);
+    dst.insert(dst.end(), record, record + bytes);
     ++count;
 }
 

@@ -194,9 +194,30 @@ Splat shadowSplat(const RenderContext& ctx, const RenderParams& rp, const ShadeR
     return {filmPosition(ctx, rp, path.x), pathSample(rp, path.x), filmKey(path.x, path.y, true),
             res.shadowContribution};
 }
-void add(Film& film, const Splat& s) {
-    film.splat(s.pos, s.sample, s.value, s.key);
-}
+// Splats gathered a few dozen at a time: each one's film line is prefetched when it joins, and
+// the adds wait until the batch is full, so that the lines' cache misses overlap instead of
+// stalling one atomic add after another (the sorted order has no pixel locality).
+class SplatBatch {
+  public:
+    explicit SplatBatch(Film& film) : film_(film) {}
+    ~SplatBatch() { flush(); }
+    void push(const Splat& s) {
+        film_.prefetch(s.pos);
+        splats_[count_++] = s;
+        if (count_ == kSize) flush();
+    }
+    void flush() {
+        for (size_t k = 0; k < count_; ++k)
+            film_.splat(splats_[k].pos, splats_[k].sample, splats_[k].value, splats_[k].key);
+        count_ = 0;
+    }
+
+  private:
+    static constexpr size_t kSize = 64;
+    Film& film_;
+    Splat splats_[kSize];
+    size_t count_ = 0;
+};
 void binOne(const RenderParams& rp, RayFormat format, const ShadeResult& res, RayBuffer& buffer) {
     if (!(res.flags & kShadeContinue)) return;
     RayState ray;
@@ -213,17 +234,19 @@ void accumulate(const RenderContext& ctx, uint iteration, const ShadeResult* res
     const RenderParams rp = paramsAt(ctx, iteration);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, hitCount, 1024),
                       [&](const tbb::blocked_range<size_t>& r) {
+                          SplatBatch splats(film);
                           for (size_t i = r.begin(); i < r.end(); ++i)
                               if (results[i].flags & kShadeEmitted)
-                                  add(film, emittedSplat(ctx, rp, results[i], paths[i]));
+                                  splats.push(emittedSplat(ctx, rp, results[i], paths[i]));
                       });
-    tbb::parallel_for(
-        tbb::blocked_range<size_t>(0, shadowOwner.size(), 1024),
-        [&](const tbb::blocked_range<size_t>& r) {
-            for (size_t j = r.begin(); j < r.end(); ++j)
-                if (!occluded[j])
-                    add(film, shadowSplat(ctx, rp, results[shadowOwner[j]], paths[shadowOwner[j]]));
-        });
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, shadowOwner.size(), 1024),
+                      [&](const tbb::blocked_range<size_t>& r) {
+                          SplatBatch splats(film);
+                          for (size_t j = r.begin(); j < r.end(); ++j)
+                              if (!occluded[j])
+                                  splats.push(shadowSplat(ctx, rp, results[shadowOwner[j]],
+                                                          paths[shadowOwner[j]]));
+                      });
 }
 
 void binContinuations(const RenderContext& ctx, uint iteration, RayFormat format,
@@ -249,7 +272,6 @@ struct FusedChunk {
     ShadowRay shadows[kFusedChunk];
     std::uint8_t owner[kFusedChunk];
     std::uint8_t occluded[kFusedChunk];
-    Splat splats[2 * kFusedChunk]; // at most one emitted and one shadow splat per hit
 };
 uvec2 pathOf(const ShadeInput& in) {
     return uvec2(in.path.pathId, in.path.bounce);
@@ -284,6 +306,7 @@ void shadeFused(const RenderContext& ctx, uint iteration, RayFormat format,
             };
             std::unique_ptr<FusedChunk> c = std::make_unique<FusedChunk>();
             RayBuffer buffer;
+            SplatBatch splats(film);
             std::uint64_t shadowCount = 0;
             for (size_t begin = r.begin(); begin < r.end(); begin += kFusedChunk) {
                 const size_t n = std::min(kFusedChunk, r.end() - begin);
@@ -305,20 +328,15 @@ void shadeFused(const RenderContext& ctx, uint iteration, RayFormat format,
                 occludedRange(ctx.embree, c->shadows, m, false, c->occluded);
                 shadowCount += m;
                 lap(kShadow);
-                // Every splat's place first, its film line prefetched; then the adds.
-                size_t splats = 0;
                 for (size_t i = 0; i < n; ++i)
                     if (c->out[i].flags & kShadeEmitted)
-                        c->splats[splats++] = emittedSplat(ctx, rp, c->out[i], pathOf(c->in[i]));
+                        splats.push(emittedSplat(ctx, rp, c->out[i], pathOf(c->in[i])));
                 for (size_t j = 0; j < m; ++j)
                     if (!c->occluded[j]) {
                         const size_t i = c->owner[j];
-                        c->splats[splats++] = shadowSplat(ctx, rp, c->out[i], pathOf(c->in[i]));
+                        splats.push(shadowSplat(ctx, rp, c->out[i], pathOf(c->in[i])));
                     }
-                for (size_t k = 0; k < splats; ++k)
-                    film.prefetch(c->splats[k].pos);
-                for (size_t k = 0; k < splats; ++k)
-                    add(film, c->splats[k]);
+                splats.flush();
                 lap(kAccumulate);
                 for (size_t i = 0; i < n; ++i)
                     binOne(rp, format, c->out[i], buffer);
