@@ -41,11 +41,13 @@ render options:
   -o, --output FILE     image to write: .exr (linear float) or .png (8-bit sRGB);
                         default: the scene's name with .exr, in the current folder
   --spp N               total samples per pixel (overrides sample base x iterations)
-  --backend NAME        auto (default: vulkan where a device exists, else cpu), vulkan (the
-                        sorted deferred pipeline, shading as Vulkan compute), cpu (the same,
-                        shading in C++) or reference (a plain depth-first path tracer on Embree)
+  --backend NAME        auto (default: a real GPU where one is usable, else cpu), vulkan (the
+                        sorted deferred pipeline, shading as Vulkan compute; on a machine
+                        without a GPU, lavapipe's software emulation), cpu (the same, shading
+                        in C++) or reference (a plain depth-first path tracer on Embree)
   --device N|NAME       the Vulkan device: its index in `spillway devices` or part of its
-                        name (default: the first usable one)
+                        name (default: the first usable one; with auto, a GPU, see
+                        `spillway devices`, or the device the Vulkan driver variables name)
   --threads N           worker threads (default: every core)
   --seed S              random seed (overrides settings: seed)
   --stats FILE.json     write render statistics (rays, stage seconds, ...) as JSON
@@ -138,6 +140,8 @@ int devicesCommand(const std::vector<std::string>& args) {
         std::printf("%u: %s\n   type: %s, Vulkan %s, driver: %s\n   %s\n", d.index, d.name.c_str(),
                     d.type.c_str(), d.api.c_str(), d.driver.c_str(),
                     d.usable ? "usable" : ("unusable: " + d.whyNot).c_str());
+    std::printf("--backend auto takes %s\n",
+                spw::vk::chooseAutoDevice(devices, spw::vk::driverVariablesSet()).why.c_str());
     return 0;
 }
 

@@ -12,7 +12,7 @@
 namespace spw {
 
 // Which renderer: the sorted pipeline shading with Vulkan or C++, or the depth-first reference.
-// Auto: Vulkan where a device exists, else cpu.
+// Auto: a real GPU where one is usable, else cpu (vk::chooseAutoDevice).
 enum class BackendKind { Auto, Vulkan, Cpu, Reference };
 BackendKind parseBackend(const std::string& name); // auto | vulkan | cpu | reference
 const char* backendName(BackendKind kind);

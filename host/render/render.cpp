@@ -84,19 +84,36 @@ std::unique_ptr<RenderResult> renderWithProgress(const Scene& scene, const Rende
     stats.backend = backendName(config.backend);
     stats.device = cpuName();
 
-    // Vulkan only when asked for (vulkan, or auto): never for cpu or reference. `auto` takes the
-    // first usable device and falls back to cpu, saying so on stderr, when there is none.
+    // Vulkan only when asked for (vulkan, or auto): never for cpu or reference. `auto` takes a
+    // real GPU, or the device --device names, or lavapipe when the driver variables ask for it
+    // (vk::chooseAutoDevice), and otherwise renders on cpu; --stats says why (backend_auto).
     std::unique_ptr<vk::Context> vulkan;
     if (config.backend == BackendKind::Vulkan || config.backend == BackendKind::Auto) {
         StageTimer t(stats.stages, "vulkan init");
+        VulkanConfig vkConfig = config.vulkan;
+        bool wanted = config.backend == BackendKind::Vulkan || !vkConfig.device.empty();
         try {
-            vulkan = std::make_unique<vk::Context>(config.vulkan);
-            stats.backend = "vulkan";
-            stats.device = vulkan->info().name;
+            if (!wanted) {
+                const vk::AutoChoice choice =
+                    vk::chooseAutoDevice(vk::listDevices(), vk::driverVariablesSet());
+                stats.extra["backend_auto"] = choice.why;
+                stats.backend = "cpu";
+                if (choice.device >= 0) {
+                    vkConfig.device = std::to_string(choice.device);
+                    wanted = true;
+                }
+            }
+            if (wanted) {
+                vulkan = std::make_unique<vk::Context>(vkConfig);
+                stats.backend = "vulkan";
+                stats.device = vulkan->info().name;
+            }
         } catch (const vk::NoDeviceError& e) {
             if (config.backend == BackendKind::Vulkan)
                 throw std::runtime_error(std::string("--backend vulkan: ") + e.what());
-            std::fprintf(stderr, "spillway: no Vulkan device; rendering on cpu\n");
+            // The user asked for Vulkan (--device, or the driver variables) and has none.
+            if (wanted || vk::driverVariablesSet())
+                std::fprintf(stderr, "spillway: no Vulkan device; rendering on cpu\n");
             stats.backend = "cpu";
             stats.extra["backend_fallback"] = e.what();
         }

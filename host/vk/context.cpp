@@ -224,6 +224,28 @@ std::vector<DeviceInfo> listDevices() {
     return out;
 }
 
+AutoChoice chooseAutoDevice(const std::vector<DeviceInfo>& devices, bool softwareAllowed) {
+    for (const char* type : {"discrete gpu", "integrated gpu"})
+        for (const DeviceInfo& d : devices)
+            if (d.usable && d.type == type)
+                return {int(d.index), "device " + std::to_string(d.index) + " (" + d.name +
+                                          "), the first usable " + type};
+    if (softwareAllowed)
+        for (const DeviceInfo& d : devices)
+            if (d.usable)
+                return {int(d.index), "device " + std::to_string(d.index) + " (" + d.name +
+                                          "): no GPU, but the Vulkan driver variables ask for "
+                                          "this driver"};
+    return {-1, "cpu: no usable GPU (a software device such as lavapipe shades more slowly "
+                "than the cpu backend on the same cores; --backend vulkan takes it)"};
+}
+
+bool driverVariablesSet() {
+    for (const char* v : {"VK_DRIVER_FILES", "VK_ICD_FILENAMES", "VK_ADD_DRIVER_FILES"})
+        if (const char* value = std::getenv(v); value && *value) return true;
+    return false;
+}
+
 Context::Context(const VulkanConfig& config) {
     validation_ = validationRequested(config);
     instance_ = createInstance(validation_, &messages_);

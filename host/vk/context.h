@@ -37,6 +37,19 @@ struct DeviceInfo {
 // can be made (no driver at all).
 std::vector<DeviceInfo> listDevices();
 
+// What `--backend auto` renders with: a real GPU when one is usable (the first discrete one, else
+// the first integrated one); a software device (lavapipe) only when the user pointed the loader
+// at drivers (`softwareAllowed`: VK_DRIVER_FILES, VK_ICD_FILENAMES or VK_ADD_DRIVER_FILES set),
+// since on the same cores it emulates a GPU more slowly than the cpu backend shades; else none,
+// and auto renders on cpu. `why` says which and why, in a line for `spillway devices`.
+struct AutoChoice {
+    int device = -1; // index into the listing, or -1: the cpu backend
+    std::string why;
+};
+AutoChoice chooseAutoDevice(const std::vector<DeviceInfo>& devices, bool softwareAllowed);
+// Whether the environment names Vulkan drivers (the variables above).
+bool driverVariablesSet();
+
 // Total warnings and errors the validation messengers of this process have reported (tests
 // read it after a render, when the instance and its messenger are gone).
 std::uint64_t validationMessageCount();

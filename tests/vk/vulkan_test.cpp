@@ -336,9 +336,8 @@ PerHit shadeSameHits(ShadingMode mode) {
             float u = unit(rng), v = unit(rng);
             if (u + v > 1.0f) u = 1.0f - u, v = 1.0f - v;
             ShadeInput& in = inputs[i];
-            in.hit =
-                embree.setUpHit(HitRecord{mesh, prim, u, v, 10.0f + 1000.0f * unit(rng)},
-                               vec3(0.0f, 0.0f, 1.0f), 0u, textures);
+            in.hit = embree.setUpHit(HitRecord{mesh, prim, u, v, 10.0f + 1000.0f * unit(rng)},
+                                     vec3(0.0f, 0.0f, 1.0f), 0u, textures);
             vec3 d = glm::normalize(vec3(unit(rng) - 0.5f, unit(rng) - 0.5f, unit(rng) - 0.5f));
             if (rng() % 8 != 0 && glm::dot(d, in.hit.ng) > 0.0f)
                 d = -d; // mostly the front, some backs
@@ -623,10 +622,12 @@ TEST(VulkanCli, DevicesAndDeviceSelectionUnderValidation) {
     const vk::DeviceInfo& first = *std::find_if(devices.begin(), devices.end(),
                                                 [](const vk::DeviceInfo& d) { return d.usable; });
 
-    // The default is auto, which takes the device; by index and by part of the name too.
+    // --backend vulkan takes the first usable device; by index and by part of the name too (the
+    // default backend, auto, then takes the device named).
     const std::string byName = first.name.substr(0, first.name.find(' '));
     for (const std::string& choice :
-         {std::string(), "--device " + std::to_string(first.index), "--device " + byName}) {
+         {std::string("--backend vulkan"), "--device " + std::to_string(first.index),
+          "--device " + byName}) {
         CommandResult r =
             runWithEnv(validated, "render " + scene + " --quiet " + choice + " -o " +
                                       dir.file("x.exr") + " --stats " + dir.file("x.json"));
@@ -650,6 +651,60 @@ TEST(VulkanCli, DevicesAndDeviceSelectionUnderValidation) {
         validated, "render " + scene + " --quiet --shading sideways -o " + dir.file("z.exr"));
     EXPECT_EQ(usage.status, 2) << usage.output;
     EXPECT_TRUE(contains(usage.output, "sideways")) << usage.output;
+}
+
+vk::DeviceInfo fakeDevice(uint32_t index, const char* type, bool usable = true) {
+    vk::DeviceInfo d;
+    d.index = index;
+    d.name = std::string(type) + " " + std::to_string(index);
+    d.type = type;
+    d.usable = usable;
+    return d;
+}
+
+// auto: a real GPU (discrete first, then integrated), never a software device unless the
+// driver variables ask for one, and the cpu backend otherwise.
+TEST(VulkanCli, AutoTakesARealGpuElseCpuAndLavapipeOnlyWhenAskedFor) {
+    using vk::chooseAutoDevice;
+    const std::vector<vk::DeviceInfo> lavapipeOnly = {fakeDevice(0, "cpu")};
+    EXPECT_EQ(chooseAutoDevice(lavapipeOnly, false).device, -1);
+    EXPECT_TRUE(contains(chooseAutoDevice(lavapipeOnly, false).why, "cpu: no usable GPU"));
+    EXPECT_EQ(chooseAutoDevice(lavapipeOnly, true).device, 0);
+    const std::vector<vk::DeviceInfo> mixed = {
+        fakeDevice(0, "cpu"), fakeDevice(1, "integrated gpu"), fakeDevice(2, "discrete gpu", false),
+        fakeDevice(3, "discrete gpu")};
+    EXPECT_EQ(chooseAutoDevice(mixed, false).device, 3);
+    EXPECT_EQ(chooseAutoDevice(mixed, true).device, 3);
+    EXPECT_EQ(chooseAutoDevice({mixed[0], mixed[1], mixed[2]}, false).device, 1);
+    EXPECT_EQ(chooseAutoDevice({fakeDevice(0, "discrete gpu", false)}, false).device, -1);
+    EXPECT_EQ(chooseAutoDevice({}, true).device, -1);
+
+    // This machine, as a new user runs it: no driver variables.
+    TempDir dir;
+    const std::string scene = tinyScene(dir);
+    const std::string plain = "-u VK_DRIVER_FILES -u VK_ICD_FILENAMES -u VK_ADD_DRIVER_FILES";
+    const vk::AutoChoice expected = chooseAutoDevice(vk::listDevices(), false);
+    CommandResult r = runWithEnv(plain, "render " + scene + " --quiet -o " + dir.file("a.exr") +
+                                            " --stats " + dir.file("a.json"));
+    ASSERT_EQ(r.status, 0) << r.output;
+    EXPECT_EQ(r.output, "");
+    nlohmann::json stats = nlohmann::json::parse(std::ifstream(dir.file("a.json")));
+    EXPECT_EQ(stats["backend"], expected.device >= 0 ? "vulkan" : "cpu");
+    EXPECT_EQ(stats["backend_auto"], expected.why);
+    CommandResult d = runWithEnv(plain, "devices");
+    EXPECT_EQ(d.status, 0) << d.output;
+    EXPECT_TRUE(contains(d.output, "--backend auto takes " + expected.why)) << d.output;
+
+    // The driver variables naming lavapipe: auto takes it.
+    const std::string lvp = "/usr/share/vulkan/icd.d/lvp_icd.x86_64.json";
+    if (!std::filesystem::exists(lvp)) return;
+    r = runWithEnv("VK_DRIVER_FILES=" + lvp, "render " + scene + " --quiet -o " +
+                                                 dir.file("b.exr") + " --stats " +
+                                                 dir.file("b.json"));
+    ASSERT_EQ(r.status, 0) << r.output;
+    stats = nlohmann::json::parse(std::ifstream(dir.file("b.json")));
+    EXPECT_EQ(stats["backend"], "vulkan");
+    EXPECT_TRUE(contains(stats["device"].get<std::string>(), "llvmpipe")) << stats["device"];
 }
 
 } // namespace
