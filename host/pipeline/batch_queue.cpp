@@ -171,8 +171,9 @@ DirectionalBins::DirectionalBins(RayFormat format, uint binExponent, BatchQueue&
 void DirectionalBins::add(RayBuffer& buffer) {
     const size_t batchBytes = batchRays_ * recordBytes_;
     for (uint b = 0; b < 6; ++b) {
-        std::vector<std::uint8_t>& src = buffer.perBin[b];
-        if (src.empty()) continue;
+        const std::vector<std::uint8_t>& src = buffer.perBin[b];
+        const size_t srcBytes = buffer.used[b];
+        if (srcBytes == 0) continue;
         // Each bin fills its batch in place; a full batch leaves for the queue (outside the
         // lock) and the next one starts. A buffer of any size simply makes several batches.
         std::vector<RayBatch> full;
@@ -180,9 +181,9 @@ void DirectionalBins::add(RayBuffer& buffer) {
         {
             std::lock_guard<std::mutex> lock(bins_[b].mutex);
             std::vector<std::uint8_t>& bin = bins_[b].bytes;
-            while (at < src.size()) {
+            while (at < srcBytes) {
                 if (bin.capacity() < batchBytes) bin.reserve(batchBytes);
-                const size_t take = std::min(src.size() - at, batchBytes - bin.size());
+                const size_t take = std::min(srcBytes - at, batchBytes - bin.size());
                 bin.insert(bin.end(), src.begin() + std::ptrdiff_t(at),
                            src.begin() + std::ptrdiff_t(at + take));
                 at += take;
@@ -196,8 +197,8 @@ void DirectionalBins::add(RayBuffer& buffer) {
                 }
             }
         }
-        queue_.noteOutsideBytes(std::int64_t(src.size()) - std::int64_t(full.size() * batchBytes));
-        src.clear();
+        queue_.noteOutsideBytes(std::int64_t(srcBytes) - std::int64_t(full.size() * batchBytes));
+        buffer.used[b] = 0;
         for (RayBatch& batch : full)
             queue_.push(std::move(batch));
     }
@@ -235,13 +236,13 @@ size_t DirectionalBins::raysWaiting() {
 }
 
 void RayBuffer::push(const RayState& ray, RayFormat format, uvec4 rounding) {
-    std::vector<std::uint8_t>& dst = perBin[cardinalBin(ray.dir)];
-    const size_t at = dst.size(), bytes = rayRecordBytes(format);
-    if (dst.capacity() < at + bytes) dst.reserve(std::max<size_t>(at * 2, 256 * kFullRayBytes));
-    // Encoded in place of a stack record, then appended: no zero-fill of the new bytes.
-    std::uint8_t record[kFullRayBytes];
-    encodeRay(ray, format, rounding, record);
-    dst.insert(dst.end(), record, record + bytes);
+    const uint b = cardinalBin(ray.dir);
+    const size_t bytes = rayRecordBytes(format);
+    std::vector<std::uint8_t>& dst = perBin[b];
+    // The vector only grows (zero-filled once, by doubling); `used` says how much holds rays.
+    if (dst.size() < used[b] + bytes) dst.resize(std::max(dst.size() * 2, 256 * kFullRayBytes));
+    encodeRay(ray, format, rounding, dst.data() + used[b]);
+    used[b] += bytes;
     ++count;
 }
 

@@ -91,7 +91,8 @@ class BatchQueue {
 
 // A thread-local buffer of encoded rays, already split by cardinal bin.
 struct RayBuffer {
-    std::vector<std::uint8_t> perBin[6];
+    std::vector<std::uint8_t> perBin[6]; // bytes [0, used[b]) of bin b hold encoded rays
+    size_t used[6] = {};
     size_t count = 0;
     void push(const RayState& ray, RayFormat format, uvec4 rounding);
 };

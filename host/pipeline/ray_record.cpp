@@ -43,7 +43,8 @@ std::uint16_t toBfloat16(float f, uint random) {
     std::uint32_t bits;
     std::memcpy(&bits, &f, 4);
     std::uint32_t hi = bits >> 16, lo = bits & 0xFFFFu;
-    if ((random & 0xFFFFu) < lo && (hi & 0x7F80u) != 0x7F80u) ++hi; // never round into Inf/NaN
+    // Without a branch (the comparison is a coin flip); never rounds into Inf/NaN.
+    hi += std::uint32_t((random & 0xFFFFu) < lo) & std::uint32_t((hi & 0x7F80u) != 0x7F80u);
     return std::uint16_t(hi);
 }
 float fromBfloat16(std::uint16_t h) {

@@ -67,11 +67,14 @@ glm::dvec2 octahedralMap(vec3 d);
 glm::dvec2 octahedralFold(glm::dvec2 p);
 
 // The cardinal direction bin of a direction: 0..5 for +X, -X, +Y, -Y, +Z, -Z (dominant axis).
+// Written without branches: bounce directions are random, and mispredicted branches here cost
+// more than the arithmetic.
 inline uint cardinalBin(vec3 d) {
-    vec3 a = glm::abs(d);
-    if (a.x >= a.y && a.x >= a.z) return d.x >= 0.0f ? 0u : 1u;
-    if (a.y >= a.z) return d.y >= 0.0f ? 2u : 3u;
-    return d.z >= 0.0f ? 4u : 5u;
+    const vec3 a = glm::abs(d);
+    const bool x = (a.x >= a.y) & (a.x >= a.z);
+    const bool y = !x & (a.y >= a.z);
+    const float along = x ? d.x : (y ? d.y : d.z);
+    return (x ? 0u : (y ? 2u : 4u)) + (along >= 0.0f ? 0u : 1u);
 }
 
 } // namespace spw
