@@ -68,7 +68,9 @@ sorted pipeline options (cpu and vulkan backends):
                         budget, or within six batches (2^E rays each) if that is larger
   --spill-dir DIR       where spilled batches go (default: the system temp folder)
   --ray-sort MODE       auto (sort only where it measures faster), morton, median or off
-  --hit-sort on|off     sort hits by (shader, object, texture order) before shading
+  --hit-sort MODE       sort hits by (shader, object, texture order) before shading: auto
+                        (default: for vulkan always, for cpu where the scene has image
+                        textures), on or off
   --shading MODE        sorted (default: one dispatch per shader range, one kernel per surface
                         model) or megakernel (unsorted hits, one uber-shader switching per hit)
   --ray-format F        compact (34-byte rays, default) or full (50 bytes, every bit kept)
@@ -199,10 +201,7 @@ int renderCommand(const std::vector<std::string>& args) {
         else if (a == "--ray-format")
             config.pipeline.rayFormat = choice(a, value(), spw::parseRayFormat);
         else if (a == "--hit-sort") {
-            std::string v = value();
-            if (v != "on" && v != "off")
-                throw UsageError("--hit-sort takes on or off, not '" + v + "'");
-            config.pipeline.hitSort = v == "on";
+            config.pipeline.hitSort = choice(a, value(), spw::parseHitSortMode);
         } else if (a == "--stages") {
             std::string v = value();
             if (v != "fused" && v != "separate")

@@ -35,6 +35,8 @@ constexpr std::pair<const char*, RaySortMode> kRaySorts[] = {{"auto", RaySortMod
                                                              {"off", RaySortMode::Off}};
 constexpr std::pair<const char*, ShadingMode> kShadings[] = {
     {"sorted", ShadingMode::Sorted}, {"megakernel", ShadingMode::Megakernel}};
+constexpr std::pair<const char*, HitSortMode> kHitSorts[] = {
+    {"auto", HitSortMode::Auto}, {"on", HitSortMode::On}, {"off", HitSortMode::Off}};
 constexpr std::pair<const char*, TextureFilter> kTextureFilters[] = {
     {"cone", TextureFilter::Cone}, {"finest", TextureFilter::Finest}};
 
@@ -63,6 +65,9 @@ ShadingMode parseShadingMode(const std::string& name) {
 }
 const char* shadingModeName(ShadingMode mode) {
     return nameOf(mode, kShadings);
+}
+HitSortMode parseHitSortMode(const std::string& name) {
+    return parseChoice("hit sort", name, kHitSorts);
 }
 TextureFilter parseTextureFilter(const std::string& name) {
     return parseChoice("texture filter", name, kTextureFilters);

@@ -37,7 +37,9 @@ SortedRenderer::SortedRenderer(const RenderContext& ctx, const PipelineConfig& c
                                std::unique_ptr<ShadingEngine> shading)
     : ctx_(ctx), config_(config), shading_(std::move(shading)), policy_(config.raySort),
       scratch_(std::make_unique<Scratch>()),
-      fused_(config.fuseStages && shading_->shadesOnHostThreads()) {
+      fused_(config.fuseStages && shading_->shadesOnHostThreads()),
+      sortHits_(config.sortsHits() && (config.hitSort == HitSortMode::On ||
+                                       !shading_->shadesOnHostThreads() || ctx.textures.active())) {
     const double budgetMiB = config.memoryBudgetMiB.value_or(ctx.scene.settings.memoryBudgetMiB);
     const uint exponent = uint(config.binExponent.value_or(ctx.scene.settings.binExponent));
     // The budget covers every ray waiting in RAM: the six bins fill up to one batch each, and
@@ -120,7 +122,7 @@ size_t SortedRenderer::traceBatch(RayBatch& batch) {
     if (cameraRays * 2 < n) policy_.record(mode != RaySortMode::Off, since(sortStart), n);
     ctx_.stats.bounceRays += n - cameraRays;
     StageTimer t(times, "sort hits");
-    return sortHits(ctx_.scene, s.hits, config_.sortsHits(), s.order, s.keyTmp);
+    return sortHits(ctx_.scene, s.hits, sortHits_, s.order, s.keyTmp);
 }
 
 void SortedRenderer::runFusedBatch(RayBatch& batch, uint iteration, Film& film) {
@@ -143,7 +145,7 @@ void SortedRenderer::startBatch(RayBatch& batch, int slot) {
     }
     {
         StageTimer t(times, "shade");
-        shadeRanges(ctx_.scene, s.order, flight.hitCount, config_.sortsHits(), s.ranges);
+        shadeRanges(ctx_.scene, s.order, flight.hitCount, sortHits_, s.ranges);
         shading_->submit(slot, s.ranges);
     }
 }
@@ -186,9 +188,8 @@ void SortedRenderer::publishStats() {
     x["ray_format"] = rayFormatName(config_.rayFormat);
     x["ray_record_bytes"] = rayRecordBytes(config_.rayFormat);
     x["ray_sort"] = raySortName(config_.raySort);
-    x["hit_sort"] = config_.sortsHits();
-    x["shading"] =
-        shadingModeName(config_.sortsHits() ? ShadingMode::Sorted : ShadingMode::Megakernel);
+    x["hit_sort"] = sortHits_;
+    x["shading"] = shadingModeName(sortHits_ ? ShadingMode::Sorted : ShadingMode::Megakernel);
     x["batches_ray_sorted"] = policy_.sortedBatches();
     x["batches_ray_unsorted_measured"] = policy_.unsortedBatches();
     x["stages"] = fused_ ? "fused" : "separate";

@@ -41,6 +41,7 @@ class SortedRenderer : public Backend {
     RaySortPolicy policy_;
     std::unique_ptr<Scratch> scratch_;
     bool fused_;
+    bool sortHits_; // the hit sort's auto rule applied (render_config.h: HitSortMode)
     std::uint64_t batchesProcessed_ = 0;
 };
 

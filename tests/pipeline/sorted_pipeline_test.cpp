@@ -143,14 +143,32 @@ TEST(SortedPipeline, ImageIsIndependentOfBatchingSortingBudgetAndThreads) {
     variant("morton ray sort", [](RenderConfig& c) { c.pipeline.raySort = RaySortMode::Morton; });
     variant("median ray sort", [](RenderConfig& c) { c.pipeline.raySort = RaySortMode::Median; });
     variant("no ray sort", [](RenderConfig& c) { c.pipeline.raySort = RaySortMode::Off; });
-    variant("no hit sort", [](RenderConfig& c) { c.pipeline.hitSort = false; });
+    variant("no hit sort", [](RenderConfig& c) { c.pipeline.hitSort = HitSortMode::Off; });
+    variant("hit sort on", [](RenderConfig& c) { c.pipeline.hitSort = HitSortMode::On; });
     // The per-hit stages one whole batch after another instead of fused chunk by chunk.
     variant("separate stages", [](RenderConfig& c) { c.pipeline.fuseStages = false; });
-    variant("separate stages, 2 threads, no hit sort", [](RenderConfig& c) {
+    variant("separate stages, 2 threads, hit sort on", [](RenderConfig& c) {
         c.pipeline.fuseStages = false;
         c.threads = 2;
-        c.pipeline.hitSort = false;
+        c.pipeline.hitSort = HitSortMode::On;
     });
+}
+
+// The hit sort's auto rule: the cpu engine sorts hits only where the scene has image textures
+// (coherent tile reads); asked for, it always does; and the image is the same either way.
+TEST(SortedPipeline, HitSortAutoSortsForTexturesOnly) {
+    Scene plain = smallCornell(16);
+    Scene textured = loadScene(sourceDir() + "/scenes/every-model.yaml");
+    textured.image.width = textured.image.height = 16;
+    RenderConfig cfg;
+    cfg.spp = 4;
+    RenderConfig on = cfg;
+    on.pipeline.hitSort = HitSortMode::On;
+    auto r = render(plain, cfg), rOn = render(plain, on);
+    EXPECT_EQ(r->stats.extra["hit_sort"], false);
+    EXPECT_EQ(rOn->stats.extra["hit_sort"], true);
+    EXPECT_TRUE(sameBits(r->film->image(), rOn->film->image()));
+    EXPECT_EQ(render(textured, cfg)->stats.extra["hit_sort"], true);
 }
 
 // The thesis's known crash: a tile's buffer (64 x 64 pixels x 64 samples = 262144 rays) far

@@ -85,7 +85,7 @@ TEST_F(ProductionScene, SortedBatchesReadFewerTilesThanUnsorted) {
     sorted.backend = BackendKind::Cpu;
     sorted.pipeline.rayFormat = RayFormat::Full;
     RenderConfig unsorted = sorted;
-    unsorted.pipeline.hitSort = false;
+    unsorted.pipeline.hitSort = HitSortMode::Off;
     unsorted.pipeline.raySort = RaySortMode::Off;
     const nlohmann::json r = textureStats(ref), s = textureStats(sorted),
                          u = textureStats(unsorted);

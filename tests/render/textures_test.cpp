@@ -88,8 +88,8 @@ TEST(Textures, LayeredImageOverConstantByImageMaskOnEveryBackend) {
         EXPECT_EQ(t["tiles_read"], 2) << backend;
         EXPECT_EQ(t["bytes_read"], 2 * 8 * 8 * 3 * 4) << backend;
         EXPECT_GE(t["peak_cache_bytes"].get<double>(), 2 * 8 * 8 * 3 * 4) << backend;
-        const double rays = double(result->stats.cameraRays + result->stats.bounceRays +
-                                   result->stats.shadowRays);
+        const double rays =
+            double(result->stats.cameraRays + result->stats.bounceRays + result->stats.shadowRays);
         EXPECT_DOUBLE_EQ(t["per_ray"]["lookups"].get<double>(), 512 / rays) << backend;
         double worst = 0;
         for (int y = 0; y < 8; ++y)
