@@ -16,10 +16,20 @@ are noisy; ratios travel, absolute seconds do not).
                                --texture-filter finest (the thesis' regime: every lookup at the
                                finest level) and cone (the default). Writes
                                out/production/bench.json.
+  scripts/bench.py incore      in-core speed: the Cornell box at 64 and 256 spp and the
+                               1M-triangle scene; reference, cpu (fused stages), cpu with
+                               separate stages, vulkan; runs alternate between configurations and
+                               the best of N is kept. Per configuration: render seconds, ratio to
+                               the reference, rays per second per core, and Embree's own rate on
+                               the same rays (the cpu backend's traverse and shadow stages, which
+                               do nothing but Embree calls), the share of the render in Embree,
+                               and the stage seconds. --baseline PATH adds another build's cpu
+                               and reference (before/after in one run). Writes
+                               out/bench/incore.json.
   scripts/bench.py all         reference and pipeline (default)
 
 Options: --repeat N (best of N, default 3; production: 1), --spillway PATH (default
-build/spillway), --depths 1,2,3 and --exponents 8,11,14,17 (production), --scene-args "..."
+build/spillway), --baseline PATH (incore), --depths 1,2,3 and --exponents 8,11,14,17 (production), --scene-args "..."
 (production: options for make_production_scene.py).
 """
 import argparse
@@ -77,6 +87,7 @@ def bench_pipeline(spillway, repeat):
                ("cpu, ray sort morton", ["--backend", "cpu", "--ray-sort", "morton"]),
                ("cpu, ray sort median", ["--backend", "cpu", "--ray-sort", "median"]),
                ("cpu, ray sort off", ["--backend", "cpu", "--ray-sort", "off"]),
+               ("cpu, hit sort on", ["--backend", "cpu", "--hit-sort", "on"]),
                ("cpu, hit sort off", ["--backend", "cpu", "--hit-sort", "off"]),
                ("cpu, 1 MiB budget (spills)", ["--backend", "cpu", "--memory-budget", "1"]),
                ("vulkan (lavapipe or GPU)", ["--backend", "vulkan"]),
@@ -101,6 +112,62 @@ def bench_pipeline(spillway, repeat):
                 print("    stages: " + stages)
                 print("    batches: %d processed, %d ray-sorted; device: %s" % (
                     s["batches_processed"], s["batches_ray_sorted"], s["device"]))
+
+
+def embree_seconds(s):
+    """The sorted backends' time in Embree: traversal, and the shadow stage (occlusion calls and
+    the gathering of their rays)."""
+    st = s["stage_seconds"]
+    return st.get("traverse", 0.0) + st.get("shadow", 0.0)
+
+
+def bench_incore(spillway, repeat, baseline):
+    heavy = subprocess.check_output([sys.executable, os.path.join(ROOT, "scripts", "make_heavy_scene.py"),
+                                     os.path.join(ROOT, "out", "heavy")], text=True).strip()
+    box = os.path.join(ROOT, "scenes", "cornell-box.yaml")
+    scenes = [("Cornell box 256x256, 64 spp", box, ["--spp", "64"]),
+              ("Cornell box 256x256, 256 spp", box, ["--spp", "256"]),
+              ("1M triangles, 17 shaders, 640x480, 16 spp", heavy, [])]
+    configs = [("reference", spillway, ["--backend", "reference"]),
+               ("cpu", spillway, ["--backend", "cpu"]),
+               ("cpu, separate stages", spillway, ["--backend", "cpu", "--stages", "separate"]),
+               ("vulkan", spillway, ["--backend", "vulkan"])]
+    if baseline:
+        configs += [("baseline reference", baseline, ["--backend", "reference"]),
+                    ("baseline cpu", baseline, ["--backend", "cpu"])]
+    results = []
+    for title, scene, extra in scenes:
+        best = {}
+        for _ in range(repeat):  # alternate: every configuration once per round
+            for name, binary, args in configs:
+                s, rss = run(binary, scene, args + extra, 1)
+                if s is not None and (name not in best or s["render_seconds"] < best[name]["render_seconds"]):
+                    best[name] = s
+        print("\n%s (best of %d, alternating)" % (title, repeat))
+        print("  %-22s %8s %8s %14s %16s %8s" % ("config", "core s", "vs ref", "Mrays/s/core",
+                                                 "Embree Mr/s/core", "Embree"))
+        for name, _, _ in configs:
+            if name not in best:
+                print("  %-22s (could not run here)" % name)
+                continue
+            s = best[name]
+            ref = best["baseline reference" if name.startswith("baseline") else "reference"]
+            core, rays, threads = s["render_seconds"], s["rays"]["total"], s["threads"]
+            emb = embree_seconds(s)
+            raw = "%16.2f" % (rays / emb / threads / 1e6) if emb > 0 else "%16s" % "-"
+            share = "%7.0f%%" % (100 * emb / core) if emb > 0 else "%8s" % "-"
+            print("  %-22s %8.2f %7.2fx %14.2f %s %s" % (name, core, core / ref["render_seconds"],
+                                                         rays / core / threads / 1e6, raw, share))
+            if name != "reference" and name != "baseline reference":
+                print("    stages: " + ", ".join("%s %.2f" % (k, v) for k, v in s["stage_seconds"].items()
+                                                 if v >= 0.005))
+            results.append({"scene": title, "config": name, "render_seconds": core,
+                            "vs_reference": core / ref["render_seconds"], "rays": rays, "threads": threads,
+                            "embree_seconds": emb, "device": s["device"], "stage_seconds": s["stage_seconds"]})
+    folder = os.path.join(ROOT, "out", "bench")
+    os.makedirs(folder, exist_ok=True)
+    with open(os.path.join(folder, "incore.json"), "w") as f:
+        json.dump(results, f, indent=1)
 
 
 def with_depth(scene, depth):
@@ -201,18 +268,23 @@ def plot_production(rows, path):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("what", nargs="?", default="all", choices=["reference", "pipeline", "production", "all"])
+    ap.add_argument("what", nargs="?", default="all",
+                    choices=["reference", "pipeline", "production", "incore", "all"])
     ap.add_argument("--repeat", type=int)
     ap.add_argument("--depths", default="1,2,3")
     ap.add_argument("--exponents", default="8,11,14,17")
     ap.add_argument("--scene-args", default="")
     ap.add_argument("--spillway", default=os.path.join(ROOT, "build", "spillway"))
+    ap.add_argument("--baseline", help="another build's spillway binary (incore: before/after)")
     a = ap.parse_args()
     if a.what == "production":
         bench_production(a.spillway, a.repeat or 1, [int(d) for d in a.depths.split(",")],
                          [int(e) for e in a.exponents.split(",")], a.scene_args.split())
         return
     a.repeat = a.repeat or 3
+    if a.what == "incore":
+        bench_incore(a.spillway, a.repeat, a.baseline)
+        return
     if a.what in ("reference", "all"):
         bench_reference(a.spillway, a.repeat)
     if a.what in ("pipeline", "all"):
