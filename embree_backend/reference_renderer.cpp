@@ -7,7 +7,7 @@
 #include <tbb/parallel_for.h>
 
 namespace spw {
-void ReferenceRenderer::renderIteration(uint iteration, Film& film) {
+bool ReferenceRenderer::renderIteration(uint iteration, Film& film) {
     const Scene& scene = ctx_.scene;
     const EmbreeScene& embree = ctx_.embree;
     const SceneView view = ctx_.lights.view();
@@ -21,6 +21,7 @@ void ReferenceRenderer::renderIteration(uint iteration, Film& film) {
     tbb::parallel_for(
         tbb::blocked_range2d<int>(0, height, tile, 0, width, tile),
         [&](const tbb::blocked_range2d<int>& r) {
+            if (stopRequested(ctx_.config)) return; // the iteration will be discarded
             std::uint64_t camera = 0, bounce = 0, shadow = 0;
             for (int y = r.rows().begin(); y < r.rows().end(); ++y)
                 for (int x = r.cols().begin(); x < r.cols().end(); ++x)
@@ -61,6 +62,7 @@ void ReferenceRenderer::renderIteration(uint iteration, Film& film) {
             ctx_.stats.bounceRays += bounce;
             ctx_.stats.shadowRays += shadow;
         });
+    return !stopRequested(ctx_.config);
 }
 
 } // namespace spw

@@ -11,7 +11,7 @@ namespace spw {
 class ReferenceRenderer : public Backend {
   public:
     explicit ReferenceRenderer(const RenderContext& ctx) : ctx_(ctx) {}
-    void renderIteration(uint iteration, Film& film) override;
+    bool renderIteration(uint iteration, Film& film) override;
 
   private:
     RenderContext ctx_;

@@ -11,7 +11,9 @@
 #include <fstream>
 #include <random>
 #include <sstream>
+#include <sys/resource.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
 namespace spw::test {
 
@@ -247,6 +249,42 @@ std::string floorObj(float h) {
     std::snprintf(buf, sizeof buf, "v %g 0 %g\nv %g 0 %g\nv %g 0 %g\nv %g 0 %g\nf 1 2 3 4\n", -h,
                   -h, -h, h, h, h, h, -h);
     return buf;
+}
+
+ChildResult runChild(const std::vector<std::string>& args,
+                     const std::function<void(pid_t)>& whileRunning) {
+    std::string log = std::filesystem::temp_directory_path() /
+                      ("spillway-child-" + std::to_string(getpid()) + ".log");
+    pid_t pid = fork();
+    if (pid == 0) {
+        FILE* f = std::freopen(log.c_str(), "w", stderr);
+        (void)f;
+        dup2(2, 1);
+        std::vector<char*> argv;
+        std::string bin = binary();
+        argv.push_back(bin.data());
+        std::vector<std::string> copy = args;
+        for (std::string& a : copy)
+            argv.push_back(a.data());
+        argv.push_back(nullptr);
+        execv(bin.c_str(), argv.data());
+        _exit(127);
+    }
+    if (whileRunning) whileRunning(pid);
+    int st = 0;
+    struct rusage ru {};
+    wait4(pid, &st, 0, &ru);
+    std::ifstream in(log);
+    std::string out((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    std::filesystem::remove(log);
+    return {WIFEXITED(st) ? WEXITSTATUS(st) : -WTERMSIG(st), ru.ru_maxrss, out};
+}
+
+size_t filesIn(const std::string& dir) {
+    size_t n = 0;
+    for ([[maybe_unused]] const auto& e : std::filesystem::directory_iterator(dir))
+        ++n;
+    return n;
 }
 
 } // namespace spw::test

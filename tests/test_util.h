@@ -9,6 +9,8 @@
 #include <string>
 #include <vector>
 
+#include <sys/types.h>
+
 namespace spw::test {
 
 // True in the sanitized build (scripts/test.sh's build-asan/): a process's RSS there includes
@@ -59,6 +61,18 @@ struct CommandResult {
 CommandResult runSpillway(const std::string& args);
 // Runs a shell command line, stdout and stderr captured together; status -1 unless it exited.
 CommandResult runShell(const std::string& command);
+
+// Runs the binary (fork and exec), stdout and stderr captured together; `whileRunning` is
+// called with the child's pid before waiting for it. Status: the exit status, or -signal.
+struct ChildResult {
+    int status;
+    long maxRssKiB; // the child's peak resident set
+    std::string output;
+};
+ChildResult runChild(const std::vector<std::string>& args,
+                     const std::function<void(pid_t)>& whileRunning = {});
+// Entries in a folder.
+size_t filesIn(const std::string& dir);
 
 // Mean of the channel average over all pixels.
 double mean(const std::vector<float>& rgb);

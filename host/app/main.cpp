@@ -2,6 +2,7 @@
 // 2 bad input (usage or scene error).
 #include "host/app/compare_command.h"
 #include "host/app/error_csv.h"
+#include "host/app/interrupt.h"
 #include "host/app/progress.h"
 #include "host/app/usage_error.h"
 #include "host/image/image_io.h"
@@ -56,6 +57,10 @@ render options:
                         two half buffers, and with --reference the compare metrics
   --reference REF.exr   the reference image for --error-csv
   --time-limit SECONDS  stop after the iteration that crosses this render time
+  --target-error E      stop after the first iteration whose relMSE, estimated from two half
+                        buffers (the --error-csv estimate), is at or below E
+  --progress MODE       auto (default: a bar on a terminal, nothing otherwise), bar, lines (a
+                        line per iteration, for logs) or none; --quiet is none
   --texture-cache MiB   the texture system's tile cache (settings: texture cache; default
                         1024): image textures beyond it are read from disk again as needed
   --texture-filter F    cone (default: lookups read the MIP levels each hit's ray-cone
@@ -77,6 +82,10 @@ sorted pipeline options (cpu and vulkan backends):
   --stages MODE         fused (default; cpu: hit setup, shade, shadow, accumulate and bin run
                         chunk by chunk of 128 hits, in cache) or separate (each stage over the
                         whole batch in turn, as the vulkan backend runs them)
+
+Ctrl-C (SIGINT) or SIGTERM stops the render at the next batch boundary, writes the image of
+every completed iteration (and --stats, --error-csv) and exits 130 or 143; a second one exits
+at once, writing nothing.
 
 exit status: 0 done; 1 runtime failure (disk, device, an output that cannot be written);
 2 bad usage or scene error (printed as FILE:LINE: message). On any failure no output file
@@ -150,6 +159,7 @@ int devicesCommand(const std::vector<std::string>& args) {
 int renderCommand(const std::vector<std::string>& args) {
     std::string scenePath, output, statsPath, errorCsvPath, referencePath;
     bool quiet = false;
+    std::string progressMode = "auto";
     spw::RenderConfig config;
     config.backend = spw::BackendKind::Auto;
     for (size_t i = 0; i < args.size(); ++i) {
@@ -186,7 +196,15 @@ int renderCommand(const std::vector<std::string>& args) {
             referencePath = value();
         else if (a == "--time-limit")
             config.timeLimitSeconds = parseNumber(a, value(), 1e-3, 1e9);
-        else if (a == "--texture-filter")
+        else if (a == "--target-error")
+            config.targetError = parseNumber(a, value(), 0.0, 1e9);
+        else if (a == "--progress") {
+            progressMode = value();
+            if (progressMode != "auto" && progressMode != "bar" && progressMode != "lines" &&
+                progressMode != "none")
+                throw UsageError("--progress takes auto, bar, lines or none, not '" + progressMode +
+                                 "'");
+        } else if (a == "--texture-filter")
             config.textureFilter = choice(a, value(), spw::parseTextureFilter);
         else if (a == "--texture-cache")
             config.textureCacheMiB = parseNumber(a, value(), 1.0, 1 << 20);
@@ -247,15 +265,33 @@ int renderCommand(const std::vector<std::string>& args) {
     if (!errorCsvPath.empty())
         errorCsv = std::make_unique<spw::ErrorCsv>(errorCsvPath, std::move(reference));
 
-    spw::ProgressBar progress(!quiet && isatty(STDERR_FILENO));
+    if (quiet) progressMode = "none";
+    if (progressMode == "auto") progressMode = isatty(STDERR_FILENO) ? "bar" : "none";
+    spw::ProgressBar progress(progressMode == "none"  ? spw::ProgressBar::Style::None
+                              : progressMode == "bar" ? spw::ProgressBar::Style::Bar
+                                                      : spw::ProgressBar::Style::Lines);
     const spw::SamplingPlan plan = spw::planSampling(scene.image, config.spp);
     const int sppPerIteration = plan.sampleBase * plan.sampleBase;
+    spw::InterruptGuard interrupt;
+    config.stop = interrupt.flag();
     auto result = spw::renderWithProgress(
         scene, config, [&](const spw::IterationInfo& info, const spw::Film& film) {
             if (errorCsv) errorCsv->addRow(info.done, info.spp, info.renderSeconds, film);
-            progress.update(info.done, info.total, info.spp, info.total * sppPerIteration);
+            progress.update(info.done, info.total, info.spp, info.total * sppPerIteration,
+                            film.halfBufferRelMseEstimate());
         });
     progress.finish();
+    const int signal = interrupt.signal();
+    if (signal != 0 && result->stats.iterations == 0) {
+        std::fprintf(stderr,
+                     "spillway: stopped by signal %d before an iteration completed; "
+                     "nothing written\n",
+                     signal);
+        return 128 + signal;
+    }
+    if (signal != 0)
+        std::fprintf(stderr, "spillway: stopped by signal %d after %d spp; writing them\n", signal,
+                     result->stats.spp);
 
     // Every output is written whole, and flushed, before any is given its name: a failure in
     // any of them leaves none (host/image/output_file.h).
@@ -288,7 +324,7 @@ int renderCommand(const std::vector<std::string>& args) {
     image.commit();
     if (stats) stats->commit();
     if (errorCsv) errorCsv->commit();
-    return 0;
+    return signal != 0 ? 128 + signal : 0;
 }
 
 } // namespace

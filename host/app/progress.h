@@ -1,21 +1,24 @@
-// A one-line progress bar on stderr (iterations, spp, elapsed, ETA), drawn only on a terminal.
+// Progress on stderr: spp done, elapsed, ETA and the half-buffer error estimate. Style Bar: one
+// line redrawn with a carriage return (a terminal); Lines: one plain line per iteration (a log,
+// no control characters); None: nothing.
 #pragma once
 
 #include <chrono>
 #include <cstdio>
+#include <optional>
 #include <string>
 
 namespace spw {
 
 class ProgressBar {
   public:
-    explicit ProgressBar(bool enabled)
-        : enabled_(enabled), start_(std::chrono::steady_clock::now()) {}
-    void update(int done, int total, int sppDone, int sppTotal);
+    enum class Style { None, Bar, Lines };
+    explicit ProgressBar(Style style) : style_(style), start_(std::chrono::steady_clock::now()) {}
+    void update(int done, int total, int sppDone, int sppTotal, std::optional<double> relMse);
     void finish();
 
   private:
-    bool enabled_;
+    Style style_;
     bool drawn_ = false;
     std::chrono::steady_clock::time_point start_;
 };

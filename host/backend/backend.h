@@ -26,10 +26,18 @@ struct RenderContext {
     RenderStats& stats;
 };
 
+// Whether a stop was asked for (RenderConfig::stop, set by a signal handler): backends look at
+// it between batches (sorted) or tiles (reference).
+inline bool stopRequested(const RenderConfig& config) {
+    return config.stop != nullptr && config.stop->load(std::memory_order_relaxed) != 0;
+}
+
 class Backend {
   public:
     virtual ~Backend() = default;
-    virtual void renderIteration(uint iteration, Film& film) = 0;
+    // Renders one iteration into the film. Returns false when it stopped early because a stop
+    // was requested: the iteration is then incomplete, and the caller discards it.
+    virtual bool renderIteration(uint iteration, Film& film) = 0;
 };
 
 } // namespace spw

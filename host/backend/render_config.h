@@ -6,6 +6,7 @@
 
 #include "shared/types.h"
 
+#include <atomic>
 #include <optional>
 #include <string>
 
@@ -92,7 +93,13 @@ struct RenderConfig {
     PipelineConfig pipeline;                // the sorted backends' knobs
     VulkanConfig vulkan;                    // the vulkan backend's knobs
     std::optional<double> timeLimitSeconds; // stop after the iteration that crosses it
-    std::optional<double> textureCacheMiB;  // overrides settings: texture cache
+    // Stop after the first iteration whose half-buffer relMSE estimate (Film::halfBufferRelMse)
+    // is at or below this.
+    std::optional<double> targetError;
+    // Nonzero: stop at the next batch (or tile) boundary and discard the iteration in progress;
+    // the render keeps every completed iteration. Set from a signal handler (the CLI's).
+    const std::atomic<int>* stop = nullptr;
+    std::optional<double> textureCacheMiB; // overrides settings: texture cache
     TextureFilter textureFilter = TextureFilter::Cone;
 };
 

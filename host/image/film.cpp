@@ -164,6 +164,10 @@ std::vector<float> Film::halfImage(int half) const {
 }
 
 double Film::halfBufferRelMse() const {
+    return halfBufferRelMseEstimate().value_or(0.0);
+}
+
+std::optional<double> Film::halfBufferRelMseEstimate() const {
     const size_t n = size_t(width_) * height_;
     double total = 0;
     size_t count = 0;
@@ -176,7 +180,8 @@ double Film::halfBufferRelMse() const {
             ++count;
         }
     }
-    return count ? total / double(count) : 0.0;
+    if (count == 0) return std::nullopt;
+    return total / double(count);
 }
 
 } // namespace spw

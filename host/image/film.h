@@ -24,6 +24,7 @@
 #include <atomic>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <vector>
 
 namespace spw {
@@ -55,6 +56,9 @@ class Film {
     // before adding them overlaps those misses.
     void prefetch(vec2 filmPos) const;
     void endIteration();
+    // Drops the iteration in progress (a stopped render): the film is as after endIteration()
+    // of the last whole iteration.
+    void discardIteration() { beginIteration(); }
 
     // The render so far: sum of weighted radiance / sum of weights, RGB, row-major.
     std::vector<float> image() const;
@@ -63,6 +67,9 @@ class Film {
     // relMSE of image() estimated from the halves: per value (A - B)^2 / 4 / (m^2 + 0.01),
     // averaged; (A - B)^2 / 4 is an unbiased estimate of the variance of m = (A + B) / 2.
     double halfBufferRelMse() const;
+    // The same, or nothing while no pixel has samples in both halves (one iteration of one
+    // sample per pixel): then there is no estimate yet, rather than an estimate of 0.
+    std::optional<double> halfBufferRelMseEstimate() const;
     // The last completed iteration alone (for per-iteration statistics).
     std::vector<float> lastIterationImage() const { return lastIteration_; }
 

@@ -144,6 +144,26 @@ std::optional<RayBatch> BatchQueue::pop(StageTimes& times) {
     return std::move(e.batch);
 }
 
+void BatchQueue::clear() {
+    std::unique_lock<std::mutex> lock(mutex_);
+    if (prefetch_.valid()) {
+        lock.unlock();
+        try {
+            prefetch_.get(); // its bytes are dropped; it released its range itself
+        } catch (const std::exception&) {
+            // A read error on rays that are being dropped anyway changes nothing.
+        }
+        lock.lock();
+    }
+    for (Entry& e : entries_)
+        if (e.spilled) {
+            spill_->release(e.offset, e.size); // the front one's again: punching twice is harmless
+        } else {
+            ramBytes_ -= e.size;
+        }
+    entries_.clear();
+}
+
 bool BatchQueue::empty() const {
     std::lock_guard<std::mutex> lock(mutex_);
     return entries_.empty();
@@ -224,6 +244,14 @@ bool DirectionalBins::flushLargest() {
     queue_.noteOutsideBytes(-std::int64_t(batch.bytes.size()));
     queue_.push(std::move(batch));
     return true;
+}
+
+void DirectionalBins::clear() {
+    for (Bin& b : bins_) {
+        std::lock_guard<std::mutex> lock(b.mutex);
+        queue_.noteOutsideBytes(-std::int64_t(b.bytes.size()));
+        b.bytes.clear();
+    }
 }
 
 size_t DirectionalBins::raysWaiting() {

@@ -66,6 +66,9 @@ class BatchQueue {
     // after it when that one is on disk.
     std::optional<RayBatch> pop(StageTimes& times);
     bool empty() const;
+    // Drops every queued batch (a stopped render): waits for a read in flight, frees the spill
+    // file's space. Not thread-safe with pop().
+    void clear();
     // Bytes of rays waiting outside the queue (bins), for the peak-RAM statistic.
     void noteOutsideBytes(std::int64_t delta);
     QueueCounters counters() const;
@@ -108,6 +111,8 @@ class DirectionalBins {
     // Moves the fullest bin into the queue; false when every bin is empty.
     bool flushLargest();
     size_t raysWaiting();
+    // Drops every waiting ray (a stopped render).
+    void clear();
 
   private:
     struct Bin {

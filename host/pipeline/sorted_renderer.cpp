@@ -56,7 +56,7 @@ SortedRenderer::SortedRenderer(const RenderContext& ctx, const PipelineConfig& c
 
 SortedRenderer::~SortedRenderer() = default;
 
-void SortedRenderer::renderIteration(uint iteration, Film& film) {
+bool SortedRenderer::renderIteration(uint iteration, Film& film) {
     shading_->beginIteration(iteration);
     {
         StageTimer t(ctx_.stats.stages, "generate");
@@ -69,6 +69,15 @@ void SortedRenderer::renderIteration(uint iteration, Film& film) {
     int pending = -1; // the slot whose batch is being shaded
     int next = 0;
     for (;;) {
+        if (stopRequested(ctx_.config)) {
+            // A batch boundary: let the engine finish what it holds, then drop every ray still
+            // waiting (the caller discards this iteration's film).
+            if (pending >= 0) shading_->finish(pending);
+            bins_->clear();
+            queue_->clear();
+            publishStats();
+            return false;
+        }
         std::optional<RayBatch> batch = queue_->pop(ctx_.stats.stages);
         if (!batch) {
             if (pending >= 0) { // its continuation rays may refill the queue
@@ -93,6 +102,7 @@ void SortedRenderer::renderIteration(uint iteration, Film& film) {
         }
     }
     publishStats();
+    return true;
 }
 
 size_t SortedRenderer::traceBatch(RayBatch& batch) {

@@ -18,7 +18,7 @@ class SortedRenderer : public Backend {
     SortedRenderer(const RenderContext& ctx, const PipelineConfig& config,
                    std::unique_ptr<ShadingEngine> shading);
     ~SortedRenderer() override;
-    void renderIteration(uint iteration, Film& film) override;
+    bool renderIteration(uint iteration, Film& film) override;
 
   private:
     struct Scratch;

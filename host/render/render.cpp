@@ -157,9 +157,18 @@ std::unique_ptr<RenderResult> renderWithProgress(const Scene& scene, const Rende
         backend = std::make_unique<SortedRenderer>(ctx, config.pipeline, makeCpuShading(ctx));
     double renderSeconds = 0;
     int done = 0;
+    const char* stopReason = "spp";
     while (done < plan.iterations) {
+        if (stopRequested(config)) {
+            stopReason = "signal";
+            break;
+        }
         const auto iterationStart = std::chrono::steady_clock::now();
-        backend->renderIteration(uint(done), *result->film);
+        if (!backend->renderIteration(uint(done), *result->film)) {
+            result->film->discardIteration(); // stopped part-way: keep only whole iterations
+            stopReason = "signal";
+            break;
+        }
         {
             StageTimer t(stats.stages, "accumulate");
             result->film->endIteration();
@@ -174,8 +183,20 @@ std::unique_ptr<RenderResult> renderWithProgress(const Scene& scene, const Rende
         const int sppDone = done * plan.sampleBase * plan.sampleBase;
         if (onIteration)
             onIteration({done, plan.iterations, sppDone, renderSeconds}, *result->film);
-        if (config.timeLimitSeconds && renderSeconds >= *config.timeLimitSeconds) break;
+        if (done == plan.iterations) break;
+        if (config.timeLimitSeconds && renderSeconds >= *config.timeLimitSeconds) {
+            stopReason = "time limit";
+            break;
+        }
+        if (config.targetError) {
+            const std::optional<double> estimate = result->film->halfBufferRelMseEstimate();
+            if (estimate && *estimate <= *config.targetError) {
+                stopReason = "target error";
+                break;
+            }
+        }
     }
+    stats.extra["stop_reason"] = stopReason;
     stats.iterations = done;
     stats.spp = done * plan.sampleBase * plan.sampleBase;
     stats.extra["render_seconds"] = renderSeconds;

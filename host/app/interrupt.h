@@ -1,0 +1,25 @@
+// Ctrl-C keeps the work. While an InterruptGuard lives, the first SIGINT or SIGTERM only sets a
+// flag (RenderConfig::stop): the render stops at the next batch or tile boundary, discards the
+// iteration in progress, and the CLI writes the image of every completed iteration, then exits
+// 130 or 143 as a shell expects. A second signal ends the process at once by the signal's
+// default action; every file Spillway writes is anonymous until committed (output_file.h) and
+// the spill file has no name at all (batch_queue.h), so no temporary file survives either way.
+#pragma once
+
+#include <atomic>
+
+namespace spw {
+
+class InterruptGuard {
+  public:
+    InterruptGuard();  // installs the handlers
+    ~InterruptGuard(); // restores the previous ones
+    InterruptGuard(const InterruptGuard&) = delete;
+    InterruptGuard& operator=(const InterruptGuard&) = delete;
+
+    // The flag: the number of the first signal received, 0 until then.
+    const std::atomic<int>* flag() const;
+    int signal() const;
+};
+
+} // namespace spw
