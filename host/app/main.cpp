@@ -11,6 +11,7 @@
 #include "host/scene/scene.h"
 #include "host/vk/context.h"
 
+#include <cctype>
 #include <cmath>
 #include <csignal>
 #include <cstdio>
@@ -57,6 +58,12 @@ render options:
                         two half buffers, and with --reference the compare metrics
   --reference REF.exr   the reference image for --error-csv
   --time-limit SECONDS  stop after the iteration that crosses this render time
+  --checkpoint FILE.exr write the render's exact state (an EXR of the image so far, with the
+                        film's sums bit for bit in extra channels) at the end, however the
+                        render stops, and every --checkpoint-interval SECONDS of rendering
+  --resume FILE.exr     continue a checkpointed render (same scene and image settings; more
+                        --spp may be asked for) to the image it would have made uninterrupted;
+                        checkpoints go back to FILE unless --checkpoint names another
   --target-error E      stop after the first iteration whose relMSE, estimated from two half
                         buffers (the --error-csv estimate), is at or below E
   --progress MODE       auto (default: a bar on a terminal, nothing otherwise), bar, lines (a
@@ -157,7 +164,9 @@ int devicesCommand(const std::vector<std::string>& args) {
 }
 
 int renderCommand(const std::vector<std::string>& args) {
-    std::string scenePath, output, statsPath, errorCsvPath, referencePath;
+    std::string scenePath, output, statsPath, errorCsvPath, referencePath, checkpointPath,
+        resumePath;
+    double checkpointInterval = 0;
     bool quiet = false;
     std::string progressMode = "auto";
     spw::RenderConfig config;
@@ -188,6 +197,12 @@ int renderCommand(const std::vector<std::string>& args) {
             config.seed = std::uint32_t(parseInteger(a, value(), 0, 0xFFFFFFFFLL));
         else if (a == "--stats")
             statsPath = value();
+        else if (a == "--checkpoint")
+            checkpointPath = value();
+        else if (a == "--checkpoint-interval")
+            checkpointInterval = parseNumber(a, value(), 1e-3, 1e9);
+        else if (a == "--resume")
+            resumePath = value();
         else if (a == "--quiet")
             quiet = true;
         else if (a == "--error-csv")
@@ -239,8 +254,25 @@ int renderCommand(const std::vector<std::string>& args) {
     if (!referencePath.empty() && errorCsvPath.empty())
         throw UsageError("--reference goes with --error-csv");
     // Every output path is checked before any work, so that a typo costs no render.
-    for (const std::string* path : {&output, &statsPath, &errorCsvPath})
+    if (!resumePath.empty() && checkpointPath.empty()) checkpointPath = resumePath;
+    if (checkpointInterval > 0 && checkpointPath.empty())
+        throw UsageError("--checkpoint-interval goes with --checkpoint");
+    if (!checkpointPath.empty()) {
+        std::string ext = std::filesystem::path(checkpointPath).extension().string();
+        for (char& c : ext)
+            c = char(std::tolower(static_cast<unsigned char>(c)));
+        if (ext != ".exr") throw UsageError("checkpoint '" + checkpointPath + "' must end in .exr");
+    }
+    for (const std::string* path : {&output, &statsPath, &errorCsvPath, &checkpointPath})
         if (!path->empty()) spw::checkWritable(*path);
+    std::optional<spw::Checkpoint> resume;
+    if (!resumePath.empty()) {
+        try {
+            resume = spw::readCheckpoint(resumePath);
+        } catch (const std::exception& e) {
+            throw UsageError(std::string("--resume: ") + e.what());
+        }
+    }
 
     spw::Scene scene = spw::loadScene(scenePath);
     for (const spw::Mesh& m : scene.meshes)
@@ -274,12 +306,23 @@ int renderCommand(const std::vector<std::string>& args) {
     const int sppPerIteration = plan.sampleBase * plan.sampleBase;
     spw::InterruptGuard interrupt;
     config.stop = interrupt.flag();
+    if (resume) {
+        const std::string why = spw::checkpointMismatch(
+            spw::checkpointKey(scene, config, plan.sampleBase), resume->key);
+        if (!why.empty())
+            throw UsageError("--resume " + resumePath +
+                             ": the checkpoint is of another render: " + why);
+    }
+    spw::CheckpointOptions checkpoints{checkpointPath, checkpointInterval,
+                                       resume ? &*resume : nullptr};
     auto result = spw::renderWithProgress(
-        scene, config, [&](const spw::IterationInfo& info, const spw::Film& film) {
+        scene, config,
+        [&](const spw::IterationInfo& info, const spw::Film& film) {
             if (errorCsv) errorCsv->addRow(info.done, info.spp, info.renderSeconds, film);
             progress.update(info.done, info.total, info.spp, info.total * sppPerIteration,
                             film.halfBufferRelMseEstimate());
-        });
+        },
+        checkpoints);
     progress.finish();
     const int signal = interrupt.signal();
     if (signal != 0 && result->stats.iterations == 0) {

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 
 namespace spw {
 namespace {
@@ -135,6 +136,19 @@ void Film::endIteration() {
         for (int c = 0; c < 3; ++c)
             lastIteration_[i * 3 + c] = it[3] > 0 ? float(it[c] / it[3]) : 0.0f;
     }
+    beginIteration();
+}
+
+Film::State Film::state() const {
+    return {sum_, nonFinite_.load(), saturated_.load()};
+}
+
+void Film::restore(const State& state) {
+    if (state.sums.size() != sum_.size())
+        throw std::invalid_argument("a film state of another size");
+    sum_ = state.sums;
+    nonFinite_ = state.nonFinite;
+    saturated_ = state.saturated;
     beginIteration();
 }
 

@@ -73,6 +73,15 @@ class Film {
     // The last completed iteration alone (for per-iteration statistics).
     std::vector<float> lastIterationImage() const { return lastIteration_; }
 
+    // The film's whole state between iterations, exactly: what a checkpoint keeps.
+    struct State {
+        std::vector<double> sums; // 8 per pixel: (r, g, b, weight) x 2 halves
+        std::uint64_t nonFinite = 0, saturated = 0;
+    };
+    State state() const;
+    // Restores a state() of a film of this size (throws std::invalid_argument otherwise).
+    void restore(const State& state);
+
     std::uint64_t nonFiniteSamples() const { return nonFinite_.load(); }
     std::uint64_t saturatedSamples() const { return saturated_.load(); }
     double fixedPointScale() const { return scale_; }

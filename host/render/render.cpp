@@ -68,7 +68,8 @@ std::unique_ptr<RenderResult> render(const Scene& scene, const RenderConfig& con
 }
 
 std::unique_ptr<RenderResult> renderWithProgress(const Scene& scene, const RenderConfig& config,
-                                                 const ProgressCallback& onIteration) {
+                                                 const ProgressCallback& onIteration,
+                                                 const CheckpointOptions& checkpoints) {
     if (config.pipeline.rayFormat == RayFormat::Compact &&
         scene.settings.maxDepth > int(kMaxCompactBounce))
         throw std::invalid_argument("max depth " + std::to_string(scene.settings.maxDepth) +
@@ -157,6 +158,23 @@ std::unique_ptr<RenderResult> renderWithProgress(const Scene& scene, const Rende
         backend = std::make_unique<SortedRenderer>(ctx, config.pipeline, makeCpuShading(ctx));
     double renderSeconds = 0;
     int done = 0;
+    std::optional<CheckpointKey> key;
+    if (!checkpoints.path.empty() || checkpoints.resume)
+        key = checkpointKey(scene, config, plan.sampleBase);
+    if (const Checkpoint* c = checkpoints.resume) {
+        if (const std::string why = checkpointMismatch(*key, c->key); !why.empty())
+            throw std::invalid_argument("the checkpoint is of another render: " + why);
+        result->film->restore(c->film);
+        done = c->iterations;
+        renderSeconds = c->renderSeconds;
+        stats.extra["resumed_iterations"] = done;
+    }
+    auto checkpoint = [&] {
+        StageTimer t(stats.stages, "checkpoint");
+        writeCheckpoint(checkpoints.path, {*key, done, renderSeconds, result->film->state()},
+                        result->film->image());
+    };
+    double lastCheckpoint = renderSeconds;
     const char* stopReason = "spp";
     while (done < plan.iterations) {
         if (stopRequested(config)) {
@@ -183,6 +201,12 @@ std::unique_ptr<RenderResult> renderWithProgress(const Scene& scene, const Rende
         const int sppDone = done * plan.sampleBase * plan.sampleBase;
         if (onIteration)
             onIteration({done, plan.iterations, sppDone, renderSeconds}, *result->film);
+        if (!checkpoints.path.empty() && checkpoints.intervalSeconds > 0 &&
+            renderSeconds - lastCheckpoint >= checkpoints.intervalSeconds &&
+            done < plan.iterations) {
+            checkpoint();
+            lastCheckpoint = renderSeconds;
+        }
         if (done == plan.iterations) break;
         if (config.timeLimitSeconds && renderSeconds >= *config.timeLimitSeconds) {
             stopReason = "time limit";
@@ -197,6 +221,7 @@ std::unique_ptr<RenderResult> renderWithProgress(const Scene& scene, const Rende
         }
     }
     stats.extra["stop_reason"] = stopReason;
+    if (!checkpoints.path.empty() && done > 0) checkpoint();
     stats.iterations = done;
     stats.spp = done * plan.sampleBase * plan.sampleBase;
     stats.extra["render_seconds"] = renderSeconds;

@@ -5,6 +5,7 @@
 #include "host/backend/render_config.h"
 #include "host/backend/stats.h"
 #include "host/image/film.h"
+#include "host/render/checkpoint.h"
 #include "host/scene/scene.h"
 
 #include <functional>
@@ -34,12 +35,22 @@ struct SamplingPlan {
 };
 SamplingPlan planSampling(const ImageSettings& image, std::optional<int> spp);
 
+// Checkpointing a render (host/render/checkpoint.h): where, how often, and where to start.
+struct CheckpointOptions {
+    std::string path;                   // empty: no checkpoint
+    double intervalSeconds = 0;         // also every this many render seconds (0: only at the end)
+    const Checkpoint* resume = nullptr; // continue from it (its key already checked)
+};
+
 // Throws std::invalid_argument for a bad configuration (unknown backend) and
 // std::runtime_error for a failure while rendering.
 std::unique_ptr<RenderResult> render(const Scene& scene, const RenderConfig& config,
                                      const IterationCallback& onIteration = {});
 // The same, reporting render time too; stops early at config.timeLimitSeconds.
+// With `checkpoints`, resumes and writes checkpoints: every interval, and at the end however the
+// render stopped (its completed iterations).
 std::unique_ptr<RenderResult> renderWithProgress(const Scene& scene, const RenderConfig& config,
-                                                 const ProgressCallback& onIteration);
+                                                 const ProgressCallback& onIteration,
+                                                 const CheckpointOptions& checkpoints = {});
 
 } // namespace spw

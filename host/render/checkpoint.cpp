@@ -1,0 +1,226 @@
+#include "host/render/checkpoint.h"
+
+#include "host/image/output_file.h"
+
+#include <OpenImageIO/filesystem.h>
+#include <OpenImageIO/imageio.h>
+
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <sstream>
+#include <stdexcept>
+
+namespace spw {
+namespace {
+
+constexpr int kSumsPerPixel = 8;
+constexpr int kChannels = 3 + 2 * kSumsPerPixel;
+
+struct Fnv {
+    std::uint64_t h = 0xcbf29ce484222325ull;
+    void bytes(const void* data, size_t n) {
+        const auto* p = static_cast<const unsigned char*>(data);
+        size_t i = 0;
+        for (; i + 8 <= n; i += 8) { // a word at a time: meshes are large
+            std::uint64_t w;
+            std::memcpy(&w, p + i, 8);
+            h = (h ^ w) * 0x100000001b3ull;
+        }
+        for (; i < n; ++i)
+            h = (h ^ p[i]) * 0x100000001b3ull;
+    }
+    void text(const std::string& s) {
+        const std::uint64_t n = s.size();
+        bytes(&n, sizeof n);
+        bytes(s.data(), s.size());
+    }
+    template <class T> void array(const std::vector<T>& v) {
+        const std::uint64_t n = v.size();
+        bytes(&n, sizeof n);
+        bytes(v.data(), v.size() * sizeof(T));
+    }
+};
+
+std::string fileText(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+const char* filterName(TextureFilter f) {
+    return f == TextureFilter::Cone ? "cone" : "finest";
+}
+
+[[noreturn]] void notACheckpoint(const std::string& path, const std::string& why) {
+    throw std::runtime_error("'" + path + "' is not a Spillway checkpoint: " + why);
+}
+
+} // namespace
+
+std::uint64_t sceneHash(const Scene& scene) {
+    Fnv f;
+    f.text(fileText(scene.file));
+    for (const Mesh& m : scene.meshes) {
+        f.array(m.positions);
+        f.array(m.normals);
+        f.array(m.uvs);
+        f.array(m.triangles);
+    }
+    for (const Texture& t : scene.textures) {
+        if (t.type != TextureType::Standard) continue;
+        f.text(t.path);
+        std::error_code ec;
+        const std::uint64_t size = std::filesystem::file_size(t.path, ec);
+        const auto time = std::filesystem::last_write_time(t.path, ec).time_since_epoch().count();
+        f.bytes(&size, sizeof size);
+        f.bytes(&time, sizeof time);
+    }
+    return f.h;
+}
+
+CheckpointKey checkpointKey(const Scene& scene, const RenderConfig& config, int sampleBase) {
+    CheckpointKey k;
+    k.version = SPILLWAY_VERSION;
+    k.sceneHash = sceneHash(scene);
+    k.seed = config.seed.value_or(scene.settings.seed);
+    k.width = scene.image.width;
+    k.height = scene.image.height;
+    k.sampleBase = sampleBase;
+    // Only the sorted backends round rays; the reference traces full ones.
+    k.rayFormat = config.backend == BackendKind::Reference
+                      ? "full"
+                      : rayFormatName(config.pipeline.rayFormat);
+    k.textureFilter = filterName(config.textureFilter);
+    k.strategy = config.strategy;
+    return k;
+}
+
+std::string checkpointMismatch(const CheckpointKey& e, const CheckpointKey& f) {
+    std::ostringstream why;
+    auto differs = [&](const char* what, const auto& want, const auto& got) {
+        if (!(want == got))
+            why << (why.tellp() > 0 ? "; " : "") << what << " " << got << " where this render has "
+                << want;
+    };
+    differs("Spillway version", e.version, f.version);
+    if (e.sceneHash != f.sceneHash)
+        why << (why.tellp() > 0 ? "; " : "")
+            << "another scene (its file, meshes or textures differ)";
+    differs("seed", e.seed, f.seed);
+    differs("width", e.width, f.width);
+    differs("height", e.height, f.height);
+    differs("sample base", e.sampleBase, f.sampleBase);
+    differs("ray format", e.rayFormat, f.rayFormat);
+    differs("texture filter", e.textureFilter, f.textureFilter);
+    differs("sampling strategy", e.strategy, f.strategy);
+    return why.str();
+}
+
+void writeCheckpoint(const std::string& path, const Checkpoint& c,
+                     const std::vector<float>& image) {
+    const size_t pixels = size_t(c.key.width) * size_t(c.key.height);
+    if (image.size() != pixels * 3 || c.film.sums.size() != pixels * kSumsPerPixel)
+        throw std::invalid_argument("checkpoint: image and film sizes differ from the key's");
+    OIIO::ImageSpec spec(c.key.width, c.key.height, kChannels, OIIO::TypeDesc::FLOAT);
+    std::vector<OIIO::TypeDesc> formats(3, OIIO::TypeDesc::FLOAT);
+    std::vector<std::string> names = {"R", "G", "B"};
+    for (int k = 0; k < kSumsPerPixel; ++k)
+        for (const char* half : {"hi", "lo"}) {
+            names.push_back("state." + std::to_string(k) + "." + half);
+            formats.push_back(OIIO::TypeDesc::UINT);
+        }
+    spec.channelnames = names;
+    spec.channelformats = formats;
+    spec.attribute("oiio:ColorSpace", "Linear");
+    spec.attribute("Software", "Spillway");
+    // Uncompressed: a checkpoint interrupts the render while it is written. Measured at
+    // 1920x1080: none 0.73 s and 158 MB, rle 0.89 s and 118 MB, zip 2.1 s and 96 MB (the
+    // doubles' low words do not compress).
+    spec.attribute("compression", "none");
+    spec.attribute("spillway:checkpoint", 1);
+    spec.attribute("spillway:version", c.key.version);
+    spec.attribute("spillway:scene_hash", std::to_string(c.key.sceneHash));
+    spec.attribute("spillway:seed", std::to_string(c.key.seed));
+    spec.attribute("spillway:sample_base", c.key.sampleBase);
+    spec.attribute("spillway:ray_format", c.key.rayFormat);
+    spec.attribute("spillway:texture_filter", c.key.textureFilter);
+    spec.attribute("spillway:strategy", int(c.key.strategy));
+    spec.attribute("spillway:iterations", c.iterations);
+    spec.attribute("spillway:render_seconds", std::to_string(c.renderSeconds));
+    spec.attribute("spillway:non_finite_samples", std::to_string(c.film.nonFinite));
+    spec.attribute("spillway:saturated_samples", std::to_string(c.film.saturated));
+
+    // Pixels as the channels lie: 3 floats, then 16 uint32, each 4 bytes.
+    std::vector<std::uint32_t> data(pixels * kChannels);
+    for (size_t i = 0; i < pixels; ++i) {
+        std::uint32_t* px = &data[i * kChannels];
+        std::memcpy(px, &image[i * 3], 3 * sizeof(float));
+        for (int k = 0; k < kSumsPerPixel; ++k) {
+            std::uint64_t bits;
+            std::memcpy(&bits, &c.film.sums[i * kSumsPerPixel + size_t(k)], 8);
+            px[3 + 2 * k] = std::uint32_t(bits >> 32);
+            px[4 + 2 * k] = std::uint32_t(bits);
+        }
+    }
+    std::vector<unsigned char> bytes;
+    OIIO::Filesystem::IOVecOutput proxy(bytes);
+    auto out = OIIO::ImageOutput::create("checkpoint.exr", &proxy);
+    if (!out) throw std::runtime_error("cannot write '" + path + "': " + OIIO::geterror());
+    bool ok = out->open(path, spec) && out->write_image(OIIO::TypeDesc::UNKNOWN, data.data());
+    std::string err = ok ? "" : out->geterror();
+    if (!out->close() && ok) err = out->geterror(), ok = false;
+    if (!ok) throw std::runtime_error("cannot write '" + path + "': " + err);
+    writeFileAtomically(path, bytes.data(), bytes.size());
+}
+
+Checkpoint readCheckpoint(const std::string& path) {
+    auto in = OIIO::ImageInput::open(path);
+    if (!in) throw std::runtime_error("cannot read checkpoint '" + path + "': " + OIIO::geterror());
+    const OIIO::ImageSpec& spec = in->spec();
+    if (spec.get_int_attribute("spillway:checkpoint") != 1)
+        notACheckpoint(path, "no spillway:checkpoint attribute");
+    if (spec.nchannels != kChannels || spec.width <= 0 || spec.height <= 0)
+        notACheckpoint(path, "not " + std::to_string(kChannels) + " channels");
+    for (int k = 0; k < kSumsPerPixel; ++k)
+        for (int h = 0; h < 2; ++h) {
+            const int c = 3 + 2 * k + h;
+            const std::string name = "state." + std::to_string(k) + (h == 0 ? ".hi" : ".lo");
+            if (spec.channelnames[size_t(c)] != name ||
+                spec.channelformat(c) != OIIO::TypeDesc::UINT)
+                notACheckpoint(path, "channel " + std::to_string(c) + " is not " + name);
+        }
+    Checkpoint c;
+    c.key.version = spec.get_string_attribute("spillway:version");
+    try {
+        c.key.sceneHash = std::stoull(spec.get_string_attribute("spillway:scene_hash"));
+        c.key.seed = std::uint32_t(std::stoul(spec.get_string_attribute("spillway:seed")));
+        c.renderSeconds = std::stod(spec.get_string_attribute("spillway:render_seconds"));
+        c.film.nonFinite = std::stoull(spec.get_string_attribute("spillway:non_finite_samples"));
+        c.film.saturated = std::stoull(spec.get_string_attribute("spillway:saturated_samples"));
+    } catch (const std::exception&) {
+        notACheckpoint(path, "its spillway:* metadata is incomplete");
+    }
+    c.key.width = spec.width;
+    c.key.height = spec.height;
+    c.key.sampleBase = spec.get_int_attribute("spillway:sample_base");
+    c.key.rayFormat = spec.get_string_attribute("spillway:ray_format");
+    c.key.textureFilter = spec.get_string_attribute("spillway:texture_filter");
+    c.key.strategy = std::uint32_t(spec.get_int_attribute("spillway:strategy"));
+    c.iterations = spec.get_int_attribute("spillway:iterations", -1);
+    if (c.iterations < 0 || c.key.sampleBase <= 0)
+        notACheckpoint(path, "its spillway:* metadata is incomplete");
+
+    const size_t pixels = size_t(spec.width) * size_t(spec.height);
+    std::vector<std::uint32_t> words(pixels * 2 * kSumsPerPixel);
+    if (!in->read_image(0, 0, 3, kChannels, OIIO::TypeDesc::UINT, words.data()))
+        throw std::runtime_error("cannot read checkpoint '" + path + "': " + in->geterror());
+    c.film.sums.resize(pixels * kSumsPerPixel);
+    for (size_t i = 0; i < pixels * kSumsPerPixel; ++i) {
+        const std::uint64_t bits = std::uint64_t(words[2 * i]) << 32 | words[2 * i + 1];
+        std::memcpy(&c.film.sums[i], &bits, 8);
+    }
+    return c;
+}
+
+} // namespace spw

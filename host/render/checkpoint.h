@@ -1,0 +1,59 @@
+// Checkpoints: a render's exact state between iterations, so that a stopped render can resume
+// and finish with the image, bit for bit, that it would have made uninterrupted.
+//
+// The checkpoint is one OpenEXR file that any image viewer opens: its R, G, B channels are the
+// image so far (float), and 16 more channels, state.0.hi .. state.7.lo (uint32), hold the film's
+// eight double-precision sums per pixel bit for bit (a double split into its high and low 32
+// bits: EXR has no 64-bit channel type, and float channels would round the sums). Metadata
+// (spillway:*) holds the rest: iterations done, render seconds, the film's counters, and what
+// must match for a resume (the key below). One file rather than an image and a state file beside
+// it: nothing can pair an image with another render's state, and one rename writes it atomically.
+#pragma once
+
+#include "host/backend/render_config.h"
+#include "host/image/film.h"
+#include "host/scene/scene.h"
+
+#include <cstdint>
+#include <string>
+
+namespace spw {
+
+// What decides the image besides the number of iterations: a checkpoint resumes only where all
+// of it matches. The backend, threads, batch sizes, budgets and sort settings are not in it:
+// they change how fast, not what (compact rays aside, which is why the ray format is).
+struct CheckpointKey {
+    std::string version;         // Spillway's
+    std::uint64_t sceneHash = 0; // sceneHash()
+    std::uint32_t seed = 0;
+    int width = 0, height = 0;
+    int sampleBase = 0;         // samples per pixel and iteration = sampleBase^2
+    std::string rayFormat;      // compact | full
+    std::string textureFilter;  // cone | finest
+    std::uint32_t strategy = 0; // light / BSDF sampling
+};
+
+struct Checkpoint {
+    CheckpointKey key;
+    int iterations = 0;       // completed
+    double renderSeconds = 0; // spent in them
+    Film::State film;
+};
+
+// The scene as rendered: its file's text, every mesh's vertices and triangles, and every image
+// texture's path, size and modification time (textures can be gigabytes; a changed file changes
+// those). FNV-1a over 64-bit words.
+std::uint64_t sceneHash(const Scene& scene);
+
+// The key of a render of `scene` with `config` (sampleBase from the sampling plan).
+CheckpointKey checkpointKey(const Scene& scene, const RenderConfig& config, int sampleBase);
+
+// Written whole or not at all (output_file.h). Throws std::runtime_error naming the path.
+void writeCheckpoint(const std::string& path, const Checkpoint& checkpoint,
+                     const std::vector<float>& image);
+// Throws std::runtime_error naming the path when it is not a Spillway checkpoint.
+Checkpoint readCheckpoint(const std::string& path);
+// "" when `found` may resume a render whose key is `expected`; else what differs, for the user.
+std::string checkpointMismatch(const CheckpointKey& expected, const CheckpointKey& found);
+
+} // namespace spw

@@ -1,0 +1,157 @@
+// Checkpoint and resume: a render stopped at any point (a signal, a kill between checkpoints,
+// a spill in flight) and resumed ends with the uninterrupted render's image bit for bit, on
+// every backend; a checkpoint of another render is refused with exit 2.
+#include "host/image/image_io.h"
+#include "host/render/checkpoint.h"
+#include "test_util.h"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <chrono>
+#include <csignal>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <thread>
+#include <unistd.h>
+
+namespace spw::test {
+namespace {
+
+std::string smallBox(const TempDir& dir, const std::string& name = "box.yaml",
+                     const std::string& colour = "[17, 12, 4]") {
+    std::string text = readFile(sourceDir() + "/scenes/cornell-box.yaml");
+    text = replaceAll(text, "{width: 256, height: 256, sample base: 2, iterations: 16}",
+                      "{width: 40, height: 40, sample base: 1, iterations: 16}");
+    text = replaceAll(text, "filename: cornell-box/",
+                      "filename: " + sourceDir() + "/scenes/cornell-box/");
+    text = replaceAll(text, "colour: [17, 12, 4]", "colour: " + colour);
+    return dir.write(name, text);
+}
+
+bool waitForLog(const std::string& text) {
+    const std::string log = (std::filesystem::temp_directory_path() /
+                             ("spillway-child-" + std::to_string(getpid()) + ".log"))
+                                .string();
+    for (int i = 0; i < 2400; ++i) {
+        if (readFile(log).find(text) != std::string::npos) return true;
+        std::this_thread::sleep_for(std::chrono::milliseconds(25));
+    }
+    return false;
+}
+
+bool sameImage(const std::string& a, const std::string& b) {
+    const ImageRGB x = readImage(a), y = readImage(b);
+    return x.width == y.width && x.height == y.height && x.rgb.size() == y.rgb.size() &&
+           std::memcmp(x.rgb.data(), y.rgb.data(), x.rgb.size() * sizeof(float)) == 0;
+}
+
+const std::vector<std::string> kSpilling = {"--memory-budget", "0.05", "--bin-exponent", "8"};
+
+std::vector<std::string> renderArgs(const std::string& scene, const std::string& backend,
+                                    std::vector<std::string> extra) {
+    std::vector<std::string> args = {"render", scene, "--backend", backend, "--spp", "24"};
+    args.insert(args.end(), kSpilling.begin(), kSpilling.end());
+    args.insert(args.end(), extra.begin(), extra.end());
+    return args;
+}
+
+// Stopped by SIGINT (the checkpoint written at the stop) and by SIGKILL (only the last
+// interval's checkpoint survives), both while batches are on disk, then resumed: the resumed
+// image is the uninterrupted one, bit for bit. The checkpoint itself is an EXR whose RGB is the
+// image so far.
+TEST(Checkpoint, StoppedAnywhereAndResumedGivesTheUninterruptedImageOnEveryBackend) {
+    TempDir dir, spill;
+    const std::string scene = smallBox(dir);
+    for (const std::string& backend : backendsUnderTest()) {
+        const std::string full = dir.file(backend + "-full.exr");
+        ChildResult f = runChild(renderArgs(scene, backend, {"--quiet", "-o", full}));
+        ASSERT_EQ(f.status, 0) << f.output;
+
+        for (int signal : {SIGINT, SIGKILL}) {
+            const std::string tag = backend + "-" + std::to_string(signal);
+            const std::string ck = dir.file(tag + "-ck.exr"), part = dir.file(tag + "-part.exr");
+            ChildResult p = runChild(
+                renderArgs(scene, backend,
+                           {"--progress", "lines", "--spill-dir", spill.path(), "--checkpoint", ck,
+                            "--checkpoint-interval", "0.001", "-o", part}),
+                [&](pid_t pid) {
+                    waitForLog("iteration 5/");
+                    kill(pid, signal);
+                });
+            EXPECT_EQ(p.status, signal == SIGKILL ? -SIGKILL : 130) << tag << "\n" << p.output;
+            EXPECT_EQ(filesIn(spill.path()), 0u) << tag;
+            ASSERT_TRUE(std::filesystem::exists(ck)) << tag << "\n" << p.output;
+            const Checkpoint c = readCheckpoint(ck);
+            EXPECT_GE(c.iterations, signal == SIGKILL ? 4 : 5) << tag;
+            EXPECT_LT(c.iterations, 24) << tag;
+            if (signal == SIGINT) {
+                EXPECT_TRUE(sameImage(ck, part)) << tag;
+            }
+
+            const std::string resumed = dir.file(tag + "-resumed.exr");
+            ChildResult r = runChild(renderArgs(
+                scene, backend,
+                {"--quiet", "--resume", ck, "-o", resumed, "--stats", dir.file(tag + ".json")}));
+            ASSERT_EQ(r.status, 0) << tag << "\n" << r.output;
+            const nlohmann::json s = nlohmann::json::parse(std::ifstream(dir.file(tag + ".json")));
+            EXPECT_EQ(s["resumed_iterations"], c.iterations) << tag;
+            EXPECT_EQ(s["spp"], 24) << tag;
+            EXPECT_TRUE(sameImage(resumed, full)) << tag << ": resumed at " << c.iterations;
+            // The resume wrote its own checkpoint back to the file: now complete.
+            EXPECT_EQ(readCheckpoint(ck).iterations, 24) << tag;
+        }
+    }
+}
+
+// A checkpoint of another render is refused before any work: exit 2, the reason named, nothing
+// written. Backends may differ (they trace the same paths).
+TEST(Checkpoint, ACheckpointOfAnotherRenderIsRefused) {
+    TempDir dir;
+    const std::string scene = smallBox(dir);
+    const std::string ck = dir.file("ck.exr");
+    ChildResult a = runChild({"render", scene, "--backend", "cpu", "--quiet", "--spp", "4",
+                              "--ray-format", "full", "--checkpoint", ck, "-o", dir.file("a.exr")});
+    ASSERT_EQ(a.status, 0) << a.output;
+
+    // The reference backend may continue a full-ray cpu checkpoint: the same paths.
+    ChildResult ok =
+        runChild({"render", scene, "--backend", "reference", "--quiet", "--spp", "8", "--resume",
+                  ck, "--checkpoint", dir.file("ok.exr"), "-o", dir.file("ok-image.exr")});
+    EXPECT_EQ(ok.status, 0) << ok.output;
+
+    // Another scene: the same file name, another light colour.
+    TempDir other;
+    const std::string changed = smallBox(other, "box.yaml", "[17, 12, 5]");
+    const Checkpoint c = readCheckpoint(ck);
+    Checkpoint newer = c;
+    newer.key.version = "99.0.0";
+    writeCheckpoint(dir.file("newer.exr"), newer, readImage(ck).rgb);
+    struct Case {
+        std::vector<std::string> args;
+        const char* says;
+    };
+    const std::vector<Case> cases = {
+        {{"render", scene, "--seed", "9", "--resume", ck}, "seed 0 where this render has 9"},
+        {{"render", changed, "--resume", ck}, "another scene"},
+        {{"render", scene, "--ray-format", "compact", "--resume", ck}, "ray format"},
+        {{"render", scene, "--texture-filter", "finest", "--resume", ck}, "texture filter"},
+        {{"render", scene, "--resume", dir.file("newer.exr")}, "Spillway version 99.0.0"},
+        {{"render", scene, "--resume", dir.file("a.exr")}, "not a Spillway checkpoint"},
+        {{"render", scene, "--resume", dir.file("missing.exr")}, "missing.exr"},
+        {{"render", scene, "--checkpoint", dir.file("x.png")}, "must end in .exr"},
+    };
+    for (const Case& k : cases) {
+        std::vector<std::string> args = k.args;
+        args.insert(args.end(), {"--backend", "cpu", "--quiet", "-o", dir.file("never.exr")});
+        ChildResult r = runChild(args);
+        EXPECT_EQ(r.status, 2) << k.says << "\n" << r.output;
+        EXPECT_NE(r.output.find(k.says), std::string::npos) << k.says << "\n" << r.output;
+        EXPECT_FALSE(std::filesystem::exists(dir.file("never.exr"))) << k.says;
+    }
+    EXPECT_EQ(readCheckpoint(ck).iterations, c.iterations) << "a refused resume wrote to it";
+}
+
+} // namespace
+} // namespace spw::test
