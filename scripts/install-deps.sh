@@ -12,7 +12,8 @@ packages=(
   libglm-dev                               # vector math shared by C++ and GLSL
   nlohmann-json3-dev                       # --stats JSON and reading it back in tests
   libtinyobjloader-dev                     # OBJ meshes
-  libglfw3-dev                             # window for interactive preview (later)
+  libglfw3-dev libgl-dev libx11-dev        # the --preview window (GLFW, OpenGL, X11)
+  xvfb x11-apps x11-utils                  # its test: a virtual display, xwd, xwininfo
   libgtest-dev                             # the test suite
   libvulkan-dev mesa-vulkan-drivers vulkan-validationlayers glslc glslang-tools
   python3 python3-numpy python3-matplotlib # convergence plots

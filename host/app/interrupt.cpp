@@ -40,6 +40,11 @@ const std::atomic<int>* InterruptGuard::flag() const {
     return &gSignal;
 }
 
+void InterruptGuard::requestStop(int code) {
+    int none = 0;
+    gSignal.compare_exchange_strong(none, code);
+}
+
 int InterruptGuard::signal() const {
     return gSignal.load();
 }

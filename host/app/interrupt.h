@@ -20,6 +20,9 @@ class InterruptGuard {
     // The flag: the number of the first signal received, 0 until then.
     const std::atomic<int>* flag() const;
     int signal() const;
+    // Stops the render as a first signal would, with `code` (kStopByWindow) as the flag's
+    // value; no-op once something else stopped it.
+    void requestStop(int code);
 };
 
 } // namespace spw

@@ -3,6 +3,7 @@
 #include "host/app/compare_command.h"
 #include "host/app/error_csv.h"
 #include "host/app/interrupt.h"
+#include "host/app/preview.h"
 #include "host/app/progress.h"
 #include "host/app/usage_error.h"
 #include "host/image/image_io.h"
@@ -16,9 +17,11 @@
 #include <csignal>
 #include <cstdio>
 #include <cstring>
+#include <exception>
 #include <filesystem>
 #include <iostream>
 #include <string>
+#include <thread>
 #include <unistd.h>
 #include <vector>
 
@@ -66,6 +69,9 @@ render options:
                         checkpoints go back to FILE unless --checkpoint names another
   --target-error E      stop after the first iteration whose relMSE, estimated from two half
                         buffers (the --error-csv estimate), is at or below E
+  --preview             a window showing the image as iterations complete (+/- exposure, 0
+                        reset; closing it, Esc or q stop the render as Ctrl-C does, but exit
+                        0); without a display: exit 2 before rendering
   --progress MODE       auto (default: a bar on a terminal, nothing otherwise), bar, lines (a
                         line per iteration, for logs) or none; --quiet is none
   --texture-cache MiB   the texture system's tile cache (settings: texture cache; default
@@ -167,7 +173,7 @@ int renderCommand(const std::vector<std::string>& args) {
     std::string scenePath, output, statsPath, errorCsvPath, referencePath, checkpointPath,
         resumePath;
     double checkpointInterval = 0;
-    bool quiet = false;
+    bool quiet = false, previewOn = false;
     std::string progressMode = "auto";
     spw::RenderConfig config;
     config.backend = spw::BackendKind::Auto;
@@ -197,6 +203,8 @@ int renderCommand(const std::vector<std::string>& args) {
             config.seed = std::uint32_t(parseInteger(a, value(), 0, 0xFFFFFFFFLL));
         else if (a == "--stats")
             statsPath = value();
+        else if (a == "--preview")
+            previewOn = true;
         else if (a == "--checkpoint")
             checkpointPath = value();
         else if (a == "--checkpoint-interval")
@@ -315,22 +323,56 @@ int renderCommand(const std::vector<std::string>& args) {
     }
     spw::CheckpointOptions checkpoints{checkpointPath, checkpointInterval,
                                        resume ? &*resume : nullptr};
-    auto result = spw::renderWithProgress(
-        scene, config,
-        [&](const spw::IterationInfo& info, const spw::Film& film) {
-            if (errorCsv) errorCsv->addRow(info.done, info.spp, info.renderSeconds, film);
-            progress.update(info.done, info.total, info.spp, info.total * sppPerIteration,
-                            film.halfBufferRelMseEstimate());
-        },
-        checkpoints);
+    std::unique_ptr<spw::PreviewWindow> preview;
+    if (previewOn) {
+        try {
+            preview = std::make_unique<spw::PreviewWindow>(
+                scene.image.width, scene.image.height,
+                "Spillway: " + std::filesystem::path(scenePath).filename().string());
+        } catch (const std::runtime_error& e) {
+            throw UsageError(e.what()); // no display: said before any work, exit 2
+        }
+    }
+    auto onIteration = [&](const spw::IterationInfo& info, const spw::Film& film) {
+        const std::optional<double> relMse = film.halfBufferRelMseEstimate();
+        if (errorCsv) errorCsv->addRow(info.done, info.spp, info.renderSeconds, film);
+        progress.update(info.done, info.total, info.spp, info.total * sppPerIteration, relMse);
+        if (preview) {
+            char status[96];
+            std::snprintf(status, sizeof status, "%d/%d spp, %.1f s, relMSE %s", info.spp,
+                          info.total * sppPerIteration, info.renderSeconds,
+                          relMse ? std::to_string(*relMse).c_str() : "-");
+            preview->publish(film.image(), status);
+        }
+    };
+    std::unique_ptr<spw::RenderResult> result;
+    if (!preview) {
+        result = spw::renderWithProgress(scene, config, onIteration, checkpoints);
+    } else {
+        // The window on this thread (GLFW's rule), the render on its own.
+        std::exception_ptr failure;
+        std::atomic<bool> finished{false};
+        std::thread worker([&] {
+            try {
+                result = spw::renderWithProgress(scene, config, onIteration, checkpoints);
+            } catch (...) {
+                failure = std::current_exception();
+            }
+            finished = true;
+            preview->wake();
+        });
+        while (!finished)
+            if (!preview->pump(0.1)) interrupt.requestStop(spw::kStopByWindow);
+        worker.join();
+        preview.reset();
+        if (failure) std::rethrow_exception(failure);
+    }
     progress.finish();
-    const int signal = interrupt.signal();
-    if (signal != 0 && result->stats.iterations == 0) {
-        std::fprintf(stderr,
-                     "spillway: stopped by signal %d before an iteration completed; "
-                     "nothing written\n",
-                     signal);
-        return 128 + signal;
+    // Closing the preview window is a normal way to end a render: exit 0.
+    const int signal = std::max(0, interrupt.signal());
+    if (interrupt.signal() != 0 && result->stats.iterations == 0) {
+        std::fprintf(stderr, "spillway: stopped before an iteration completed; nothing written\n");
+        return signal != 0 ? 128 + signal : 0;
     }
     if (signal != 0)
         std::fprintf(stderr, "spillway: stopped by signal %d after %d spp; writing them\n", signal,

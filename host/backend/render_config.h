@@ -82,6 +82,8 @@ struct VulkanConfig {
     std::uint64_t maxBindingBytes = 0; // tests: cap on a bound buffer range (0: the device's)
 };
 
+constexpr int kStopByWindow = -1; // RenderConfig::stop's value when the preview window closed
+
 struct RenderConfig {
     // The library's default stays cpu so that callers that do not ask for a device never
     // initialise Vulkan; the CLI's default is auto.
@@ -98,6 +100,7 @@ struct RenderConfig {
     std::optional<double> targetError;
     // Nonzero: stop at the next batch (or tile) boundary and discard the iteration in progress;
     // the render keeps every completed iteration. Set from a signal handler (the CLI's).
+    // kStopByWindow when the preview window was closed, else the signal's number.
     const std::atomic<int>* stop = nullptr;
     std::optional<double> textureCacheMiB; // overrides settings: texture cache
     TextureFilter textureFilter = TextureFilter::Cone;

@@ -20,13 +20,13 @@ std::string extension(const std::string& path) {
     return e;
 }
 
+} // namespace
+
 std::uint8_t linearToSrgb8(float v) {
     if (!(v > 0.0f)) return 0; // also maps NaN to black
     float s = v <= 0.0031308f ? 12.92f * v : 1.055f * std::pow(v, 1.0f / 2.4f) - 0.055f;
     return std::uint8_t(std::lround(std::clamp(s, 0.0f, 1.0f) * 255.0f));
 }
-
-} // namespace
 
 bool isSupportedOutput(const std::string& path) {
     std::string e = extension(path);

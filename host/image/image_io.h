@@ -2,6 +2,7 @@
 #pragma once
 
 #include <cmath>
+#include <cstdint>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -17,6 +18,10 @@ struct ImageRGB {
 inline float srgbToLinear(float c) {
     return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f);
 }
+
+// A linear value as 8-bit sRGB, as PNG output and the preview window write it (NaN and
+// negatives black, above 1 white).
+std::uint8_t linearToSrgb8(float v);
 
 // True for the extensions writeImage understands (.exr, .png; any case).
 bool isSupportedOutput(const std::string& path);

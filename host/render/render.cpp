@@ -178,13 +178,13 @@ std::unique_ptr<RenderResult> renderWithProgress(const Scene& scene, const Rende
     const char* stopReason = "spp";
     while (done < plan.iterations) {
         if (stopRequested(config)) {
-            stopReason = "signal";
+            stopReason = *config.stop == kStopByWindow ? "window" : "signal";
             break;
         }
         const auto iterationStart = std::chrono::steady_clock::now();
         if (!backend->renderIteration(uint(done), *result->film)) {
             result->film->discardIteration(); // stopped part-way: keep only whole iterations
-            stopReason = "signal";
+            stopReason = *config.stop == kStopByWindow ? "window" : "signal";
             break;
         }
         {

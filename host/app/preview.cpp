@@ -1,0 +1,123 @@
+#include "host/app/preview.h"
+
+#include "host/image/image_io.h"
+
+#include <GLFW/glfw3.h>
+
+#include <cmath>
+#include <cstdio>
+#include <stdexcept>
+
+namespace spw {
+namespace {
+
+std::string lastGlfwError() {
+    const char* what = nullptr;
+    glfwGetError(&what);
+    return what ? what : "unknown";
+}
+
+void onKey(GLFWwindow* window, int key, int /*scancode*/, int action, int /*mods*/) {
+    if (action != GLFW_PRESS && action != GLFW_REPEAT) return;
+    auto* self = static_cast<int*>(glfwGetWindowUserPointer(window)); // &exposure_
+    switch (key) {
+    case GLFW_KEY_ESCAPE:
+    case GLFW_KEY_Q:
+        glfwSetWindowShouldClose(window, GLFW_TRUE);
+        break;
+    case GLFW_KEY_EQUAL:
+    case GLFW_KEY_KP_ADD:
+        ++*self;
+        break;
+    case GLFW_KEY_MINUS:
+    case GLFW_KEY_KP_SUBTRACT:
+        --*self;
+        break;
+    case GLFW_KEY_0:
+    case GLFW_KEY_KP_0:
+        *self = 0;
+        break;
+    default:
+        break;
+    }
+}
+
+} // namespace
+
+PreviewWindow::PreviewWindow(int width, int height, const std::string& title)
+    : width_(width), height_(height), name_(title) {
+    if (!glfwInit()) throw std::runtime_error("--preview: no display (" + lastGlfwError() + ")");
+    glfwWindowHint(GLFW_RESIZABLE, GLFW_FALSE);
+    window_ = glfwCreateWindow(width, height, title.c_str(), nullptr, nullptr);
+    if (!window_) {
+        const std::string why = lastGlfwError();
+        glfwTerminate();
+        throw std::runtime_error("--preview: cannot open a window (" + why + ")");
+    }
+    glfwSetWindowUserPointer(window_, &exposure_);
+    glfwSetKeyCallback(window_, onKey);
+    glfwMakeContextCurrent(window_);
+    glfwSwapInterval(0);
+    shown_.assign(size_t(width) * size_t(height) * 3, 0.0f);
+    draw();
+}
+
+PreviewWindow::~PreviewWindow() {
+    if (window_) glfwDestroyWindow(window_);
+    glfwTerminate();
+}
+
+void PreviewWindow::publish(std::vector<float> rgb, const std::string& status) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    pending_ = std::move(rgb);
+    status_ = status;
+    fresh_ = true;
+    glfwPostEmptyEvent(); // wakes pump()
+}
+
+void PreviewWindow::wake() {
+    glfwPostEmptyEvent();
+}
+
+bool PreviewWindow::pump(double seconds) {
+    const int exposure = exposure_;
+    glfwWaitEventsTimeout(seconds);
+    {
+        std::lock_guard<std::mutex> lock(mutex_);
+        if (fresh_) {
+            shown_.swap(pending_);
+            fresh_ = false;
+            dirty_ = true;
+        }
+    }
+    if (exposure != exposure_) dirty_ = true;
+    if (dirty_) {
+        char stops[32];
+        std::snprintf(stops, sizeof stops, ", exposure %+d", exposure_);
+        glfwSetWindowTitle(window_, (name_ + " - " + status_ + stops).c_str());
+    }
+    if (dirty_) draw();
+    return !glfwWindowShouldClose(window_);
+}
+
+void PreviewWindow::draw() {
+    const float scale = std::ldexp(1.0f, exposure_);
+    pixels_.resize(shown_.size());
+    for (size_t i = 0; i < shown_.size(); ++i)
+        pixels_[i] = linearToSrgb8(exposure_ == 0 ? shown_[i] : shown_[i] * scale);
+    int fbWidth = 0, fbHeight = 0;
+    glfwGetFramebufferSize(window_, &fbWidth, &fbHeight);
+    glViewport(0, 0, fbWidth, fbHeight);
+    glClearColor(0.0f, 0.0f, 0.0f, 1.0f);
+    glClear(GL_COLOR_BUFFER_BIT);
+    // Row 0 of the image is its top: start at the top-left corner and draw downwards.
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+    glRasterPos2f(-1.0f, 1.0f);
+    glPixelZoom(float(fbWidth) / float(width_), -float(fbHeight) / float(height_));
+    glDrawPixels(width_, height_, GL_RGB, GL_UNSIGNED_BYTE, pixels_.data());
+    glfwSwapBuffers(window_);
+    glFinish();
+    dirty_ = false;
+}
+
+} // namespace spw
