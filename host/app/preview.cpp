@@ -92,11 +92,13 @@ bool PreviewWindow::pump(double seconds) {
     }
     if (exposure != exposure_) dirty_ = true;
     if (dirty_) {
+        draw();
+        // The title after the pixels: X handles requests in order, so a title that shows an
+        // iteration means its image is already in the window.
         char stops[32];
         std::snprintf(stops, sizeof stops, ", exposure %+d", exposure_);
         glfwSetWindowTitle(window_, (name_ + " - " + status_ + stops).c_str());
     }
-    if (dirty_) draw();
     return !glfwWindowShouldClose(window_);
 }
 
