@@ -48,9 +48,11 @@ if [ "$mode" = all ] || [ "$mode" = --asan ]; then
   # suite already runs under the sanitizers, for ten times the samples, and would take 10 of the
   # sanitized run's 12 CPU-minutes (measured: 259, 251 and 123 s under ASan).
   slow='^Convergence\.|StiffEnclosure\.ReachesLeOverOneMinusAlbedo/0\.999'
+  # The Preview.* tests likewise: GLFW's glfwTerminate unloads Mesa's OpenGL driver, and what
+  # its globals held (240 bytes) is then reported from an "<unknown module>" in the same way.
   ASAN_OPTIONS="detect_leaks=1:$asan" ctest --test-dir "$root/build-asan" --output-on-failure \
-    --parallel "$(nproc)" --timeout 900 -E "^Vulkan|$slow"
+    --parallel "$(nproc)" --timeout 900 -E "^Vulkan|^Preview\.|$slow"
   ASAN_OPTIONS="detect_leaks=0:$asan" ctest --test-dir "$root/build-asan" --output-on-failure \
-    --parallel "$(nproc)" --timeout 900 -R '^Vulkan'
+    --parallel "$(nproc)" --timeout 900 -R '^Vulkan|^Preview\.'
 
 fi
