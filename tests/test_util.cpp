@@ -1,18 +1,22 @@
 #include "test_util.h"
 
+#include "host/image/image_io.h"
 #include "host/vk/context.h"
 
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <random>
 #include <sstream>
 #include <sys/resource.h>
 #include <sys/wait.h>
+#include <thread>
 #include <unistd.h>
 
 namespace spw::test {
@@ -251,10 +255,47 @@ std::string floorObj(float h) {
     return buf;
 }
 
+std::string childLogPath() {
+    return (std::filesystem::temp_directory_path() /
+            ("spillway-child-" + std::to_string(getpid()) + ".log"))
+        .string();
+}
+
+bool waitForChildOutput(pid_t pid, const std::string& text) {
+    for (int i = 0; i < 2400; ++i) {
+        if (readFile(childLogPath()).find(text) != std::string::npos) return true;
+        // Exited (a zombie not yet waited for): the text will not come.
+        const std::string stat = readFile("/proc/" + std::to_string(pid) + "/stat");
+        const size_t close = stat.rfind(')');
+        if (stat.empty() ||
+            (close != std::string::npos && close + 2 < stat.size() && stat[close + 2] == 'Z'))
+            return false;
+        std::this_thread::sleep_for(std::chrono::milliseconds(25));
+    }
+    return false;
+}
+
+std::string smallCornellBox(const TempDir& dir, int width, int height, const std::string& name,
+                            const std::string& light) {
+    std::string text = readFile(sourceDir() + "/scenes/cornell-box.yaml");
+    text = replaceAll(text, "{width: 256, height: 256, sample base: 2, iterations: 16}",
+                      "{width: " + std::to_string(width) + ", height: " + std::to_string(height) +
+                          ", sample base: 1, iterations: 16}");
+    text = replaceAll(text, "filename: cornell-box/",
+                      "filename: " + sourceDir() + "/scenes/cornell-box/");
+    text = replaceAll(text, "colour: [17, 12, 4]", "colour: " + light);
+    return dir.write(name, text);
+}
+
+bool samePixels(const std::string& a, const std::string& b) {
+    const ImageRGB x = readImage(a), y = readImage(b);
+    return x.width == y.width && x.height == y.height && x.rgb.size() == y.rgb.size() &&
+           std::memcmp(x.rgb.data(), y.rgb.data(), x.rgb.size() * sizeof(float)) == 0;
+}
+
 ChildResult runChild(const std::vector<std::string>& args,
                      const std::function<void(pid_t)>& whileRunning) {
-    std::string log = std::filesystem::temp_directory_path() /
-                      ("spillway-child-" + std::to_string(getpid()) + ".log");
+    const std::string log = childLogPath();
     pid_t pid = fork();
     if (pid == 0) {
         FILE* f = std::freopen(log.c_str(), "w", stderr);

@@ -73,6 +73,18 @@ ChildResult runChild(const std::vector<std::string>& args,
                      const std::function<void(pid_t)>& whileRunning = {});
 // Entries in a folder.
 size_t filesIn(const std::string& dir);
+// Where runChild collects the running child's output (readable while it runs).
+std::string childLogPath();
+// Waits (up to 60 s) until the running child's output contains `text`; false if it does not,
+// or if the child `pid` exits first.
+bool waitForChildOutput(pid_t pid, const std::string& text);
+// The scenes/cornell-box.yaml Cornell box at width x height with one sample per pixel and
+// iteration (many short iterations), its light colour `light`, written as dir/name.
+std::string smallCornellBox(const TempDir& dir, int width, int height,
+                            const std::string& name = "box.yaml",
+                            const std::string& light = "[17, 12, 4]");
+// Whether two image files hold the same pixels, bit for bit.
+bool samePixels(const std::string& a, const std::string& b);
 
 // Mean of the channel average over all pixels.
 double mean(const std::vector<float>& rgb);

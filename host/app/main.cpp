@@ -314,15 +314,17 @@ int renderCommand(const std::vector<std::string>& args) {
     const int sppPerIteration = plan.sampleBase * plan.sampleBase;
     spw::InterruptGuard interrupt;
     config.stop = interrupt.flag();
-    if (resume) {
-        const std::string why = spw::checkpointMismatch(
-            spw::checkpointKey(scene, config, plan.sampleBase), resume->key);
+    spw::CheckpointOptions checkpoints{checkpointPath, checkpointInterval,
+                                       resume ? &*resume : nullptr, std::nullopt};
+    if (!checkpointPath.empty()) {
+        // Checked here, before any work, for exit 2; the render reuses the key.
+        checkpoints.key = spw::checkpointKey(scene, config, plan.sampleBase);
+        const std::string why =
+            resume ? spw::checkpointMismatch(*checkpoints.key, resume->key) : "";
         if (!why.empty())
             throw UsageError("--resume " + resumePath +
                              ": the checkpoint is of another render: " + why);
     }
-    spw::CheckpointOptions checkpoints{checkpointPath, checkpointInterval,
-                                       resume ? &*resume : nullptr};
     std::unique_ptr<spw::PreviewWindow> preview;
     if (previewOn) {
         try {
@@ -334,8 +336,9 @@ int renderCommand(const std::vector<std::string>& args) {
         }
     }
     auto onIteration = [&](const spw::IterationInfo& info, const spw::Film& film) {
-        const std::optional<double> relMse = film.halfBufferRelMseEstimate();
         if (errorCsv) errorCsv->addRow(info.done, info.spp, info.renderSeconds, film);
+        if (progressMode == "none" && !preview) return;
+        const std::optional<double> relMse = film.halfBufferRelMseEstimate(); // O(pixels)
         progress.update(info.done, info.total, info.spp, info.total * sppPerIteration, relMse);
         if (preview) {
             char status[96];

@@ -158,8 +158,8 @@ std::unique_ptr<RenderResult> renderWithProgress(const Scene& scene, const Rende
         backend = std::make_unique<SortedRenderer>(ctx, config.pipeline, makeCpuShading(ctx));
     double renderSeconds = 0;
     int done = 0;
-    std::optional<CheckpointKey> key;
-    if (!checkpoints.path.empty() || checkpoints.resume)
+    std::optional<CheckpointKey> key = checkpoints.key;
+    if (!key && (!checkpoints.path.empty() || checkpoints.resume))
         key = checkpointKey(scene, config, plan.sampleBase);
     if (const Checkpoint* c = checkpoints.resume) {
         if (const std::string why = checkpointMismatch(*key, c->key); !why.empty())

@@ -10,6 +10,7 @@
 
 #include <functional>
 #include <memory>
+#include <optional>
 
 namespace spw {
 
@@ -39,7 +40,9 @@ SamplingPlan planSampling(const ImageSettings& image, std::optional<int> spp);
 struct CheckpointOptions {
     std::string path;                   // empty: no checkpoint
     double intervalSeconds = 0;         // also every this many render seconds (0: only at the end)
-    const Checkpoint* resume = nullptr; // continue from it (its key already checked)
+    const Checkpoint* resume = nullptr; // continue from it
+    // This render's key when the caller has it already (checkpointKey() hashes every mesh).
+    std::optional<CheckpointKey> key;
 };
 
 // Throws std::invalid_argument for a bad configuration (unknown backend) and

@@ -19,34 +19,6 @@
 namespace spw::test {
 namespace {
 
-std::string smallBox(const TempDir& dir, const std::string& name = "box.yaml",
-                     const std::string& colour = "[17, 12, 4]") {
-    std::string text = readFile(sourceDir() + "/scenes/cornell-box.yaml");
-    text = replaceAll(text, "{width: 256, height: 256, sample base: 2, iterations: 16}",
-                      "{width: 40, height: 40, sample base: 1, iterations: 16}");
-    text = replaceAll(text, "filename: cornell-box/",
-                      "filename: " + sourceDir() + "/scenes/cornell-box/");
-    text = replaceAll(text, "colour: [17, 12, 4]", "colour: " + colour);
-    return dir.write(name, text);
-}
-
-bool waitForLog(const std::string& text) {
-    const std::string log = (std::filesystem::temp_directory_path() /
-                             ("spillway-child-" + std::to_string(getpid()) + ".log"))
-                                .string();
-    for (int i = 0; i < 2400; ++i) {
-        if (readFile(log).find(text) != std::string::npos) return true;
-        std::this_thread::sleep_for(std::chrono::milliseconds(25));
-    }
-    return false;
-}
-
-bool sameImage(const std::string& a, const std::string& b) {
-    const ImageRGB x = readImage(a), y = readImage(b);
-    return x.width == y.width && x.height == y.height && x.rgb.size() == y.rgb.size() &&
-           std::memcmp(x.rgb.data(), y.rgb.data(), x.rgb.size() * sizeof(float)) == 0;
-}
-
 const std::vector<std::string> kSpilling = {"--memory-budget", "0.05", "--bin-exponent", "8"};
 
 std::vector<std::string> renderArgs(const std::string& scene, const std::string& backend,
@@ -63,7 +35,7 @@ std::vector<std::string> renderArgs(const std::string& scene, const std::string&
 // image so far.
 TEST(Checkpoint, StoppedAnywhereAndResumedGivesTheUninterruptedImageOnEveryBackend) {
     TempDir dir, spill;
-    const std::string scene = smallBox(dir);
+    const std::string scene = smallCornellBox(dir, 40, 40);
     for (const std::string& backend : backendsUnderTest()) {
         const std::string full = dir.file(backend + "-full.exr");
         ChildResult f = runChild(renderArgs(scene, backend, {"--quiet", "-o", full}));
@@ -77,7 +49,7 @@ TEST(Checkpoint, StoppedAnywhereAndResumedGivesTheUninterruptedImageOnEveryBacke
                            {"--progress", "lines", "--spill-dir", spill.path(), "--checkpoint", ck,
                             "--checkpoint-interval", "0.001", "-o", part}),
                 [&](pid_t pid) {
-                    waitForLog("iteration 5/");
+                    waitForChildOutput(pid, "iteration 5/");
                     kill(pid, signal);
                 });
             EXPECT_EQ(p.status, signal == SIGKILL ? -SIGKILL : 130) << tag << "\n" << p.output;
@@ -87,7 +59,7 @@ TEST(Checkpoint, StoppedAnywhereAndResumedGivesTheUninterruptedImageOnEveryBacke
             EXPECT_GE(c.iterations, signal == SIGKILL ? 4 : 5) << tag;
             EXPECT_LT(c.iterations, 24) << tag;
             if (signal == SIGINT) {
-                EXPECT_TRUE(sameImage(ck, part)) << tag;
+                EXPECT_TRUE(samePixels(ck, part)) << tag;
             }
 
             const std::string resumed = dir.file(tag + "-resumed.exr");
@@ -98,7 +70,7 @@ TEST(Checkpoint, StoppedAnywhereAndResumedGivesTheUninterruptedImageOnEveryBacke
             const nlohmann::json s = nlohmann::json::parse(std::ifstream(dir.file(tag + ".json")));
             EXPECT_EQ(s["resumed_iterations"], c.iterations) << tag;
             EXPECT_EQ(s["spp"], 24) << tag;
-            EXPECT_TRUE(sameImage(resumed, full)) << tag << ": resumed at " << c.iterations;
+            EXPECT_TRUE(samePixels(resumed, full)) << tag << ": resumed at " << c.iterations;
             // The resume wrote its own checkpoint back to the file: now complete.
             EXPECT_EQ(readCheckpoint(ck).iterations, 24) << tag;
         }
@@ -109,7 +81,7 @@ TEST(Checkpoint, StoppedAnywhereAndResumedGivesTheUninterruptedImageOnEveryBacke
 // written. Backends may differ (they trace the same paths).
 TEST(Checkpoint, ACheckpointOfAnotherRenderIsRefused) {
     TempDir dir;
-    const std::string scene = smallBox(dir);
+    const std::string scene = smallCornellBox(dir, 40, 40);
     const std::string ck = dir.file("ck.exr");
     ChildResult a = runChild({"render", scene, "--backend", "cpu", "--quiet", "--spp", "4",
                               "--ray-format", "full", "--checkpoint", ck, "-o", dir.file("a.exr")});
@@ -123,7 +95,7 @@ TEST(Checkpoint, ACheckpointOfAnotherRenderIsRefused) {
 
     // Another scene: the same file name, another light colour.
     TempDir other;
-    const std::string changed = smallBox(other, "box.yaml", "[17, 12, 5]");
+    const std::string changed = smallCornellBox(other, 40, 40, "box.yaml", "[17, 12, 5]");
     const Checkpoint c = readCheckpoint(ck);
     Checkpoint newer = c;
     newer.key.version = "99.0.0";

@@ -18,45 +18,13 @@
 namespace spw::test {
 namespace {
 
-// The Cornell box at 48 x 48, one sample per pixel and iteration: many short iterations.
-std::string smallBox(const TempDir& dir) {
-    std::string text = readFile(sourceDir() + "/scenes/cornell-box.yaml");
-    text = replaceAll(text, "{width: 256, height: 256, sample base: 2, iterations: 16}",
-                      "{width: 48, height: 48, sample base: 1, iterations: 16}");
-    text = replaceAll(text, "filename: cornell-box/",
-                      "filename: " + sourceDir() + "/scenes/cornell-box/");
-    return dir.write("box.yaml", text);
-}
-
-// The log runChild writes the child's output to, read while the child runs.
-std::string childLog() {
-    return (std::filesystem::temp_directory_path() /
-            ("spillway-child-" + std::to_string(getpid()) + ".log"))
-        .string();
-}
-
-// Waits (up to 60 s) until the running child's log contains `text`.
-bool waitForLog(const std::string& text) {
-    for (int i = 0; i < 2400; ++i) {
-        if (readFile(childLog()).find(text) != std::string::npos) return true;
-        std::this_thread::sleep_for(std::chrono::milliseconds(25));
-    }
-    return false;
-}
-
-bool sameImage(const std::string& a, const std::string& b) {
-    const ImageRGB x = readImage(a), y = readImage(b);
-    return x.width == y.width && x.height == y.height && x.rgb.size() == y.rgb.size() &&
-           std::memcmp(x.rgb.data(), y.rgb.data(), x.rgb.size() * sizeof(float)) == 0;
-}
-
 // SIGINT after the third iteration: exit 130, the image of every completed iteration (bit for
 // bit the image of an uninterrupted render of that many samples), --stats saying why; SIGTERM
 // likewise with 143. On every backend, the sorted ones with a budget small enough that the
 // stop lands while batches are on disk.
 TEST(Interrupt, SignalKeepsEveryCompletedIterationOnEveryBackend) {
     TempDir dir, spill;
-    const std::string scene = smallBox(dir);
+    const std::string scene = smallCornellBox(dir, 48, 48);
     for (const std::string& backend : backendsUnderTest())
         for (int signal : {SIGINT, SIGTERM}) {
             const std::string tag = backend + "-" + std::to_string(signal);
@@ -67,7 +35,7 @@ TEST(Interrupt, SignalKeepsEveryCompletedIterationOnEveryBackend) {
                           "100000", "--memory-budget", "0.05", "--bin-exponent", "8", "--spill-dir",
                           spill.path(), "-o", out, "--stats", stats},
                          [&](pid_t pid) {
-                             seen = waitForLog("iteration 3/");
+                             seen = waitForChildOutput(pid, "iteration 3/");
                              kill(pid, signal);
                          });
             ASSERT_TRUE(seen) << tag << "\n" << r.output;
@@ -87,7 +55,7 @@ TEST(Interrupt, SignalKeepsEveryCompletedIterationOnEveryBackend) {
             ChildResult w = runChild({"render", scene, "--backend", backend, "--quiet", "--spp",
                                       std::to_string(spp), "-o", whole});
             ASSERT_EQ(w.status, 0) << w.output;
-            EXPECT_TRUE(sameImage(out, whole)) << tag << ": " << spp << " spp";
+            EXPECT_TRUE(samePixels(out, whole)) << tag << ": " << spp << " spp";
         }
 }
 
@@ -96,7 +64,7 @@ TEST(Interrupt, SignalKeepsEveryCompletedIterationOnEveryBackend) {
 // kernel does not merge), then resumed, so that the second surely arrives during the first's stop.
 TEST(Interrupt, SecondSignalExitsAtOnceLeavingNoFile) {
     TempDir dir, out, spill;
-    const std::string scene = smallBox(dir);
+    const std::string scene = smallCornellBox(dir, 48, 48);
     for (const std::string& backend : backendsUnderTest()) {
         ChildResult r = runChild({"render",
                                   scene,
@@ -119,7 +87,7 @@ TEST(Interrupt, SecondSignalExitsAtOnceLeavingNoFile) {
                                   "--error-csv",
                                   out.file("x.csv")},
                                  [&](pid_t pid) {
-                                     waitForLog("iteration 2/");
+                                     waitForChildOutput(pid, "iteration 2/");
                                      kill(pid, SIGSTOP);
                                      kill(pid, SIGINT);
                                      kill(pid, SIGTERM);
@@ -136,7 +104,7 @@ TEST(Interrupt, SecondSignalExitsAtOnceLeavingNoFile) {
 // is that iteration exactly, not merely close).
 TEST(Interrupt, TargetErrorStopsWhereTheErrorCsvCrossesIt) {
     TempDir dir;
-    const std::string scene = smallBox(dir);
+    const std::string scene = smallCornellBox(dir, 48, 48);
     ChildResult full = runChild({"render", scene, "--backend", "cpu", "--quiet", "--spp", "16",
                                  "--error-csv", dir.file("full.csv"), "-o", dir.file("full.exr")});
     ASSERT_EQ(full.status, 0) << full.output;
@@ -182,7 +150,7 @@ TEST(Interrupt, TargetErrorStopsWhereTheErrorCsvCrossesIt) {
 // never a control character; on a non-terminal without --progress, nothing.
 TEST(Interrupt, ProgressLinesForLogsAndNothingByDefaultOffATerminal) {
     TempDir dir;
-    const std::string scene = smallBox(dir);
+    const std::string scene = smallCornellBox(dir, 48, 48);
     ChildResult lines = runChild({"render", scene, "--backend", "cpu", "--spp", "4", "--progress",
                                   "lines", "-o", dir.file("a.exr")});
     ASSERT_EQ(lines.status, 0) << lines.output;

@@ -81,35 +81,6 @@ class VirtualDisplay {
     bool ready_ = false;
 };
 
-std::string smallBox(const TempDir& dir) {
-    std::string text = readFile(sourceDir() + "/scenes/cornell-box.yaml");
-    text = replaceAll(text, "{width: 256, height: 256, sample base: 2, iterations: 16}",
-                      "{width: 64, height: 48, sample base: 1, iterations: 16}");
-    text = replaceAll(text, "filename: cornell-box/",
-                      "filename: " + sourceDir() + "/scenes/cornell-box/");
-    return dir.write("box.yaml", text);
-}
-
-// True once the child `pid` has exited (a zombie not yet waited for).
-bool exited(pid_t pid) {
-    const std::string stat = readFile("/proc/" + std::to_string(pid) + "/stat");
-    const size_t close = stat.rfind(')');
-    return stat.empty() ||
-           (close != std::string::npos && close + 2 < stat.size() && stat[close + 2] == 'Z');
-}
-
-bool waitForLog(const std::string& text, pid_t pid) {
-    const std::string log = (std::filesystem::temp_directory_path() /
-                             ("spillway-child-" + std::to_string(getpid()) + ".log"))
-                                .string();
-    for (int i = 0; i < 2400; ++i) {
-        if (readFile(log).find(text) != std::string::npos) return true;
-        if (exited(pid)) return false;
-        std::this_thread::sleep_for(std::chrono::milliseconds(25));
-    }
-    return false;
-}
-
 // The preview window's id and the spp its title shows, from the X server's window tree.
 struct WindowInfo {
     std::string id;
@@ -186,7 +157,7 @@ TEST(Preview, ScreenshotMatchesTheImageAndClosingStopsTheRender) {
     ASSERT_TRUE(display.ready()) << "Xvfb did not start (scripts/install-deps.sh installs xvfb)\n"
                                  << readFile(VirtualDisplay::log()) << display.describe();
     TempDir dir;
-    const std::string scene = smallBox(dir);
+    const std::string scene = smallCornellBox(dir, 64, 48);
     WindowInfo shown;
     int shotWidth = 0, shotHeight = 0;
     std::vector<std::uint8_t> shot;
@@ -194,7 +165,7 @@ TEST(Preview, ScreenshotMatchesTheImageAndClosingStopsTheRender) {
         runChild({"render", scene, "--backend", "cpu", "--preview", "--progress", "lines", "--spp",
                   "100000", "-o", dir.file("live.png"), "--stats", dir.file("live.json")},
                  [&](pid_t pid) {
-                     if (!waitForLog("iteration 3/", pid)) return;
+                     if (!waitForChildOutput(pid, "iteration 3/")) return;
                      // Frozen, so that the window's title and pixels are of one iteration.
                      for (int i = 0; i < 100 && shown.spp < 3; ++i) {
                          std::this_thread::sleep_for(std::chrono::milliseconds(50));
@@ -251,7 +222,7 @@ TEST(Preview, ScreenshotMatchesTheImageAndClosingStopsTheRender) {
 
 TEST(Preview, WithoutADisplayExitsTwoBeforeRendering) {
     TempDir dir;
-    const std::string scene = smallBox(dir);
+    const std::string scene = smallCornellBox(dir, 64, 48);
     const char* saved = std::getenv("DISPLAY");
     const std::string keep = saved ? saved : "";
     unsetenv("DISPLAY");
