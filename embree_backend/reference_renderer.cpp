@@ -24,7 +24,8 @@ bool ReferenceRenderer::renderIteration(uint iteration, Film& film) {
             if (stopRequested(ctx_.config)) return; // the iteration will be discarded
             std::uint64_t camera = 0, bounce = 0, shadow = 0;
             for (int y = r.rows().begin(); y < r.rows().end(); ++y)
-                for (int x = r.cols().begin(); x < r.cols().end(); ++x)
+                for (int x = r.cols().begin(); x < r.cols().end(); ++x) {
+                    if (!film.sampling(x, y)) continue; // adaptive sampling: converged
                     for (uint s = 0; s < spi; ++s) {
                         const uint pixel = uint(y * width + x);
                         const uint sampleIndex = iteration * spi + s;
@@ -36,7 +37,13 @@ bool ReferenceRenderer::renderIteration(uint iteration, Film& film) {
                         ++camera;
                         for (;;) {
                             const HitRecord h = intersectOne(embree, org, dir);
-                            if (h.mesh == kNoHit) break;
+                            if (h.mesh == kNoHit) {
+                                if (rp.environment != kNoEmitter)
+                                    film.splat(cr.filmPos, sampleIndex,
+                                               escapedRadiance(view, rp, dir, st),
+                                               filmKey(st.pathId, st.bounce, false));
+                                break;
+                            }
                             const SurfaceHit hit = embree.setUpHit(h, dir, st.cone, ctx_.textures,
                                                                    st.bounce < rp.maxDepth);
                             ShadeResult res;
@@ -58,6 +65,7 @@ bool ReferenceRenderer::renderIteration(uint iteration, Film& film) {
                             st = res.next;
                         }
                     }
+                }
             ctx_.stats.cameraRays += camera;
             ctx_.stats.bounceRays += bounce;
             ctx_.stats.shadowRays += shadow;

@@ -1,23 +1,33 @@
 #!/usr/bin/python3
-"""Error against run time for every backend: the convergence report.
+"""Error against run time for every backend and sampler: the convergence report.
 
-Renders a reference once at high spp (or takes --reference), then renders the scene on each
-backend with --error-csv against it, and writes
-  OUT/convergence.csv   backend, iteration, spp, seconds, relmse, relmse_estimate
-  OUT/convergence.png   log-log relMSE against seconds, one line per backend
-and prints each backend's efficiency 1 / (relMSE x seconds) at its last iteration (higher is
-better; for an unbiased estimator it stays roughly constant along the curve).
+Renders a reference once at high spp (or takes --reference), then renders the scene with each
+configuration, a backend and a sampler, with --error-csv against it, and writes
+  OUT/convergence.csv   config, backend, sampler, iteration, spp, seconds, relmse, relmse_estimate
+  OUT/convergence.png   log-log relMSE against seconds, one line per configuration
+and prints for each configuration its last point, its efficiency 1 / (relMSE x seconds), the
+convergence slope (a least-squares fit of log relMSE against log seconds over the second half
+of its points: -1 is Monte Carlo's rate, steeper is better) and the equal-error time ratio: the
+seconds it takes to reach the first configuration's final error, over the first configuration's
+seconds (interpolated on its curve, or extrapolated along its slope, marked "~").
 
   scripts/convergence.py [SCENE] [--backends reference,cpu,vulkan] [--spp 256]
+                         [--samplers Independent,Stratified,Sobol,Sobol+adaptive]
+                         [--adaptive-threshold 0.02] [--adaptive-spp 1024]
                          [--reference-spp 4096 | --reference REF.exr] [--out out/convergence]
 
+Samplers are the scene format's (Independent, Grid, Stratified, Sobol; default: the scene's
+own), each optionally "+adaptive": adaptive sampling at --adaptive-threshold, allowed up to
+--adaptive-spp so that its curve reaches past the others' errors (it stops earlier once every
+tile is below the threshold). The curves have a point per iteration.
 A backend that cannot run here (vulkan without a Vulkan device) is reported and skipped.
---replot redraws OUT/convergence.png from OUT/convergence.csv without rendering. The plot needs
+--replot redraws the report from OUT/convergence.csv without rendering. The plot needs
 Debian's python3-matplotlib, hence /usr/bin/python3 rather than whatever python3 is first on
 the PATH.
 """
 import argparse
 import csv
+import math
 import os
 import subprocess
 import sys
@@ -25,10 +35,16 @@ import sys
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
 
+FIELDS = ["config", "backend", "sampler", "iteration", "spp", "seconds", "relmse", "relmse_estimate"]
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("scene", nargs="?", default=os.path.join(ROOT, "scenes", "cornell-box.yaml"))
     ap.add_argument("--backends", default="reference,cpu,vulkan")
+    ap.add_argument("--samplers", default="", help="comma-separated; empty: the scene's own")
+    ap.add_argument("--adaptive-threshold", type=float, default=0.02)
+    ap.add_argument("--adaptive-spp", type=int, default=1024)
     ap.add_argument("--spp", type=int, default=256)
     ap.add_argument("--reference-spp", type=int, default=4096)
     ap.add_argument("--reference")
@@ -40,9 +56,9 @@ def main():
     out_csv = os.path.join(a.out, "convergence.csv")
     if a.replot:
         with open(out_csv) as f:
-            rows = [{"backend": r["backend"], "iteration": int(r["iteration"]), "spp": int(r["spp"]),
-                     "seconds": float(r["seconds"]), "relmse": float(r["relmse"]),
-                     "relmse_estimate": float(r["relmse_estimate"])} for r in csv.DictReader(f)]
+            rows = [dict(r, iteration=int(r["iteration"]), spp=int(r["spp"]), seconds=float(r["seconds"]),
+                         relmse=float(r["relmse"]), relmse_estimate=float(r["relmse_estimate"]))
+                    for r in csv.DictReader(f)]
         report(a, rows)
         return
 
@@ -54,55 +70,108 @@ def main():
                                "--seed", "1000003", "--quiet", "-o", ref])
 
     rows = []
+    samplers = a.samplers.split(",") if a.samplers else [""]
     for backend in a.backends.split(","):
-        csv_path = os.path.join(a.out, backend + ".csv")
-        cmd = [a.spillway, "render", a.scene, "--backend", backend, "--spp", str(a.spp), "--quiet",
-               "-o", os.path.join(a.out, backend + ".exr"), "--error-csv", csv_path, "--reference", ref]
-        p = subprocess.run(cmd, capture_output=True, text=True)
-        if p.returncode != 0:
-            print("%s: skipped (%s)" % (backend, p.stderr.strip().splitlines()[-1] if p.stderr.strip() else p.returncode))
-            continue
-        with open(csv_path) as f:
-            for r in csv.DictReader(f):
-                rows.append({"backend": backend, "iteration": int(r["iteration"]), "spp": int(r["spp"]),
-                             "seconds": float(r["seconds"]), "relmse": float(r["relmse"]),
-                             "relmse_estimate": float(r["relmse_estimate"])})
+        for sampler in samplers:
+            name = backend + ("/" + sampler if sampler else "")
+            label = name.replace("/", "-").replace("+", "-")
+            csv_path = os.path.join(a.out, label + ".csv")
+            adaptive = sampler.endswith("+adaptive")
+            cmd = [a.spillway, "render", a.scene, "--backend", backend, "--quiet",
+                   "--spp", str(a.adaptive_spp if adaptive else a.spp),
+                   "-o", os.path.join(a.out, label + ".exr"), "--error-csv", csv_path, "--reference", ref]
+            if sampler:
+                cmd += ["--sampler", sampler.split("+")[0]]
+            if adaptive:
+                cmd += ["--adaptive-threshold", str(a.adaptive_threshold)]
+            print("rendering", name)
+            p = subprocess.run(cmd, capture_output=True, text=True)
+            if p.returncode != 0:
+                print("%s: skipped (%s)" % (name, p.stderr.strip().splitlines()[-1] if p.stderr.strip() else p.returncode))
+                continue
+            with open(csv_path) as f:
+                for r in csv.DictReader(f):
+                    rows.append({"config": name, "backend": backend, "sampler": sampler or "scene",
+                                 "iteration": int(r["iteration"]), "spp": int(r["spp"]),
+                                 "seconds": float(r["seconds"]), "relmse": float(r["relmse"]),
+                                 "relmse_estimate": float(r["relmse_estimate"])})
     if not rows:
-        sys.exit("no backend rendered")
+        sys.exit("no configuration rendered")
 
     with open(out_csv, "w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=["backend", "iteration", "spp", "seconds", "relmse", "relmse_estimate"])
+        w = csv.DictWriter(f, fieldnames=FIELDS)
         w.writeheader()
         w.writerows(rows)
     report(a, rows)
 
 
+def slope(pts):
+    """Least-squares slope of log relMSE against log seconds over the second half of the points."""
+    pts = [p for p in pts[len(pts) // 2:] if p["seconds"] > 0 and p["relmse"] > 0]
+    if len(pts) < 2:
+        return float("nan")
+    xs = [math.log(p["seconds"]) for p in pts]
+    ys = [math.log(p["relmse"]) for p in pts]
+    mx, my = sum(xs) / len(xs), sum(ys) / len(ys)
+    sxx = sum((x - mx) ** 2 for x in xs)
+    return sum((x - mx) * (y - my) for x, y in zip(xs, ys)) / sxx if sxx > 0 else float("nan")
+
+
+def time_to_reach(pts, target, k):
+    """Seconds at which a curve first reaches relMSE `target`: interpolated in log-log between the
+    points around the crossing, or extrapolated from the last point along slope k. Returns
+    (seconds, extrapolated)."""
+    for prev, cur in zip(pts, pts[1:]):
+        if cur["relmse"] <= target < prev["relmse"]:
+            t = (math.log(target) - math.log(prev["relmse"])) / (math.log(cur["relmse"]) - math.log(prev["relmse"]))
+            return math.exp(math.log(prev["seconds"]) + t * (math.log(cur["seconds"]) - math.log(prev["seconds"]))), False
+    if pts and pts[0]["relmse"] <= target:
+        return pts[0]["seconds"], False
+    last = pts[-1]
+    if not (k < 0):
+        return float("nan"), True
+    return last["seconds"] * (target / last["relmse"]) ** (1.0 / k), True
+
+
 def report(a, rows):
-    """Prints each backend's last point and efficiency, and draws the log-log plot."""
+    """Prints each configuration's last point, efficiency, slope and equal-error time ratio, and
+    draws the log-log plot."""
     out_csv = os.path.join(a.out, "convergence.csv")
-    backends = [b for b in a.backends.split(",") if any(r["backend"] == b for r in rows)]
-    print("\n%-10s %6s %10s %12s %14s" % ("backend", "spp", "seconds", "relMSE", "efficiency"))
-    for b in backends:
-        last = [r for r in rows if r["backend"] == b][-1]
-        print("%-10s %6d %10.3f %12.4g %14.4g" % (b, last["spp"], last["seconds"], last["relmse"],
-                                                  1.0 / (last["relmse"] * last["seconds"])))
+    configs = []
+    for r in rows:
+        if r["config"] not in configs:
+            configs.append(r["config"])
+    curves = {c: [r for r in rows if r["config"] == c] for c in configs}
+    base = curves[configs[0]]
+    target, base_seconds = base[-1]["relmse"], base[-1]["seconds"]
+    print("\nequal-error time: the seconds to reach %s's final relMSE %.4g (%.3f s)" % (configs[0], target, base_seconds))
+    print("%-28s %6s %10s %12s %12s %8s %12s" % ("config", "spp", "seconds", "relMSE", "efficiency", "slope",
+                                                "time ratio"))
+    for c in configs:
+        pts = curves[c]
+        last, k = pts[-1], slope(pts)
+        t, extrapolated = time_to_reach(pts, target, k)
+        print("%-28s %6d %10.3f %12.4g %12.4g %8.2f %11s%s" % (
+            c, last["spp"], last["seconds"], last["relmse"], 1.0 / (last["relmse"] * last["seconds"]), k,
+            "~" if extrapolated else "", "%.3f" % (t / base_seconds)))
 
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     fig, ax = plt.subplots(figsize=(6, 4.2), dpi=120)
-    for b in backends:
-        pts = [r for r in rows if r["backend"] == b]
-        ax.loglog([r["seconds"] for r in pts], [r["relmse"] for r in pts], marker=".", markersize=3, label=b)
+    for c in configs:
+        pts = curves[c]
+        ax.loglog([r["seconds"] for r in pts], [r["relmse"] for r in pts], marker=".", markersize=2, label=c)
     xs = [r["seconds"] for r in rows]
     ys = [r["relmse"] for r in rows]
     x0, y0 = min(xs), max(ys)
     ax.loglog([x0, x0 * 100], [y0, y0 / 100], "k:", linewidth=0.8, label="slope -1")
+    ax.axhline(target, color="grey", linewidth=0.6, linestyle="--")
     ax.set_xlabel("render seconds")
     ax.set_ylabel("relMSE against the reference")
     ax.set_title(os.path.basename(a.scene) + ": error against time")
     ax.grid(True, which="both", alpha=0.3)
-    ax.legend()
+    ax.legend(fontsize=7)
     fig.tight_layout()
     png = os.path.join(a.out, "convergence.png")
     fig.savefig(png)

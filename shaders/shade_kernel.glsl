@@ -22,8 +22,8 @@
 //                   colour x reflectance (the same product the host's TextureResolver computes)
 //                   and the host-resolved per-hit albedo is not read.
 //
-// Bindings (set 0): 0 shader table, 1 emitters, 2 emitter CDF, 3 inputs, 4 results; 3 and 4
-// are bound as a window of the batch's buffers (within maxStorageBufferRange) and
+// Bindings (set 0): 0 shader table, 1 emitters, 2 emitter CDF, 3 the environment's map and
+// CDFs (shared/lights.h; 4 unread bytes without a map), 4 inputs, 5 results; 4 and 5 are bound as a window of the batch's buffers (within maxStorageBufferRange) and
 // ShadePush.offset is relative to it. Dispatches are 1D, or 2D when the range needs more than
 // maxComputeWorkGroupCount[0] workgroups; the linear index covers both.
 #extension GL_EXT_scalar_block_layout : require
@@ -38,8 +38,9 @@ layout(constant_id = 1) const bool kTextured = true;
 layout(scalar, set = 0, binding = 0) readonly buffer ShaderTable { ShaderParams shaderTable[]; };
 layout(scalar, set = 0, binding = 1) readonly buffer EmitterTable { Emitter emitterTable[]; };
 layout(scalar, set = 0, binding = 2) readonly buffer EmitterCdf { float emitterCdf[]; };
-layout(scalar, set = 0, binding = 3) readonly buffer Inputs { ShadeInput inputs[]; };
-layout(scalar, set = 0, binding = 4) writeonly buffer Results { ShadeResult results[]; };
+layout(scalar, set = 0, binding = 3) readonly buffer EnvironmentData { float environmentData[]; };
+layout(scalar, set = 0, binding = 4) readonly buffer Inputs { ShadeInput inputs[]; };
+layout(scalar, set = 0, binding = 5) writeonly buffer Results { ShadeResult results[]; };
 layout(scalar, push_constant) uniform Push { ShadePush pc; };
 
 ShaderParams kernelShader(uint i) {
@@ -53,6 +54,7 @@ ShaderParams kernelShader(uint i) {
 #define SHADER(i) kernelShader(i)
 #define EMITTER(i) emitterTable[i]
 #define EMITTER_CDF(i) emitterCdf[i]
+#define ENVIRONMENT_DATA(i) environmentData[i]
 #include "shared/path.h"
 
 void main() {

@@ -55,6 +55,7 @@ render options:
                         `spillway devices`, or the device the Vulkan driver variables name)
   --threads N           worker threads (default: every core)
   --seed S              random seed (overrides settings: seed)
+  --sampler TYPE        Independent, Grid, Stratified or Sobol (overrides the scene's sampler)
   --stats FILE.json     write render statistics (rays, stage seconds, ...) as JSON
   --quiet               no progress bar
   --error-csv FILE.csv  after every iteration, a row: seconds, spp, relMSE estimated from
@@ -69,6 +70,10 @@ render options:
                         checkpoints go back to FILE unless --checkpoint names another
   --target-error E      stop after the first iteration whose relMSE, estimated from two half
                         buffers (the --error-csv estimate), is at or below E
+  --adaptive-threshold T  adaptive sampling (settings: adaptive threshold; 0 off, default):
+                        8x8 tiles whose relative RMS error, estimated from two half
+                        buffers, is below T stop taking samples, once they have
+                        --adaptive-min-spp N (settings: adaptive min samples; default 16)
   --preview             a window showing the image as iterations complete (+/- exposure, 0
                         reset; closing it, Esc or q stop the render as Ctrl-C does, but exit
                         0); without a display: exit 2 before rendering
@@ -173,6 +178,7 @@ int renderCommand(const std::vector<std::string>& args) {
     std::string scenePath, output, statsPath, errorCsvPath, referencePath, checkpointPath,
         resumePath;
     double checkpointInterval = 0;
+    std::optional<spw::SamplerType> samplerOverride;
     bool quiet = false, previewOn = false;
     std::string progressMode = "auto";
     spw::RenderConfig config;
@@ -199,7 +205,13 @@ int renderCommand(const std::vector<std::string>& args) {
             config.pipeline.shading = choice(a, value(), spw::parseShadingMode);
         else if (a == "--threads")
             config.threads = int(parseInteger(a, value(), 1, 1024));
-        else if (a == "--seed")
+        else if (a == "--sampler") {
+            const std::string v = value();
+            samplerOverride = spw::parseSampler(v);
+            if (!samplerOverride)
+                throw UsageError("--sampler takes Independent, Grid, Stratified or Sobol, not '" +
+                                 v + "'");
+        } else if (a == "--seed")
             config.seed = std::uint32_t(parseInteger(a, value(), 0, 0xFFFFFFFFLL));
         else if (a == "--stats")
             statsPath = value();
@@ -219,6 +231,10 @@ int renderCommand(const std::vector<std::string>& args) {
             referencePath = value();
         else if (a == "--time-limit")
             config.timeLimitSeconds = parseNumber(a, value(), 1e-3, 1e9);
+        else if (a == "--adaptive-threshold")
+            config.adaptiveThreshold = parseNumber(a, value(), 0.0, 1e9);
+        else if (a == "--adaptive-min-spp")
+            config.adaptiveMinSamples = int(parseInteger(a, value(), 2, 1 << 24));
         else if (a == "--target-error")
             config.targetError = parseNumber(a, value(), 0.0, 1e9);
         else if (a == "--progress") {
@@ -283,6 +299,7 @@ int renderCommand(const std::vector<std::string>& args) {
     }
 
     spw::Scene scene = spw::loadScene(scenePath);
+    if (samplerOverride) scene.sampler = *samplerOverride;
     for (const spw::Mesh& m : scene.meshes)
         if (m.droppedTriangles > 0)
             std::fprintf(stderr, "spillway: warning: %s: dropped %d zero-area triangle%s\n",

@@ -103,6 +103,8 @@ struct RenderConfig {
     // kStopByWindow when the preview window was closed, else the signal's number.
     const std::atomic<int>* stop = nullptr;
     std::optional<double> textureCacheMiB; // overrides settings: texture cache
+    std::optional<double> adaptiveThreshold; // overrides settings: adaptive threshold
+    std::optional<int> adaptiveMinSamples;   // overrides settings: adaptive min samples
     TextureFilter textureFilter = TextureFilter::Cone;
 };
 

@@ -33,7 +33,10 @@ Film::Film(int width, int height, const Filter& filter, float brightestRadiance,
            int samplesPerIteration)
     : width_(width), height_(height), samplesPerIteration_(uint(samplesPerIteration)),
       filter_(filter), acc_(new PixelSums[size_t(width) * height]),
-      sum_(size_t(width) * height * 8, 0.0), lastIteration_(size_t(width) * height * 3, 0.0f) {
+      sum_(size_t(width) * height * 8, 0.0), lastIteration_(size_t(width) * height * 3, 0.0f),
+      iterationSamples_(new std::atomic<std::uint32_t>[size_t(width) * height]),
+      samples_(size_t(width) * height, 0u), tilesX_((width + kAdaptiveTile - 1) / kAdaptiveTile),
+      tilesY_((height + kAdaptiveTile - 1) / kAdaptiveTile) {
     // No clamp on e: the scale is a double, and every emission the loader accepts (up to
     // kMaxRadiance, down to the smallest float) keeps its brightest sample at 2^40.
     const int e =
@@ -51,9 +54,62 @@ Film::Film(int width, int height, const Filter& filter, float brightestRadiance,
 }
 
 void Film::beginIteration() {
-    for (size_t i = 0; i < size_t(width_) * height_; ++i)
+    for (size_t i = 0; i < size_t(width_) * height_; ++i) {
         for (std::atomic<std::int64_t>& v : acc_[i].v)
             v.store(0, std::memory_order_relaxed);
+        iterationSamples_[i].store(0, std::memory_order_relaxed);
+    }
+}
+
+void Film::setAdaptive(double threshold, int minSamples) {
+    adaptiveThreshold_ = threshold;
+    adaptiveMinSamples_ = minSamples;
+    decideTiles();
+}
+
+void Film::decideTiles() {
+    if (!(adaptiveThreshold_ > 0.0)) {
+        active_.clear();
+        activeTiles_ = 1;
+        return;
+    }
+    active_.assign(size_t(tilesX_) * size_t(tilesY_), 1);
+    activeTiles_ = active_.size();
+    const double limit = adaptiveThreshold_ * adaptiveThreshold_; // on the mean square
+    for (int ty = 0; ty < tilesY_; ++ty)
+        for (int tx = 0; tx < tilesX_; ++tx) {
+            double total = 0.0;
+            size_t values = 0;
+            bool ready = true;
+            for (int y = ty * kAdaptiveTile; y < std::min(height_, (ty + 1) * kAdaptiveTile); ++y)
+                for (int x = tx * kAdaptiveTile; x < std::min(width_, (tx + 1) * kAdaptiveTile);
+                     ++x) {
+                    const size_t i = size_t(y) * size_t(width_) + size_t(x);
+                    const double* s = &sum_[i * 8];
+                    if (samples_[i] < std::uint32_t(adaptiveMinSamples_) ||
+                        !(s[3] > 0 && s[7] > 0)) {
+                        ready = false;
+                        continue;
+                    }
+                    for (int c = 0; c < 3; ++c) {
+                        const double a = s[c] / s[3], b = s[4 + c] / s[7],
+                                     m = (s[c] + s[4 + c]) / (s[3] + s[7]);
+                        total += (a - b) * (a - b) / 4.0 / (m * m + kRelMseEpsilon);
+                        ++values;
+                    }
+                }
+            if (ready && values > 0 && total / double(values) < limit) {
+                active_[size_t(ty) * size_t(tilesX_) + size_t(tx)] = 0;
+                --activeTiles_;
+            }
+        }
+}
+
+std::uint64_t Film::samplesTaken() const {
+    std::uint64_t n = 0;
+    for (std::uint32_t s : samples_)
+        n += s;
+    return n;
 }
 
 void Film::add(int px, int py, int half, vec3 value, float weight, uint key) {
@@ -85,6 +141,9 @@ void Film::splat(vec2 filmPos, uint sampleIndex, vec3 radiance, uint key) {
 }
 
 void Film::addSample(vec2 filmPos, uint sampleIndex) {
+    const int px = std::min(int(filmPos.x), width_ - 1), py = std::min(int(filmPos.y), height_ - 1);
+    iterationSamples_[size_t(py) * size_t(width_) + size_t(px)].fetch_add(
+        1, std::memory_order_relaxed);
     filtered(filmPos, halfOf(sampleIndex), vec3(0.0f), 1.0f, roundingKey(0u, sampleIndex));
 }
 
@@ -135,21 +194,25 @@ void Film::endIteration() {
         }
         for (int c = 0; c < 3; ++c)
             lastIteration_[i * 3 + c] = it[3] > 0 ? float(it[c] / it[3]) : 0.0f;
+        samples_[i] += iterationSamples_[i].load(std::memory_order_relaxed);
     }
     beginIteration();
+    decideTiles();
 }
 
 Film::State Film::state() const {
-    return {sum_, nonFinite_.load(), saturated_.load()};
+    return {sum_, samples_, nonFinite_.load(), saturated_.load()};
 }
 
 void Film::restore(const State& state) {
-    if (state.sums.size() != sum_.size())
+    if (state.sums.size() != sum_.size() || state.samples.size() != samples_.size())
         throw std::invalid_argument("a film state of another size");
     sum_ = state.sums;
+    samples_ = state.samples;
     nonFinite_ = state.nonFinite;
     saturated_ = state.saturated;
     beginIteration();
+    decideTiles();
 }
 
 std::vector<float> Film::image() const {

@@ -16,6 +16,16 @@
 // within the iteration) mod 2: over any two iterations each half takes every stratum of the
 // Stratified and Grid samplers once, so the halves are identically distributed and their
 // difference estimates the image's own error without a reference (halfBufferRelMse).
+//
+// Adaptive sampling (setAdaptive): the image is cut into 8 x 8 tiles, as MoonRay does; after each
+// whole iteration a tile whose pixels have at least the minimum samples and whose error
+// estimate, sqrt of the mean over its pixels and channels of (A - B)^2 / 4 / (m^2 + 0.01) (the
+// half buffers' relMSE, as a relative RMS error), is below the threshold stops taking samples
+// (sampling() false), and takes them again should its estimate rise above it. The decision reads
+// only the film's sums and per-pixel sample counts after whole iterations, so it is the same for
+// any thread count, batch size or backend, and a checkpoint (which keeps both) resumes it
+// exactly. A tile estimates more steadily than a pixel: 192 values rather than 3, so a pixel
+// that drew a few lucky samples does not stop early.
 #pragma once
 
 #include "host/image/filter.h"
@@ -45,7 +55,8 @@ class Film {
     int height() const { return height_; }
 
     void beginIteration();
-    // Thread-safe. Once per camera sample: adds the sample's filter weight.
+    // Thread-safe. Once per camera sample: adds the sample's filter weight, and counts the sample
+    // in its pixel.
     void addSample(vec2 filmPos, uint sampleIndex);
     // Thread-safe. Any number of times per sample: adds radiance it carried to the camera.
     // `key` makes the stochastic rounding deterministic (filmKey()).
@@ -73,9 +84,25 @@ class Film {
     // The last completed iteration alone (for per-iteration statistics).
     std::vector<float> lastIterationImage() const { return lastIteration_; }
 
+    // Adaptive sampling: `threshold` 0 turns it off (every pixel samples); tiles decide once
+    // their pixels hold `minSamples` samples. Takes effect from the next iteration.
+    static constexpr int kAdaptiveTile = 8;
+    void setAdaptive(double threshold, int minSamples);
+    // Whether pixel (x, y) takes samples in the coming iteration.
+    bool sampling(int x, int y) const {
+        return active_.empty() ||
+               active_[size_t(y / kAdaptiveTile) * size_t(tilesX_) + size_t(x / kAdaptiveTile)];
+    }
+    // Whether any pixel takes samples in the coming iteration.
+    bool anySampling() const { return activeTiles_ > 0; }
+    // Camera samples each pixel took in whole iterations, and their total.
+    const std::vector<std::uint32_t>& sampleCounts() const { return samples_; }
+    std::uint64_t samplesTaken() const;
+
     // The film's whole state between iterations, exactly: what a checkpoint keeps.
     struct State {
-        std::vector<double> sums; // 8 per pixel: (r, g, b, weight) x 2 halves
+        std::vector<double> sums;           // 8 per pixel: (r, g, b, weight) x 2 halves
+        std::vector<std::uint32_t> samples; // per pixel
         std::uint64_t nonFinite = 0, saturated = 0;
     };
     State state() const;
@@ -88,6 +115,7 @@ class Film {
 
   private:
     int halfOf(uint sampleIndex) const; // (iteration + index within it) mod 2
+    void decideTiles();                 // the adaptive mask, from the sums and counts
     void filtered(vec2 filmPos, int half, vec3 radiance, float weight, uint key);
     void add(int px, int py, int half, vec3 value, float weight, uint key);
 
@@ -105,6 +133,13 @@ class Film {
     std::vector<double> sum_; // 8 per pixel, whole render
     std::vector<float> lastIteration_;
     std::atomic<std::uint64_t> nonFinite_{0}, saturated_{0};
+    std::unique_ptr<std::atomic<std::uint32_t>[]> iterationSamples_; // per pixel, this iteration
+    std::vector<std::uint32_t> samples_;                             // per pixel, whole render
+    double adaptiveThreshold_ = 0.0;
+    int adaptiveMinSamples_ = 0;
+    int tilesX_ = 0, tilesY_ = 0;
+    std::vector<std::uint8_t> active_; // per tile; empty: adaptive sampling off
+    size_t activeTiles_ = 1;
 };
 
 } // namespace spw

@@ -92,7 +92,7 @@ bool SortedRenderer::renderIteration(uint iteration, Film& film) {
             runFusedBatch(*batch, iteration, film);
             continue;
         }
-        startBatch(*batch, next);
+        startBatch(*batch, next, iteration, film);
         if (pending >= 0) finishBatch(pending, iteration, film);
         if (overlap) {
             pending = next;
@@ -138,14 +138,16 @@ size_t SortedRenderer::traceBatch(RayBatch& batch) {
 void SortedRenderer::runFusedBatch(RayBatch& batch, uint iteration, Film& film) {
     Scratch& s = *scratch_;
     const size_t hitCount = traceBatch(batch);
+    escapes(iteration, hitCount, film);
     shadeFused(ctx_, iteration, config_.rayFormat, s.rays, s.hits, s.order, hitCount, film, *bins_);
 }
 
-void SortedRenderer::startBatch(RayBatch& batch, int slot) {
+void SortedRenderer::startBatch(RayBatch& batch, int slot, uint iteration, Film& film) {
     Scratch& s = *scratch_;
     Scratch::InFlight& flight = s.inFlight[slot];
     StageTimes& times = ctx_.stats.stages;
     flight.hitCount = traceBatch(batch);
+    escapes(iteration, flight.hitCount, film);
     {
         StageTimer t(times, "hit setup");
         flight.shading = shading_->reserve(slot, flight.hitCount);
@@ -184,6 +186,12 @@ void SortedRenderer::finishBatch(int slot, uint iteration, Film& film) {
         StageTimer t(times, "bin");
         binContinuations(ctx_, iteration, config_.rayFormat, results, flight.hitCount, *bins_);
     }
+}
+
+void SortedRenderer::escapes(uint iteration, size_t hitCount, Film& film) {
+    if (ctx_.params.environment == kNoEmitter) return; // a miss sees black: nothing to add
+    StageTimer t(ctx_.stats.stages, "escape");
+    accumulateEscapes(ctx_, iteration, scratch_->rays, scratch_->order, hitCount, film);
 }
 
 void SortedRenderer::publishStats() {

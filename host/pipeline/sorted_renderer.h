@@ -24,13 +24,16 @@ class SortedRenderer : public Backend {
     struct Scratch;
     // One batch in two halves, so that a batch's shading can overlap the next one's traversal:
     // decompress .. hit setup, then submit its shading to `slot`; then wait for it, trace its
-    // shadow rays, accumulate and bin its continuation rays.
-    void startBatch(RayBatch& batch, int slot);
+    // shadow rays, accumulate and bin its continuation rays. The misses' environment goes into
+    // the film at once.
+    void startBatch(RayBatch& batch, int slot, uint iteration, Film& film);
     // decompress .. sort hits: the batch's hits in shading order in the scratch; their count.
     size_t traceBatch(RayBatch& batch);
     // The whole batch with the per-hit stages fused (stages.h: shadeFused), for the cpu engine.
     void runFusedBatch(RayBatch& batch, uint iteration, Film& film);
     void finishBatch(int slot, uint iteration, Film& film);
+    // escape: the batch's misses see the environment (stages.h: accumulateEscapes).
+    void escapes(uint iteration, size_t hitCount, Film& film);
     void publishStats();
 
     RenderContext ctx_;

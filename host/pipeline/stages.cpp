@@ -52,7 +52,8 @@ void generateCameraRays(const RenderContext& ctx, uint iteration, RayFormat form
         const int x0 = (t % tilesX) * tile, y0 = (t / tilesX) * tile;
         RayBuffer buffer; // the tile's thread-local buffer, handed to the bins whole
         for (int y = y0; y < std::min(height, y0 + tile); ++y)
-            for (int x = x0; x < std::min(width, x0 + tile); ++x)
+            for (int x = x0; x < std::min(width, x0 + tile); ++x) {
+                if (!film.sampling(x, y)) continue; // adaptive sampling: converged
                 for (uint s = 0; s < spi; ++s) {
                     CameraRay cr =
                         ctx.camera.generate(uint(x), uint(y), s, iteration * spi + s, rp.seed);
@@ -63,6 +64,7 @@ void generateCameraRays(const RenderContext& ctx, uint iteration, RayFormat form
                     r.path = cameraPath(rp, uint(y * width + x), s, spread);
                     buffer.push(r, format, roundingBits(rp, r.path));
                 }
+            }
         ctx.stats.cameraRays += buffer.count;
         bins.add(buffer);
     });
@@ -246,6 +248,23 @@ void accumulate(const RenderContext& ctx, uint iteration, const ShadeResult* res
                               if (!occluded[j])
                                   splats.push(shadowSplat(ctx, rp, results[shadowOwner[j]],
                                                           paths[shadowOwner[j]]));
+                      });
+}
+
+void accumulateEscapes(const RenderContext& ctx, uint iteration, const std::vector<RayState>& rays,
+                       const std::vector<SortedHit>& order, size_t hitCount, Film& film) {
+    const RenderParams rp = paramsAt(ctx, iteration);
+    const SceneView view = ctx.lights.view();
+    tbb::parallel_for(tbb::blocked_range<size_t>(hitCount, order.size(), 1024),
+                      [&](const tbb::blocked_range<size_t>& r) {
+                          SplatBatch splats(film);
+                          for (size_t i = r.begin(); i < r.end(); ++i) {
+                              const RayState& ray = rays[order[i].index];
+                              const uint id = ray.path.pathId;
+                              splats.push({filmPosition(ctx, rp, id), pathSample(rp, id),
+                                           filmKey(id, ray.path.bounce, false),
+                                           escapedRadiance(view, rp, ray.dir, ray.path)});
+                          }
                       });
 }
 

@@ -8,6 +8,7 @@
 //   sort rays     Morton radix sort, median split, or none        ray_sort.h; RaySortPolicy decides
 //   traverse      closest hits of the whole batch                 intersectBatch (embree_backend/)
 //   sort hits     by (shader, object, texture order), misses last
+//   escape        misses see the environment (scenes with one)
 //   hit setup     world-space hit and texture albedo, in sorted order, into the engine's inputs
 //   shade         one pass per shader range                       ShadingEngine (shading_engine.h)
 //   shade wait    until the engine's results are complete
@@ -62,6 +63,11 @@ void gatherShadowRays(const ShadeResult* results, size_t hitCount,
 void accumulate(const RenderContext& ctx, uint iteration, const ShadeResult* results,
                 const uvec2* paths, size_t hitCount, const std::vector<std::uint32_t>& shadowOwner,
                 const std::vector<std::uint8_t>& occluded, Film& film);
+
+// escape: what the environment gives each ray that missed (the sorted order's tail, from
+// hitCount), into the film. Only for a scene with an environment.
+void accumulateEscapes(const RenderContext& ctx, uint iteration, const std::vector<RayState>& rays,
+                       const std::vector<SortedHit>& order, size_t hitCount, Film& film);
 
 // bin: the continuation rays, encoded, into the bins.
 void binContinuations(const RenderContext& ctx, uint iteration, RayFormat format,

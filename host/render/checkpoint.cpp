@@ -16,7 +16,8 @@ namespace spw {
 namespace {
 
 constexpr int kSumsPerPixel = 8;
-constexpr int kChannels = 3 + 2 * kSumsPerPixel;
+constexpr int kSamplesChannel = 3 + 2 * kSumsPerPixel; // the pixel's sample count
+constexpr int kChannels = kSamplesChannel + 1;
 
 struct Fnv {
     std::uint64_t h = 0xcbf29ce484222325ull;
@@ -93,6 +94,9 @@ CheckpointKey checkpointKey(const Scene& scene, const RenderConfig& config, int 
                       : rayFormatName(config.pipeline.rayFormat);
     k.textureFilter = filterName(config.textureFilter);
     k.strategy = config.strategy;
+    k.sampler = samplerName(scene.sampler);
+    k.adaptiveThreshold = config.adaptiveThreshold.value_or(scene.settings.adaptiveThreshold);
+    k.adaptiveMinSamples = config.adaptiveMinSamples.value_or(scene.settings.adaptiveMinSamples);
     return k;
 }
 
@@ -114,13 +118,17 @@ std::string checkpointMismatch(const CheckpointKey& e, const CheckpointKey& f) {
     differs("ray format", e.rayFormat, f.rayFormat);
     differs("texture filter", e.textureFilter, f.textureFilter);
     differs("sampling strategy", e.strategy, f.strategy);
+    differs("sampler", e.sampler, f.sampler);
+    differs("adaptive threshold", e.adaptiveThreshold, f.adaptiveThreshold);
+    differs("adaptive min samples", e.adaptiveMinSamples, f.adaptiveMinSamples);
     return why.str();
 }
 
 void writeCheckpoint(const std::string& path, const Checkpoint& c,
                      const std::vector<float>& image) {
     const size_t pixels = size_t(c.key.width) * size_t(c.key.height);
-    if (image.size() != pixels * 3 || c.film.sums.size() != pixels * kSumsPerPixel)
+    if (image.size() != pixels * 3 || c.film.sums.size() != pixels * kSumsPerPixel ||
+        c.film.samples.size() != pixels)
         throw std::invalid_argument("checkpoint: image and film sizes differ from the key's");
     OIIO::ImageSpec spec(c.key.width, c.key.height, kChannels, OIIO::TypeDesc::FLOAT);
     std::vector<OIIO::TypeDesc> formats(3, OIIO::TypeDesc::FLOAT);
@@ -130,6 +138,8 @@ void writeCheckpoint(const std::string& path, const Checkpoint& c,
             names.push_back("state." + std::to_string(k) + "." + half);
             formats.push_back(OIIO::TypeDesc::UINT);
         }
+    names.push_back("state.samples");
+    formats.push_back(OIIO::TypeDesc::UINT);
     spec.channelnames = names;
     spec.channelformats = formats;
     spec.attribute("oiio:ColorSpace", "Linear");
@@ -146,12 +156,16 @@ void writeCheckpoint(const std::string& path, const Checkpoint& c,
     spec.attribute("spillway:ray_format", c.key.rayFormat);
     spec.attribute("spillway:texture_filter", c.key.textureFilter);
     spec.attribute("spillway:strategy", int(c.key.strategy));
+    spec.attribute("spillway:sampler", c.key.sampler);
+    spec.attribute("spillway:adaptive_threshold", std::to_string(c.key.adaptiveThreshold));
+    spec.attribute("spillway:adaptive_min_samples", c.key.adaptiveMinSamples);
     spec.attribute("spillway:iterations", c.iterations);
     spec.attribute("spillway:render_seconds", std::to_string(c.renderSeconds));
     spec.attribute("spillway:non_finite_samples", std::to_string(c.film.nonFinite));
     spec.attribute("spillway:saturated_samples", std::to_string(c.film.saturated));
 
-    // Pixels as the channels lie: 3 floats, then 16 uint32, each 4 bytes.
+    // Pixels as the channels lie: 3 floats, then 16 uint32 (the sums), then the sample count,
+    // each 4 bytes.
     std::vector<std::uint32_t> data(pixels * kChannels);
     for (size_t i = 0; i < pixels; ++i) {
         std::uint32_t* px = &data[i * kChannels];
@@ -162,6 +176,7 @@ void writeCheckpoint(const std::string& path, const Checkpoint& c,
             px[3 + 2 * k] = std::uint32_t(bits >> 32);
             px[4 + 2 * k] = std::uint32_t(bits);
         }
+        px[kSamplesChannel] = c.film.samples[i];
     }
     std::vector<unsigned char> bytes;
     OIIO::Filesystem::IOVecOutput proxy(bytes);
@@ -174,6 +189,19 @@ void writeCheckpoint(const std::string& path, const Checkpoint& c,
     writeFileAtomically(path, bytes.data(), bytes.size());
 }
 
+namespace {
+// The index of a state channel (at least 3: R, G, B come first), checked to be uint32.
+int stateChannel(const OIIO::ImageSpec& spec, const std::string& path, const std::string& name) {
+    for (int c = 3; c < spec.nchannels; ++c)
+        if (spec.channelnames[size_t(c)] == name) {
+            if (spec.channelformat(c) != OIIO::TypeDesc::UINT)
+                notACheckpoint(path, "channel " + name + " is not uint32");
+            return c;
+        }
+    notACheckpoint(path, "no channel " + name);
+}
+} // namespace
+
 Checkpoint readCheckpoint(const std::string& path) {
     auto in = OIIO::ImageInput::open(path);
     if (!in) throw std::runtime_error("cannot read checkpoint '" + path + "': " + OIIO::geterror());
@@ -182,14 +210,14 @@ Checkpoint readCheckpoint(const std::string& path) {
         notACheckpoint(path, "no spillway:checkpoint attribute");
     if (spec.nchannels != kChannels || spec.width <= 0 || spec.height <= 0)
         notACheckpoint(path, "not " + std::to_string(kChannels) + " channels");
+    // The state channels by name: OpenEXR keeps channels sorted, and OpenImageIO may list a
+    // file's channels in another order than they were written.
+    std::vector<size_t> word; // each state word's place among the file's channels 3 .. N
     for (int k = 0; k < kSumsPerPixel; ++k)
-        for (int h = 0; h < 2; ++h) {
-            const int c = 3 + 2 * k + h;
-            const std::string name = "state." + std::to_string(k) + (h == 0 ? ".hi" : ".lo");
-            if (spec.channelnames[size_t(c)] != name ||
-                spec.channelformat(c) != OIIO::TypeDesc::UINT)
-                notACheckpoint(path, "channel " + std::to_string(c) + " is not " + name);
-        }
+        for (const char* half : {".hi", ".lo"})
+            word.push_back(
+                size_t(stateChannel(spec, path, "state." + std::to_string(k) + half) - 3));
+    word.push_back(size_t(stateChannel(spec, path, "state.samples") - 3));
     Checkpoint c;
     c.key.version = spec.get_string_attribute("spillway:version");
     try {
@@ -198,6 +226,8 @@ Checkpoint readCheckpoint(const std::string& path) {
         c.renderSeconds = std::stod(spec.get_string_attribute("spillway:render_seconds"));
         c.film.nonFinite = std::stoull(spec.get_string_attribute("spillway:non_finite_samples"));
         c.film.saturated = std::stoull(spec.get_string_attribute("spillway:saturated_samples"));
+        c.key.adaptiveThreshold =
+            std::stod(spec.get_string_attribute("spillway:adaptive_threshold"));
     } catch (const std::exception&) {
         notACheckpoint(path, "its spillway:* metadata is incomplete");
     }
@@ -207,18 +237,26 @@ Checkpoint readCheckpoint(const std::string& path) {
     c.key.rayFormat = spec.get_string_attribute("spillway:ray_format");
     c.key.textureFilter = spec.get_string_attribute("spillway:texture_filter");
     c.key.strategy = std::uint32_t(spec.get_int_attribute("spillway:strategy"));
+    c.key.sampler = spec.get_string_attribute("spillway:sampler");
+    c.key.adaptiveMinSamples = spec.get_int_attribute("spillway:adaptive_min_samples");
     c.iterations = spec.get_int_attribute("spillway:iterations", -1);
     if (c.iterations < 0 || c.key.sampleBase <= 0)
         notACheckpoint(path, "its spillway:* metadata is incomplete");
 
     const size_t pixels = size_t(spec.width) * size_t(spec.height);
-    std::vector<std::uint32_t> words(pixels * 2 * kSumsPerPixel);
+    constexpr size_t kWords = kChannels - 3; // per pixel, as the file lists them
+    std::vector<std::uint32_t> words(pixels * kWords);
     if (!in->read_image(0, 0, 3, kChannels, OIIO::TypeDesc::UINT, words.data()))
         throw std::runtime_error("cannot read checkpoint '" + path + "': " + in->geterror());
     c.film.sums.resize(pixels * kSumsPerPixel);
-    for (size_t i = 0; i < pixels * kSumsPerPixel; ++i) {
-        const std::uint64_t bits = std::uint64_t(words[2 * i]) << 32 | words[2 * i + 1];
-        std::memcpy(&c.film.sums[i], &bits, 8);
+    c.film.samples.resize(pixels);
+    for (size_t p = 0; p < pixels; ++p) {
+        const std::uint32_t* w = &words[p * kWords];
+        for (size_t k = 0; k < kSumsPerPixel; ++k) {
+            const std::uint64_t bits = std::uint64_t(w[word[2 * k]]) << 32 | w[word[2 * k + 1]];
+            std::memcpy(&c.film.sums[p * kSumsPerPixel + k], &bits, 8);
+        }
+        c.film.samples[p] = w[word.back()];
     }
     return c;
 }

@@ -4,7 +4,8 @@
 // The checkpoint is one OpenEXR file that any image viewer opens: its R, G, B channels are the
 // image so far (float), and 16 more channels, state.0.hi .. state.7.lo (uint32), hold the film's
 // eight double-precision sums per pixel bit for bit (a double split into its high and low 32
-// bits: EXR has no 64-bit channel type, and float channels would round the sums). Metadata
+// bits: EXR has no 64-bit channel type, and float channels would round the sums), and one more,
+// state.samples (uint32), the camera samples each pixel took (adaptive sampling reads them). Metadata
 // (spillway:*) holds the rest: iterations done, render seconds, the film's counters, and what
 // must match for a resume (the key below). One file rather than an image and a state file beside
 // it: nothing can pair an image with another render's state, and one rename writes it atomically.
@@ -31,6 +32,9 @@ struct CheckpointKey {
     std::string rayFormat;      // compact | full
     std::string textureFilter;  // cone | finest
     std::uint32_t strategy = 0; // light / BSDF sampling
+    std::string sampler;        // Independent | Grid | Stratified | Sobol
+    double adaptiveThreshold = 0; // 0: off
+    int adaptiveMinSamples = 0;
 };
 
 struct Checkpoint {

@@ -142,7 +142,12 @@ std::unique_ptr<RenderResult> renderWithProgress(const Scene& scene, const Rende
     params.maxDepth = uint(scene.settings.maxDepth);
     params.threshold = scene.settings.threshold;
     params.strategy = config.strategy;
-    params.emitterCount = uint(lights.emitters().size());
+    params.emitterCount = lights.sampledEmitters();
+    params.environment = lights.environment();
+    params.envWidth = lights.environmentWidth();
+    params.envHeight = lights.environmentHeight();
+    params.sampling = dimensionSampler(scene.sampler);
+    stats.extra["sampler"] = samplerName(scene.sampler);
 
     RenderContext ctx{scene, config, lights, *embree, textures, camera, params, threads, stats};
     result->film =
@@ -158,6 +163,11 @@ std::unique_ptr<RenderResult> renderWithProgress(const Scene& scene, const Rende
         backend = std::make_unique<SortedRenderer>(ctx, config.pipeline, makeCpuShading(ctx));
     double renderSeconds = 0;
     int done = 0;
+    const double adaptiveThreshold =
+        config.adaptiveThreshold.value_or(scene.settings.adaptiveThreshold);
+    const int adaptiveMinSamples =
+        config.adaptiveMinSamples.value_or(scene.settings.adaptiveMinSamples);
+    result->film->setAdaptive(adaptiveThreshold, adaptiveMinSamples);
     std::optional<CheckpointKey> key = checkpoints.key;
     if (!key && (!checkpoints.path.empty() || checkpoints.resume))
         key = checkpointKey(scene, config, plan.sampleBase);
@@ -212,6 +222,10 @@ std::unique_ptr<RenderResult> renderWithProgress(const Scene& scene, const Rende
             stopReason = "time limit";
             break;
         }
+        if (!result->film->anySampling()) {
+            stopReason = "adaptive"; // every tile is below the adaptive threshold
+            break;
+        }
         if (config.targetError) {
             const std::optional<double> estimate = result->film->halfBufferRelMseEstimate();
             if (estimate && *estimate <= *config.targetError) {
@@ -225,6 +239,13 @@ std::unique_ptr<RenderResult> renderWithProgress(const Scene& scene, const Rende
     stats.iterations = done;
     stats.spp = done * plan.sampleBase * plan.sampleBase;
     stats.extra["render_seconds"] = renderSeconds;
+    stats.extra["samples_taken"] = result->film->samplesTaken();
+    if (adaptiveThreshold > 0.0)
+        stats.extra["adaptive"] = {
+            {"threshold", adaptiveThreshold},
+            {"min_samples", adaptiveMinSamples},
+            {"samples_of_full_render",
+             std::uint64_t(scene.image.width) * scene.image.height * std::uint64_t(stats.spp)}};
     if (textures.active()) stats.extra["textures"] = textureStatistics(textures, stats);
     stats.nonFiniteSamples = result->film->nonFiniteSamples();
     stats.saturatedSamples = result->film->saturatedSamples();

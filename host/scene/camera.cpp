@@ -22,7 +22,8 @@ vec2 CameraModel::filmPosition(uint x, uint y, uint sample, uint sampleIndex, ui
     if (sampler_ == SamplerType::Grid) {
         offset = (vec2(float(cx), float(cy)) + 0.5f) / float(base_);
     } else {
-        vec4 u = rand4(seed, y * uint(width_) + x, sampleIndex, kBounceCamera, kDimCamera);
+        vec4 u = rand4(dimensionSampler(sampler_), seed, y * uint(width_) + x, sampleIndex,
+                       kBounceCamera, kDimCamera);
         if (sampler_ == SamplerType::Stratified)
             offset = (vec2(float(cx), float(cy)) + vec2(u.x, u.y)) / float(base_);
         else
@@ -47,7 +48,8 @@ CameraRay CameraModel::generate(uint x, uint y, uint sample, uint sampleIndex, u
     vec3 d(sx, sy, -1.0f);
     vec3 o(0.0f);
     if (cam_.type == CameraType::ThinLens && cam_.apertureRadius > 0.0f) {
-        vec4 u = rand4(seed, y * uint(width_) + x, sampleIndex, kBounceCamera, kDimCamera);
+        vec4 u = rand4(dimensionSampler(sampler_), seed, y * uint(width_) + x, sampleIndex,
+                       kBounceCamera, kDimCamera);
         vec2 lens = sampleConcentricDisk(vec2(u.z, u.w)) * cam_.apertureRadius;
         vec3 focus = d * cam_.focalDistance;
         o = vec3(lens, 0.0f);

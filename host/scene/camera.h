@@ -1,10 +1,11 @@
-// Camera rays: the pixel sampler (Independent, Grid, Stratified) picks a point in the pixel, the
-// camera (PinHole, ThinLens) turns it into a world-space ray. Both are pure functions of
-// (seed, pixel, sample), so the sorted backends can recompute a sample's film position when its
+// Camera rays: the pixel sampler (Independent, Grid, Stratified, Sobol) picks a point in the pixel,
+// the camera (PinHole, ThinLens) turns it into a world-space ray. Both are pure functions of (seed,
+// pixel, sample), so the sorted backends can recompute a sample's film position when its
 // contribution arrives instead of carrying it in every ray.
 #pragma once
 
 #include "host/scene/scene.h"
+#include "shared/rng.h"
 
 namespace spw {
 
@@ -13,6 +14,11 @@ struct CameraRay {
     vec3 dir;     // unit
     vec2 filmPos; // continuous pixel coordinates: pixel (x, y) spans [x, x+1) x [y, y+1)
 };
+
+// The sampler of every dimension but the camera sample's place in the pixel (kSampler*).
+inline uint dimensionSampler(SamplerType s) {
+    return s == SamplerType::Sobol ? kSamplerSobol : kSamplerIndependent;
+}
 
 class CameraModel {
   public:

@@ -72,6 +72,10 @@ struct Settings {
     // it leaves the rest to geometry and rays, and holds every scene but the out-of-core ones.
     double textureCacheMiB = 1024.0;
     std::uint32_t seed = 0;
+    // Adaptive sampling (host/image/film.h): off at 0; 8 x 8 tiles whose relative RMS error
+    // estimate is below it stop taking samples, once they have adaptiveMinSamples.
+    double adaptiveThreshold = 0.0;
+    int adaptiveMinSamples = 16;
 };
 
 enum class CameraType { PinHole, ThinLens };
@@ -90,7 +94,13 @@ struct Camera {
     float tanHalfFovX() const;
 };
 
-enum class SamplerType { Independent, Grid, Stratified };
+// Independent, Grid and Stratified place the camera sample in the pixel and draw every other
+// dimension independently; Sobol draws every dimension, the pixel's included, from Owen-scrambled
+// Sobol points (shared/rng.h).
+enum class SamplerType { Independent, Grid, Stratified, Sobol };
+const char* samplerName(SamplerType s);
+// The sampler named `name`, or nothing.
+std::optional<SamplerType> parseSampler(const std::string& name);
 
 enum class TextureType { Constant, Standard, Layered };
 struct Texture {
@@ -120,6 +130,23 @@ struct Mesh {
     int droppedTriangles = 0; // zero-area triangles left out when loading
 };
 
+// A point light: `intensity` W/sr in every direction (intensity x colour), at `position`.
+struct PointLight {
+    vec3 position;
+    vec3 intensity;
+    int line = 0;
+};
+
+// Radiance at infinity: a constant, or a lat-long map (shared/lights.h draws its layout) scaled
+// by `radiance`.
+struct Environment {
+    vec3 radiance{1.0f};
+    std::string path; // the map's absolute path, or empty for a constant environment
+    int width = 0, height = 0;
+    std::vector<float> rgb; // the map, linear RGB, row 0 straight up
+    int line = 0;
+};
+
 // Rendering is camera-relative: the loader applies every transform in double and subtracts the
 // camera's position before rounding to float, so the float world has the camera at (0, 0, 0)
 // and the image does not depend on where the scene sits in the file's coordinates.
@@ -136,6 +163,8 @@ struct Scene {
     std::vector<Mesh> meshes; // objects first, then the quad lights' geometry
     int objectCount = 0;
     int quadLightCount = 0;
+    std::vector<PointLight> pointLights;
+    std::optional<Environment> environment;
 
     bool usesTextures() const;
 };

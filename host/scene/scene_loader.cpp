@@ -1,5 +1,6 @@
 // The YAML scene loader: docs/scene-format.md made executable. Every value is checked for type and
 // range where it is read, and every error names the file and line of the offending node.
+#include "host/image/image_io.h"
 #include "host/scene/obj_mesh.h"
 #include "host/scene/scene.h"
 #include "host/scene/surface_models.h"
@@ -194,7 +195,8 @@ void readImage(const Reader& rd, const YAML::Node& n, ImageSettings& img) {
 void readSettings(const Reader& rd, const YAML::Node& n, Settings& s) {
     rd.checkKeys(n, "settings",
                  {"min depth", "max depth", "threshold", "bucket size", "shading size",
-                  "bin exponent", "memory budget", "texture cache", "seed"});
+                  "bin exponent", "memory budget", "texture cache", "seed", "adaptive threshold",
+                  "adaptive min samples"});
     if (n["min depth"]) s.minDepth = int(rd.integer(n["min depth"], "min depth", 0, kMaxDepth));
     if (n["max depth"]) s.maxDepth = int(rd.integer(n["max depth"], "max depth", 0, kMaxDepth));
     if (n["threshold"]) s.threshold = float(rd.number(n["threshold"], "threshold", 0.0, 1e30));
@@ -208,6 +210,11 @@ void readSettings(const Reader& rd, const YAML::Node& n, Settings& s) {
     if (n["texture cache"])
         s.textureCacheMiB = rd.number(n["texture cache"], "texture cache", 1.0, 1 << 20);
     if (n["seed"]) s.seed = std::uint32_t(rd.integer(n["seed"], "seed", 0, 0xFFFFFFFFLL));
+    if (n["adaptive threshold"])
+        s.adaptiveThreshold = rd.number(n["adaptive threshold"], "adaptive threshold", 0.0, 1e9);
+    if (n["adaptive min samples"])
+        s.adaptiveMinSamples =
+            int(rd.integer(n["adaptive min samples"], "adaptive min samples", 2, 1 << 24));
 }
 
 // Reads the camera and returns its position in the file's coordinates: the scene's origin.
@@ -300,10 +307,8 @@ void readFilter(const Reader& rd, const YAML::Node& n, Filter& f) {
 SamplerType readSampler(const Reader& rd, const YAML::Node& n) {
     rd.checkKeys(n, "sampler", {"type"});
     std::string t = n["type"] ? rd.string(n["type"], "sampler type") : "Independent";
-    if (t == "Independent") return SamplerType::Independent;
-    if (t == "Grid") return SamplerType::Grid;
-    if (t == "Stratified") return SamplerType::Stratified;
-    rd.fail(n["type"], "unknown sampler type '" + t + "' (Independent, Grid or Stratified)");
+    if (std::optional<SamplerType> s = parseSampler(t)) return *s;
+    rd.fail(n["type"], "unknown sampler type '" + t + "' (Independent, Grid, Stratified or Sobol)");
 }
 
 // Texture trees. A YAML anchor may be used many times and even inside itself: a node seen
@@ -486,33 +491,34 @@ void readObject(const Reader& rd, const YAML::Node& n, const fs::path& dir, Scen
     pending.push_back({n, shader, (n["shader"] ? n["shader"] : n).Mark().line + 1});
 }
 
+// A light's `intensity` (1) x `colour` ([1, 1, 1]): the radiance of a quad light or an
+// environment, the intensity of a point light. Each channel must fit the range of any emission.
+glm::dvec3 lightIntensity(const Reader& rd, const YAML::Node& n, bool colourKey) {
+    const double intensity =
+        n["intensity"] ? rd.number(n["intensity"], "light intensity", 0.0, kMaxRadiance) : 1.0;
+    const glm::dvec3 colour = colourKey && n["colour"]
+                                  ? rd.dvec<3>(n["colour"], "light colour", 0.0, kMaxRadiance)
+                                  : glm::dvec3(1.0);
+    for (int i = 0; i < 3; ++i)
+        if (intensity * colour[i] > kMaxRadiance)
+            rd.fail(n["colour"] ? n["colour"] : n["intensity"],
+                    "light intensity x colour = " + Reader::fmt(intensity * colour[i]) +
+                        " exceeds " + Reader::fmt(kMaxRadiance) +
+                        ", the brightest radiance Spillway renders");
+    return intensity * colour;
+}
+
 // A quad light becomes two triangles (appended to lightMeshes) and an emissive Null shader of
 // its own (returned); both go after the scene's objects and shaders once the file is read.
-Shader readLight(const Reader& rd, const YAML::Node& n, const glm::dvec3& origin,
-                 std::vector<Mesh>& lightMeshes) {
-    if (!n.IsMap() || !n["type"]) rd.fail(n, "light needs a type (Quad)");
-    std::string t = rd.string(n["type"], "light type");
-    if (t == "Point" || t == "Environment")
-        rd.fail(n["type"], "light type '" + t + "' is not supported yet");
-    if (t != "Quad") rd.fail(n["type"], "unknown light type '" + t + "' (Quad)");
+Shader readQuadLight(const Reader& rd, const YAML::Node& n, const glm::dvec3& origin,
+                     std::vector<Mesh>& lightMeshes) {
     rd.checkKeys(n, "Quad light",
                  {"type", "translation", "rotation", "scale", "intensity", "colour"});
     glm::dvec2 size(1.0);
     if (n["scale"]) {
         size = rd.dvec<2>(n["scale"], "light scale", 1e-30, kMaxDistance);
     }
-    const double intensity =
-        n["intensity"] ? rd.number(n["intensity"], "light intensity", 0.0, kMaxRadiance) : 1.0;
-    const glm::dvec3 colour =
-        n["colour"] ? rd.dvec<3>(n["colour"], "light colour", 0.0, kMaxRadiance) : glm::dvec3(1.0);
-    for (int i = 0; i < 3; ++i) {
-        // The product is the light's radiance: it must fit the same range as any emission.
-        if (intensity * colour[i] > kMaxRadiance)
-            rd.fail(n["colour"] ? n["colour"] : n["intensity"],
-                    "light intensity x colour = " + Reader::fmt(intensity * colour[i]) +
-                        " exceeds " + Reader::fmt(kMaxRadiance) +
-                        ", the brightest radiance Spillway renders");
-    }
+    const glm::dvec3 emitted = lightIntensity(rd, n, true);
     const glm::dmat4 xf = readTransform(rd, n, "light", false);
 
     Mesh m;
@@ -538,9 +544,63 @@ Shader readLight(const Reader& rd, const YAML::Node& n, const glm::dvec3& origin
     s.typeName = "Quad light";
     s.line = n.Mark().line + 1;
     s.params.model = kModelNull;
-    s.params.emission = vec3(intensity * colour);
+    s.params.emission = vec3(emitted);
     lightMeshes.push_back(std::move(m));
     return s;
+}
+
+// `position` (camera-relative from here on), intensity x colour in W/sr.
+PointLight readPointLight(const Reader& rd, const YAML::Node& n, const glm::dvec3& origin) {
+    rd.checkKeys(n, "Point light", {"type", "position", "intensity", "colour"});
+    if (!n["position"]) rd.fail(n, "Point light needs a position");
+    const glm::dvec3 p = rd.dvec<3>(n["position"], "light position") - origin;
+    checkDistance(rd, n["position"], p, "point light");
+    PointLight light;
+    light.position = vec3(p);
+    light.intensity = vec3(lightIntensity(rd, n, true));
+    light.line = n.Mark().line + 1;
+    return light;
+}
+
+// `colour` (a constant) or `string` / `filename` (a lat-long image, read here, so that a bad
+// file is a scene error), times `intensity`.
+Environment readEnvironment(const Reader& rd, const YAML::Node& n, const fs::path& dir) {
+    rd.checkKeys(n, "Environment light", {"type", "colour", "string", "filename", "intensity"});
+    const YAML::Node file = n["string"] ? n["string"] : n["filename"];
+    if (file && n["colour"])
+        rd.fail(n["colour"], "Environment light takes a colour or an image ('string'), not both");
+    Environment env;
+    env.line = n.Mark().line + 1;
+    env.radiance = vec3(lightIntensity(rd, n, !file));
+    if (!file) return env;
+    const fs::path p = dir / rd.string(file, "environment image");
+    if (!fs::is_regular_file(p))
+        rd.fail(file, "environment image '" + p.string() + "' does not exist");
+    env.path = fs::absolute(p).lexically_normal().string();
+    ImageRGB img;
+    try {
+        img = spw::readImage(env.path);
+    } catch (const std::exception& e) {
+        rd.fail(file, e.what());
+    }
+    if (img.width < 1 || img.height < 1 || size_t(img.width) * size_t(img.height) > (1u << 26))
+        rd.fail(file, "environment image '" + env.path + "' is " + std::to_string(img.width) +
+                          " x " + std::to_string(img.height) +
+                          "; Spillway takes maps of 1 to 2^26 texels");
+    for (size_t i = 0; i < img.rgb.size(); ++i) {
+        const double v = double(img.rgb[i]) * double(env.radiance[int(i % 3)]);
+        if (!(v >= 0.0 && v <= kMaxRadiance)) {
+            const size_t texel = i / 3;
+            rd.fail(file, "environment image '" + env.path + "' has radiance " + Reader::fmt(v) +
+                              " at texel (" + std::to_string(texel % size_t(img.width)) + ", " +
+                              std::to_string(texel / size_t(img.width)) +
+                              "): every value must lie in 0 .. " + Reader::fmt(kMaxRadiance));
+        }
+    }
+    env.width = img.width;
+    env.height = img.height;
+    env.rgb = std::move(img.rgb);
+    return env;
 }
 
 } // namespace
@@ -555,6 +615,27 @@ std::string beyondReach(const glm::dvec3& p, const std::string& what) {
 float Camera::tanHalfFovX() const {
     if (fovDegrees) return std::tan(glm::radians(*fovDegrees) * 0.5f);
     return 0.5f * filmWidth / focalLength;
+}
+
+const char* samplerName(SamplerType s) {
+    switch (s) {
+    case SamplerType::Independent:
+        return "Independent";
+    case SamplerType::Grid:
+        return "Grid";
+    case SamplerType::Stratified:
+        return "Stratified";
+    case SamplerType::Sobol:
+        return "Sobol";
+    }
+    return "?";
+}
+
+std::optional<SamplerType> parseSampler(const std::string& name) {
+    for (SamplerType s :
+         {SamplerType::Independent, SamplerType::Grid, SamplerType::Stratified, SamplerType::Sobol})
+        if (name == samplerName(s)) return s;
+    return std::nullopt;
 }
 
 bool Scene::usesTextures() const {
@@ -669,8 +750,23 @@ Scene loadScene(const std::string& path) {
             } else if (key == "light" || key == "lights") {
                 if (key == "lights" && !v.IsSequence()) rd.fail(v, "'lights' must be a list");
                 each([&](const YAML::Node& e) {
-                    roomFor(e, 1, 1);
-                    lightShaders.push_back(readLight(rd, e, scene.origin, lightMeshes));
+                    if (!e.IsMap() || !e["type"])
+                        rd.fail(e, "light needs a type (Quad, Point or Environment)");
+                    const std::string t = rd.string(e["type"], "light type");
+                    if (t == "Quad") {
+                        roomFor(e, 1, 1);
+                        lightShaders.push_back(readQuadLight(rd, e, scene.origin, lightMeshes));
+                    } else if (t == "Point") {
+                        scene.pointLights.push_back(readPointLight(rd, e, scene.origin));
+                    } else if (t == "Environment") {
+                        if (scene.environment)
+                            rd.fail(e, "a second Environment light (the first is at line " +
+                                           std::to_string(scene.environment->line) + ")");
+                        scene.environment = readEnvironment(rd, e, dir);
+                    } else {
+                        rd.fail(e["type"],
+                                "unknown light type '" + t + "' (Quad, Point or Environment)");
+                    }
                 });
             } else {
                 rd.fail(it->first,

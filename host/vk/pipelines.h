@@ -1,5 +1,6 @@
 // The shading pipelines: one compute pipeline per kernel the scene needs, all sharing one
-// descriptor-set layout (0 shader table, 1 emitters, 2 emitter CDF, 3 inputs, 4 results) and
+// descriptor-set layout (0 shader table, 1 emitters, 2 emitter CDF, 3 environment map and CDFs,
+// 4 inputs, 5 results) and
 // one push-constant range (ShadePush). Kernels come from the embedded SPIR-V; specialisation
 // constants drop the code paths the scene does not need (shaders/shade_kernel.glsl lists them).
 #pragma once
@@ -35,7 +36,7 @@ class ShadingPipelines {
     VkPipeline pipeline(size_t i) const { return pipelines_[i]; }
     const std::vector<std::string>& names() const { return names_; }
 
-    static constexpr uint32_t kBindings = 5;
+    static constexpr uint32_t kBindings = 6;
 
   private:
     void release();

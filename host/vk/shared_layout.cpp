@@ -11,11 +11,12 @@ static_assert(sizeof(ShaderParams) == 48, "ShaderParams layout changed");
 static_assert(offsetof(ShaderParams, model) == 12 && offsetof(ShaderParams, flags) == 32,
               "ShaderParams layout");
 static_assert(sizeof(Emitter) == 80, "Emitter layout changed");
-static_assert(offsetof(Emitter, normal) == 48 && offsetof(Emitter, radiance) == 64,
+static_assert(offsetof(Emitter, normal) == 48 && offsetof(Emitter, type) == 60 &&
+                  offsetof(Emitter, radiance) == 64,
               "Emitter layout");
 static_assert(sizeof(SurfaceHit) == 64, "SurfaceHit layout changed");
 static_assert(sizeof(PathState) == 32, "PathState layout changed");
-static_assert(sizeof(RenderParams) == 32, "RenderParams layout changed");
+static_assert(sizeof(RenderParams) == 48, "RenderParams layout changed");
 // What the shading kernels read and write (shaders/shared/shade_io.h, shaders/shade_kernel.glsl).
 static_assert(offsetof(SurfaceHit, shader) == 28 && offsetof(SurfaceHit, emitter) == 44 &&
                   offsetof(SurfaceHit, albedo) == 48,
@@ -30,8 +31,8 @@ static_assert(offsetof(ShadeResult, emitted) == 4 && offsetof(ShadeResult, shado
 static_assert(sizeof(ShadeInput) == 112, "ShadeInput layout changed");
 static_assert(offsetof(ShadeInput, path) == 64 && offsetof(ShadeInput, rayDir) == 96,
               "ShadeInput layout");
-static_assert(sizeof(ShadePush) == 48 && offsetof(ShadePush, offset) == 32 &&
-                  offsetof(ShadePush, count) == 36,
+static_assert(sizeof(ShadePush) == 64 && offsetof(ShadePush, offset) == 48 &&
+                  offsetof(ShadePush, count) == 52,
               "ShadePush layout changed");
 static_assert(sizeof(ShadePush) <= 128,
               "push constants beyond the 128 bytes every device guarantees");

@@ -80,7 +80,7 @@ class VulkanShading : public ShadingEngine {
     RenderParams params_;
     VulkanConfig config_;
     StageTimes& stages_;
-    std::unique_ptr<HostArray> shaderTable_, emitterTable_, emitterCdf_;
+    std::unique_ptr<HostArray> shaderTable_, emitterTable_, emitterCdf_, environment_;
     std::unique_ptr<vk::ShadingPipelines> pipelines_;
     int modelPipeline_[kModelCount];
     int megakernel_ = -1;
@@ -196,16 +196,21 @@ VulkanShading::VulkanShading(const RenderContext& ctx, const PipelineConfig& pip
             };
             shaderTable_ =
                 table(view.shaders, scene.shaders.size() * sizeof(ShaderParams), "shader");
-            emitterTable_ = table(view.emitters, view.emitterCount * sizeof(Emitter), "emitter");
+            const SceneLights& lights = ctx.lights;
+            emitterTable_ =
+                table(view.emitters, lights.emitters().size() * sizeof(Emitter), "emitter");
             emitterCdf_ = table(view.emitterCdf, view.emitterCount * sizeof(float), "emitter CDF");
+            // The environment's map and CDFs; a constant environment (or none) binds 4 bytes.
+            environment_ = table(lights.environmentData().data(),
+                                 lights.environmentData().size() * sizeof(float), "environment");
             if (shaderTable_->staged()) {
                 VkCommandBuffer cmd = slots_[0].cmd;
                 auto begin =
                     zeroed<VkCommandBufferBeginInfo>(VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO);
                 begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
                 SPW_VK_CHECK(vkBeginCommandBuffer(cmd, &begin));
-                for (const HostArray* a :
-                     {shaderTable_.get(), emitterTable_.get(), emitterCdf_.get()})
+                for (const HostArray* a : {shaderTable_.get(), emitterTable_.get(),
+                                           emitterCdf_.get(), environment_.get()})
                     a->recordCopy(cmd, a->size());
                 barrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
                         VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT);
@@ -260,6 +265,7 @@ void VulkanShading::release() {
     shaderTable_.reset();
     emitterTable_.reset();
     emitterCdf_.reset();
+    environment_.reset();
 }
 
 void VulkanShading::submitAndWait(VkCommandBuffer cmd, VkFence fence) {
@@ -316,6 +322,7 @@ void VulkanShading::grow(Slot& s, size_t count) {
             {shaderTable_->device(), 0, VK_WHOLE_SIZE},
             {emitterTable_->device(), 0, VK_WHOLE_SIZE},
             {emitterCdf_->device(), 0, VK_WHOLE_SIZE},
+            {environment_->device(), 0, VK_WHOLE_SIZE},
             {s.inputs->device(), first * sizeof(ShadeInput), records * sizeof(ShadeInput)},
             {s.results->device(), first * sizeof(ShadeResult), records * sizeof(ShadeResult)},
         };

@@ -11,6 +11,7 @@
 //   * no references, pointers, templates or constructors: parameters are `in`, `OUT(T)` or
 //     `INOUT(T)`, and structs are filled field by field;
 //   * functions are declared `SHARED_FN` (inline in C++, nothing in GLSL);
+//   * constant tables are written SHARED_ARRAY_BEGIN(T, name, n) values SHARED_ARRAY_END;
 //   * a parameter an interface requires but a function does not read is marked `UNUSED(p);`;
 //   * GLSL's `out` parameters are not copied in, and a callee's unwritten `out` overwrites the
 //     caller's variable with an undefined value: a function writes every `out` it promises;
@@ -48,12 +49,27 @@ using glm::mix;
 using glm::normalize;
 using glm::sign;
 using glm::uintBitsToFloat;
+using std::acos;
 using std::atan;
+// GLSL's two-argument atan.
+inline float atan(float y, float x) {
+    return std::atan2(y, x);
+}
 using std::cos;
 using std::exp;
 using std::floor;
 using std::sin;
 using std::sqrt;
+// GLSL's bit built-ins, as the compilers' own instructions (glm's are generic loops and masks).
+inline uint bitfieldReverse(uint x) {
+    x = __builtin_bswap32(x);
+    x = ((x >> 4u) & 0x0F0F0F0Fu) | ((x & 0x0F0F0F0Fu) << 4u);
+    x = ((x >> 2u) & 0x33333333u) | ((x & 0x33333333u) << 2u);
+    return ((x >> 1u) & 0x55555555u) | ((x & 0x55555555u) << 1u);
+}
+inline int findLSB(uint x) {
+    return x != 0u ? __builtin_ctz(x) : -1;
+}
 } // namespace spw
 
 #define SHARED_FN inline
@@ -62,6 +78,8 @@ using std::sqrt;
 #define SHARED_BEGIN namespace spw {
 #define SHARED_END }
 #define UNUSED(x) (void)(x)
+#define SHARED_ARRAY_BEGIN(T, name, n) constexpr T name[n] = {
+#define SHARED_ARRAY_END }
 #else
 #define SHARED_FN
 #define OUT(T) out T
@@ -69,6 +87,8 @@ using std::sqrt;
 #define SHARED_BEGIN
 #define SHARED_END
 #define UNUSED(x)
+#define SHARED_ARRAY_BEGIN(T, name, n) const T name[n] = T[n](
+#define SHARED_ARRAY_END )
 #endif
 
 SHARED_BEGIN

@@ -34,6 +34,8 @@ SHARED_BEGIN
 
 const float kOffsetRelative = 1.0f / 1048576.0f; // 2^-20
 const float kOffsetAbsolute = 1e-30f;
+// A shadow ray toward the environment: beyond anything the scene format places (1e15 units).
+const float kInfiniteDistance = 1e30f;
 
 // How far rays leave point p of triangle (v0, v1, v2), whose unit geometric normal is n.
 SHARED_FN float surfaceOffset(vec3 p, vec3 v0, vec3 v1, vec3 v2, vec3 n) {

@@ -35,6 +35,64 @@ SHARED_FN PathState cameraPath(RenderParams rp, uint pixel, uint s, float pixelS
     return st;
 }
 
+// One light sample from a shading point: the direction, how far the shadow ray may go, the
+// radiance (or a point light's intensity / r^2) arriving along it, and its solid-angle pdf
+// including the emitter's pick probability (for a point light, the pick probability alone).
+struct LightSample {
+    vec3 wi;
+    float tmax;
+    vec3 radiance;
+    float pdf;
+};
+
+SHARED_FN LightSample sampleEmitter(SCENE_PARAM RenderParams rp, Emitter e, SurfaceHit hit,
+                                    vec2 u) {
+    LightSample ls;
+    ls.wi = vec3(0.0f, 0.0f, 1.0f);
+    ls.tmax = 0.0f;
+    ls.radiance = vec3(0.0f);
+    ls.pdf = 0.0f;
+    if (e.type == kEmitterEnvironment) {
+        ls.wi = environmentSample(SCENE_ARG rp, u);
+        ls.pdf = e.pickPdf * environmentPdf(SCENE_ARG rp, ls.wi);
+        ls.radiance = environmentRadiance(SCENE_ARG rp, e, ls.wi);
+        ls.tmax = kInfiniteDistance;
+        return ls;
+    }
+    vec3 q = e.type == kEmitterPoint ? e.p0 : emitterPoint(e, u);
+    vec3 d = q - hit.p;
+    float dist = length(d);
+    if (!(dist > 0.0f)) return ls;
+    ls.wi = d / dist;
+    if (e.type == kEmitterPoint) {
+        ls.radiance = e.radiance / (dist * dist);
+        ls.pdf = e.pickPdf;
+        // Stop short of the point by the origin's own offset: there is no surface at q.
+        ls.tmax = shadowRayTmax(dist, hit.offset, 0.0f, 1.0f);
+        return ls;
+    }
+    float cosLight = emitterCosine(e, -ls.wi);
+    ls.pdf = emitterSolidAnglePdf(e, dist, cosLight);
+    ls.radiance = e.radiance;
+    // Stop short of the emitter's own surface, whatever the scene's scale.
+    float offsetQ = surfaceOffset(q, e.p0, e.p0 + e.e1, e.p0 + e.e2, e.normal);
+    ls.tmax = shadowRayTmax(dist, hit.offset, offsetQ, cosLight);
+    return ls;
+}
+
+// What a ray that leaves the scene brings back: the environment's radiance along it, weighted
+// against having sampled that direction from the previous vertex (zero without an environment).
+SHARED_FN vec3 escapedRadiance(SCENE_PARAM RenderParams rp, vec3 rayDir, PathState st) {
+    if (rp.environment == kNoEmitter) return vec3(0.0f);
+    Emitter e = EMITTER(rp.environment);
+    float w = 1.0f;
+    bool sampledByBsdf = st.bounce > 0u && (st.flags & kPathSpecular) == 0u;
+    if (sampledByBsdf && rp.strategy == kStrategyLight) w = 0.0f;
+    if (sampledByBsdf && rp.strategy == kStrategyMis)
+        w = powerHeuristic(st.prevPdf, e.pickPdf * environmentPdf(SCENE_ARG rp, rayDir));
+    return st.beta * environmentRadiance(SCENE_ARG rp, e, rayDir) * w;
+}
+
 SHARED_FN void shadeSurface(SCENE_PARAM RenderParams rp, SurfaceHit hit, vec3 rayDir, PathState st,
                             OUT(ShadeResult) r) {
     r.flags = 0u;
@@ -71,39 +129,33 @@ SHARED_FN void shadeSurface(SCENE_PARAM RenderParams rp, SurfaceHit hit, vec3 ra
 
     if (st.bounce >= rp.maxDepth || sh.model == kModelNull) return;
 
-    vec4 uLight = rand4(rp.seed, pixel, sampleIndex, st.bounce, kDimLight);
+    vec4 uLight = rand4(rp.sampling, rp.seed, pixel, sampleIndex, st.bounce, kDimLight);
 
-    // 2. Next-event estimation: one emitter picked by power, one point on it by area. A BSDF of
-    //    delta lobes only can never reach the sampled point: no shadow ray.
+    // 2. Next-event estimation: one emitter picked by power, one point on it (or direction to
+    //    it). A BSDF of delta lobes only can never reach the sampled point: no shadow ray.
     if (rp.emitterCount > 0u && rp.strategy != kStrategyBsdf && !bsdfIsDelta(sh)) {
         uint ei = pickEmitter(SCENE_ARG rp.emitterCount, uLight.x);
         Emitter e = EMITTER(ei);
-        vec3 q = emitterPoint(e, vec2(uLight.y, uLight.z));
-        vec3 d = q - hit.p;
-        float dist = length(d);
-        if (dist > 0.0f) {
-            vec3 wi = d / dist;
-            float cosLight = emitterCosine(e, -wi);
-            float lightPdf = emitterSolidAnglePdf(e, dist, cosLight);
+        LightSample ls = sampleEmitter(SCENE_ARG rp, e, hit, vec2(uLight.y, uLight.z));
+        if (ls.pdf > 0.0f) {
             float bsdfPdf;
-            vec3 fcos = bsdfEval(sh, hit.albedo, hit.ng, hit.ns, wo, wi, bsdfPdf);
-            if (lightPdf > 0.0f && maxComponent(fcos) > 0.0f) {
-                float w = rp.strategy == kStrategyMis
-                              ? powerHeuristic(lightPdf, quantizePdf(bsdfPdf))
+            vec3 fcos = bsdfEval(sh, hit.albedo, hit.ng, hit.ns, wo, ls.wi, bsdfPdf);
+            if (maxComponent(fcos) > 0.0f) {
+                // A point light is a delta: BSDF sampling cannot find it, no MIS.
+                float w = rp.strategy == kStrategyMis && e.type != kEmitterPoint
+                              ? powerHeuristic(ls.pdf, quantizePdf(bsdfPdf))
                               : 1.0f;
-                r.shadowOrigin = offsetOrigin(hit.p, hit.ng, hit.offset, wi);
-                r.shadowDir = wi;
-                // Stop short of the emitter's own surface, whatever the scene's scale.
-                float offsetQ = surfaceOffset(q, e.p0, e.p0 + e.e1, e.p0 + e.e2, e.normal);
-                r.shadowTmax = shadowRayTmax(dist, hit.offset, offsetQ, cosLight);
-                r.shadowContribution = st.beta * fcos * e.radiance * (w / lightPdf);
+                r.shadowOrigin = offsetOrigin(hit.p, hit.ng, hit.offset, ls.wi);
+                r.shadowDir = ls.wi;
+                r.shadowTmax = ls.tmax;
+                r.shadowContribution = st.beta * fcos * ls.radiance * (w / ls.pdf);
                 if (r.shadowTmax > 0.0f) r.flags |= kShadeShadow;
             }
         }
     }
 
     // 3. Continuation: sample the BSDF, then Russian roulette once min depth bounces are done.
-    vec4 uBsdf = rand4(rp.seed, pixel, sampleIndex, st.bounce, kDimBsdf);
+    vec4 uBsdf = rand4(rp.sampling, rp.seed, pixel, sampleIndex, st.bounce, kDimBsdf);
     vec3 wi;
     vec3 weight;
     float pdf;

@@ -31,18 +31,24 @@ struct ShaderParams {
     uint pad0;
 };
 
-// One emitting triangle (quad lights are two). Sampled uniformly by area; picked with
-// probability pickPdf, proportional to its power.
+// What next-event estimation picks, with probability pickPdf, proportional to its power
+// (host/scene/lights.cpp says how each kind's power is estimated).
+const uint kEmitterTriangle = 0u;    // one triangle of an emitting mesh (a quad light is two),
+                                     // sampled uniformly by area
+const uint kEmitterPoint = 1u;       // a point light at p0: a delta light, never hit
+const uint kEmitterEnvironment = 2u; // radiance at infinity, seen by rays that escape
+
 struct Emitter {
-    vec3 p0;
+    vec3 p0; // triangle: vertex 0; point: the position
     float area;
-    vec3 e1; // v1 - v0
+    vec3 e1; // triangle: v1 - v0
     float pickPdf;
-    vec3 e2; // v2 - v0
+    vec3 e2; // triangle: v2 - v0
     uint twoSided;
-    vec3 normal; // unit, cross(e1, e2) direction: the front face
-    float pad0;
-    vec3 radiance;
+    vec3 normal;   // triangle: unit, cross(e1, e2) direction: the front face
+    uint type;     // kEmitter*
+    vec3 radiance; // triangle: radiance; point: intensity (W/sr); environment: radiance (times
+                   // the map's texel where it has one)
     float pad1;
 };
 
@@ -84,6 +90,10 @@ struct RenderParams {
     float threshold;
     uint strategy;
     uint emitterCount;
+    uint sampling;    // kSampler* (shared/rng.h): the numbers of every dimension after the pixel's
+    uint environment; // the environment's emitter index, or kNoEmitter
+    uint envWidth;    // its lat-long map's size in texels; 0 x 0 for a constant environment
+    uint envHeight;
 };
 
 const uint kShadeEmitted = 1u;

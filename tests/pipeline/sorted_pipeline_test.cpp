@@ -38,7 +38,8 @@ bool sameBits(const std::vector<float>& a, const std::vector<float>& b) {
 // With full-precision rays the sorted pipeline traces exactly the reference's paths with the
 // same random numbers, and the fixed-point film makes the sums order-independent: the images
 // are identical, not merely close. The Cornell box (Lambert, Stratified, Box filter) and a
-// scene with every surface model, a Layered image texture, a Gaussian filter and a thin lens.
+// scene with every surface model, a Layered image texture, a Gaussian filter and a thin lens,
+// each also with the Sobol sampler.
 TEST(SortedPipeline, FullPrecisionRaysGiveTheReferenceImageBitForBit) {
     // scenes/every-model.yaml at 24 x 24 (8 spp below).
     Scene everyModel = loadScene(sourceDir() + "/scenes/every-model.yaml");
@@ -49,7 +50,9 @@ TEST(SortedPipeline, FullPrecisionRaysGiveTheReferenceImageBitForBit) {
     Scene strip = smallCornell(4);
     strip.image.width = 16384;
     strip.settings.maxDepth = 2;
-    for (const Scene& scene : {smallCornell(40), everyModel, strip}) {
+    Scene sobolCornell = smallCornell(40), sobolEveryModel = everyModel;
+    sobolCornell.sampler = sobolEveryModel.sampler = SamplerType::Sobol;
+    for (const Scene& scene : {smallCornell(40), everyModel, strip, sobolCornell, sobolEveryModel}) {
         RenderConfig ref;
         ref.backend = BackendKind::Reference;
         ref.spp = 8;

@@ -2,6 +2,7 @@
 // every class of bad input stops the program with "file:line:" and exit status 2 before anything
 // is rendered, a scene without entries takes the documented defaults, and transforms compose as
 // specified (scale, then R = Rz*Ry*Rx, then translation).
+#include "host/image/image_io.h"
 #include "test_util.h"
 
 #include <OpenImageIO/imageio.h>
@@ -422,6 +423,33 @@ TEST(Loader, QuadLightRotatedNinetyAboutXFacesDown) {
     expectNear(hi, vec3(3, 5, -2), 1e-5f, "upper corner");
 }
 
+TEST(Loader, PointAndEnvironmentLightsAddNoShaderOrObject) {
+    TempDir dir;
+    writeImage(dir.file("sky.exr"), ImageRGB{4, 2, std::vector<float>(24, 0.25f)});
+    Scene scene = loadScene(
+        dir.write("lights.yaml",
+                  "camera: {look at: {eye: [1, 0, 0], target: [0, 0, 0]}}\n"
+                  "lights:\n"
+                  "  - {type: Point, position: [1, 5, -3], intensity: 2, colour: [1, 0.5, 0]}\n"
+                  "  - {type: Environment, string: sky.exr, intensity: 4}\n"));
+    EXPECT_TRUE(scene.shaders.empty());
+    EXPECT_TRUE(scene.meshes.empty());
+    ASSERT_EQ(scene.pointLights.size(), 1u);
+    // Camera-relative, as all geometry.
+    expectNear(scene.pointLights[0].position, vec3(0, 5, -3), 1e-6f, "position");
+    expectNear(scene.pointLights[0].intensity, vec3(2, 1, 0), 0.0f, "intensity");
+    ASSERT_TRUE(scene.environment);
+    EXPECT_EQ(scene.environment->width, 4);
+    EXPECT_EQ(scene.environment->height, 2);
+    expectNear(scene.environment->radiance, vec3(4), 0.0f, "scale");
+    EXPECT_FLOAT_EQ(scene.environment->rgb[5], 0.25f);
+    Scene constant =
+        loadScene(dir.write("c.yaml", "light: {type: Environment, colour: [1, 2, 3]}\n"));
+    ASSERT_TRUE(constant.environment);
+    EXPECT_TRUE(constant.environment->path.empty());
+    expectNear(constant.environment->radiance, vec3(1, 2, 3), 0.0f, "colour");
+}
+
 // The hit-sort key holds 12 bits of shader and 20 of object: the loader caps both, a light
 // counting one of each, and names the first element beyond the cap.
 TEST(Loader, ShaderAndObjectCountsStayWithinTheHitKey) {
@@ -541,10 +569,16 @@ const ErrorCase kErrorCases[] = {
      3, "ior"},
     {"DielectricNegativeAlpha", "shader:\n  type: Dielectric\n  alpha: -0.1\n", 3, "alpha"},
     {"DielectricTakesNoColour", "shader:\n  type: Dielectric\n  colour: [1, 1, 1]\n", 3, "colour"},
-    {"PointLightNotSupported",
-     "light: {type: Quad}\nlight:\n  type: Point\n  position: [0, 1, 0]\n", 3, "not supported yet"},
-    {"EnvironmentLightNotSupported", "lights:\n  - {type: Environment, colour: [1, 1, 1]}\n", 2,
-     "not supported yet"},
+    {"PointLightWithoutPosition", "light: {type: Quad}\nlight:\n  type: Point\n  intensity: 2\n", 3,
+     "needs a position"},
+    {"PointLightFarAway", "light: {type: Point, position: [0, 1e16, 0]}\n", 1, "1e16 units"},
+    {"EnvironmentColourAndImage",
+     "lights:\n  - {type: Environment, colour: [1, 1, 1], string: sky.exr}\n", 2, "not both"},
+    {"EnvironmentImageMissing", "light: {type: Environment, string: none.exr}\n", 1,
+     "does not exist"},
+    {"SecondEnvironment", "lights:\n  - {type: Environment}\n  - {type: Environment}\n", 3,
+     "second Environment"},
+    {"UnknownLightType", "light: {type: Spot}\n", 1, "Quad, Point or Environment"},
     {"UnknownShaderType", "shader:\n  type: Phong\n", 2, "Phong"},
     {"YamlSyntaxError", "image:\n  width: 8\n  height: 8: 9\n", 3, "YAML"},
     {"ImageTwice", "image: {width: 8}\ncamera: {fov: 40}\nimage: {height: 8}\n", 3, "image"},
