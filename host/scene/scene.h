@@ -157,7 +157,7 @@ struct Scene {
     Settings settings;
     Camera camera;
     Filter filter;
-    SamplerType sampler = SamplerType::Independent;
+    SamplerType sampler = SamplerType::Sobol; // measured best: README, "Convergence"
     std::vector<Shader> shaders; // scene shaders first, then one emissive Null per quad light
     std::vector<Texture> textures;
     std::vector<Mesh> meshes; // objects first, then the quad lights' geometry

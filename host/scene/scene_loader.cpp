@@ -306,7 +306,7 @@ void readFilter(const Reader& rd, const YAML::Node& n, Filter& f) {
 
 SamplerType readSampler(const Reader& rd, const YAML::Node& n) {
     rd.checkKeys(n, "sampler", {"type"});
-    std::string t = n["type"] ? rd.string(n["type"], "sampler type") : "Independent";
+    std::string t = n["type"] ? rd.string(n["type"], "sampler type") : "Sobol";
     if (std::optional<SamplerType> s = parseSampler(t)) return *s;
     rd.fail(n["type"], "unknown sampler type '" + t + "' (Independent, Grid, Stratified or Sobol)");
 }

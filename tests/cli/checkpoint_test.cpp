@@ -77,6 +77,40 @@ TEST(Checkpoint, StoppedAnywhereAndResumedGivesTheUninterruptedImageOnEveryBacke
     }
 }
 
+// Adaptive sampling and the Sobol sampler resume exactly too: the tiles' decisions come back
+// from the checkpoint's sums and sample counts, so the resumed render takes the same samples.
+TEST(Checkpoint, AdaptiveSobolRenderResumesToTheSameImageAndSamples) {
+    TempDir dir;
+    const std::string scene = smallCornellBox(dir, 40, 40);
+    const std::vector<std::string> adaptive = {"--sampler", "Sobol", "--adaptive-threshold",
+                                               "0.2", "--adaptive-min-spp", "4"};
+    auto args = [&](std::vector<std::string> extra) {
+        std::vector<std::string> a = {"render", scene, "--backend", "cpu", "--spp", "64"};
+        a.insert(a.end(), adaptive.begin(), adaptive.end());
+        a.insert(a.end(), extra.begin(), extra.end());
+        return a;
+    };
+    const std::string full = dir.file("full.exr"), ck = dir.file("ck.exr");
+    ChildResult f = runChild(args({"--quiet", "-o", full, "--stats", dir.file("full.json")}));
+    ASSERT_EQ(f.status, 0) << f.output;
+    ChildResult p = runChild(args({"--progress", "lines", "--checkpoint", ck, "-o",
+                                   dir.file("part.exr")}),
+                             [&](pid_t pid) {
+                                 waitForChildOutput(pid, "iteration 6/");
+                                 kill(pid, SIGINT);
+                             });
+    ASSERT_EQ(p.status, 130) << p.output;
+    const std::string resumed = dir.file("resumed.exr");
+    ChildResult r =
+        runChild(args({"--quiet", "--resume", ck, "-o", resumed, "--stats", dir.file("r.json")}));
+    ASSERT_EQ(r.status, 0) << r.output;
+    EXPECT_TRUE(samePixels(resumed, full));
+    const nlohmann::json a = nlohmann::json::parse(std::ifstream(dir.file("full.json")));
+    const nlohmann::json b = nlohmann::json::parse(std::ifstream(dir.file("r.json")));
+    EXPECT_EQ(a["samples_taken"], b["samples_taken"]);
+    EXPECT_LT(a["samples_taken"].get<std::uint64_t>(), std::uint64_t(40 * 40 * 64));
+}
+
 // A checkpoint of another render is refused before any work: exit 2, the reason named, nothing
 // written. Backends may differ (they trace the same paths).
 TEST(Checkpoint, ACheckpointOfAnotherRenderIsRefused) {

@@ -100,6 +100,7 @@ TEST(Adaptive, FlatRegionsTakeFewerSamplesThanEdges) {
                             "settings: {max depth: 4, adaptive threshold: 0.03, "
                             "adaptive min samples: 8}\n"
                             "camera: {look at: {eye: [0, 0, 6], target: [0, 0, 0]}, fov: 40}\n"
+                            "sampler: {type: Independent}\n"
                             "object: {filename: cube.obj, shader: 0}\n"
                             "shader: {type: Emissive, emission: [0.2, 0.2, 0.2]}\n"
                             "light: {type: Environment, colour: [1, 1, 1]}\n"));

@@ -205,7 +205,7 @@ TEST(Loader, EmptyFileTakesTheDocumentedDefaults) {
     EXPECT_FLOAT_EQ(scene.camera.filmWidth, 35.0f);
     EXPECT_FALSE(scene.camera.fovDegrees.has_value());
     EXPECT_EQ(scene.filter.type, FilterType::Box);
-    EXPECT_EQ(scene.sampler, SamplerType::Independent);
+    EXPECT_EQ(scene.sampler, SamplerType::Sobol);
     EXPECT_TRUE(scene.meshes.empty());
     EXPECT_TRUE(scene.shaders.empty());
     EXPECT_EQ(scene.objectCount, 0);
