@@ -135,6 +135,19 @@ TEST(Sobol, PaddingDecorrelatesGroups) {
     EXPECT_LT(chi2, 340.0);
 }
 
+// The C++ build reads Sobol's matrix columns a byte at a time from tables; the GLSL kernels
+// loop over the bits. Both must give the same numbers, or vulkan and cpu would trace different
+// paths.
+TEST(Sobol, ByteTablesEqualTheBitLoop) {
+    uint r = 12345u;
+    for (int i = 0; i < 100000; ++i) {
+        r = pcg4d(uvec4(r, uint(i), 7u, 9u)).x;
+        ASSERT_EQ(sobolReversedColumns(r), sobolReversedColumnsLoop(r)) << "r = " << r;
+    }
+    for (uint bit = 0; bit < 32; ++bit)
+        ASSERT_EQ(sobolReversedColumns(1u << bit), sobolReversedColumnsLoop(1u << bit)) << bit;
+}
+
 TEST(Sobol, NumbersArePureFunctionsOfTheirKey) {
     for (uint i = 0; i < 100; ++i) {
         vec4 a = rand4(kSamplerSobol, 3u, i * 7u, i, i % 4u, kDimCamera);
