@@ -1,6 +1,7 @@
 #include "test_util.h"
 
 #include "host/image/image_io.h"
+#include "host/scene/camera.h"
 #include "host/vk/context.h"
 
 #include <gtest/gtest.h>
@@ -253,6 +254,28 @@ std::string floorObj(float h) {
     std::snprintf(buf, sizeof buf, "v %g 0 %g\nv %g 0 %g\nv %g 0 %g\nv %g 0 %g\nf 1 2 3 4\n", -h,
                   -h, -h, h, h, h, h, -h);
     return buf;
+}
+
+Scene floorUnderLight(TempDir& dir, int iterations, const std::string& settings,
+                      const std::string& light) {
+    dir.write("floor.obj", floorObj(4.0f));
+    return loadScene(dir.write(
+        "floor.yaml", "image: {width: 16, height: 16, sample base: 1, iterations: " +
+                          std::to_string(iterations) + "}\nsettings: {" + settings +
+                          "}\n"
+                          "camera: {look at: {eye: [0.2, 0.6, 0.1], target: [0.2, 0, 0.1], "
+                          "up: [0, 0, -1]}, fov: 90}\n"
+                          "sampler: {type: Grid}\n"
+                          "object: {filename: floor.obj, shader: 0}\n"
+                          "shader: {type: Lambert, reflectance: 0.5}\n"
+                          "light: " +
+                          light + "\n"));
+}
+
+vec3 floorPointAtPixelCentre(const Scene& scene, int x, int y) {
+    const CameraRay r = CameraModel(scene, 1).generate(uint(x), uint(y), 0, 0, 0);
+    const vec3 o = vec3(scene.origin) + r.origin; // the world is camera-relative
+    return o + r.dir * (-o.y / r.dir.y);
 }
 
 std::string childLogPath() {

@@ -143,4 +143,13 @@ std::string insideCubeObj();
 // A square [-h,h]^2 at y = 0 facing +Y, as OBJ text.
 std::string floorObj(float halfSize);
 
+// The scene of the per-pixel closed-form tests: a Lambert floor of albedo 0.5 (floorObj(4)) seen
+// from 0.6 above by a 90-degree camera looking down, 16 x 16 pixels, the Grid sampler (every
+// sample at the pixel centre), `iterations` of one sample, under `light` (a light entry), with
+// `settings` (the settings map's entries, max depth 1 among them). Returns the loaded scene.
+Scene floorUnderLight(TempDir& dir, int iterations, const std::string& settings,
+                      const std::string& light);
+// The point of the floor y = 0, in the scene file's coordinates, that pixel (x, y)'s centre sees.
+vec3 floorPointAtPixelCentre(const Scene& scene, int x, int y);
+
 } // namespace spw::test

@@ -61,17 +61,10 @@ TEST(Adaptive, EnclosureMeanIsLeOverOneMinusAlbedo) {
 // form (each pixel's polygon irradiance at its centre, the Grid sampler), within standard errors.
 TEST(Adaptive, QuadLightIrradianceIsUnbiased) {
     TempDir dir;
-    dir.write("floor.obj", floorObj(4.0f));
-    const Scene scene = loadScene(
-        dir.write("quad.yaml", "image: {width: 16, height: 16, sample base: 1, iterations: 256}\n"
-                               "settings: {max depth: 1, adaptive threshold: 0.02}\n"
-                               "camera: {look at: {eye: [0.2, 0.6, 0.1], target: [0.2, 0, 0.1], "
-                               "up: [0, 0, -1]}, fov: 90}\n"
-                               "sampler: {type: Grid}\n"
-                               "object: {filename: floor.obj, shader: 0}\n"
-                               "shader: {type: Lambert, reflectance: 0.5}\n"
-                               "light: {type: Quad, translation: [0, 1, 0], rotation: [90, 0, 0], "
-                               "scale: [1, 0.5], intensity: 3}\n"));
+    const Scene scene =
+        floorUnderLight(dir, 256, "max depth: 1, adaptive threshold: 0.02",
+                        "{type: Quad, translation: [0, 1, 0], rotation: [90, 0, 0], "
+                        "scale: [1, 0.5], intensity: 3}");
     // The same scene without adaptive sampling, many samples: its mean is the closed form's to
     // well within this test's errors (QuadLight.PixelsMatchPolygonIrradiance).
     Scene full = scene;

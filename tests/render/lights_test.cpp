@@ -117,19 +117,10 @@ TEST(Environment, WhiteFurnaceConvexLambertIsAlbedoTimesRadiance) {
 // delta light, one bounce): the render equals the closed form up to float rounding.
 TEST(PointLight, RadianceIsAlbedoOverPiTimesIntensityCosOverRSquared) {
     TempDir dir;
-    dir.write("floor.obj", floorObj(4.0f));
-    const Scene scene = loadScene(
-        dir.write("point.yaml", "image: {width: 16, height: 16, sample base: 1, iterations: 4}\n"
-                                "settings: {max depth: 1}\n"
-                                "camera: {look at: {eye: [0.2, 0.6, 0.1], target: [0.2, 0, 0.1], "
-                                "up: [0, 0, -1]}, fov: 90}\n"
-                                "sampler: {type: Grid}\n"
-                                "object: {filename: floor.obj, shader: 0}\n"
-                                "shader: {type: Lambert, reflectance: 0.5}\n"
-                                "light: {type: Point, position: [0.5, 0.7, -0.2], intensity: 3, "
-                                "colour: [1, 0.5, 0.25]}\n"));
+    const Scene scene = floorUnderLight(
+        dir, 4, "max depth: 1",
+        "{type: Point, position: [0.5, 0.7, -0.2], intensity: 3, colour: [1, 0.5, 0.25]}");
     const vec3 light(0.5f, 0.7f, -0.2f);
-    CameraModel cam(scene, 1);
     for (BackendKind b : hostBackends()) {
         RenderConfig cfg;
         cfg.backend = b;
@@ -137,10 +128,7 @@ TEST(PointLight, RadianceIsAlbedoOverPiTimesIntensityCosOverRSquared) {
         double worst = 0;
         for (int y = 0; y < 16; ++y)
             for (int x = 0; x < 16; ++x) {
-                const CameraRay r = cam.generate(uint(x), uint(y), 0, 0, 0);
-                const vec3 o = vec3(scene.origin) + r.origin; // the world is camera-relative
-                const vec3 p = o + r.dir * (-o.y / r.dir.y);
-                const vec3 d = light - p;
+                const vec3 d = light - floorPointAtPixelCentre(scene, x, y);
                 const double r2 = double(glm::dot(d, d));
                 const double e = 3.0 * double(d.y) / std::sqrt(r2) / r2;
                 for (int c = 0; c < 3; ++c) {

@@ -75,29 +75,18 @@ double polygonIrradiance(vec3 x, vec3 n, const std::vector<vec3>& corners, doubl
 // A Lambert floor under one quad light, direct light only: every pixel is albedo/pi * E(x).
 TEST(QuadLight, PixelsMatchPolygonIrradiance) {
     TempDir dir;
-    dir.write("floor.obj", floorObj(4.0f));
-    const std::string path =
-        dir.write("quad.yaml", "image: {width: 16, height: 16, sample base: 1, iterations: 256}\n"
-                               "settings: {max depth: 1}\n"
-                               "camera: {look at: {eye: [0.2, 0.6, 0.1], target: [0.2, 0, 0.1], "
-                               "up: [0, 0, -1]}, fov: 90}\n"
-                               "sampler: {type: Grid}\n"
-                               "object: {filename: floor.obj, shader: 0}\n"
-                               "shader: {type: Lambert, reflectance: 0.5}\n"
-                               "light: {type: Quad, translation: [0, 1, 0], rotation: [90, 0, 0], "
-                               "scale: [1, 0.5], intensity: 3}\n");
-    Scene scene = loadScene(path);
+    const Scene scene =
+        floorUnderLight(dir, 256, "max depth: 1",
+                        "{type: Quad, translation: [0, 1, 0], rotation: [90, 0, 0], "
+                        "scale: [1, 0.5], intensity: 3}");
     PixelStats ps;
     auto result = renderWithStats(scene, referenceConfig(), &ps);
     const std::vector<vec3> corners = {
         {-0.5f, 1, -0.25f}, {0.5f, 1, -0.25f}, {0.5f, 1, 0.25f}, {-0.5f, 1, 0.25f}};
-    CameraModel cam(scene, 1);
     double worstZ = 0, sumZ = 0;
     for (int y = 0; y < 16; ++y)
         for (int x = 0; x < 16; ++x) {
-            CameraRay r = cam.generate(uint(x), uint(y), 0, 0, 0); // Grid: the pixel centre
-            const vec3 o = vec3(scene.origin) + r.origin;          // the world is camera-relative
-            vec3 p = o + r.dir * (-o.y / r.dir.y);
+            const vec3 p = floorPointAtPixelCentre(scene, x, y);
             double expected = 0.5 / kPi * polygonIrradiance(p, vec3(0, 1, 0), corners, 3.0);
             size_t i = size_t(y * 16 + x);
             double z = (ps.mean(i) - expected) / std::max(ps.stderror(i), 1e-12);

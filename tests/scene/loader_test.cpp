@@ -503,6 +503,7 @@ TEST_P(LoaderError, ExitsTwoNamingFileAndLine) {
     dir.write("bad_inf.obj", "v 0 0 0\nv 0 inf 0\nv 1 0 0\nf 1 2 3\n");
     dir.write("big.obj", "v 0 0 0\nv 1e15 0 0\nv 0 1e15 0\nf 1 2 3\n");
     writeTexture(dir.file("textures/ok.tx"), 0.5f);
+    writeImage(dir.file("negative.exr"), ImageRGB{2, 1, {0.5f, 0.5f, 0.5f, 0.5f, -1.0f, 0.5f}});
     const std::string scenePath = dir.write("scene.yaml", c.scene);
     const std::string output = dir.file("out.exr");
     CommandResult r = runSpillway("render " + scenePath + " -o " + output + " --quiet");
@@ -576,6 +577,8 @@ const ErrorCase kErrorCases[] = {
      "lights:\n  - {type: Environment, colour: [1, 1, 1], string: sky.exr}\n", 2, "not both"},
     {"EnvironmentImageMissing", "light: {type: Environment, string: none.exr}\n", 1,
      "does not exist"},
+    {"EnvironmentNegativeRadiance", "light: {type: Environment, string: negative.exr}\n", 1,
+     "radiance -1 at texel (1, 0)"},
     {"SecondEnvironment", "lights:\n  - {type: Environment}\n  - {type: Environment}\n", 3,
      "second Environment"},
     {"UnknownLightType", "light: {type: Spot}\n", 1, "Quad, Point or Environment"},

@@ -150,6 +150,21 @@ void expectSameUpToRounding(const char* what, const std::vector<std::vector<floa
                              rounding * mean(c));
 }
 
+// Renders `scene` on vulkan (under validation) and on cpu with the same settings and asserts
+// that they agree up to `rounding` (expectSameUpToRounding). Returns the vulkan render.
+std::unique_ptr<RenderResult> expectVulkanMatchesCpu(const Scene& scene, int spp, const char* what,
+                                                     double rounding) {
+    RenderConfig vkCfg = validatedVulkan(spp);
+    RenderConfig cpuCfg = vkCfg;
+    cpuCfg.backend = BackendKind::Cpu;
+    std::vector<std::vector<float>> v, c;
+    auto result = renderValidated(scene, vkCfg, &v);
+    render(scene, cpuCfg,
+           [&](int, int, const Film& film) { c.push_back(film.lastIterationImage()); });
+    expectSameUpToRounding(what, v, c, scene.image.width, scene.image.height, rounding);
+    return result;
+}
+
 // --- the device ----------------------------------------------------------------------------
 
 // CI installs mesa-vulkan-drivers: lavapipe is always there. No device is a failure, not a skip.
@@ -203,15 +218,7 @@ TEST(VulkanDevice, EveryRenderInTheSuiteRunsUnderTheValidationLayer) {
 
 // Measured: 99.9th percentile 1.3e-6, max 2.1e-6, nothing diverged.
 TEST(VulkanVsCpu, CornellBoxAgreesUpToFloatRounding) {
-    Scene scene = smallCornell(32);
-    RenderConfig vkCfg = validatedVulkan(16);
-    RenderConfig cpuCfg = vkCfg;
-    cpuCfg.backend = BackendKind::Cpu;
-    std::vector<std::vector<float>> v, c;
-    auto result = renderValidated(scene, vkCfg, &v);
-    render(scene, cpuCfg,
-           [&](int, int, const Film& film) { c.push_back(film.lastIterationImage()); });
-    expectSameUpToRounding("Cornell box", v, c, 32, 32, 1e-5);
+    auto result = expectVulkanMatchesCpu(smallCornell(32), 16, "Cornell box", 1e-5);
     // The scene's models: its Lambert walls and blocks, and the quad light's Null shader.
     EXPECT_EQ(result->stats.extra["vulkan"]["pipelines"], nlohmann::json({"null", "lambert"}));
     EXPECT_EQ(result->stats.extra["vulkan"]["specialization"]["emitters"], true);
@@ -223,14 +230,7 @@ TEST(VulkanVsCpu, CornellBoxAgreesUpToFloatRounding) {
 TEST(VulkanVsCpu, SobolSamplerAgreesUpToFloatRounding) {
     Scene scene = smallCornell(32);
     scene.sampler = SamplerType::Sobol;
-    RenderConfig vkCfg = validatedVulkan(8);
-    RenderConfig cpuCfg = vkCfg;
-    cpuCfg.backend = BackendKind::Cpu;
-    std::vector<std::vector<float>> v, c;
-    auto result = renderValidated(scene, vkCfg, &v);
-    render(scene, cpuCfg,
-           [&](int, int, const Film& film) { c.push_back(film.lastIterationImage()); });
-    expectSameUpToRounding("Cornell box, Sobol", v, c, 32, 32, 1e-5);
+    auto result = expectVulkanMatchesCpu(scene, 8, "Cornell box, Sobol", 1e-5);
     EXPECT_EQ(result->stats.extra["sampler"], "Sobol");
 }
 
@@ -256,30 +256,15 @@ TEST(VulkanVsCpu, PointLightsAndEnvironmentMapAgreeUpToFloatRounding) {
           "  - {type: Point, position: [-1, 0.5, 1], intensity: 1, colour: [0.2, 0.4, 1]}\n",
           "light: {type: Environment, string: sky.exr}\n"}) {
         const Scene scene = loadScene(dir.write("lights.yaml", common + lights));
-        RenderConfig vkCfg = validatedVulkan(16);
-        RenderConfig cpuCfg = vkCfg;
-        cpuCfg.backend = BackendKind::Cpu;
-        std::vector<std::vector<float>> v, c;
-        auto result = renderValidated(scene, vkCfg, &v);
-        render(scene, cpuCfg,
-               [&](int, int, const Film& film) { c.push_back(film.lastIterationImage()); });
+        auto result = expectVulkanMatchesCpu(scene, 16, lights.c_str(), 1e-4);
         EXPECT_GT(mean(result->film->image()), 0.01) << lights;
-        expectSameUpToRounding(lights.c_str(), v, c, 24, 24, 1e-4);
     }
 }
 
 // Paths of up to 300 bounces: rounding adds up along them. Measured: 99.9th percentile 4.5e-5.
 TEST(VulkanVsCpu, ClosedEnclosureAgreesUpToFloatRounding) {
     TempDir dir;
-    Scene scene = enclosure(dir);
-    RenderConfig vkCfg = validatedVulkan(32);
-    RenderConfig cpuCfg = vkCfg;
-    cpuCfg.backend = BackendKind::Cpu;
-    std::vector<std::vector<float>> v, c;
-    auto result = renderValidated(scene, vkCfg, &v);
-    render(scene, cpuCfg,
-           [&](int, int, const Film& film) { c.push_back(film.lastIterationImage()); });
-    expectSameUpToRounding("closed enclosure", v, c, scene.image.width, scene.image.height, 5e-4);
+    auto result = expectVulkanMatchesCpu(enclosure(dir), 32, "closed enclosure", 5e-4);
     // And against the closed form Le / (1 - a) = 5.
     const MeanError m = meanAndError(result->film->image());
     EXPECT_NEAR(m.mean, 5.0, 4.0 * m.stderror);
