@@ -38,6 +38,9 @@ const char* kUsage = R"(Spillway: a breadth-first, sorted-deferred-shading path 
 usage:
   spillway render SCENE [options]   render a scene file (see docs/scene-format.md)
   spillway compare A B [options]    error metrics of image A against reference B
+  spillway merge PART... -o IMAGE   add partial renders (--samples A:B --partial PART) that
+                                    cover every sample once into the whole render's image,
+                                    bit for bit the image one process would have made
   spillway devices                  the Vulkan devices, their drivers, and which are usable
   spillway --help                   this text
   spillway --version                the version
@@ -68,6 +71,9 @@ render options:
   --resume FILE.exr     continue a checkpointed render (same scene and image settings; more
                         --spp may be asked for) to the image it would have made uninterrupted;
                         checkpoints go back to FILE unless --checkpoint names another
+  --samples A:B         a partial render: only sample indices A <= s < B of the --spp N
+                        render (A and B on iteration boundaries), written with --partial
+  --partial PART.exr    where a partial render's exact sums go, for `spillway merge`
   --target-error E      stop after the first iteration whose relMSE, estimated from two half
                         buffers (the --error-csv estimate), is at or below E
   --adaptive-threshold T  adaptive sampling (settings: adaptive threshold; 0 off, default):
@@ -179,6 +185,7 @@ int renderCommand(const std::vector<std::string>& args) {
         resumePath;
     double checkpointInterval = 0;
     std::optional<spw::SamplerType> samplerOverride;
+    std::string partialPath;
     bool quiet = false, previewOn = false;
     std::string progressMode = "auto";
     spw::RenderConfig config;
@@ -231,6 +238,17 @@ int renderCommand(const std::vector<std::string>& args) {
             referencePath = value();
         else if (a == "--time-limit")
             config.timeLimitSeconds = parseNumber(a, value(), 1e-3, 1e9);
+        else if (a == "--samples") {
+            const std::string v = value();
+            const size_t colon = v.find(':');
+            if (colon == std::string::npos)
+                throw UsageError("--samples takes A:B (sample indices A <= s < B), not '" + v +
+                                 "'");
+            config.sampleRange =
+                std::make_pair(int(parseInteger(a, v.substr(0, colon), 0, 1 << 24)),
+                               int(parseInteger(a, v.substr(colon + 1), 0, 1 << 24)));
+        } else if (a == "--partial")
+            partialPath = value();
         else if (a == "--adaptive-threshold")
             config.adaptiveThreshold = parseNumber(a, value(), 0.0, 1e9);
         else if (a == "--adaptive-min-spp")
@@ -278,6 +296,15 @@ int renderCommand(const std::vector<std::string>& args) {
     if (!referencePath.empty() && errorCsvPath.empty())
         throw UsageError("--reference goes with --error-csv");
     // Every output path is checked before any work, so that a typo costs no render.
+    if (!partialPath.empty() && !config.sampleRange)
+        throw UsageError("--partial goes with --samples A:B");
+    if (config.sampleRange && partialPath.empty())
+        throw UsageError("--samples A:B goes with --partial PART.exr, where its sums go");
+    if (!partialPath.empty()) {
+        if (!checkpointPath.empty())
+            throw UsageError("--partial is the render's checkpoint: give it or --checkpoint");
+        checkpointPath = partialPath; // a partial is the checkpoint of its samples
+    }
     if (!resumePath.empty() && checkpointPath.empty()) checkpointPath = resumePath;
     if (checkpointInterval > 0 && checkpointPath.empty())
         throw UsageError("--checkpoint-interval goes with --checkpoint");
@@ -329,6 +356,14 @@ int renderCommand(const std::vector<std::string>& args) {
                                                       : spw::ProgressBar::Style::Lines);
     const spw::SamplingPlan plan = spw::planSampling(scene.image, config.spp);
     const int sppPerIteration = plan.sampleBase * plan.sampleBase;
+    if (config.sampleRange) {
+        const auto [a, b] = *config.sampleRange;
+        if (!spw::sampleRangeAllowed(a, b, sppPerIteration, plan.iterations))
+            throw UsageError(spw::sampleRangeError(a, b, sppPerIteration, plan.iterations));
+        if (config.adaptiveThreshold.value_or(scene.settings.adaptiveThreshold) > 0.0)
+            throw UsageError("--samples: a partial render cannot sample adaptively (its "
+                             "decisions read the iterations before it)");
+    }
     spw::InterruptGuard interrupt;
     config.stop = interrupt.flag();
     spw::CheckpointOptions checkpoints{checkpointPath, checkpointInterval,
@@ -434,6 +469,50 @@ int renderCommand(const std::vector<std::string>& args) {
 
 } // namespace
 
+// spillway merge PART... -o IMAGE: partial renders' sums added into the whole render's image.
+int mergeCommand(const std::vector<std::string>& args) {
+    std::string output;
+    std::vector<std::string> parts;
+    for (size_t i = 0; i < args.size(); ++i) {
+        if (args[i] == "-o" || args[i] == "--output") {
+            if (i + 1 >= args.size()) throw UsageError(args[i] + " needs a value");
+            output = args[++i];
+        } else if (!args[i].empty() && args[i][0] == '-') {
+            throw UsageError("unknown merge option '" + args[i] + "'");
+        } else {
+            parts.push_back(args[i]);
+        }
+    }
+    if (parts.empty()) throw UsageError("merge needs partial renders (render --partial)");
+    if (output.empty()) throw UsageError("merge needs -o IMAGE");
+    if (!spw::isSupportedOutput(output))
+        throw UsageError("output '" + output + "' must end in .exr or .png");
+    spw::checkWritable(output);
+    std::vector<std::pair<std::string, spw::Checkpoint>> partials;
+    for (const std::string& p : parts) {
+        try {
+            partials.emplace_back(p, spw::readCheckpoint(p));
+        } catch (const std::exception& e) {
+            throw UsageError(std::string("merge: ") + e.what());
+        }
+    }
+    spw::Checkpoint whole;
+    try {
+        whole = spw::mergePartials(partials);
+    } catch (const std::invalid_argument& e) {
+        throw UsageError(std::string("merge: ") + e.what());
+    }
+    spw::OutputFile image(output);
+    const std::vector<unsigned char> bytes = spw::encodeImage(
+        output, {whole.key.width, whole.key.height, spw::Film::imageOf(whole.film)});
+    image.write(bytes.data(), bytes.size());
+    image.flush();
+    image.commit();
+    std::fprintf(stderr, "spillway: merged %zu partial renders: %d spp\n", partials.size(),
+                 whole.iterations * whole.key.sampleBase * whole.key.sampleBase);
+    return 0;
+}
+
 int main(int argc, char** argv) {
     // A file-size limit must surface as a write error (EFBIG) with a message, not kill us.
     std::signal(SIGXFSZ, SIG_IGN);
@@ -454,6 +533,7 @@ int main(int argc, char** argv) {
         if (args[0] == "render") return renderCommand({args.begin() + 1, args.end()});
         if (args[0] == "compare") return spw::compareCommand({args.begin() + 1, args.end()});
         if (args[0] == "devices") return devicesCommand({args.begin() + 1, args.end()});
+        if (args[0] == "merge") return mergeCommand({args.begin() + 1, args.end()});
         throw UsageError("unknown command '" + args[0] + "' (try spillway --help)");
     } catch (const UsageError& e) {
         std::fprintf(stderr, "spillway: %s\n", e.what());

@@ -9,6 +9,7 @@
 #include <atomic>
 #include <optional>
 #include <string>
+#include <utility>
 
 namespace spw {
 
@@ -104,6 +105,8 @@ struct RenderConfig {
     const std::atomic<int>* stop = nullptr;
     std::optional<double> textureCacheMiB; // overrides settings: texture cache
     std::optional<double> adaptiveThreshold; // overrides settings: adaptive threshold
+    // A partial render: only samples [first, second) of the spp (iteration boundaries).
+    std::optional<std::pair<int, int>> sampleRange;
     std::optional<int> adaptiveMinSamples;   // overrides settings: adaptive min samples
     TextureFilter textureFilter = TextureFilter::Cone;
 };

@@ -33,7 +33,7 @@ Film::Film(int width, int height, const Filter& filter, float brightestRadiance,
            int samplesPerIteration)
     : width_(width), height_(height), samplesPerIteration_(uint(samplesPerIteration)),
       filter_(filter), acc_(new PixelSums[size_t(width) * height]),
-      sum_(size_t(width) * height * 8, 0.0), lastIteration_(size_t(width) * height * 3, 0.0f),
+      sum_(size_t(width) * height * 8, 0), lastIteration_(size_t(width) * height * 3, 0.0f),
       iterationSamples_(new std::atomic<std::uint32_t>[size_t(width) * height]),
       samples_(size_t(width) * height, 0u), tilesX_((width + kAdaptiveTile - 1) / kAdaptiveTile),
       tilesY_((height + kAdaptiveTile - 1) / kAdaptiveTile) {
@@ -85,7 +85,8 @@ void Film::decideTiles() {
                 for (int x = tx * kAdaptiveTile; x < std::min(width_, (tx + 1) * kAdaptiveTile);
                      ++x) {
                     const size_t i = size_t(y) * size_t(width_) + size_t(x);
-                    const double* s = &sum_[i * 8];
+                    double s[8];
+                    pixelSums(i, s);
                     if (samples_[i] < std::uint32_t(adaptiveMinSamples_) ||
                         !(s[3] > 0 && s[7] > 0)) {
                         ready = false;
@@ -181,19 +182,16 @@ void Film::filtered(vec2 filmPos, int half, vec3 radiance, float weight, uint ke
 void Film::endIteration() {
     const size_t n = size_t(width_) * height_;
     for (size_t i = 0; i < n; ++i) {
-        double it[4] = {0, 0, 0, 0};
-        for (int h = 0; h < 2; ++h) {
-            double v[4];
-            for (int c = 0; c < 4; ++c)
-                v[c] = double(acc_[i].v[h * 4 + c].load(std::memory_order_relaxed)) /
-                       (c < 3 ? scale_ : weightScale_);
+        std::int64_t it[4] = {0, 0, 0, 0};
+        for (int h = 0; h < 2; ++h)
             for (int c = 0; c < 4; ++c) {
-                sum_[i * 8 + size_t(h) * 4 + size_t(c)] += v[c];
-                it[c] += v[c];
+                const std::int64_t v = acc_[i].v[h * 4 + c].load(std::memory_order_relaxed);
+                sum_[i * 8 + size_t(h) * 4 + size_t(c)] += v;
+                it[c] += v;
             }
-        }
+        const double weight = double(it[3]) / weightScale_;
         for (int c = 0; c < 3; ++c)
-            lastIteration_[i * 3 + c] = it[3] > 0 ? float(it[c] / it[3]) : 0.0f;
+            lastIteration_[i * 3 + c] = it[3] > 0 ? float(double(it[c]) / scale_ / weight) : 0.0f;
         samples_[i] += iterationSamples_[i].load(std::memory_order_relaxed);
     }
     beginIteration();
@@ -201,12 +199,20 @@ void Film::endIteration() {
 }
 
 Film::State Film::state() const {
-    return {sum_, samples_, nonFinite_.load(), saturated_.load()};
+    return {sum_,
+            samples_,
+            nonFinite_.load(),
+            saturated_.load(),
+            std::ilogb(scale_),
+            std::ilogb(weightScale_)};
 }
 
 void Film::restore(const State& state) {
     if (state.sums.size() != sum_.size() || state.samples.size() != samples_.size())
         throw std::invalid_argument("a film state of another size");
+    if (state.scaleExponent != std::ilogb(scale_) ||
+        state.weightExponent != std::ilogb(weightScale_))
+        throw std::invalid_argument("a film state of another fixed-point scale");
     sum_ = state.sums;
     samples_ = state.samples;
     nonFinite_ = state.nonFinite;
@@ -215,11 +221,19 @@ void Film::restore(const State& state) {
     decideTiles();
 }
 
-std::vector<float> Film::image() const {
-    const size_t n = size_t(width_) * height_;
-    std::vector<float> out(n * 3, 0.0f);
-    for (size_t i = 0; i < n; ++i) {
-        const double* s = &sum_[i * 8];
+namespace {
+// A pixel's eight sums in radiance and weight units.
+void toUnits(const Film::Fixed* sums, double scale, double weightScale, double* s) {
+    for (int k = 0; k < 8; ++k)
+        s[k] = double(sums[k]) / (k % 4 == 3 ? weightScale : scale);
+}
+
+std::vector<float> imageFromSums(const Film::Fixed* sums, size_t pixels, double scale,
+                                 double weightScale) {
+    std::vector<float> out(pixels * 3, 0.0f);
+    for (size_t i = 0; i < pixels; ++i) {
+        double s[8];
+        toUnits(sums + i * 8, scale, weightScale, s);
         double w = s[3] + s[7];
         if (w > 0)
             for (int c = 0; c < 3; ++c)
@@ -227,12 +241,29 @@ std::vector<float> Film::image() const {
     }
     return out;
 }
+} // namespace
+
+void Film::pixelSums(size_t pixel, double* s) const {
+    toUnits(&sum_[pixel * 8], scale_, weightScale_, s);
+}
+
+std::vector<float> Film::image() const {
+    return imageFromSums(sum_.data(), size_t(width_) * height_, scale_, weightScale_);
+}
+
+std::vector<float> Film::imageOf(const State& state) {
+    return imageFromSums(state.sums.data(), state.sums.size() / 8,
+                         std::ldexp(1.0, state.scaleExponent),
+                         std::ldexp(1.0, state.weightExponent));
+}
 
 std::vector<float> Film::halfImage(int half) const {
     const size_t n = size_t(width_) * height_;
     std::vector<float> out(n * 3, 0.0f);
     for (size_t i = 0; i < n; ++i) {
-        const double* s = &sum_[i * 8 + size_t(half) * 4];
+        double all[8];
+        pixelSums(i, all);
+        const double* s = all + half * 4;
         if (s[3] > 0)
             for (int c = 0; c < 3; ++c)
                 out[i * 3 + c] = float(s[c] / s[3]);
@@ -249,7 +280,8 @@ std::optional<double> Film::halfBufferRelMseEstimate() const {
     double total = 0;
     size_t count = 0;
     for (size_t i = 0; i < n; ++i) {
-        const double* s = &sum_[i * 8];
+        double s[8];
+        pixelSums(i, s);
         if (!(s[3] > 0 && s[7] > 0)) continue;
         for (int c = 0; c < 3; ++c) {
             double a = s[c] / s[3], b = s[4 + c] / s[7], m = (s[c] + s[4 + c]) / (s[3] + s[7]);

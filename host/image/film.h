@@ -3,7 +3,9 @@
 // same bit for bit whatever the thread count, batch size or order in which paths finish. Each
 // value is rounded to the fixed-point grid stochastically with a hash of the sample's key, so
 // the rounding is unbiased and still deterministic. At the end of an iteration the integer sums
-// are folded, pixel by pixel, into double-precision accumulators that hold the whole render.
+// are added, pixel by pixel, into 128-bit integer accumulators that hold the whole render: the
+// film is exact end to end, so sums of any iterations, added in any grouping (checkpoints,
+// partial renders merged later), give the same image bit for bit.
 //
 // No accumulator can wrap: at most N = (samples per pixel and iteration) x (pixels a filter
 // reaches) adds land in one in an iteration, and each add is clamped (and counted as saturated)
@@ -47,6 +49,10 @@ inline uint filmKey(uint pathId, uint bounce, bool shadow) {
 
 class Film {
   public:
+    // The whole render's sums: 2^62 per iteration at most, so 2^65 iterations before they could
+    // wrap.
+    using Fixed = __int128;
+
     // `samplesPerIteration`: camera samples per pixel in one iteration (sample base^2).
     Film(int width, int height, const Filter& filter, float brightestRadiance,
          int samplesPerIteration = 1);
@@ -101,12 +107,16 @@ class Film {
 
     // The film's whole state between iterations, exactly: what a checkpoint keeps.
     struct State {
-        std::vector<double> sums;           // 8 per pixel: (r, g, b, weight) x 2 halves
+        std::vector<Fixed> sums;            // 8 per pixel: (r, g, b, weight) x 2 halves
         std::vector<std::uint32_t> samples; // per pixel
         std::uint64_t nonFinite = 0, saturated = 0;
+        int scaleExponent = 0, weightExponent = 0; // the fixed point: 2^e units per 1
     };
+    // The image of a film state (as image() is of the film's): for merging partial renders.
+    static std::vector<float> imageOf(const State& state);
     State state() const;
-    // Restores a state() of a film of this size (throws std::invalid_argument otherwise).
+    // Restores a state() of a film of this size and fixed point (throws std::invalid_argument
+    // otherwise).
     void restore(const State& state);
 
     std::uint64_t nonFiniteSamples() const { return nonFinite_.load(); }
@@ -116,6 +126,8 @@ class Film {
   private:
     int halfOf(uint sampleIndex) const; // (iteration + index within it) mod 2
     void decideTiles();                 // the adaptive mask, from the sums and counts
+    // Pixel `pixel`'s eight sums in radiance and weight units.
+    void pixelSums(size_t pixel, double* s) const;
     void filtered(vec2 filmPos, int half, vec3 radiance, float weight, uint key);
     void add(int px, int py, int half, vec3 value, float weight, uint key);
 
@@ -130,7 +142,7 @@ class Film {
         std::atomic<std::int64_t> v[8];
     };
     std::unique_ptr<PixelSums[]> acc_;
-    std::vector<double> sum_; // 8 per pixel, whole render
+    std::vector<Fixed> sum_; // 8 per pixel, whole render, in fixed-point units
     std::vector<float> lastIteration_;
     std::atomic<std::uint64_t> nonFinite_{0}, saturated_{0};
     std::unique_ptr<std::atomic<std::uint32_t>[]> iterationSamples_; // per pixel, this iteration

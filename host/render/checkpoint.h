@@ -2,13 +2,15 @@
 // and finish with the image, bit for bit, that it would have made uninterrupted.
 //
 // The checkpoint is one OpenEXR file that any image viewer opens: its R, G, B channels are the
-// image so far (float), and 16 more channels, state.0.hi .. state.7.lo (uint32), hold the film's
-// eight double-precision sums per pixel bit for bit (a double split into its high and low 32
-// bits: EXR has no 64-bit channel type, and float channels would round the sums), and one more,
-// state.samples (uint32), the camera samples each pixel took (adaptive sampling reads them). Metadata
-// (spillway:*) holds the rest: iterations done, render seconds, the film's counters, and what
-// must match for a resume (the key below). One file rather than an image and a state file beside
-// it: nothing can pair an image with another render's state, and one rename writes it atomically.
+// image so far (float), and 32 more channels, state.0.0 .. state.7.3 (uint32), hold the film's
+// eight 128-bit integer sums per pixel bit for bit (each as four 32-bit words, the most
+// significant first: EXR has no wider integer channel type, and float channels would round
+// the sums), and one more,
+// state.samples (uint32), the camera samples each pixel took (adaptive sampling reads them).
+// Metadata (spillway:*) holds the rest: iterations done, render seconds, the film's counters, and
+// what must match for a resume (the key below). One file rather than an image and a state file
+// beside it: nothing can pair an image with another render's state, and one rename writes it
+// atomically.
 #pragma once
 
 #include "host/backend/render_config.h"
@@ -28,18 +30,20 @@ struct CheckpointKey {
     std::uint64_t sceneHash = 0; // sceneHash()
     std::uint32_t seed = 0;
     int width = 0, height = 0;
-    int sampleBase = 0;         // samples per pixel and iteration = sampleBase^2
-    std::string rayFormat;      // compact | full
-    std::string textureFilter;  // cone | finest
-    std::uint32_t strategy = 0; // light / BSDF sampling
-    std::string sampler;        // Independent | Grid | Stratified | Sobol
+    int sampleBase = 0;           // samples per pixel and iteration = sampleBase^2
+    std::string rayFormat;        // compact | full
+    std::string textureFilter;    // cone | finest
+    std::uint32_t strategy = 0;   // light / BSDF sampling
+    std::string sampler;          // Independent | Grid | Stratified | Sobol
     double adaptiveThreshold = 0; // 0: off
     int adaptiveMinSamples = 0;
 };
 
 struct Checkpoint {
     CheckpointKey key;
-    int iterations = 0;       // completed
+    int iterations = 0;       // completed, from firstIteration on
+    int firstIteration = 0;   // 0, or where a partial render (--samples A:B) began
+    int totalIterations = 0;  // of the whole render (partials: what merge must cover)
     double renderSeconds = 0; // spent in them
     Film::State film;
 };
@@ -57,6 +61,12 @@ void writeCheckpoint(const std::string& path, const Checkpoint& checkpoint,
                      const std::vector<float>& image);
 // Throws std::runtime_error naming the path when it is not a Spillway checkpoint.
 Checkpoint readCheckpoint(const std::string& path);
+// Adds partial renders' checkpoints (--samples A:B --partial), each with the file it came from,
+// into the whole render's: throws std::invalid_argument naming the files when they are of
+// different renders, overlap, or leave samples out. The film's sums are integers, so the result
+// is the uninterrupted render's, bit for bit, whatever the partials and their order.
+Checkpoint mergePartials(const std::vector<std::pair<std::string, Checkpoint>>& partials);
+
 // "" when `found` may resume a render whose key is `expected`; else what differs, for the user.
 std::string checkpointMismatch(const CheckpointKey& expected, const CheckpointKey& found);
 

@@ -52,6 +52,23 @@ nlohmann::json textureStatistics(const TextureResolver& textures, const RenderSt
 
 } // namespace
 
+bool sampleRangeAllowed(int a, int b, int samplesPerIteration, int iterations) {
+    return a >= 0 && a < b && b <= samplesPerIteration * iterations &&
+           a % samplesPerIteration == 0 && b % samplesPerIteration == 0;
+}
+
+std::string sampleRangeError(int a, int b, int samplesPerIteration, int iterations) {
+    const int total = samplesPerIteration * iterations;
+    std::string why = "--samples " + std::to_string(a) + ":" + std::to_string(b) + ": ";
+    if (!(a >= 0 && a < b && b <= total))
+        return why + "a range A:B needs 0 <= A < B <= " + std::to_string(total) +
+               " (the render's spp)";
+    return why + "a range starts and ends on an iteration boundary, a multiple of " +
+           std::to_string(samplesPerIteration) + " samples (0, " +
+           std::to_string(samplesPerIteration) + ", " + std::to_string(2 * samplesPerIteration) +
+           ", ... " + std::to_string(total) + ")";
+}
+
 SamplingPlan planSampling(const ImageSettings& image, std::optional<int> spp) {
     if (!spp) return {image.sampleBase, image.iterations};
     const int n2 = image.samplesPerIteration();
@@ -162,7 +179,20 @@ std::unique_ptr<RenderResult> renderWithProgress(const Scene& scene, const Rende
     else
         backend = std::make_unique<SortedRenderer>(ctx, config.pipeline, makeCpuShading(ctx));
     double renderSeconds = 0;
-    int done = 0;
+    // A partial render (--samples A:B) runs iterations [first, end) of the whole render's.
+    const int spi = plan.sampleBase * plan.sampleBase;
+    if (config.sampleRange) {
+        const auto [a, b] = *config.sampleRange;
+        if (!sampleRangeAllowed(a, b, spi, plan.iterations))
+            throw std::invalid_argument(sampleRangeError(a, b, spi, plan.iterations));
+        if (config.adaptiveThreshold.value_or(scene.settings.adaptiveThreshold) > 0.0)
+            throw std::invalid_argument(
+                "a partial render (--samples) cannot sample adaptively: the decisions read the "
+                "iterations before it");
+    }
+    const int first = config.sampleRange ? config.sampleRange->first / spi : 0;
+    const int end = config.sampleRange ? config.sampleRange->second / spi : plan.iterations;
+    int done = first;
     const double adaptiveThreshold =
         config.adaptiveThreshold.value_or(scene.settings.adaptiveThreshold);
     const int adaptiveMinSamples =
@@ -174,19 +204,29 @@ std::unique_ptr<RenderResult> renderWithProgress(const Scene& scene, const Rende
     if (const Checkpoint* c = checkpoints.resume) {
         if (const std::string why = checkpointMismatch(*key, c->key); !why.empty())
             throw std::invalid_argument("the checkpoint is of another render: " + why);
+        if (c->firstIteration != first)
+            throw std::invalid_argument("the checkpoint is of a partial render from sample " +
+                                        std::to_string(c->firstIteration * spi) +
+                                        ", this render starts at " + std::to_string(first * spi));
         result->film->restore(c->film);
-        done = c->iterations;
+        done = first + c->iterations;
         renderSeconds = c->renderSeconds;
-        stats.extra["resumed_iterations"] = done;
+        stats.extra["resumed_iterations"] = c->iterations;
     }
     auto checkpoint = [&] {
         StageTimer t(stats.stages, "checkpoint");
-        writeCheckpoint(checkpoints.path, {*key, done, renderSeconds, result->film->state()},
-                        result->film->image());
+        Checkpoint c;
+        c.key = *key;
+        c.iterations = done - first;
+        c.firstIteration = first;
+        c.totalIterations = plan.iterations;
+        c.renderSeconds = renderSeconds;
+        c.film = result->film->state();
+        writeCheckpoint(checkpoints.path, c, result->film->image());
     };
     double lastCheckpoint = renderSeconds;
     const char* stopReason = "spp";
-    while (done < plan.iterations) {
+    while (done < end) {
         if (stopRequested(config)) {
             stopReason = *config.stop == kStopByWindow ? "window" : "signal";
             break;
@@ -208,16 +248,15 @@ std::unique_ptr<RenderResult> renderWithProgress(const Scene& scene, const Rende
             std::chrono::duration<double>(std::chrono::steady_clock::now() - iterationStart)
                 .count();
         ++done;
-        const int sppDone = done * plan.sampleBase * plan.sampleBase;
+        const int sppDone = (done - first) * spi;
         if (onIteration)
-            onIteration({done, plan.iterations, sppDone, renderSeconds}, *result->film);
+            onIteration({done - first, end - first, sppDone, renderSeconds}, *result->film);
         if (!checkpoints.path.empty() && checkpoints.intervalSeconds > 0 &&
-            renderSeconds - lastCheckpoint >= checkpoints.intervalSeconds &&
-            done < plan.iterations) {
+            renderSeconds - lastCheckpoint >= checkpoints.intervalSeconds && done < end) {
             checkpoint();
             lastCheckpoint = renderSeconds;
         }
-        if (done == plan.iterations) break;
+        if (done == end) break;
         if (config.timeLimitSeconds && renderSeconds >= *config.timeLimitSeconds) {
             stopReason = "time limit";
             break;
@@ -235,9 +274,10 @@ std::unique_ptr<RenderResult> renderWithProgress(const Scene& scene, const Rende
         }
     }
     stats.extra["stop_reason"] = stopReason;
-    if (!checkpoints.path.empty() && done > 0) checkpoint();
-    stats.iterations = done;
-    stats.spp = done * plan.sampleBase * plan.sampleBase;
+    if (!checkpoints.path.empty() && done > first) checkpoint();
+    stats.iterations = done - first;
+    stats.spp = (done - first) * spi;
+    if (config.sampleRange) stats.extra["samples_range"] = {first * spi, done * spi};
     stats.extra["render_seconds"] = renderSeconds;
     stats.extra["samples_taken"] = result->film->samplesTaken();
     if (adaptiveThreshold > 0.0)

@@ -11,6 +11,9 @@
 #include <functional>
 #include <memory>
 #include <optional>
+#include <string>
+#include <utility>
+#include <vector>
 
 namespace spw {
 
@@ -35,6 +38,11 @@ struct SamplingPlan {
     int iterations;
 };
 SamplingPlan planSampling(const ImageSettings& image, std::optional<int> spp);
+
+// A partial render's sample range A:B (--samples): within the render's spp and on iteration
+// boundaries. The message says which boundaries are allowed.
+bool sampleRangeAllowed(int a, int b, int samplesPerIteration, int iterations);
+std::string sampleRangeError(int a, int b, int samplesPerIteration, int iterations);
 
 // Checkpointing a render (host/render/checkpoint.h): where, how often, and where to start.
 struct CheckpointOptions {
