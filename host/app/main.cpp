@@ -356,14 +356,8 @@ int renderCommand(const std::vector<std::string>& args) {
                                                       : spw::ProgressBar::Style::Lines);
     const spw::SamplingPlan plan = spw::planSampling(scene.image, config.spp);
     const int sppPerIteration = plan.sampleBase * plan.sampleBase;
-    if (config.sampleRange) {
-        const auto [a, b] = *config.sampleRange;
-        if (!spw::sampleRangeAllowed(a, b, sppPerIteration, plan.iterations))
-            throw UsageError(spw::sampleRangeError(a, b, sppPerIteration, plan.iterations));
-        if (config.adaptiveThreshold.value_or(scene.settings.adaptiveThreshold) > 0.0)
-            throw UsageError("--samples: a partial render cannot sample adaptively (its "
-                             "decisions read the iterations before it)");
-    }
+    if (const std::string why = spw::partialRenderProblem(scene, config, plan); !why.empty())
+        throw UsageError(why); // before any work, for exit 2
     spw::InterruptGuard interrupt;
     config.stop = interrupt.flag();
     spw::CheckpointOptions checkpoints{checkpointPath, checkpointInterval,

@@ -85,19 +85,9 @@ void Film::decideTiles() {
                 for (int x = tx * kAdaptiveTile; x < std::min(width_, (tx + 1) * kAdaptiveTile);
                      ++x) {
                     const size_t i = size_t(y) * size_t(width_) + size_t(x);
-                    double s[8];
-                    pixelSums(i, s);
                     if (samples_[i] < std::uint32_t(adaptiveMinSamples_) ||
-                        !(s[3] > 0 && s[7] > 0)) {
+                        !addHalfBufferRelMse(i, total, values))
                         ready = false;
-                        continue;
-                    }
-                    for (int c = 0; c < 3; ++c) {
-                        const double a = s[c] / s[3], b = s[4 + c] / s[7],
-                                     m = (s[c] + s[4 + c]) / (s[3] + s[7]);
-                        total += (a - b) * (a - b) / 4.0 / (m * m + kRelMseEpsilon);
-                        ++values;
-                    }
                 }
             if (ready && values > 0 && total / double(values) < limit) {
                 active_[size_t(ty) * size_t(tilesX_) + size_t(tx)] = 0;
@@ -247,6 +237,18 @@ void Film::pixelSums(size_t pixel, double* s) const {
     toUnits(&sum_[pixel * 8], scale_, weightScale_, s);
 }
 
+bool Film::addHalfBufferRelMse(size_t pixel, double& total, size_t& count) const {
+    double s[8];
+    pixelSums(pixel, s);
+    if (!(s[3] > 0 && s[7] > 0)) return false;
+    for (int c = 0; c < 3; ++c) {
+        const double a = s[c] / s[3], b = s[4 + c] / s[7], m = (s[c] + s[4 + c]) / (s[3] + s[7]);
+        total += (a - b) * (a - b) / 4.0 / (m * m + kRelMseEpsilon);
+        ++count;
+    }
+    return true;
+}
+
 std::vector<float> Film::image() const {
     return imageFromSums(sum_.data(), size_t(width_) * height_, scale_, weightScale_);
 }
@@ -279,16 +281,8 @@ std::optional<double> Film::halfBufferRelMseEstimate() const {
     const size_t n = size_t(width_) * height_;
     double total = 0;
     size_t count = 0;
-    for (size_t i = 0; i < n; ++i) {
-        double s[8];
-        pixelSums(i, s);
-        if (!(s[3] > 0 && s[7] > 0)) continue;
-        for (int c = 0; c < 3; ++c) {
-            double a = s[c] / s[3], b = s[4 + c] / s[7], m = (s[c] + s[4 + c]) / (s[3] + s[7]);
-            total += (a - b) * (a - b) / 4.0 / (m * m + kRelMseEpsilon);
-            ++count;
-        }
-    }
+    for (size_t i = 0; i < n; ++i)
+        addHalfBufferRelMse(i, total, count);
     if (count == 0) return std::nullopt;
     return total / double(count);
 }

@@ -128,6 +128,9 @@ class Film {
     void decideTiles();                 // the adaptive mask, from the sums and counts
     // Pixel `pixel`'s eight sums in radiance and weight units.
     void pixelSums(size_t pixel, double* s) const;
+    // Adds the pixel's three per-channel terms of the half-buffer relMSE, (A - B)^2 / 4 /
+    // (m^2 + 0.01), to total and count; false (nothing added) while a half has no samples.
+    bool addHalfBufferRelMse(size_t pixel, double& total, size_t& count) const;
     void filtered(vec2 filmPos, int half, vec3 radiance, float weight, uint key);
     void add(int px, int py, int half, vec3 value, float weight, uint key);
 

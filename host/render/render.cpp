@@ -52,21 +52,23 @@ nlohmann::json textureStatistics(const TextureResolver& textures, const RenderSt
 
 } // namespace
 
-bool sampleRangeAllowed(int a, int b, int samplesPerIteration, int iterations) {
-    return a >= 0 && a < b && b <= samplesPerIteration * iterations &&
-           a % samplesPerIteration == 0 && b % samplesPerIteration == 0;
-}
-
-std::string sampleRangeError(int a, int b, int samplesPerIteration, int iterations) {
-    const int total = samplesPerIteration * iterations;
-    std::string why = "--samples " + std::to_string(a) + ":" + std::to_string(b) + ": ";
+std::string partialRenderProblem(const Scene& scene, const RenderConfig& config,
+                                 const SamplingPlan& plan) {
+    if (!config.sampleRange) return "";
+    const auto [a, b] = *config.sampleRange;
+    const int spi = plan.sampleBase * plan.sampleBase, total = spi * plan.iterations;
+    const std::string range = "--samples " + std::to_string(a) + ":" + std::to_string(b) + ": ";
     if (!(a >= 0 && a < b && b <= total))
-        return why + "a range A:B needs 0 <= A < B <= " + std::to_string(total) +
+        return range + "a range A:B needs 0 <= A < B <= " + std::to_string(total) +
                " (the render's spp)";
-    return why + "a range starts and ends on an iteration boundary, a multiple of " +
-           std::to_string(samplesPerIteration) + " samples (0, " +
-           std::to_string(samplesPerIteration) + ", " + std::to_string(2 * samplesPerIteration) +
-           ", ... " + std::to_string(total) + ")";
+    if (a % spi != 0 || b % spi != 0)
+        return range + "a range starts and ends on an iteration boundary, a multiple of " +
+               std::to_string(spi) + " samples (0, " + std::to_string(spi) + ", " +
+               std::to_string(2 * spi) + ", ... " + std::to_string(total) + ")";
+    if (config.adaptiveThreshold.value_or(scene.settings.adaptiveThreshold) > 0.0)
+        return range + "a partial render cannot sample adaptively (its decisions read the "
+                       "iterations before it)";
+    return "";
 }
 
 SamplingPlan planSampling(const ImageSettings& image, std::optional<int> spp) {
@@ -181,15 +183,8 @@ std::unique_ptr<RenderResult> renderWithProgress(const Scene& scene, const Rende
     double renderSeconds = 0;
     // A partial render (--samples A:B) runs iterations [first, end) of the whole render's.
     const int spi = plan.sampleBase * plan.sampleBase;
-    if (config.sampleRange) {
-        const auto [a, b] = *config.sampleRange;
-        if (!sampleRangeAllowed(a, b, spi, plan.iterations))
-            throw std::invalid_argument(sampleRangeError(a, b, spi, plan.iterations));
-        if (config.adaptiveThreshold.value_or(scene.settings.adaptiveThreshold) > 0.0)
-            throw std::invalid_argument(
-                "a partial render (--samples) cannot sample adaptively: the decisions read the "
-                "iterations before it");
-    }
+    if (const std::string why = partialRenderProblem(scene, config, plan); !why.empty())
+        throw std::invalid_argument(why);
     const int first = config.sampleRange ? config.sampleRange->first / spi : 0;
     const int end = config.sampleRange ? config.sampleRange->second / spi : plan.iterations;
     int done = first;

@@ -39,10 +39,11 @@ struct SamplingPlan {
 };
 SamplingPlan planSampling(const ImageSettings& image, std::optional<int> spp);
 
-// A partial render's sample range A:B (--samples): within the render's spp and on iteration
-// boundaries. The message says which boundaries are allowed.
-bool sampleRangeAllowed(int a, int b, int samplesPerIteration, int iterations);
-std::string sampleRangeError(int a, int b, int samplesPerIteration, int iterations);
+// What is wrong with a partial render's sample range A:B (--samples), or "": it must lie within
+// the render's spp, on iteration boundaries (the message names them), without adaptive
+// sampling.
+std::string partialRenderProblem(const Scene& scene, const RenderConfig& config,
+                                 const SamplingPlan& plan);
 
 // Checkpointing a render (host/render/checkpoint.h): where, how often, and where to start.
 struct CheckpointOptions {
