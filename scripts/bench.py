@@ -26,6 +26,13 @@ are noisy; ratios travel, absolute seconds do not).
                                and the stage seconds. --baseline PATH adds another build's cpu
                                and reference (before/after in one run). Writes
                                out/bench/incore.json.
+  scripts/bench.py mpi         distributed rendering: 1 process x 2 threads against mpirun -np 2
+                               x 1 thread (and --ranks R1,R2,... x --threads-per-rank T) on the
+                               Cornell box (64 spp) and the 1M-triangle scene, cpu and reference;
+                               alternating, best of N. Per configuration: the launch's wall time
+                               (MPI start-up included), rank 0's render seconds, the seconds the
+                               ranks spent in the film's reduction, and the ratio to one process.
+                               Writes out/bench/mpi.json.
   scripts/bench.py all         reference and pipeline (default)
 
 Options: --repeat N (best of N, default 3; production: 1), --spillway PATH (default
@@ -266,16 +273,69 @@ def plot_production(rows, path):
     print("plot: " + path)
 
 
+def bench_mpi(spillway, repeat, ranks_list, threads_per_rank, one_process_threads):
+    import time
+    heavy = subprocess.check_output([sys.executable, os.path.join(ROOT, "scripts", "make_heavy_scene.py"),
+                                     os.path.join(ROOT, "out", "heavy")], text=True).strip()
+    box = os.path.join(ROOT, "scenes", "cornell-box.yaml")
+    scenes = [("Cornell box 256x256, 64 spp", box, ["--spp", "64"]),
+              ("1M triangles, 17 shaders, 640x480, 16 spp", heavy, [])]
+    mpirun = ["mpirun", "--oversubscribe", "--bind-to", "none"]
+    env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
+    configs = [("1 process x %d threads" % one_process_threads, 1, one_process_threads)]
+    configs += [("%d ranks x %d thread%s" % (r, threads_per_rank, "s" if threads_per_rank > 1 else ""),
+                 r, threads_per_rank) for r in ranks_list]
+    results = []
+    with tempfile.TemporaryDirectory() as tmp:
+        for title, scene, extra in scenes:
+            for backend in ("cpu", "reference"):
+                best = {}
+                for _ in range(repeat):  # alternate: every configuration once per round
+                    for name, n, threads in configs:
+                        stats = os.path.join(tmp, "s.json")
+                        cmd = [spillway, "render", scene, "--backend", backend, "--threads", str(threads),
+                               "-o", os.path.join(tmp, "o.exr"), "--quiet", "--stats", stats] + extra
+                        if n > 1:
+                            cmd = mpirun + ["-np", str(n)] + cmd
+                        start = time.monotonic()
+                        subprocess.run(cmd, check=True, env=env)
+                        s = json.load(open(stats))
+                        s["launch_seconds"] = time.monotonic() - start
+                        if name not in best or s["launch_seconds"] < best[name]["launch_seconds"]:
+                            best[name] = s
+                one = best[configs[0][0]]
+                print("\n%s, %s backend (best of %d, alternating)" % (title, backend, repeat))
+                print("  %-22s %9s %9s %9s %10s %10s" % ("config", "launch s", "render s", "reduce s",
+                                                        "vs 1 proc", "render vs"))
+                for name, n, threads in configs:
+                    s = best[name]
+                    reduce_s = max((r["reduce_seconds"] for r in s.get("ranks", [])), default=0.0)
+                    print("  %-22s %9.2f %9.2f %9.3f %9.2fx %9.2fx" % (
+                        name, s["launch_seconds"], s["render_seconds"], reduce_s,
+                        s["launch_seconds"] / one["launch_seconds"], s["render_seconds"] / one["render_seconds"]))
+                    results.append({"scene": title, "backend": backend, "config": name, "ranks": n,
+                                    "threads_per_rank": threads, "launch_seconds": s["launch_seconds"],
+                                    "render_seconds": s["render_seconds"], "reduce_seconds": reduce_s,
+                                    "wall_seconds": s["wall_seconds"], "rays": s["rays"]["total"]})
+    folder = os.path.join(ROOT, "out", "bench")
+    os.makedirs(folder, exist_ok=True)
+    with open(os.path.join(folder, "mpi.json"), "w") as f:
+        json.dump(results, f, indent=1)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("what", nargs="?", default="all",
-                    choices=["reference", "pipeline", "production", "incore", "all"])
+                    choices=["reference", "pipeline", "production", "incore", "mpi", "all"])
     ap.add_argument("--repeat", type=int)
     ap.add_argument("--depths", default="1,2,3")
     ap.add_argument("--exponents", default="8,11,14,17")
     ap.add_argument("--scene-args", default="")
     ap.add_argument("--spillway", default=os.path.join(ROOT, "build", "spillway"))
     ap.add_argument("--baseline", help="another build's spillway binary (incore: before/after)")
+    ap.add_argument("--ranks", default="2", help="mpi: rank counts to run, e.g. 2,4,8,16")
+    ap.add_argument("--threads-per-rank", type=int, default=1, help="mpi: threads of each rank")
+    ap.add_argument("--threads", type=int, default=2, help="mpi: threads of the single process")
     a = ap.parse_args()
     if a.what == "production":
         bench_production(a.spillway, a.repeat or 1, [int(d) for d in a.depths.split(",")],
@@ -284,6 +344,9 @@ def main():
     a.repeat = a.repeat or 3
     if a.what == "incore":
         bench_incore(a.spillway, a.repeat, a.baseline)
+        return
+    if a.what == "mpi":
+        bench_mpi(a.spillway, a.repeat, [int(r) for r in a.ranks.split(",")], a.threads_per_rank, a.threads)
         return
     if a.what in ("reference", "all"):
         bench_reference(a.spillway, a.repeat)

@@ -14,6 +14,7 @@ packages=(
   libtinyobjloader-dev                     # OBJ meshes
   libglfw3-dev libgl-dev libx11-dev        # the --preview window (GLFW, OpenGL, X11)
   xvfb x11-apps x11-utils                  # its test: a virtual display, xwd, xwininfo
+  libopenmpi-dev openmpi-bin               # distributed rendering (mpirun -np N spillway render)
   libgtest-dev                             # the test suite
   libvulkan-dev mesa-vulkan-drivers vulkan-validationlayers glslc glslang-tools
   python3 python3-numpy python3-matplotlib # convergence plots

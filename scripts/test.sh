@@ -50,9 +50,12 @@ if [ "$mode" = all ] || [ "$mode" = --asan ]; then
   slow='^Convergence\.|StiffEnclosure\.ReachesLeOverOneMinusAlbedo/0\.999'
   # The Preview.* tests likewise: GLFW's glfwTerminate unloads Mesa's OpenGL driver, and what
   # its globals held (240 bytes) is then reported from an "<unknown module>" in the same way.
+  # And the Mpi.* tests: Open MPI loads its components with dlopen and unloads them at
+  # MPI_Finalize, after which what they still held is reported the same way (Open MPI 4.1.4 has
+  # no switch to keep them loaded).
   ASAN_OPTIONS="detect_leaks=1:$asan" ctest --test-dir "$root/build-asan" --output-on-failure \
-    --parallel "$(nproc)" --timeout 900 -E "^Vulkan|^Preview\.|$slow"
+    --parallel "$(nproc)" --timeout 900 -E "^Vulkan|^Preview\.|^Mpi\.|$slow"
   ASAN_OPTIONS="detect_leaks=0:$asan" ctest --test-dir "$root/build-asan" --output-on-failure \
-    --parallel "$(nproc)" --timeout 900 -R '^Vulkan|^Preview\.'
+    --parallel "$(nproc)" --timeout 900 -R '^Vulkan|^Preview\.|^Mpi\.'
 
 fi

@@ -180,7 +180,13 @@ int devicesCommand(const std::vector<std::string>& args) {
     return 0;
 }
 
-int renderCommand(const std::vector<std::string>& args) {
+// A distributed render's rank, for the error messages main() prints ("" for one process).
+std::string gRankLabel;
+
+// `ranks`: this process's place in a distributed render (mpirun), or nullptr. Every rank renders
+// its share; rank 0 alone reads the reference, shows progress and writes every output.
+int renderCommand(const std::vector<std::string>& args, spw::Ranks* ranks) {
+    const bool writes = !ranks || ranks->rank() == 0;
     std::string scenePath, output, statsPath, errorCsvPath, referencePath, checkpointPath,
         resumePath;
     double checkpointInterval = 0;
@@ -315,7 +321,22 @@ int renderCommand(const std::vector<std::string>& args) {
         if (ext != ".exr") throw UsageError("checkpoint '" + checkpointPath + "' must end in .exr");
     }
     for (const std::string* path : {&output, &statsPath, &errorCsvPath, &checkpointPath})
-        if (!path->empty()) spw::checkWritable(*path);
+        if (!path->empty() && writes) spw::checkWritable(*path);
+    if (ranks && previewOn && writes)
+        std::fprintf(stderr, "spillway: --preview shows rank 0's film, which holds every "
+                             "rank's samples after each iteration\n");
+    if (!writes) {
+        // The outputs are rank 0's: the others only render.
+        previewOn = false;
+        errorCsvPath.clear();
+        referencePath.clear();
+        progressMode = "none";
+    }
+    // Ranks sharing a host share its cores, unless --threads says otherwise (mpirun may also
+    // have bound each rank to fewer cores, which the thread pool's default respects).
+    if (ranks && config.threads == 0 && ranks->ranksOnHost() > 1)
+        config.threads =
+            std::max(1u, std::thread::hardware_concurrency() / unsigned(ranks->ranksOnHost()));
     std::optional<spw::Checkpoint> resume;
     if (!resumePath.empty()) {
         try {
@@ -328,7 +349,7 @@ int renderCommand(const std::vector<std::string>& args) {
     spw::Scene scene = spw::loadScene(scenePath);
     if (samplerOverride) scene.sampler = *samplerOverride;
     for (const spw::Mesh& m : scene.meshes)
-        if (m.droppedTriangles > 0)
+        if (m.droppedTriangles > 0 && writes)
             std::fprintf(stderr, "spillway: warning: %s: dropped %d zero-area triangle%s\n",
                          m.name.c_str(), m.droppedTriangles, m.droppedTriangles == 1 ? "" : "s");
 
@@ -396,14 +417,14 @@ int renderCommand(const std::vector<std::string>& args) {
     };
     std::unique_ptr<spw::RenderResult> result;
     if (!preview) {
-        result = spw::renderWithProgress(scene, config, onIteration, checkpoints);
+        result = spw::renderWithProgress(scene, config, onIteration, checkpoints, ranks);
     } else {
         // The window on this thread (GLFW's rule), the render on its own.
         std::exception_ptr failure;
         std::atomic<bool> finished{false};
         std::thread worker([&] {
             try {
-                result = spw::renderWithProgress(scene, config, onIteration, checkpoints);
+                result = spw::renderWithProgress(scene, config, onIteration, checkpoints, ranks);
             } catch (...) {
                 failure = std::current_exception();
             }
@@ -419,6 +440,7 @@ int renderCommand(const std::vector<std::string>& args) {
     progress.finish();
     // Closing the preview window is a normal way to end a render: exit 0.
     const int signal = std::max(0, interrupt.signal());
+    if (!writes) return signal != 0 ? 128 + signal : 0;
     if (interrupt.signal() != 0 && result->stats.iterations == 0) {
         std::fprintf(stderr, "spillway: stopped before an iteration completed; nothing written\n");
         return signal != 0 ? 128 + signal : 0;
@@ -524,19 +546,31 @@ int main(int argc, char** argv) {
             std::printf("spillway %s\n", SPILLWAY_VERSION);
             return 0;
         }
-        if (args[0] == "render") return renderCommand({args.begin() + 1, args.end()});
+        if (args[0] == "render") {
+            // Started by mpirun as several ranks: one distributed render (host/render/ranks.h).
+            std::unique_ptr<spw::Ranks> ranks = spw::joinMpiWorld();
+            if (ranks)
+                gRankLabel = "rank " + std::to_string(ranks->rank()) + " of " +
+                             std::to_string(ranks->size()) + ": ";
+            try {
+                return renderCommand({args.begin() + 1, args.end()}, ranks.get());
+            } catch (...) {
+                if (ranks) ranks->failed(); // the other ranks stop at their next agreement
+                throw;
+            }
+        }
         if (args[0] == "compare") return spw::compareCommand({args.begin() + 1, args.end()});
         if (args[0] == "devices") return devicesCommand({args.begin() + 1, args.end()});
         if (args[0] == "merge") return mergeCommand({args.begin() + 1, args.end()});
         throw UsageError("unknown command '" + args[0] + "' (try spillway --help)");
     } catch (const UsageError& e) {
-        std::fprintf(stderr, "spillway: %s\n", e.what());
+        std::fprintf(stderr, "spillway: %s%s\n", gRankLabel.c_str(), e.what());
         return 2;
     } catch (const spw::SceneError& e) {
-        std::fprintf(stderr, "%s\n", e.what());
+        std::fprintf(stderr, "%s%s\n", gRankLabel.c_str(), e.what());
         return 2;
     } catch (const std::exception& e) {
-        std::fprintf(stderr, "spillway: error: %s\n", e.what());
+        std::fprintf(stderr, "spillway: %serror: %s\n", gRankLabel.c_str(), e.what());
         return 1;
     }
 }

@@ -54,6 +54,8 @@ Film::Film(int width, int height, const Filter& filter, float brightestRadiance,
 }
 
 void Film::beginIteration() {
+    nonFiniteBefore_ = nonFinite_.load();
+    saturatedBefore_ = saturated_.load();
     for (size_t i = 0; i < size_t(width_) * height_; ++i) {
         for (std::atomic<std::int64_t>& v : acc_[i].v)
             v.store(0, std::memory_order_relaxed);
@@ -68,6 +70,21 @@ void Film::setAdaptive(double threshold, int minSamples) {
 }
 
 void Film::decideTiles() {
+    decideAdaptiveTiles();
+    // This process's share: every shares_-th of the tiles still sampling.
+    take_.clear();
+    if (shares_ <= 1) {
+        take_ = active_;
+        return;
+    }
+    const size_t tiles = size_t(tilesX_) * size_t(tilesY_);
+    take_.assign(tiles, 0);
+    size_t k = 0;
+    for (size_t t = 0; t < tiles; ++t)
+        if (active_.empty() || active_[t]) take_[t] = k++ % size_t(shares_) == size_t(share_);
+}
+
+void Film::decideAdaptiveTiles() {
     if (!(adaptiveThreshold_ > 0.0)) {
         active_.clear();
         activeTiles_ = 1;
@@ -94,6 +111,38 @@ void Film::decideTiles() {
                 --activeTiles_;
             }
         }
+}
+
+void Film::setShare(int index, int shares) {
+    share_ = index;
+    shares_ = shares;
+    decideTiles();
+}
+
+std::vector<std::int64_t> Film::iterationAccumulators() const {
+    const size_t n = size_t(width_) * height_;
+    std::vector<std::int64_t> out(n * 9 + 2);
+    for (size_t i = 0; i < n; ++i) {
+        for (int k = 0; k < 8; ++k)
+            out[i * 9 + size_t(k)] = acc_[i].v[k].load(std::memory_order_relaxed);
+        out[i * 9 + 8] = iterationSamples_[i].load(std::memory_order_relaxed);
+    }
+    out[n * 9] = std::int64_t(nonFinite_.load() - nonFiniteBefore_);
+    out[n * 9 + 1] = std::int64_t(saturated_.load() - saturatedBefore_);
+    return out;
+}
+
+void Film::setIterationAccumulators(const std::vector<std::int64_t>& values) {
+    const size_t n = size_t(width_) * height_;
+    if (values.size() != n * 9 + 2)
+        throw std::invalid_argument("iteration accumulators of another film size");
+    for (size_t i = 0; i < n; ++i) {
+        for (int k = 0; k < 8; ++k)
+            acc_[i].v[k].store(values[i * 9 + size_t(k)], std::memory_order_relaxed);
+        iterationSamples_[i].store(std::uint32_t(values[i * 9 + 8]), std::memory_order_relaxed);
+    }
+    nonFinite_ = nonFiniteBefore_ + std::uint64_t(values[n * 9]);
+    saturated_ = saturatedBefore_ + std::uint64_t(values[n * 9 + 1]);
 }
 
 std::uint64_t Film::samplesTaken() const {

@@ -94,13 +94,26 @@ class Film {
     // their pixels hold `minSamples` samples. Takes effect from the next iteration.
     static constexpr int kAdaptiveTile = 8;
     void setAdaptive(double threshold, int minSamples);
-    // Whether pixel (x, y) takes samples in the coming iteration.
+    // Whether this process takes pixel (x, y)'s samples in the coming iteration: the pixel's tile
+    // is still sampling, and is in this process's share.
     bool sampling(int x, int y) const {
-        return active_.empty() ||
-               active_[size_t(y / kAdaptiveTile) * size_t(tilesX_) + size_t(x / kAdaptiveTile)];
+        return take_.empty() ||
+               take_[size_t(y / kAdaptiveTile) * size_t(tilesX_) + size_t(x / kAdaptiveTile)];
     }
-    // Whether any pixel takes samples in the coming iteration.
+    // Whether any pixel (in any process's share) takes samples in the coming iteration.
     bool anySampling() const { return activeTiles_ > 0; }
+
+    // Distributed rendering (host/render/ranks.h): this process takes the samples of share
+    // `index` of `shares`: the k-th tile still sampling (row-major) goes to share k mod `shares`,
+    // so that the shares stay even as adaptive sampling stops tiles. Takes effect from the next
+    // iteration. The processes' iteration accumulators are then added together
+    // (iterationAccumulators, setIterationAccumulators) before endIteration().
+    void setShare(int index, int shares);
+    // The iteration's integer accumulators: 8 sums and a sample count per pixel, then the
+    // iteration's non-finite and saturated counts.
+    std::vector<std::int64_t> iterationAccumulators() const;
+    // Replaces them, with their sum over the processes (the same layout).
+    void setIterationAccumulators(const std::vector<std::int64_t>& values);
     // Camera samples each pixel took in whole iterations, and their total.
     const std::vector<std::uint32_t>& sampleCounts() const { return samples_; }
     std::uint64_t samplesTaken() const;
@@ -125,7 +138,8 @@ class Film {
 
   private:
     int halfOf(uint sampleIndex) const; // (iteration + index within it) mod 2
-    void decideTiles();                 // the adaptive mask, from the sums and counts
+    void decideTiles();                 // the tiles this process samples: adaptive mask and share
+    void decideAdaptiveTiles();         // the adaptive mask, from the sums and counts
     // Pixel `pixel`'s eight sums in radiance and weight units.
     void pixelSums(size_t pixel, double* s) const;
     // Adds the pixel's three per-channel terms of the half-buffer relMSE, (A - B)^2 / 4 /
@@ -155,6 +169,10 @@ class Film {
     int tilesX_ = 0, tilesY_ = 0;
     std::vector<std::uint8_t> active_; // per tile; empty: adaptive sampling off
     size_t activeTiles_ = 1;
+    int share_ = 0, shares_ = 1;
+    std::vector<std::uint8_t> take_; // per tile: active and in this share; empty: every tile
+    // nonFinite_ and saturated_ when the iteration began.
+    std::uint64_t nonFiniteBefore_ = 0, saturatedBefore_ = 0;
 };
 
 } // namespace spw

@@ -50,6 +50,48 @@ nlohmann::json textureStatistics(const TextureResolver& textures, const RenderSt
               {"bytes_read", perRay(t.bytesRead)}}}};
 }
 
+// --stats of a distributed render, on rank 0: every rank's own stats (`all`, JSON in rank
+// order) as `ranks`, and the traffic summed over them.
+void addRanksToStats(const std::vector<std::string>& all, RenderStats& stats) {
+    nlohmann::json perRank = nlohmann::json::array();
+    std::uint64_t rays[3] = {0, 0, 0};
+    nlohmann::json totals = nlohmann::json::object();
+    const char* summed[] = {"batches_processed", "batches_queued", "batches_spilled",
+                            "bytes_spilled_written", "bytes_spilled_read"};
+    for (size_t r = 0; r < all.size(); ++r) {
+        const nlohmann::json j = nlohmann::json::parse(all[r]);
+        nlohmann::json entry = {{"rank", r},
+                                {"host", j.value("host", "")},
+                                {"threads", j["threads"]},
+                                {"wall_seconds", j["wall_seconds"]},
+                                {"render_seconds", j["render_seconds"]},
+                                {"reduce_seconds", j["stage_seconds"].value("reduce", 0.0)},
+                                {"rays", j["rays"]}};
+        rays[0] += j["rays"]["camera"].get<std::uint64_t>();
+        rays[1] += j["rays"]["bounce"].get<std::uint64_t>();
+        rays[2] += j["rays"]["shadow"].get<std::uint64_t>();
+        for (const char* key : summed)
+            if (j.contains(key)) {
+                entry[key] = j[key];
+                totals[key] = totals.value(key, std::uint64_t(0)) + j[key].get<std::uint64_t>();
+            }
+        if (j.contains("peak_ray_bytes_in_ram"))
+            entry["peak_ray_bytes_in_ram"] = j["peak_ray_bytes_in_ram"];
+        if (j.contains("textures")) entry["textures"] = j["textures"];
+        perRank.push_back(entry);
+    }
+    stats.cameraRays = rays[0];
+    stats.bounceRays = rays[1];
+    stats.shadowRays = rays[2];
+    for (auto it = totals.begin(); it != totals.end(); ++it)
+        stats.extra[it.key()] = it.value();
+    stats.extra["ranks"] = perRank;
+}
+
+std::unique_ptr<RenderResult> renderOnRanks(const Scene& scene, const RenderConfig& config,
+                                            const ProgressCallback& onIteration,
+                                            const CheckpointOptions& checkpoints, Ranks* ranks);
+
 } // namespace
 
 std::string partialRenderProblem(const Scene& scene, const RenderConfig& config,
@@ -88,7 +130,21 @@ std::unique_ptr<RenderResult> render(const Scene& scene, const RenderConfig& con
 
 std::unique_ptr<RenderResult> renderWithProgress(const Scene& scene, const RenderConfig& config,
                                                  const ProgressCallback& onIteration,
-                                                 const CheckpointOptions& checkpoints) {
+                                                 const CheckpointOptions& checkpoints,
+                                                 Ranks* ranks) {
+    try {
+        return renderOnRanks(scene, config, onIteration, checkpoints, ranks);
+    } catch (...) {
+        if (ranks) ranks->failed(); // the others learn it at their next agreement
+        throw;
+    }
+}
+
+namespace {
+
+std::unique_ptr<RenderResult> renderOnRanks(const Scene& scene, const RenderConfig& config,
+                                            const ProgressCallback& onIteration,
+                                            const CheckpointOptions& checkpoints, Ranks* ranks) {
     if (config.pipeline.rayFormat == RayFormat::Compact &&
         scene.settings.maxDepth > int(kMaxCompactBounce))
         throw std::invalid_argument("max depth " + std::to_string(scene.settings.maxDepth) +
@@ -193,6 +249,7 @@ std::unique_ptr<RenderResult> renderWithProgress(const Scene& scene, const Rende
     const int adaptiveMinSamples =
         config.adaptiveMinSamples.value_or(scene.settings.adaptiveMinSamples);
     result->film->setAdaptive(adaptiveThreshold, adaptiveMinSamples);
+    if (ranks) result->film->setShare(ranks->rank(), ranks->size());
     std::optional<CheckpointKey> key = checkpoints.key;
     if (!key && (!checkpoints.path.empty() || checkpoints.resume))
         key = checkpointKey(scene, config, plan.sampleBase);
@@ -220,24 +277,59 @@ std::unique_ptr<RenderResult> renderWithProgress(const Scene& scene, const Rende
         writeCheckpoint(checkpoints.path, c, result->film->image());
     };
     double lastCheckpoint = renderSeconds;
+    const bool writes = !ranks || ranks->rank() == 0; // distributed: rank 0 writes
     const char* stopReason = "spp";
-    while (done < end) {
-        if (stopRequested(config)) {
-            stopReason = *config.stop == kStopByWindow ? "window" : "signal";
+    auto stopBySignal = [&] {
+        return config.stop && *config.stop == kStopByWindow ? "window" : "signal";
+    };
+    for (int ran = 0; done < end; ++ran) {
+        // What a rank alone knows is agreed first, so that every rank renders the same
+        // iterations; the film's own decisions (adaptive, target error) agree already.
+        Ranks::Agreement agreed;
+        agreed.stop = stopRequested(config);
+        agreed.timeUp =
+            ran > 0 && config.timeLimitSeconds && renderSeconds >= *config.timeLimitSeconds;
+        if (ranks) agreed = ranks->agree(false, agreed.stop, agreed.timeUp);
+        if (agreed.timeUp) {
+            stopReason = "time limit";
             break;
         }
-        const auto iterationStart = std::chrono::steady_clock::now();
-        if (!backend->renderIteration(uint(done), *result->film)) {
-            result->film->discardIteration(); // stopped part-way: keep only whole iterations
-            stopReason = *config.stop == kStopByWindow ? "window" : "signal";
+        if (agreed.stop) {
+            stopReason = stopBySignal();
             break;
+        }
+        if (ran > 0 && !result->film->anySampling()) {
+            stopReason = "adaptive"; // every tile is below the adaptive threshold
+            break;
+        }
+        if (ran > 0 && config.targetError) {
+            const std::optional<double> estimate = result->film->halfBufferRelMseEstimate();
+            if (estimate && *estimate <= *config.targetError) {
+                stopReason = "target error";
+                break;
+            }
+        }
+        const auto iterationStart = std::chrono::steady_clock::now();
+        bool whole = backend->renderIteration(uint(done), *result->film);
+        embree->checkError("tracing");
+        textures.checkErrors();
+        if (ranks) whole = !ranks->agree(false, !whole, false).stop;
+        if (!whole) {
+            result->film->discardIteration(); // stopped part-way: keep only whole iterations
+            stopReason = stopBySignal();
+            break;
+        }
+        if (ranks) {
+            // Every rank's share of the iteration, added exactly: the same film on every rank.
+            StageTimer t(stats.stages, "reduce");
+            std::vector<std::int64_t> sums = result->film->iterationAccumulators();
+            ranks->sum(sums);
+            result->film->setIterationAccumulators(sums);
         }
         {
             StageTimer t(stats.stages, "accumulate");
             result->film->endIteration();
         }
-        embree->checkError("tracing");
-        textures.checkErrors();
         textures.noteCacheUse();
         renderSeconds +=
             std::chrono::duration<double>(std::chrono::steady_clock::now() - iterationStart)
@@ -246,30 +338,13 @@ std::unique_ptr<RenderResult> renderWithProgress(const Scene& scene, const Rende
         const int sppDone = (done - first) * spi;
         if (onIteration)
             onIteration({done - first, end - first, sppDone, renderSeconds}, *result->film);
-        if (!checkpoints.path.empty() && checkpoints.intervalSeconds > 0 &&
+        if (writes && !checkpoints.path.empty() && checkpoints.intervalSeconds > 0 &&
             renderSeconds - lastCheckpoint >= checkpoints.intervalSeconds && done < end) {
             checkpoint();
             lastCheckpoint = renderSeconds;
         }
-        if (done == end) break;
-        if (config.timeLimitSeconds && renderSeconds >= *config.timeLimitSeconds) {
-            stopReason = "time limit";
-            break;
-        }
-        if (!result->film->anySampling()) {
-            stopReason = "adaptive"; // every tile is below the adaptive threshold
-            break;
-        }
-        if (config.targetError) {
-            const std::optional<double> estimate = result->film->halfBufferRelMseEstimate();
-            if (estimate && *estimate <= *config.targetError) {
-                stopReason = "target error";
-                break;
-            }
-        }
     }
     stats.extra["stop_reason"] = stopReason;
-    if (!checkpoints.path.empty() && done > first) checkpoint();
     stats.iterations = done - first;
     stats.spp = (done - first) * spi;
     if (config.sampleRange) stats.extra["samples_range"] = {first * spi, done * spi};
@@ -282,6 +357,16 @@ std::unique_ptr<RenderResult> renderWithProgress(const Scene& scene, const Rende
             {"samples_of_full_render",
              std::uint64_t(scene.image.width) * scene.image.height * std::uint64_t(stats.spp)}};
     if (textures.active()) stats.extra["textures"] = textureStatistics(textures, stats);
+    if (ranks) {
+        stats.wallSeconds =
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        nlohmann::json mine = stats.toJson();
+        mine["host"] = ranks->host();
+        const std::vector<std::string> all = ranks->gather(mine.dump());
+        ranks->finish(); // the last collective: rank 0 writes the outputs alone
+        if (writes) addRanksToStats(all, stats);
+    }
+    if (writes && !checkpoints.path.empty() && done > first) checkpoint();
     stats.nonFiniteSamples = result->film->nonFiniteSamples();
     stats.saturatedSamples = result->film->saturatedSamples();
     stats.wallSeconds =
@@ -289,4 +374,5 @@ std::unique_ptr<RenderResult> renderWithProgress(const Scene& scene, const Rende
     return result;
 }
 
+} // namespace
 } // namespace spw

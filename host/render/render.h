@@ -6,6 +6,7 @@
 #include "host/backend/stats.h"
 #include "host/image/film.h"
 #include "host/render/checkpoint.h"
+#include "host/render/ranks.h"
 #include "host/scene/scene.h"
 
 #include <functional>
@@ -61,8 +62,12 @@ std::unique_ptr<RenderResult> render(const Scene& scene, const RenderConfig& con
 // The same, reporting render time too; stops early at config.timeLimitSeconds.
 // With `checkpoints`, resumes and writes checkpoints: every interval, and at the end however the
 // render stopped (its completed iterations).
+// With `ranks`, renders this rank's share of a distributed render (host/render/ranks.h): every
+// rank returns the whole film; only rank 0 writes checkpoints, and its stats hold every rank's
+// (`ranks`) and their totals. A failure on any rank throws on every rank.
 std::unique_ptr<RenderResult> renderWithProgress(const Scene& scene, const RenderConfig& config,
                                                  const ProgressCallback& onIteration,
-                                                 const CheckpointOptions& checkpoints = {});
+                                                 const CheckpointOptions& checkpoints = {},
+                                                 Ranks* ranks = nullptr);
 
 } // namespace spw

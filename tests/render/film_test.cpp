@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <limits>
+#include <memory>
 
 namespace spw {
 namespace {
@@ -75,6 +76,62 @@ TEST(Film, UsualFilmsKeepTheBrightestSampleAt2To40) {
         const Film film(8, 8, Filter{}, 17.0f, spi);
         EXPECT_EQ(film.fixedPointScale() * 32.0, std::ldexp(1.0, 40)) << spi; // 17 rounds up to 2^5
     }
+}
+
+// Distributed rendering's split (Film::setShare): three films' shares cover every tile exactly
+// once, evenly (within one tile), and their accumulators, added, are one film's: the same image
+// and counts, bit for bit, with the non-finite samples counted once.
+TEST(Film, SharesCoverEveryTileOnceAndAddUpToOneFilm) {
+    const int width = 41, height = 17, shares = 3; // 6 x 3 tiles, the last ones partial
+    Film whole(width, height, Filter{FilterType::Gaussian, 1.5f}, 4.0f);
+    std::vector<std::unique_ptr<Film>> parts;
+    for (int s = 0; s < shares; ++s) {
+        parts.push_back(
+            std::make_unique<Film>(width, height, Filter{FilterType::Gaussian, 1.5f}, 4.0f));
+        parts.back()->setShare(s, shares);
+    }
+    std::vector<int> tiles(size_t(shares), 0);
+    for (int y = 0; y < height; y += Film::kAdaptiveTile)
+        for (int x = 0; x < width; x += Film::kAdaptiveTile) {
+            int owners = 0;
+            for (int s = 0; s < shares; ++s)
+                if (parts[size_t(s)]->sampling(x, y)) {
+                    ++owners;
+                    ++tiles[size_t(s)];
+                }
+            EXPECT_EQ(owners, 1) << "tile at " << x << ", " << y;
+        }
+    for (int s = 0; s < shares; ++s)
+        EXPECT_EQ(tiles[size_t(s)], 6) << "18 tiles in 3 even shares";
+
+    // Each pixel's sample goes to the film whose share holds it; all of them to `whole`.
+    std::vector<std::int64_t> sum;
+    for (int y = 0; y < height; ++y)
+        for (int x = 0; x < width; ++x)
+            for (int s = 0; s < shares; ++s) {
+                Film& f = *parts[size_t(s)];
+                if (!f.sampling(x, y)) continue;
+                const vec2 p(float(x) + 0.3f, float(y) + 0.6f);
+                const vec3 v(float(x % 7) * 0.1f, float(y % 5) * 0.2f, 0.7f);
+                const uint key = uint(y * width + x);
+                for (Film* film : {&f, &whole}) {
+                    film->addSample(p, 0);
+                    film->splat(p, 0, v, key);
+                    if (x == 3 && y == 4) film->splat(p, 0, vec3(NAN, 0.0f, 0.0f), key);
+                }
+            }
+    for (int s = 0; s < shares; ++s) {
+        const std::vector<std::int64_t> a = parts[size_t(s)]->iterationAccumulators();
+        if (sum.empty()) sum.assign(a.size(), 0);
+        for (size_t i = 0; i < a.size(); ++i)
+            sum[i] += a[i];
+    }
+    parts[0]->setIterationAccumulators(sum);
+    parts[0]->endIteration();
+    whole.endIteration();
+    EXPECT_EQ(parts[0]->image(), whole.image());
+    EXPECT_EQ(parts[0]->sampleCounts(), whole.sampleCounts());
+    EXPECT_EQ(parts[0]->nonFiniteSamples(), 1u);
 }
 
 } // namespace

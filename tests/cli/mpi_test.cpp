@@ -1,0 +1,166 @@
+// Distributed rendering: `mpirun -np 2 spillway render ...` (host/render/ranks.h) makes the image
+// one process makes, bit for bit, on every backend; rank 0 writes the outputs and the stats of
+// every rank; a rank that fails fails the job with its own message and leaves no file.
+#include "test_util.h"
+
+#include <nlohmann/json.hpp>
+
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <sstream>
+
+namespace spw::test {
+namespace {
+
+#ifdef SPILLWAY_MPIEXEC
+// Open MPI's launcher, as root in CI, with more ranks than cores allowed (2 ranks x 1 thread on
+// any machine). `programs`: what each group of ranks runs ("-np 2 BINARY ARGS", or several
+// groups joined by " : ").
+CommandResult launch(const std::string& programs) {
+    return runShell("OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 " +
+                    std::string(SPILLWAY_MPIEXEC) + " --oversubscribe " + programs);
+}
+CommandResult twoRanks(const std::string& args) {
+    return launch("-np 2 " + binary() + " " + args);
+}
+#define REQUIRE_MPI()
+#else
+CommandResult twoRanks(const std::string&) {
+    return {-1, ""};
+}
+CommandResult launch(const std::string&) {
+    return {-1, ""};
+}
+#define REQUIRE_MPI() GTEST_SKIP() << "built without MPI (SPILLWAY_MPI off)"
+#endif
+
+nlohmann::json readJson(const std::string& path) {
+    std::ifstream in(path);
+    return nlohmann::json::parse(in);
+}
+
+size_t lines(const std::string& path) {
+    std::istringstream in(readFile(path));
+    size_t n = 0;
+    for (std::string line; std::getline(in, line);)
+        ++n;
+    return n;
+}
+
+// 2 ranks x 1 thread against 1 process: the same pixels, the same rays (each path is traced
+// once, by one rank), every iteration in --error-csv, and each rank's share in --stats.
+TEST(Mpi, TwoRanksRenderTheSingleProcessImageOnEveryBackend) {
+    REQUIRE_MPI();
+    TempDir dir;
+    const std::string scene = smallCornellBox(dir, 40, 24); // 5 x 3 tiles: uneven shares
+    for (const std::string& backend : backendsUnderTest()) {
+        const std::string common = "render " + scene + " --backend " + backend + " --quiet";
+        const CommandResult one =
+            runSpillway(common + " --threads 2 -o " + dir.file(backend + "-one.exr") + " --stats " +
+                        dir.file(backend + "-one.json"));
+        ASSERT_EQ(one.status, 0) << one.output;
+        const CommandResult two = twoRanks(
+            common + " --threads 1 -o " + dir.file(backend + "-two.exr") + " --stats " +
+            dir.file(backend + "-two.json") + " --error-csv " + dir.file(backend + ".csv"));
+        ASSERT_EQ(two.status, 0) << two.output;
+        EXPECT_TRUE(samePixels(dir.file(backend + "-one.exr"), dir.file(backend + "-two.exr")))
+            << backend;
+
+        const nlohmann::json a = readJson(dir.file(backend + "-one.json"));
+        const nlohmann::json b = readJson(dir.file(backend + "-two.json"));
+        EXPECT_EQ(b["rays"], a["rays"]) << backend;
+        EXPECT_EQ(b["spp"], 16);
+        ASSERT_EQ(b["ranks"].size(), 2u);
+        std::uint64_t camera = 0;
+        for (int r = 0; r < 2; ++r) {
+            const nlohmann::json& rank = b["ranks"][size_t(r)];
+            EXPECT_EQ(rank["rank"], r);
+            EXPECT_EQ(rank["threads"], 1);
+            EXPECT_GT(rank["rays"]["camera"].get<std::uint64_t>(), 0u) << "rank " << r;
+            camera += rank["rays"]["camera"].get<std::uint64_t>();
+        }
+        EXPECT_EQ(camera, 40u * 24u * 16u);
+        EXPECT_EQ(lines(dir.file(backend + ".csv")), 1u + 16u) << "a header and 16 iterations";
+        EXPECT_FALSE(a.contains("ranks")) << "a single process has no ranks";
+    }
+}
+
+// The shares follow adaptive sampling (the k-th tile still sampling goes to rank k mod 2), and
+// each rank spills through its own anonymous file: still the single process's image, and the
+// spill traffic of both ranks adds up in --stats.
+TEST(Mpi, AdaptiveSamplingAndSpillingStayBitIdentical) {
+    REQUIRE_MPI();
+    TempDir dir;
+    const std::string scene = smallCornellBox(dir, 48, 32);
+    const std::string spill = dir.file("spill");
+    ASSERT_EQ(runShell("mkdir " + spill).status, 0);
+    const std::string common = "render " + scene +
+                               " --backend cpu --quiet --adaptive-threshold 0.3 "
+                               "--adaptive-min-spp 4 --memory-budget 0.05 --bin-exponent 8 "
+                               "--spill-dir " +
+                               spill;
+    const CommandResult one = runSpillway(common + " --threads 2 -o " + dir.file("one.exr") +
+                                          " --stats " + dir.file("one.json"));
+    ASSERT_EQ(one.status, 0) << one.output;
+    const CommandResult two = twoRanks(common + " --threads 1 -o " + dir.file("two.exr") +
+                                       " --stats " + dir.file("two.json"));
+    ASSERT_EQ(two.status, 0) << two.output;
+    EXPECT_TRUE(samePixels(dir.file("one.exr"), dir.file("two.exr")));
+
+    const nlohmann::json a = readJson(dir.file("one.json")), b = readJson(dir.file("two.json"));
+    EXPECT_EQ(b["samples_taken"], a["samples_taken"]);
+    ASSERT_LT(a["samples_taken"].get<std::uint64_t>(), 48u * 32u * 16u)
+        << "adaptive sampling stopped no tile: the test needs a higher threshold";
+    const std::uint64_t written = b["bytes_spilled_written"].get<std::uint64_t>();
+    EXPECT_GT(written, 0u) << "nothing spilled: the test needs a smaller budget";
+    EXPECT_EQ(written, b["ranks"][0]["bytes_spilled_written"].get<std::uint64_t>() +
+                           b["ranks"][1]["bytes_spilled_written"].get<std::uint64_t>());
+    EXPECT_EQ(filesIn(spill), 0u);
+}
+
+// A scene that is bad on one node only (MPMD: rank 1 runs another file): the job exits non-zero,
+// rank 1 prints its file:line error and rank 0 says it stopped with it; nothing is written.
+TEST(Mpi, ARankWithABadSceneFailsTheJob) {
+    REQUIRE_MPI();
+    TempDir dir;
+    const std::string good = smallCornellBox(dir, 16, 16);
+    const std::string bad = dir.write("bad.yaml", "camera: {\n  type: Pinhole\n");
+    const std::string out = dir.file("out.exr");
+    const std::string opts = " --backend cpu --threads 1 --quiet -o " + out;
+    const CommandResult r = launch("-np 1 " + binary() + " render " + good + opts + " : -np 1 " +
+                                   binary() + " render " + bad + opts);
+    EXPECT_NE(r.status, 0) << r.output;
+    EXPECT_NE(r.output.find("rank 1 of 2: " + bad + ":"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("rank 0 of 2: error: rank 1 failed"), std::string::npos) << r.output;
+    EXPECT_FALSE(std::ifstream(out).good()) << "no image from a failed job";
+    EXPECT_EQ(filesIn(dir.path()), 2u) << "only the two scenes";
+}
+
+// A rank that fails while rendering (it cannot create its spill file) stops every rank at the
+// next iteration boundary: non-zero exit, its message, no image, no spill file anywhere.
+TEST(Mpi, ARankFailingWhileRenderingFailsTheJob) {
+    REQUIRE_MPI();
+    TempDir dir;
+    const std::string scene = smallCornellBox(dir, 32, 32);
+    const std::string spill = dir.file("spill");
+    ASSERT_EQ(runShell("mkdir " + spill).status, 0);
+    const std::string out = dir.file("out.exr");
+    const std::string opts = " render " + scene +
+                             " --backend cpu --threads 1 --quiet --memory-budget 0.02 "
+                             "--bin-exponent 8 -o " +
+                             out + " --spill-dir ";
+    const CommandResult r = launch("-np 1 " + binary() + opts + spill + " : -np 1 " + binary() +
+                                   opts + dir.file("missing"));
+    EXPECT_NE(r.status, 0) << r.output;
+    EXPECT_NE(r.output.find("rank 1 of 2: error: cannot create a spill file in '" +
+                            dir.file("missing") + "'"),
+              std::string::npos)
+        << r.output;
+    EXPECT_NE(r.output.find("rank 0 of 2: error: rank 1 failed"), std::string::npos) << r.output;
+    EXPECT_FALSE(std::ifstream(out).good()) << "no image from a failed job";
+    EXPECT_EQ(filesIn(spill), 0u);
+}
+
+} // namespace
+} // namespace spw::test
