@@ -27,11 +27,14 @@ are noisy; ratios travel, absolute seconds do not).
                                and reference (before/after in one run). Writes
                                out/bench/incore.json.
   scripts/bench.py mpi         distributed rendering: 1 process x 2 threads against mpirun -np 2
-                               x 1 thread (and --ranks R1,R2,... x --threads-per-rank T) on the
+                               x 1 thread (--threads T: the process's; --ranks R1,R2,...: rank
+                               counts, each rank with T/R threads or --threads-per-rank) on the
                                Cornell box (64 spp) and the 1M-triangle scene, cpu and reference;
                                alternating, best of N. Per configuration: the launch's wall time
                                (MPI start-up included), rank 0's render seconds, the seconds the
-                               ranks spent in the film's reduction, and the ratio to one process.
+                               ranks spent in the film's reduction and in the agreements around
+                               each iteration (waiting for the slowest rank, mostly; the most of
+                               any rank), and the ratios to one process.
                                Writes out/bench/mpi.json.
   scripts/bench.py all         reference and pipeline (default)
 
@@ -283,8 +286,9 @@ def bench_mpi(spillway, repeat, ranks_list, threads_per_rank, one_process_thread
     mpirun = ["mpirun", "--oversubscribe", "--bind-to", "none"]
     env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
     configs = [("1 process x %d threads" % one_process_threads, 1, one_process_threads)]
-    configs += [("%d ranks x %d thread%s" % (r, threads_per_rank, "s" if threads_per_rank > 1 else ""),
-                 r, threads_per_rank) for r in ranks_list]
+    for r in ranks_list:
+        t = threads_per_rank or max(1, one_process_threads // r)  # default: the same cores in all
+        configs.append(("%d rank%s x %d thread%s" % (r, "s" if r > 1 else "", t, "s" if t > 1 else ""), r, t))
     results = []
     with tempfile.TemporaryDirectory() as tmp:
         for title, scene, extra in scenes:
@@ -305,17 +309,18 @@ def bench_mpi(spillway, repeat, ranks_list, threads_per_rank, one_process_thread
                             best[name] = s
                 one = best[configs[0][0]]
                 print("\n%s, %s backend (best of %d, alternating)" % (title, backend, repeat))
-                print("  %-22s %9s %9s %9s %10s %10s" % ("config", "launch s", "render s", "reduce s",
-                                                        "vs 1 proc", "render vs"))
+                print("  %-22s %9s %9s %9s %9s %10s %10s" % ("config", "launch s", "render s", "reduce s",
+                                                             "wait s", "vs 1 proc", "render vs"))
                 for name, n, threads in configs:
                     s = best[name]
                     reduce_s = max((r["reduce_seconds"] for r in s.get("ranks", [])), default=0.0)
-                    print("  %-22s %9.2f %9.2f %9.3f %9.2fx %9.2fx" % (
-                        name, s["launch_seconds"], s["render_seconds"], reduce_s,
+                    wait_s = max((r["agree_seconds"] for r in s.get("ranks", [])), default=0.0)
+                    print("  %-22s %9.2f %9.2f %9.3f %9.3f %9.2fx %9.2fx" % (
+                        name, s["launch_seconds"], s["render_seconds"], reduce_s, wait_s,
                         s["launch_seconds"] / one["launch_seconds"], s["render_seconds"] / one["render_seconds"]))
                     results.append({"scene": title, "backend": backend, "config": name, "ranks": n,
                                     "threads_per_rank": threads, "launch_seconds": s["launch_seconds"],
-                                    "render_seconds": s["render_seconds"], "reduce_seconds": reduce_s,
+                                    "render_seconds": s["render_seconds"], "reduce_seconds": reduce_s, "wait_seconds": wait_s,
                                     "wall_seconds": s["wall_seconds"], "rays": s["rays"]["total"]})
     folder = os.path.join(ROOT, "out", "bench")
     os.makedirs(folder, exist_ok=True)
@@ -334,7 +339,8 @@ def main():
     ap.add_argument("--spillway", default=os.path.join(ROOT, "build", "spillway"))
     ap.add_argument("--baseline", help="another build's spillway binary (incore: before/after)")
     ap.add_argument("--ranks", default="2", help="mpi: rank counts to run, e.g. 2,4,8,16")
-    ap.add_argument("--threads-per-rank", type=int, default=1, help="mpi: threads of each rank")
+    ap.add_argument("--threads-per-rank", type=int, default=0,
+                    help="mpi: threads of each rank (default: --threads / ranks)")
     ap.add_argument("--threads", type=int, default=2, help="mpi: threads of the single process")
     a = ap.parse_args()
     if a.what == "production":

@@ -66,6 +66,7 @@ void addRanksToStats(const std::vector<std::string>& all, RenderStats& stats) {
                                 {"wall_seconds", j["wall_seconds"]},
                                 {"render_seconds", j["render_seconds"]},
                                 {"reduce_seconds", j["stage_seconds"].value("reduce", 0.0)},
+                                {"agree_seconds", j["stage_seconds"].value("agree", 0.0)},
                                 {"rays", j["rays"]}};
         rays[0] += j["rays"]["camera"].get<std::uint64_t>();
         rays[1] += j["rays"]["bounce"].get<std::uint64_t>();
@@ -289,7 +290,10 @@ std::unique_ptr<RenderResult> renderOnRanks(const Scene& scene, const RenderConf
         agreed.stop = stopRequested(config);
         agreed.timeUp =
             ran > 0 && config.timeLimitSeconds && renderSeconds >= *config.timeLimitSeconds;
-        if (ranks) agreed = ranks->agree(false, agreed.stop, agreed.timeUp);
+        if (ranks) {
+            StageTimer t(stats.stages, "agree"); // waiting for the slowest rank, mostly
+            agreed = ranks->agree(false, agreed.stop, agreed.timeUp);
+        }
         if (agreed.timeUp) {
             stopReason = "time limit";
             break;
@@ -313,7 +317,10 @@ std::unique_ptr<RenderResult> renderOnRanks(const Scene& scene, const RenderConf
         bool whole = backend->renderIteration(uint(done), *result->film);
         embree->checkError("tracing");
         textures.checkErrors();
-        if (ranks) whole = !ranks->agree(false, !whole, false).stop;
+        if (ranks) {
+            StageTimer t(stats.stages, "agree");
+            whole = !ranks->agree(false, !whole, false).stop;
+        }
         if (!whole) {
             result->film->discardIteration(); // stopped part-way: keep only whole iterations
             stopReason = stopBySignal();
