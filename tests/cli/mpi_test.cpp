@@ -119,6 +119,37 @@ TEST(Mpi, AdaptiveSamplingAndSpillingStayBitIdentical) {
     EXPECT_EQ(filesIn(spill), 0u);
 }
 
+// Rank 0 writes checkpoints and partials of the ranks' whole film: a 2-rank partial merged with
+// a single process's, and a 2-rank checkpoint resumed by a single process, both give the single
+// process's image bit for bit.
+TEST(Mpi, PartialsAndCheckpointsOfRanksAreTheSingleProcesssSums) {
+    REQUIRE_MPI();
+    TempDir dir;
+    const std::string scene = smallCornellBox(dir, 24, 16);
+    const std::string common = "render " + scene + " --backend cpu --quiet --threads 1 ";
+    const CommandResult full = runSpillway(common + "-o " + dir.file("full.exr"));
+    ASSERT_EQ(full.status, 0) << full.output;
+
+    const CommandResult a = twoRanks(common + "--spp 16 --samples 0:10 --partial " +
+                                     dir.file("a.exr") + " -o " + dir.file("a-image.exr"));
+    ASSERT_EQ(a.status, 0) << a.output;
+    const CommandResult b = runSpillway(common + "--spp 16 --samples 10:16 --partial " +
+                                        dir.file("b.exr") + " -o " + dir.file("b-image.exr"));
+    ASSERT_EQ(b.status, 0) << b.output;
+    const CommandResult m = runSpillway("merge " + dir.file("a.exr") + " " + dir.file("b.exr") +
+                                        " -o " + dir.file("merged.exr"));
+    ASSERT_EQ(m.status, 0) << m.output;
+    EXPECT_TRUE(samePixels(dir.file("merged.exr"), dir.file("full.exr")));
+
+    const CommandResult first = twoRanks(common + "--spp 6 --checkpoint " + dir.file("ck.exr") +
+                                         " -o " + dir.file("six.exr"));
+    ASSERT_EQ(first.status, 0) << first.output;
+    const CommandResult rest = runSpillway(common + "--spp 16 --resume " + dir.file("ck.exr") +
+                                           " -o " + dir.file("resumed.exr"));
+    ASSERT_EQ(rest.status, 0) << rest.output;
+    EXPECT_TRUE(samePixels(dir.file("resumed.exr"), dir.file("full.exr")));
+}
+
 // A scene that is bad on one node only (MPMD: rank 1 runs another file): the job exits non-zero,
 // rank 1 prints its file:line error and rank 0 says it stopped with it; nothing is written.
 TEST(Mpi, ARankWithABadSceneFailsTheJob) {
