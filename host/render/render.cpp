@@ -369,7 +369,9 @@ std::unique_ptr<RenderResult> renderOnRanks(const Scene& scene, const RenderConf
             std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         nlohmann::json mine = stats.toJson();
         mine["host"] = ranks->host();
-        const std::vector<std::string> all = ranks->gather(mine.dump());
+        const std::string text = mine.dump();
+        ranks->agree(false, false, false); // a rank that failed since the last one says so here
+        const std::vector<std::string> all = ranks->gather(text);
         ranks->finish(); // the last collective: rank 0 writes the outputs alone
         if (writes) addRanksToStats(all, stats);
     }

@@ -150,6 +150,34 @@ TEST(Mpi, PartialsAndCheckpointsOfRanksAreTheSingleProcesssSums) {
     EXPECT_TRUE(samePixels(dir.file("resumed.exr"), dir.file("full.exr")));
 }
 
+// Ctrl-C on mpirun: it sends SIGTERM to every rank, the ranks agree to stop at the same
+// iteration, and rank 0 writes the completed iterations: the image a single process makes of
+// that many samples, bit for bit.
+TEST(Mpi, InterruptingMpirunKeepsTheCompletedIterations) {
+    REQUIRE_MPI();
+    TempDir dir;
+    const std::string scene = smallCornellBox(dir, 32, 32);
+    const std::string common = "render " + scene + " --backend cpu --threads 1 ";
+    const std::string log = dir.file("log");
+    // mpirun in the background; SIGINT once rank 0 has reported its third iteration.
+    const CommandResult r =
+        launch("-np 2 " + binary() + " " + common + "--spp 100000 --progress lines -o " +
+               dir.file("two.exr") + " --stats " + dir.file("two.json") + " > " + log +
+               " 2>&1 & pid=$!; for i in $(seq 600); do grep -q 'iteration 3/' " + log +
+               " && break; sleep 0.1; done; kill -INT $pid; wait $pid");
+    const std::string output = readFile(log);
+    ASSERT_NE(output.find("stopped by signal 15"), std::string::npos) << r.output << output;
+    const nlohmann::json stats = readJson(dir.file("two.json"));
+    EXPECT_EQ(stats["stop_reason"], "signal");
+    const int spp = stats["spp"].get<int>();
+    ASSERT_GE(spp, 3);
+    ASSERT_LT(spp, 100000);
+    const CommandResult one =
+        runSpillway(common + "--quiet --spp " + std::to_string(spp) + " -o " + dir.file("one.exr"));
+    ASSERT_EQ(one.status, 0) << one.output;
+    EXPECT_TRUE(samePixels(dir.file("one.exr"), dir.file("two.exr"))) << spp << " spp";
+}
+
 // A scene that is bad on one node only (MPMD: rank 1 runs another file): the job exits non-zero,
 // rank 1 prints its file:line error and rank 0 says it stopped with it; nothing is written.
 TEST(Mpi, ARankWithABadSceneFailsTheJob) {
