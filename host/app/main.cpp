@@ -41,6 +41,10 @@ usage:
   spillway merge PART... -o IMAGE   add partial renders (--samples A:B --partial PART) that
                                     cover every sample once into the whole render's image,
                                     bit for bit the image one process would have made
+  mpirun -np N spillway render SCENE [options]
+                                    one render across N MPI ranks (hosts): every rank takes
+                                    a share of each iteration's tiles, rank 0 writes the
+                                    outputs; the image is the single process's, bit for bit
   spillway devices                  the Vulkan devices, their drivers, and which are usable
   spillway --help                   this text
   spillway --version                the version
