@@ -12,6 +12,8 @@
 #include "host/scene/scene.h"
 #include "host/vk/context.h"
 
+#include <tbb/info.h>
+
 #include <cctype>
 #include <cmath>
 #include <csignal>
@@ -336,11 +338,12 @@ int renderCommand(const std::vector<std::string>& args, spw::Ranks* ranks) {
         referencePath.clear();
         progressMode = "none";
     }
-    // Ranks sharing a host share its cores, unless --threads says otherwise (mpirun may also
-    // have bound each rank to fewer cores, which the thread pool's default respects).
+    // Ranks sharing a host share its cores, unless --threads says otherwise; where mpirun bound
+    // a rank to fewer cores than its share (one core each, its default for two ranks), those.
     if (ranks && config.threads == 0 && ranks->ranksOnHost() > 1)
         config.threads =
-            std::max(1u, std::thread::hardware_concurrency() / unsigned(ranks->ranksOnHost()));
+            std::max(1, std::min(tbb::info::default_concurrency(),
+                                 int(std::thread::hardware_concurrency()) / ranks->ranksOnHost()));
     std::optional<spw::Checkpoint> resume;
     if (!resumePath.empty()) {
         try {
