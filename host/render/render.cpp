@@ -51,7 +51,7 @@ nlohmann::json textureStatistics(const TextureResolver& textures, const RenderSt
 }
 
 // --stats of a distributed render, on rank 0: every rank's own stats (`all`, JSON in rank
-// order) as `ranks`, and the traffic summed over them.
+// order) as `ranks`, and the traffic (rays, spill, textures) summed over them.
 void addRanksToStats(const std::vector<std::string>& all, RenderStats& stats) {
     nlohmann::json perRank = nlohmann::json::array();
     std::uint64_t rays[3] = {0, 0, 0};
@@ -78,12 +78,29 @@ void addRanksToStats(const std::vector<std::string>& all, RenderStats& stats) {
             }
         if (j.contains("peak_ray_bytes_in_ram"))
             entry["peak_ray_bytes_in_ram"] = j["peak_ray_bytes_in_ram"];
-        if (j.contains("textures")) entry["textures"] = j["textures"];
+        if (j.contains("textures")) {
+            entry["textures"] = j["textures"];
+            // The counters summed; the cache's peak is the largest rank's.
+            if (!totals.contains("textures")) totals["textures"] = nlohmann::json::object();
+            nlohmann::json& t = totals["textures"];
+            for (const char* key : {"lookups", "tiles_read", "bytes_read", "files_opened",
+                                    "files_reopened", "cache_misses"})
+                t[key] = t.value(key, std::uint64_t(0)) + j["textures"][key].get<std::uint64_t>();
+            t["peak_cache_bytes"] =
+                std::max(t.value("peak_cache_bytes", std::uint64_t(0)),
+                         j["textures"]["peak_cache_bytes"].get<std::uint64_t>());
+        }
         perRank.push_back(entry);
     }
     stats.cameraRays = rays[0];
     stats.bounceRays = rays[1];
     stats.shadowRays = rays[2];
+    if (totals.contains("textures")) {
+        nlohmann::json& t = totals["textures"];
+        const double all = double(rays[0] + rays[1] + rays[2]);
+        for (const char* key : {"lookups", "tiles_read", "bytes_read"})
+            t["per_ray"][key] = all > 0 ? t[key].get<double>() / all : 0.0;
+    }
     for (auto it = totals.begin(); it != totals.end(); ++it)
         stats.extra[it.key()] = it.value();
     stats.extra["ranks"] = perRank;

@@ -86,6 +86,33 @@ TEST(Mpi, TwoRanksRenderTheSingleProcessImageOnEveryBackend) {
     }
 }
 
+// Image textures (the production workload's test preset, textures four times the cache): the
+// single process's image, and --stats counts every rank's lookups, the same lookups one process
+// makes (each hit is shaded once, by one rank).
+TEST(Mpi, TexturedScenesCountEveryRanksLookups) {
+    REQUIRE_MPI();
+    TempDir dir;
+    const CommandResult made =
+        runShell(sourceDir() + "/scripts/make_production_scene.py " + dir.path() + " --small");
+    ASSERT_EQ(made.status, 0) << made.output;
+    const std::string common = "render " + dir.file("scene.yaml") + " --backend cpu --quiet";
+    const CommandResult one = runSpillway(common + " --threads 2 -o " + dir.file("one.exr") +
+                                          " --stats " + dir.file("one.json"));
+    ASSERT_EQ(one.status, 0) << one.output;
+    const CommandResult two = twoRanks(common + " --threads 1 -o " + dir.file("two.exr") +
+                                       " --stats " + dir.file("two.json"));
+    ASSERT_EQ(two.status, 0) << two.output;
+    EXPECT_TRUE(samePixels(dir.file("one.exr"), dir.file("two.exr")));
+    const nlohmann::json a = readJson(dir.file("one.json"))["textures"];
+    const nlohmann::json b = readJson(dir.file("two.json"));
+    ASSERT_GT(a["lookups"].get<std::uint64_t>(), 0u);
+    EXPECT_EQ(b["textures"]["lookups"], a["lookups"]);
+    EXPECT_EQ(b["textures"]["lookups"].get<std::uint64_t>(),
+              b["ranks"][0]["textures"]["lookups"].get<std::uint64_t>() +
+                  b["ranks"][1]["textures"]["lookups"].get<std::uint64_t>());
+    EXPECT_GT(b["ranks"][1]["textures"]["lookups"].get<std::uint64_t>(), 0u);
+}
+
 // The shares follow adaptive sampling (the k-th tile still sampling goes to rank k mod 2), and
 // each rank spills through its own anonymous file: still the single process's image, and the
 // spill traffic of both ranks adds up in --stats.
