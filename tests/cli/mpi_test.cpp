@@ -48,6 +48,24 @@ size_t lines(const std::string& path) {
     return n;
 }
 
+// Renders `args` as one process with 2 threads (dir/NAME-one.exr, .json) and as 2 ranks with 1
+// thread each (dir/NAME-two.exr, .json; `twoExtra` added), expects the same pixels, and reads
+// both --stats.
+void renderOnOneAndTwoRanks(const TempDir& dir, const std::string& args, const std::string& name,
+                            nlohmann::json& one, nlohmann::json& two,
+                            const std::string& twoExtra = "") {
+    const std::string stem = dir.file(name);
+    const CommandResult a =
+        runSpillway(args + " --threads 2 -o " + stem + "-one.exr --stats " + stem + "-one.json");
+    ASSERT_EQ(a.status, 0) << a.output;
+    const CommandResult b = twoRanks(args + " --threads 1 -o " + stem + "-two.exr --stats " + stem +
+                                     "-two.json " + twoExtra);
+    ASSERT_EQ(b.status, 0) << b.output;
+    EXPECT_TRUE(samePixels(stem + "-one.exr", stem + "-two.exr")) << name;
+    one = readJson(stem + "-one.json");
+    two = readJson(stem + "-two.json");
+}
+
 // 2 ranks x 1 thread against 1 process: the same pixels, the same rays (each path is traced
 // once, by one rank), every iteration in --error-csv, and each rank's share in --stats.
 TEST(Mpi, TwoRanksRenderTheSingleProcessImageOnEveryBackend) {
@@ -55,20 +73,10 @@ TEST(Mpi, TwoRanksRenderTheSingleProcessImageOnEveryBackend) {
     TempDir dir;
     const std::string scene = smallCornellBox(dir, 40, 24); // 5 x 3 tiles: uneven shares
     for (const std::string& backend : backendsUnderTest()) {
-        const std::string common = "render " + scene + " --backend " + backend + " --quiet";
-        const CommandResult one =
-            runSpillway(common + " --threads 2 -o " + dir.file(backend + "-one.exr") + " --stats " +
-                        dir.file(backend + "-one.json"));
-        ASSERT_EQ(one.status, 0) << one.output;
-        const CommandResult two = twoRanks(
-            common + " --threads 1 -o " + dir.file(backend + "-two.exr") + " --stats " +
-            dir.file(backend + "-two.json") + " --error-csv " + dir.file(backend + ".csv"));
-        ASSERT_EQ(two.status, 0) << two.output;
-        EXPECT_TRUE(samePixels(dir.file(backend + "-one.exr"), dir.file(backend + "-two.exr")))
-            << backend;
-
-        const nlohmann::json a = readJson(dir.file(backend + "-one.json"));
-        const nlohmann::json b = readJson(dir.file(backend + "-two.json"));
+        nlohmann::json a, b;
+        ASSERT_NO_FATAL_FAILURE(
+            renderOnOneAndTwoRanks(dir, "render " + scene + " --backend " + backend + " --quiet",
+                                   backend, a, b, "--error-csv " + dir.file(backend + ".csv")));
         EXPECT_EQ(b["rays"], a["rays"]) << backend;
         EXPECT_EQ(b["spp"], 16);
         ASSERT_EQ(b["ranks"].size(), 2u);
@@ -95,16 +103,10 @@ TEST(Mpi, TexturedScenesCountEveryRanksLookups) {
     const CommandResult made =
         runShell(sourceDir() + "/scripts/make_production_scene.py " + dir.path() + " --small");
     ASSERT_EQ(made.status, 0) << made.output;
-    const std::string common = "render " + dir.file("scene.yaml") + " --backend cpu --quiet";
-    const CommandResult one = runSpillway(common + " --threads 2 -o " + dir.file("one.exr") +
-                                          " --stats " + dir.file("one.json"));
-    ASSERT_EQ(one.status, 0) << one.output;
-    const CommandResult two = twoRanks(common + " --threads 1 -o " + dir.file("two.exr") +
-                                       " --stats " + dir.file("two.json"));
-    ASSERT_EQ(two.status, 0) << two.output;
-    EXPECT_TRUE(samePixels(dir.file("one.exr"), dir.file("two.exr")));
-    const nlohmann::json a = readJson(dir.file("one.json"))["textures"];
-    const nlohmann::json b = readJson(dir.file("two.json"));
+    nlohmann::json one, b;
+    ASSERT_NO_FATAL_FAILURE(renderOnOneAndTwoRanks(
+        dir, "render " + dir.file("scene.yaml") + " --backend cpu --quiet", "textured", one, b));
+    const nlohmann::json a = one["textures"];
     ASSERT_GT(a["lookups"].get<std::uint64_t>(), 0u);
     EXPECT_EQ(b["textures"]["lookups"], a["lookups"]);
     EXPECT_EQ(b["textures"]["lookups"].get<std::uint64_t>(),
@@ -122,20 +124,14 @@ TEST(Mpi, AdaptiveSamplingAndSpillingStayBitIdentical) {
     const std::string scene = smallCornellBox(dir, 48, 32);
     const std::string spill = dir.file("spill");
     ASSERT_EQ(runShell("mkdir " + spill).status, 0);
-    const std::string common = "render " + scene +
-                               " --backend cpu --quiet --adaptive-threshold 0.3 "
-                               "--adaptive-min-spp 4 --memory-budget 0.05 --bin-exponent 8 "
-                               "--spill-dir " +
-                               spill;
-    const CommandResult one = runSpillway(common + " --threads 2 -o " + dir.file("one.exr") +
-                                          " --stats " + dir.file("one.json"));
-    ASSERT_EQ(one.status, 0) << one.output;
-    const CommandResult two = twoRanks(common + " --threads 1 -o " + dir.file("two.exr") +
-                                       " --stats " + dir.file("two.json"));
-    ASSERT_EQ(two.status, 0) << two.output;
-    EXPECT_TRUE(samePixels(dir.file("one.exr"), dir.file("two.exr")));
-
-    const nlohmann::json a = readJson(dir.file("one.json")), b = readJson(dir.file("two.json"));
+    nlohmann::json a, b;
+    ASSERT_NO_FATAL_FAILURE(renderOnOneAndTwoRanks(
+        dir,
+        "render " + scene +
+            " --backend cpu --quiet --adaptive-threshold 0.3 --adaptive-min-spp 4 "
+            "--memory-budget 0.05 --bin-exponent 8 --spill-dir " +
+            spill,
+        "adaptive", a, b));
     EXPECT_EQ(b["samples_taken"], a["samples_taken"]);
     ASSERT_LT(a["samples_taken"].get<std::uint64_t>(), 48u * 32u * 16u)
         << "adaptive sampling stopped no tile: the test needs a higher threshold";
