@@ -149,6 +149,10 @@ std::string floorObj(float halfSize);
 // `settings` (the settings map's entries, max depth 1 among them). Returns the loaded scene.
 Scene floorUnderLight(TempDir& dir, int iterations, const std::string& settings,
                       const std::string& light);
+// floorUnderLight's quad light: 1 x 0.5, intensity 3, facing down from 1 above the floor (its
+// corners (+-0.5, 1, +-0.25)).
+constexpr const char* kQuadOverFloor =
+    "{type: Quad, translation: [0, 1, 0], rotation: [90, 0, 0], scale: [1, 0.5], intensity: 3}";
 // The point of the floor y = 0, in the scene file's coordinates, that pixel (x, y)'s centre sees.
 vec3 floorPointAtPixelCentre(const Scene& scene, int x, int y);
 

@@ -62,9 +62,7 @@ TEST(Adaptive, EnclosureMeanIsLeOverOneMinusAlbedo) {
 TEST(Adaptive, QuadLightIrradianceIsUnbiased) {
     TempDir dir;
     const Scene scene =
-        floorUnderLight(dir, 256, "max depth: 1, adaptive threshold: 0.02",
-                        "{type: Quad, translation: [0, 1, 0], rotation: [90, 0, 0], "
-                        "scale: [1, 0.5], intensity: 3}");
+        floorUnderLight(dir, 256, "max depth: 1, adaptive threshold: 0.02", kQuadOverFloor);
     // The same scene without adaptive sampling, many samples: its mean is the closed form's to
     // well within this test's errors (QuadLight.PixelsMatchPolygonIrradiance).
     Scene full = scene;

@@ -75,10 +75,7 @@ double polygonIrradiance(vec3 x, vec3 n, const std::vector<vec3>& corners, doubl
 // A Lambert floor under one quad light, direct light only: every pixel is albedo/pi * E(x).
 TEST(QuadLight, PixelsMatchPolygonIrradiance) {
     TempDir dir;
-    const Scene scene =
-        floorUnderLight(dir, 256, "max depth: 1",
-                        "{type: Quad, translation: [0, 1, 0], rotation: [90, 0, 0], "
-                        "scale: [1, 0.5], intensity: 3}");
+    const Scene scene = floorUnderLight(dir, 256, "max depth: 1", kQuadOverFloor);
     PixelStats ps;
     auto result = renderWithStats(scene, referenceConfig(), &ps);
     const std::vector<vec3> corners = {
