@@ -100,7 +100,9 @@ sorted pipeline options (cpu and vulkan backends):
   --bin-exponent E      a directional bin becomes a batch at 2^E rays (settings: bin exponent)
   --memory-budget MiB   RAM for rays waiting in bins and queued batches; the rest spills to
                         disk (settings: memory budget). Peak rays in RAM stay within the
-                        budget, or within six batches (2^E rays each) if that is larger
+                        budget, or within six batches (2^E rays each) if that is larger;
+                        camera rays are made a batch at a time, so they stay under seven
+                        batches whatever the budget
   --spill-dir DIR       where spilled batches go (default: the system temp folder)
   --ray-sort MODE       auto (sort only where it measures faster), morton, median or off
   --hit-sort MODE       sort hits by (shader, object, texture order) before shading: auto

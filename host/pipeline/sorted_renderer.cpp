@@ -52,6 +52,7 @@ SortedRenderer::SortedRenderer(const RenderContext& ctx, const PipelineConfig& c
     queue_ =
         std::make_unique<BatchQueue>(budget > binBytes ? budget - binBytes : 0, config.spillDir);
     bins_ = std::make_unique<DirectionalBins>(config.rayFormat, exponent, *queue_);
+    batchRays_ = size_t(1) << exponent;
 }
 
 SortedRenderer::~SortedRenderer() = default;
@@ -60,7 +61,7 @@ bool SortedRenderer::renderIteration(uint iteration, Film& film) {
     shading_->beginIteration(iteration);
     {
         StageTimer t(ctx_.stats.stages, "generate");
-        generateCameraRays(ctx_, iteration, config_.rayFormat, film, *bins_);
+        cameraRays_.begin(ctx_, iteration, film);
     }
     // With two engine slots, batch k's shading runs while batch k+1 is loaded, traversed and set
     // up; batch k is then finished (its continuation rays binned) before k+2 starts. Batches may
@@ -78,21 +79,19 @@ bool SortedRenderer::renderIteration(uint iteration, Film& film) {
             publishStats();
             return false;
         }
-        std::optional<RayBatch> batch = queue_->pop(ctx_.stats.stages);
-        if (!batch) {
-            if (pending >= 0) { // its continuation rays may refill the queue
-                finishBatch(pending, iteration, film);
-                pending = -1;
-                continue;
-            }
-            if (!bins_->flushLargest()) break; // queue and bins empty: the iteration is done
+        bool camera = false;
+        // With a batch pending, its continuation rays may yet fill a bin: flush none before.
+        if (!nextBatch(film, pending < 0, camera)) {
+            if (pending < 0) break; // nothing queued, binned, pending or still to make
+            finishBatch(pending, iteration, film); // its continuation rays may refill the queue
+            pending = -1;
             continue;
         }
         if (fused_) {
-            runFusedBatch(*batch, iteration, film);
+            runFusedBatch(camera, iteration, film);
             continue;
         }
-        startBatch(*batch, next, iteration, film);
+        startBatch(camera, next, iteration, film);
         if (pending >= 0) finishBatch(pending, iteration, film);
         if (overlap) {
             pending = next;
@@ -105,18 +104,33 @@ bool SortedRenderer::renderIteration(uint iteration, Film& film) {
     return true;
 }
 
-size_t SortedRenderer::traceBatch(RayBatch& batch) {
+bool SortedRenderer::nextBatch(Film& film, bool flush, bool& camera) {
     Scratch& s = *scratch_;
     StageTimes& times = ctx_.stats.stages;
-    const size_t n = batch.count;
-    ++batchesProcessed_;
-
-    size_t cameraRays = 0;
-    {
-        StageTimer t(times, "decompress");
-        cameraRays = decompressRays(batch, s.rays);
+    // Bounce rays first, so that the rays in flight stay few: camera rays are made only when no
+    // batch waits in the queue, and the bins are flushed part-full only once every camera ray of
+    // the iteration is made.
+    std::optional<RayBatch> batch = queue_->pop(times);
+    if (!batch && cameraRays_.remaining() > 0) {
+        StageTimer t(times, "generate");
+        cameraRays_.generate(ctx_, batchRays_, film, s.rays);
+        camera = true;
+        return true;
     }
-    const RaySortMode mode = policy_.choose(double(cameraRays) / double(std::max<size_t>(n, 1)));
+    if (!batch && flush && bins_->flushLargest()) batch = queue_->pop(times);
+    if (!batch) return false;
+    StageTimer t(times, "decompress");
+    decompressRays(*batch, s.rays);
+    return true;
+}
+
+size_t SortedRenderer::traceBatch(bool camera) {
+    Scratch& s = *scratch_;
+    StageTimes& times = ctx_.stats.stages;
+    const size_t n = s.rays.size();
+    ++batchesProcessed_;
+    // Camera batches are coherent as made (tile by tile): they are never sorted or measured.
+    const RaySortMode mode = camera ? RaySortMode::Off : policy_.choose(0.0);
     const auto sortStart = Clock::now();
     if (mode == RaySortMode::Morton || mode == RaySortMode::Median) {
         StageTimer t(times, "sort rays");
@@ -129,24 +143,26 @@ size_t SortedRenderer::traceBatch(RayBatch& batch) {
         StageTimer t(times, "traverse");
         traverse(ctx_.embree, s.rays, mode != RaySortMode::Off, s.hits);
     }
-    if (cameraRays * 2 < n) policy_.record(mode != RaySortMode::Off, since(sortStart), n);
-    ctx_.stats.bounceRays += n - cameraRays;
+    if (!camera) {
+        policy_.record(mode != RaySortMode::Off, since(sortStart), n);
+        ctx_.stats.bounceRays += n;
+    }
     StageTimer t(times, "sort hits");
     return sortHits(ctx_.scene, s.hits, sortHits_, s.order, s.keyTmp);
 }
 
-void SortedRenderer::runFusedBatch(RayBatch& batch, uint iteration, Film& film) {
+void SortedRenderer::runFusedBatch(bool camera, uint iteration, Film& film) {
     Scratch& s = *scratch_;
-    const size_t hitCount = traceBatch(batch);
+    const size_t hitCount = traceBatch(camera);
     escapes(iteration, hitCount, film);
     shadeFused(ctx_, iteration, config_.rayFormat, s.rays, s.hits, s.order, hitCount, film, *bins_);
 }
 
-void SortedRenderer::startBatch(RayBatch& batch, int slot, uint iteration, Film& film) {
+void SortedRenderer::startBatch(bool camera, int slot, uint iteration, Film& film) {
     Scratch& s = *scratch_;
     Scratch::InFlight& flight = s.inFlight[slot];
     StageTimes& times = ctx_.stats.stages;
-    flight.hitCount = traceBatch(batch);
+    flight.hitCount = traceBatch(camera);
     escapes(iteration, flight.hitCount, film);
     {
         StageTimer t(times, "hit setup");

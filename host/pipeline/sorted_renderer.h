@@ -8,6 +8,7 @@
 #include "host/pipeline/batch_queue.h"
 #include "host/pipeline/ray_sort.h"
 #include "host/pipeline/shading_engine.h"
+#include "host/pipeline/stages.h"
 
 #include <memory>
 
@@ -22,15 +23,18 @@ class SortedRenderer : public Backend {
 
   private:
     struct Scratch;
+    // The next batch's rays into the scratch: a queued batch of bounce rays (load, decompress),
+    // else the next camera rays (generate), else, if `flush`, the fullest bin's. False when none.
+    bool nextBatch(Film& film, bool flush, bool& camera);
     // One batch in two halves, so that a batch's shading can overlap the next one's traversal:
-    // decompress .. hit setup, then submit its shading to `slot`; then wait for it, trace its
+    // sort rays .. hit setup, then submit its shading to `slot`; then wait for it, trace its
     // shadow rays, accumulate and bin its continuation rays. The misses' environment goes into
     // the film at once.
-    void startBatch(RayBatch& batch, int slot, uint iteration, Film& film);
-    // decompress .. sort hits: the batch's hits in shading order in the scratch; their count.
-    size_t traceBatch(RayBatch& batch);
+    void startBatch(bool camera, int slot, uint iteration, Film& film);
+    // sort rays .. sort hits: the batch's hits in shading order in the scratch; their count.
+    size_t traceBatch(bool camera);
     // The whole batch with the per-hit stages fused (stages.h: shadeFused), for the cpu engine.
-    void runFusedBatch(RayBatch& batch, uint iteration, Film& film);
+    void runFusedBatch(bool camera, uint iteration, Film& film);
     void finishBatch(int slot, uint iteration, Film& film);
     // escape: the batch's misses see the environment (stages.h: accumulateEscapes).
     void escapes(uint iteration, size_t hitCount, Film& film);
@@ -41,6 +45,8 @@ class SortedRenderer : public Backend {
     std::unique_ptr<ShadingEngine> shading_;
     std::unique_ptr<BatchQueue> queue_;
     std::unique_ptr<DirectionalBins> bins_;
+    CameraRays cameraRays_;
+    size_t batchRays_; // 2^(bin exponent)
     RaySortPolicy policy_;
     std::unique_ptr<Scratch> scratch_;
     bool fused_;

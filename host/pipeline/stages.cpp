@@ -39,38 +39,74 @@ vec2 filmPosition(const RenderContext& ctx, const RenderParams& rp, uint pathId)
 
 } // namespace
 
-void generateCameraRays(const RenderContext& ctx, uint iteration, RayFormat format, Film& film,
-                        DirectionalBins& bins) {
+void CameraRays::begin(const RenderContext& ctx, uint iteration, const Film& film) {
     const Scene& scene = ctx.scene;
-    const RenderParams rp = paramsAt(ctx, iteration);
-    const int width = scene.image.width, height = scene.image.height,
-              tile = scene.settings.bucketSize;
-    const uint spi = rp.samplesPerIteration;
-    const float spread = ctx.camera.pixelSpread();
-    const int tilesX = (width + tile - 1) / tile, tilesY = (height + tile - 1) / tile;
-    tbb::parallel_for(0, tilesX * tilesY, [&](int t) {
-        const int x0 = (t % tilesX) * tile, y0 = (t / tilesX) * tile;
-        RayBuffer buffer; // the tile's thread-local buffer, handed to the bins whole
-        for (int y = y0; y < std::min(height, y0 + tile); ++y)
-            for (int x = x0; x < std::min(width, x0 + tile); ++x) {
-                if (!film.sampling(x, y)) continue; // adaptive sampling: converged
-                for (uint s = 0; s < spi; ++s) {
-                    CameraRay cr =
-                        ctx.camera.generate(uint(x), uint(y), s, iteration * spi + s, rp.seed);
-                    film.addSample(cr.filmPos, iteration * spi + s);
-                    RayState r;
-                    r.origin = cr.origin;
-                    r.dir = cr.dir;
-                    r.path = cameraPath(rp, uint(y * width + x), s, spread);
-                    buffer.push(r, format, roundingBits(rp, r.path));
-                }
-            }
-        ctx.stats.cameraRays += buffer.count;
-        bins.add(buffer);
+    rp_ = paramsAt(ctx, iteration);
+    width_ = scene.image.width;
+    height_ = scene.image.height;
+    tile_ = scene.settings.bucketSize;
+    tilesX_ = (width_ + tile_ - 1) / tile_;
+    const int tiles = tilesX_ * ((height_ + tile_ - 1) / tile_);
+    // Each tile's rays: its sampling pixels times the samples per iteration, then their prefix.
+    tileStart_.assign(size_t(tiles) + 1, 0);
+    tbb::parallel_for(0, tiles, [&](int t) {
+        const int x0 = (t % tilesX_) * tile_, y0 = (t / tilesX_) * tile_;
+        std::uint64_t pixels = 0;
+        for (int y = y0; y < std::min(height_, y0 + tile_); ++y)
+            for (int x = x0; x < std::min(width_, x0 + tile_); ++x)
+                pixels += film.sampling(x, y);
+        tileStart_[size_t(t) + 1] = pixels * rp_.samplesPerIteration;
     });
+    for (size_t t = 1; t < tileStart_.size(); ++t)
+        tileStart_[t] += tileStart_[t - 1];
+    next_ = 0;
 }
 
-size_t decompressRays(RayBatch& batch, std::vector<RayState>& rays) {
+size_t CameraRays::remaining() const {
+    return tileStart_.empty() ? 0 : size_t(tileStart_.back() - next_);
+}
+
+void CameraRays::generate(const RenderContext& ctx, size_t count, Film& film,
+                          std::vector<RayState>& rays) {
+    const std::uint64_t begin = next_, end = next_ + std::min<std::uint64_t>(count, remaining());
+    next_ = end;
+    rays.resize(size_t(end - begin));
+    if (end == begin) return;
+    const uint spi = rp_.samplesPerIteration;
+    const float spread = ctx.camera.pixelSpread();
+    // The tiles that hold rays [begin, end): the first whose rays end after `begin`, up to the
+    // last that starts before `end`.
+    const size_t first =
+        size_t(std::upper_bound(tileStart_.begin(), tileStart_.end(), begin) - tileStart_.begin()) -
+        1;
+    const size_t last =
+        size_t(std::lower_bound(tileStart_.begin(), tileStart_.end(), end) - tileStart_.begin());
+    tbb::parallel_for(first, last, [&](size_t t) {
+        const int x0 = int(t % size_t(tilesX_)) * tile_, y0 = int(t / size_t(tilesX_)) * tile_;
+        std::uint64_t k = tileStart_[t]; // the index of the tile's next ray
+        for (int y = y0; y < std::min(height_, y0 + tile_) && k < end; ++y)
+            for (int x = x0; x < std::min(width_, x0 + tile_) && k < end; ++x) {
+                if (!film.sampling(x, y)) continue; // adaptive sampling: converged
+                if (k + spi <= begin) {             // the batch starts after this pixel
+                    k += spi;
+                    continue;
+                }
+                for (uint s = 0; s < spi; ++s, ++k) {
+                    if (k < begin || k >= end) continue;
+                    const uint index = rp_.iteration * spi + s;
+                    CameraRay cr = ctx.camera.generate(uint(x), uint(y), s, index, rp_.seed);
+                    film.addSample(cr.filmPos, index);
+                    RayState& r = rays[size_t(k - begin)];
+                    r.origin = cr.origin;
+                    r.dir = cr.dir;
+                    r.path = cameraPath(rp_, uint(y * width_ + x), s, spread);
+                }
+            }
+    });
+    ctx.stats.cameraRays += end - begin;
+}
+
+void decompressRays(RayBatch& batch, std::vector<RayState>& rays) {
     const size_t n = batch.count;
     const size_t recordBytes = rayRecordBytes(batch.format);
     rays.resize(n);
@@ -80,7 +116,6 @@ size_t decompressRays(RayBatch& batch, std::vector<RayState>& rays) {
                               decodeRay(&batch.bytes[i * recordBytes], batch.format, rays[i]);
                       });
     std::vector<std::uint8_t>().swap(batch.bytes);
-    return parallelCount(n, [&](size_t i) { return rays[i].path.bounce == 0; });
 }
 
 void traverse(const EmbreeScene& embree, const std::vector<RayState>& rays, bool coherent,

@@ -2,7 +2,7 @@
 // order docs/design.md draws the data flow. SortedRenderer (sorted_renderer.cpp) calls them one a
 // line; each is timed in --stats under the name given here.
 //
-//   generate      camera tiles -> thread-local ray buffers -> six directional bins
+//   generate      camera rays, a batch at a time, when no bounce batch is waiting
 //   load          the next batch from RAM or the spill file      BatchQueue::pop (batch_queue.h)
 //   decompress    34- or 50-byte records -> RayState
 //   sort rays     Morton radix sort, median split, or none        ray_sort.h; RaySortPolicy decides
@@ -29,13 +29,28 @@
 
 namespace spw {
 
-// generate: every pixel's samples of the iteration as camera rays into the bins; each sample
-// is counted in the film (its filter weight) as it is made.
-void generateCameraRays(const RenderContext& ctx, uint iteration, RayFormat format, Film& film,
-                        DirectionalBins& bins);
+// generate: the iteration's camera rays, made straight into batches when the pipeline asks for
+// them (no record, no bin, no decompress: a camera ray is a function of its pixel and sample).
+// Their order is the bucket tiles', row by row within a tile, a pixel's samples together, which
+// is what makes a camera batch coherent. Each sample is counted in the film (its filter weight)
+// as its ray is made.
+class CameraRays {
+  public:
+    // Lays out the iteration: the rays of every pixel `film` is sampling.
+    void begin(const RenderContext& ctx, uint iteration, const Film& film);
+    size_t remaining() const;
+    // The next min(count, remaining()) rays into `rays` (resized to them).
+    void generate(const RenderContext& ctx, size_t count, Film& film, std::vector<RayState>& rays);
 
-// decompress: the batch's records into `rays`, the records freed. Returns how many are camera rays.
-size_t decompressRays(RayBatch& batch, std::vector<RayState>& rays);
+  private:
+    RenderParams rp_{};
+    int width_ = 0, height_ = 0, tile_ = 1, tilesX_ = 0;
+    std::vector<std::uint64_t> tileStart_; // the index of each tile's first ray, then the total
+    std::uint64_t next_ = 0;
+};
+
+// decompress: the batch's records into `rays`, the records freed.
+void decompressRays(RayBatch& batch, std::vector<RayState>& rays);
 
 // traverse: the rays' closest hits.
 void traverse(const EmbreeScene& embree, const std::vector<RayState>& rays, bool coherent,
