@@ -1,5 +1,7 @@
 #include "host/pipeline/batch_queue.h"
 
+#include <algorithm>
+
 #include <cerrno>
 #include <cstdlib>
 #include <cstring>
@@ -225,22 +227,33 @@ void DirectionalBins::add(RayBuffer& buffer) {
     buffer.count = 0;
 }
 
-bool DirectionalBins::flushLargest() {
-    int best = -1;
-    size_t bestSize = 0;
+bool DirectionalBins::flush() {
+    // Every bin holds less than a batch (a full one has left already). Lock them all, in order.
+    std::unique_lock<std::mutex> locks[6];
+    int order[6];
     for (int b = 0; b < 6; ++b) {
-        std::lock_guard<std::mutex> lock(bins_[b].mutex);
-        if (bins_[b].bytes.size() > bestSize) best = b, bestSize = bins_[b].bytes.size();
+        locks[b] = std::unique_lock<std::mutex>(bins_[b].mutex);
+        order[b] = b;
     }
-    if (best < 0) return false;
+    std::stable_sort(order, order + 6,
+                     [&](int a, int b) { return bins_[a].bytes.size() > bins_[b].bytes.size(); });
+    if (bins_[order[0]].bytes.empty()) return false;
+    // The fullest bin, then the next fullest, until the batch is full: the last one taken may
+    // give only the end of its rays.
+    const size_t batchBytes = batchRays_ * recordBytes_;
     RayBatch batch;
-    {
-        std::lock_guard<std::mutex> lock(bins_[best].mutex);
-        batch.bytes.swap(bins_[best].bytes);
+    batch.bytes.swap(bins_[order[0]].bytes);
+    batch.bin = uint(order[0]);
+    for (int k = 1; k < 6 && batch.bytes.size() < batchBytes; ++k) {
+        std::vector<std::uint8_t>& bin = bins_[order[k]].bytes;
+        const size_t take = std::min(bin.size(), batchBytes - batch.bytes.size());
+        batch.bytes.insert(batch.bytes.end(), bin.end() - std::ptrdiff_t(take), bin.end());
+        bin.resize(bin.size() - take);
     }
+    for (auto& lock : locks)
+        lock.unlock();
     batch.format = format_;
     batch.count = batch.bytes.size() / recordBytes_;
-    batch.bin = uint(best);
     queue_.noteOutsideBytes(-std::int64_t(batch.bytes.size()));
     queue_.push(std::move(batch));
     return true;

@@ -26,7 +26,7 @@ struct RayBatch {
     RayFormat format = RayFormat::Compact;
     size_t count = 0;
     std::vector<std::uint8_t> bytes; // count * record size
-    uint bin = 0;                    // cardinal bin the rays came from
+    uint bin = 0; // cardinal bin the rays came from (a flushed batch: its fullest bin)
 };
 
 // Traffic counters for --stats.
@@ -102,14 +102,17 @@ struct RayBuffer {
 
 // Six cardinal-direction bins. Rays arrive in thread-local buffers; a bin holding 2^e rays
 // becomes a batch of exactly 2^e rays in the queue (a buffer larger than a batch simply makes
-// several). When the queue runs dry the largest bin is flushed whatever its size.
+// several). When the queue runs dry, the part-full bins are flushed, the fullest first, into one
+// batch of up to 2^e rays.
 class DirectionalBins {
   public:
     DirectionalBins(RayFormat format, uint binExponent, BatchQueue& queue);
     // Thread-safe. Takes the buffer's rays (leaving it empty, capacity kept).
     void add(RayBuffer& buffer);
-    // Moves the fullest bin into the queue; false when every bin is empty.
-    bool flushLargest();
+    // Moves the rays of part-full bins into the queue as one batch of up to 2^e rays, the
+    // fullest bins first: the end of an iteration, where bins fill slowly, makes a few mixed
+    // batches rather than many small ones. False when every bin is empty.
+    bool flush();
     size_t raysWaiting();
     // Drops every waiting ray (a stopped render).
     void clear();

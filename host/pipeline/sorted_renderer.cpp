@@ -117,7 +117,7 @@ bool SortedRenderer::nextBatch(Film& film, bool flush, bool& camera) {
         camera = true;
         return true;
     }
-    if (!batch && flush && bins_->flushLargest()) batch = queue_->pop(times);
+    if (!batch && flush && bins_->flush()) batch = queue_->pop(times);
     if (!batch) return false;
     StageTimer t(times, "decompress");
     decompressRays(*batch, s.rays);

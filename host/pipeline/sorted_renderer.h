@@ -24,7 +24,8 @@ class SortedRenderer : public Backend {
   private:
     struct Scratch;
     // The next batch's rays into the scratch: a queued batch of bounce rays (load, decompress),
-    // else the next camera rays (generate), else, if `flush`, the fullest bin's. False when none.
+    // else the next camera rays (generate), else, if `flush`, the part-full bins'
+    // (DirectionalBins::flush). False when none.
     bool nextBatch(Film& film, bool flush, bool& camera);
     // One batch in two halves, so that a batch's shading can overlap the next one's traversal:
     // sort rays .. hit setup, then submit its shading to `slot`; then wait for it, trace its
