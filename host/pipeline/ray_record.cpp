@@ -31,11 +31,14 @@ void octEncode(vec3 d, uint& u, uint& v) {
 }
 
 vec3 octDecode(uint u, uint v) {
-    glm::dvec2 p(double(u) / kOctScale * 2.0 - 1.0, double(v) / kOctScale * 2.0 - 1.0);
+    // Multiplications by reciprocals rather than divisions: each adds at most an ulp of a
+    // double, 2^-29 of the float the direction is rounded to.
+    constexpr double kToUnit = 2.0 / kOctScale;
+    glm::dvec2 p(double(u) * kToUnit - 1.0, double(v) * kToUnit - 1.0);
     const double z = 1.0 - std::fabs(p.x) - std::fabs(p.y);
     if (z < 0) p = octahedralFold(p);
-    const double len = std::sqrt(p.x * p.x + p.y * p.y + z * z);
-    return vec3(float(p.x / len), float(p.y / len), float(z / len));
+    const double inv = 1.0 / std::sqrt(p.x * p.x + p.y * p.y + z * z);
+    return vec3(float(p.x * inv), float(p.y * inv), float(z * inv));
 }
 
 // bfloat16 with stochastic rounding: round the magnitude up with probability (dropped bits / 2^16).

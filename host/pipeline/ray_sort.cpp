@@ -137,29 +137,41 @@ void sortRaysMedian(std::vector<RayState>& rays) {
     medianByOrigin(rays.data(), rays.size());
 }
 
-RaySortMode RaySortPolicy::choose(double cameraFraction) {
+RaySortMode RaySortPolicy::choose(size_t rays) {
     if (mode_ != RaySortMode::Auto) return mode_;
-    if (cameraFraction > 0.5) return RaySortMode::Off;
+    if (!measured(rays)) return RaySortMode::Off;
     ++decisions_;
     bool sort;
-    if (samples_[0] == 0)
+    if (samples_[0] == 0) {
         sort = false;
-    else if (samples_[1] == 0)
+    } else if (samples_[1] == 0) {
         sort = true;
-    else {
-        sort = cost_[1] < cost_[0];
-        if (decisions_ % 16 == 0) sort = !sort; // keep the other estimate fresh
+    } else {
+        const double other = cost_[sorting_ ? 0 : 1], current = cost_[sorting_ ? 1 : 0];
+        if (other < 0.9 * current) { // the choice changes: watch it closely again
+            sorting_ = !sorting_;
+            interval_ = 16;
+            nextTry_ = decisions_ + interval_;
+        }
+        sort = sorting_;
+        if (decisions_ >= nextTry_) { // keep the other estimate fresh, ever more rarely
+            sort = !sorting_;
+            interval_ = std::min<size_t>(interval_ * 2, 256);
+            nextTry_ = decisions_ + interval_;
+        }
     }
     return sort ? RaySortMode::Morton : RaySortMode::Off;
 }
 
 void RaySortPolicy::record(bool sorted, double seconds, size_t rays) {
-    if (rays == 0) return;
     (sorted ? sortedBatches_ : unsortedBatches_)++;
+    if (mode_ != RaySortMode::Auto || !measured(rays)) return;
     const int k = sorted ? 1 : 0;
     const double perRay = seconds / double(rays);
-    // Running mean that forgets: the last ~8 batches dominate.
-    cost_[k] = samples_[k] == 0 ? perRay : 0.875 * cost_[k] + 0.125 * perRay;
+    // The way taken: a running mean that forgets, the last ~8 batches dominating. The other way,
+    // measured again after many batches: its old estimate is stale, the new one replaces it.
+    const bool taken = sorted == sorting_;
+    cost_[k] = samples_[k] == 0 || !taken ? perRay : 0.875 * cost_[k] + 0.125 * perRay;
     ++samples_[k];
 }
 

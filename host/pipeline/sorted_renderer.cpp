@@ -35,7 +35,9 @@ double since(Clock::time_point t) {
 
 SortedRenderer::SortedRenderer(const RenderContext& ctx, const PipelineConfig& config,
                                std::unique_ptr<ShadingEngine> shading)
-    : ctx_(ctx), config_(config), shading_(std::move(shading)), policy_(config.raySort),
+    : ctx_(ctx), config_(config), shading_(std::move(shading)),
+      policy_(config.raySort, size_t(1)
+                                  << config.binExponent.value_or(ctx.scene.settings.binExponent)),
       scratch_(std::make_unique<Scratch>()),
       fused_(config.fuseStages && shading_->shadesOnHostThreads()),
       sortHits_(config.sortsHits() && (config.hitSort == HitSortMode::On ||
@@ -130,7 +132,7 @@ size_t SortedRenderer::traceBatch(bool camera) {
     const size_t n = s.rays.size();
     ++batchesProcessed_;
     // Camera batches are coherent as made (tile by tile): they are never sorted or measured.
-    const RaySortMode mode = camera ? RaySortMode::Off : policy_.choose(0.0);
+    const RaySortMode mode = camera ? RaySortMode::Off : policy_.choose(n);
     const auto sortStart = Clock::now();
     if (mode == RaySortMode::Morton || mode == RaySortMode::Median) {
         StageTimer t(times, "sort rays");
@@ -141,7 +143,7 @@ size_t SortedRenderer::traceBatch(bool camera) {
     }
     {
         StageTimer t(times, "traverse");
-        traverse(ctx_.embree, s.rays, mode != RaySortMode::Off, s.hits);
+        traverse(ctx_.embree, s.rays, camera || mode != RaySortMode::Off, s.hits);
     }
     if (!camera) {
         policy_.record(mode != RaySortMode::Off, since(sortStart), n);

@@ -126,42 +126,48 @@ TEST(RaySort, MedianSplitsAtTheMedianOfOriginsThenOfDirections) {
 
 TEST(RaySortPolicy, FixedModesAreKept) {
     for (RaySortMode m : {RaySortMode::Morton, RaySortMode::Median, RaySortMode::Off}) {
-        RaySortPolicy p(m);
-        EXPECT_EQ(p.choose(0.0), m);
-        EXPECT_EQ(p.choose(1.0), m);
+        RaySortPolicy p(m, 1024);
+        EXPECT_EQ(p.choose(1024), m);
+        EXPECT_EQ(p.choose(3), m);
     }
 }
 
-TEST(RaySortPolicy, AutoMeasuresBothWaysThenTakesTheCheaperAndReMeasuresEvery16th) {
-    RaySortPolicy p(RaySortMode::Auto);
-    EXPECT_EQ(p.choose(0.9), RaySortMode::Off) << "camera batches are never sorted";
-    // First unsorted, then sorted, each measured once.
-    EXPECT_EQ(p.choose(0.0), RaySortMode::Off);
-    p.record(false, 1.0, 1000); // 1 ms a ray unsorted
-    EXPECT_EQ(p.choose(0.0), RaySortMode::Morton);
-    p.record(true, 0.5, 1000); // sorting halves the cost
-    // From now on sorted, except every 16th decision (re-measuring the other way).
-    int flips = 0;
-    for (int k = 3; k <= 32; ++k) {
-        const RaySortMode m = p.choose(0.0);
-        if (k % 16 == 0) {
-            EXPECT_EQ(m, RaySortMode::Off) << "decision " << k;
-            ++flips;
-        } else {
-            EXPECT_EQ(m, RaySortMode::Morton) << "decision " << k;
-        }
-        p.record(m == RaySortMode::Morton, m == RaySortMode::Morton ? 0.5 : 1.0, 1000);
+// Feeds the policy `decisions` full batches whose cost per ray is `sorted` or `unsorted`; returns
+// the decisions (counted from 1 over the policy's life) at which it sorted.
+std::vector<int> run(RaySortPolicy& p, int& decision, int decisions, double sorted,
+                     double unsorted) {
+    std::vector<int> at;
+    for (int k = 0; k < decisions; ++k) {
+        const bool sort = p.choose(1024) == RaySortMode::Morton;
+        ++decision;
+        if (sort) at.push_back(decision);
+        p.record(sort, (sort ? sorted : unsorted) * 1024, 1024);
     }
-    EXPECT_EQ(flips, 2);
-    // The workload changes: sorting now costs 4x; the running mean (1/8 a batch) turns over.
-    int sorted = 0;
-    for (int k = 0; k < 40; ++k) {
-        const RaySortMode m = p.choose(0.0);
-        p.record(m == RaySortMode::Morton, m == RaySortMode::Morton ? 4.0 : 1.0, 1000);
-        if (k >= 30) sorted += m == RaySortMode::Morton;
+    return at;
+}
+
+TEST(RaySortPolicy, AutoMeasuresBothWaysTakesTheCheaperAndReMeasuresEverMoreRarely) {
+    RaySortPolicy p(RaySortMode::Auto, 1024);
+    // Small batches (an iteration's tail) are neither sorted nor measured.
+    for (int k = 0; k < 100; ++k) {
+        EXPECT_EQ(p.choose(511), RaySortMode::Off);
+        p.record(false, 1e6, 511);
     }
-    EXPECT_LE(sorted, 1) << "still sorting after it became the dearer way";
-    EXPECT_EQ(p.sortedBatches() + p.unsortedBatches(), 2u + 30u + 40u);
+    // First unsorted, then sorted, each measured once; then sorting loses (it doubles the
+    // cost) and is measured again at the 16th decision, then 32, 64, 128, 256, 256 later.
+    int decision = 0;
+    std::vector<int> sorted = run(p, decision, 1000, 2.0, 1.0);
+    EXPECT_EQ(sorted, (std::vector<int>{2, 16, 48, 112, 240, 496, 752})) << "sorted at";
+    // Noise within 10 % does not flip the choice.
+    EXPECT_TRUE(run(p, decision, 200, 0.95, 1.0).size() <= 1u) << "flipped by noise";
+    // The workload changes: sorting now halves the cost. The next re-measurement notices it,
+    // the running mean (1/8 a batch) turns over, and from then on it sorts, re-measuring the
+    // other way after 16, 32, ... batches.
+    sorted = run(p, decision, 600, 0.5, 1.0);
+    EXPECT_GE(sorted.size(), 600u - 256u - 16u - 32u - 64u - 128u - 10u);
+    const std::vector<int> last = run(p, decision, 100, 0.5, 1.0);
+    EXPECT_GE(last.size(), 99u) << "not sorting after it became the cheaper way";
+    EXPECT_EQ(p.sortedBatches() + p.unsortedBatches(), 100u + 1000u + 200u + 600u + 100u);
 }
 
 } // namespace
