@@ -77,8 +77,8 @@ glm::dvec2 octahedralFold(glm::dvec2 p) {
 
 glm::dvec2 octahedralMap(vec3 d) {
     const double x = d.x, y = d.y, z = d.z;
-    const double n = std::fabs(x) + std::fabs(y) + std::fabs(z);
-    const glm::dvec2 p(x / n, y / n);
+    const double inv = 1.0 / (std::fabs(x) + std::fabs(y) + std::fabs(z)); // one division
+    const glm::dvec2 p(x * inv, y * inv);
     return z < 0 ? octahedralFold(p) : p;
 }
 
