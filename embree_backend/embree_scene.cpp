@@ -85,15 +85,14 @@ void EmbreeScene::surfaceHit(uint geomID, uint primID, float u, float v, float t
     hit.offset = surfaceOffset(hit.p, p0, p1, p2, hit.ng);
 }
 
-SurfaceHit EmbreeScene::setUpHit(const HitRecord& h, vec3 dir, uint cone,
-                                 const TextureResolver& textures, bool albedo) const {
-    SurfaceHit hit;
+void EmbreeScene::setUpHit(const HitRecord& h, vec3 dir, uint cone, const TextureResolver& textures,
+                           bool albedo, SurfaceHit& hit) const {
     surfaceHit(h.mesh, h.prim, h.u, h.v, h.t, hit);
-    if (!albedo) return hit;
+    if (!albedo) return;
     const Shader& shader = src_.shaders[hit.shader];
     if (shader.texture < 0) {
         hit.albedo = textures.albedo(shader, vec2(0.0f), 0.0f);
-        return hit;
+        return;
     }
     // The filter width in texture space: the cone's width at the hit, stretched by the
     // incidence (1/|cos|, at most 1000x at grazing angles) and scaled by the triangle's texture
@@ -113,7 +112,6 @@ SurfaceHit EmbreeScene::setUpHit(const HitRecord& h, vec3 dir, uint cone,
             footprint = coneWidthAt(cone, h.t) / cosine * std::sqrt(uvArea / worldArea);
     }
     hit.albedo = textures.albedo(shader, uvAt(h.mesh, h.prim, h.u, h.v), footprint);
-    return hit;
 }
 
 vec2 EmbreeScene::uvAt(uint geomID, uint primID, float u, float v) const {

@@ -42,9 +42,10 @@ class EmbreeScene {
     // intersection offset, shader, emitter) and the albedo the shader's texture gives there.
     // `dir` and `cone`: the ray's unit direction and packed cone (shared/cone.h), for the
     // texture filter width. `albedo` false: the hit ends its path (max depth), so shading never
-    // reads the albedo, and no texture is looked up for it (albedo left 0).
-    SurfaceHit setUpHit(const HitRecord& h, vec3 dir, uint cone, const TextureResolver& textures,
-                        bool albedo = true) const;
+    // reads the albedo, and no texture is looked up for it (albedo left 0). Written into `hit`
+    // in place: a returned 72-byte struct is copied through the stack, which stalls.
+    void setUpHit(const HitRecord& h, vec3 dir, uint cone, const TextureResolver& textures,
+                  bool albedo, SurfaceHit& hit) const;
     // Throws if Embree reported an error since the last check.
     void checkError(const char* what) const;
 

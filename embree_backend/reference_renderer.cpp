@@ -44,8 +44,9 @@ bool ReferenceRenderer::renderIteration(uint iteration, Film& film) {
                                                filmKey(st.pathId, st.bounce, false));
                                 break;
                             }
-                            const SurfaceHit hit = embree.setUpHit(h, dir, st.cone, ctx_.textures,
-                                                                   st.bounce < rp.maxDepth);
+                            SurfaceHit hit;
+                            embree.setUpHit(h, dir, st.cone, ctx_.textures, st.bounce < rp.maxDepth,
+                                            hit);
                             ShadeResult res;
                             shadeSurface(view, rp, hit, dir, st, res);
                             if (res.flags & kShadeEmitted)

@@ -276,13 +276,14 @@ size_t DirectionalBins::raysWaiting() {
     return n / recordBytes_;
 }
 
-void RayBuffer::push(const RayState& ray, RayFormat format, uvec4 rounding) {
-    const uint b = cardinalBin(ray.dir);
+void RayBuffer::push(vec3 origin, vec3 dir, const PathState& path, RayFormat format,
+                     uvec4 rounding) {
+    const uint b = cardinalBin(dir);
     const size_t bytes = rayRecordBytes(format);
     std::vector<std::uint8_t>& dst = perBin[b];
     // The vector only grows (zero-filled once, by doubling); `used` says how much holds rays.
     if (dst.size() < used[b] + bytes) dst.resize(std::max(dst.size() * 2, 256 * kFullRayBytes));
-    encodeRay(ray, format, rounding, dst.data() + used[b]);
+    encodeRay(origin, dir, path, format, rounding, dst.data() + used[b]);
     used[b] += bytes;
     ++count;
 }

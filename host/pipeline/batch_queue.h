@@ -97,7 +97,7 @@ struct RayBuffer {
     std::vector<std::uint8_t> perBin[6]; // bytes [0, used[b]) of bin b hold encoded rays
     size_t used[6] = {};
     size_t count = 0;
-    void push(const RayState& ray, RayFormat format, uvec4 rounding);
+    void push(vec3 origin, vec3 dir, const PathState& path, RayFormat format, uvec4 rounding);
 };
 
 // Six cardinal-direction bins. Rays arrive in thread-local buffers; a bin holding 2^e rays

@@ -82,35 +82,36 @@ glm::dvec2 octahedralMap(vec3 d) {
     return z < 0 ? octahedralFold(p) : p;
 }
 
-void encodeRay(const RayState& r, RayFormat format, uvec4 rounding, std::uint8_t* out) {
+void encodeRay(vec3 origin, vec3 dir, const PathState& path, RayFormat format, uvec4 rounding,
+               std::uint8_t* out) {
     std::uint8_t* p = out;
     for (int i = 0; i < 3; ++i)
-        put<float>(p, r.origin[i]);
-    put<std::uint32_t>(p, r.path.pathId);
+        put<float>(p, origin[i]);
+    put<std::uint32_t>(p, path.pathId);
     if (format == RayFormat::Full) {
         for (int i = 0; i < 3; ++i)
-            put<float>(p, r.dir[i]);
+            put<float>(p, dir[i]);
         for (int i = 0; i < 3; ++i)
-            put<float>(p, r.path.beta[i]);
-        put<float>(p, r.path.prevPdf);
-        put<std::uint32_t>(p, r.path.bounce | r.path.flags << 16);
-        put<std::uint16_t>(p, std::uint16_t(r.path.cone));
+            put<float>(p, path.beta[i]);
+        put<float>(p, path.prevPdf);
+        put<std::uint32_t>(p, path.bounce | path.flags << 16);
+        put<std::uint16_t>(p, std::uint16_t(path.cone));
         return;
     }
     uint u, v;
-    octEncode(r.dir, u, v);
+    octEncode(dir, u, v);
     put24(p, u);
     put24(p + 3, v);
     p += 6;
     // One random number for the three channels: rounding stays monotone, so the largest channel
     // (what Russian roulette reads) is still unbiased after rounding (ray_record.h).
-    put<std::uint16_t>(p, toBfloat16(r.path.beta.x, rounding.x));
-    put<std::uint16_t>(p, toBfloat16(r.path.beta.y, rounding.x));
-    put<std::uint16_t>(p, toBfloat16(r.path.beta.z, rounding.x));
-    put<std::uint16_t>(p, std::uint16_t(floatBitsToUint(r.path.prevPdf) >> 16));
-    put<std::uint16_t>(p, std::uint16_t(std::min(r.path.bounce, kMaxCompactBounce) |
-                                        ((r.path.flags & kPathSpecular) ? 0x8000u : 0u)));
-    put<std::uint16_t>(p, std::uint16_t(r.path.cone));
+    put<std::uint16_t>(p, toBfloat16(path.beta.x, rounding.x));
+    put<std::uint16_t>(p, toBfloat16(path.beta.y, rounding.x));
+    put<std::uint16_t>(p, toBfloat16(path.beta.z, rounding.x));
+    put<std::uint16_t>(p, std::uint16_t(floatBitsToUint(path.prevPdf) >> 16));
+    put<std::uint16_t>(p, std::uint16_t(std::min(path.bounce, kMaxCompactBounce) |
+                                        ((path.flags & kPathSpecular) ? 0x8000u : 0u)));
+    put<std::uint16_t>(p, std::uint16_t(path.cone));
 }
 
 void decodeRay(const std::uint8_t* in, RayFormat format, RayState& r) {

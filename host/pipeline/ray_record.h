@@ -57,7 +57,11 @@ inline size_t rayRecordBytes(RayFormat f) {
 }
 
 // `rounding`: four uniform 32-bit words for the stochastic rounding (compact only).
-void encodeRay(const RayState& ray, RayFormat format, uvec4 rounding, std::uint8_t* out);
+void encodeRay(vec3 origin, vec3 dir, const PathState& path, RayFormat format, uvec4 rounding,
+               std::uint8_t* out);
+inline void encodeRay(const RayState& ray, RayFormat format, uvec4 rounding, std::uint8_t* out) {
+    encodeRay(ray.origin, ray.dir, ray.path, format, rounding, out);
+}
 void decodeRay(const std::uint8_t* in, RayFormat format, RayState& ray);
 
 // The octahedral map (Cigolle et al. 2014) of a direction to [-1, 1]^2, in double so that the

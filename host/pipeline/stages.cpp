@@ -159,16 +159,14 @@ size_t sortHits(const Scene& scene, const std::vector<HitRecord>& hits, bool byS
 }
 
 namespace {
-// One hit as the shade stage receives it. Hits that end their path (max depth) skip the albedo:
-// shading never reads it there.
-ShadeInput setUpOne(const RenderContext& ctx, const RayState& ray, const HitRecord& hit) {
-    ShadeInput in;
-    in.hit = ctx.embree.setUpHit(hit, ray.dir, ray.path.cone, ctx.textures,
-                                 ray.path.bounce < ctx.params.maxDepth);
+// One hit as the shade stage receives it, written in place. Hits that end their path (max
+// depth) skip the albedo: shading never reads it there.
+void setUpOne(const RenderContext& ctx, const RayState& ray, const HitRecord& hit, ShadeInput& in) {
+    ctx.embree.setUpHit(hit, ray.dir, ray.path.cone, ctx.textures,
+                        ray.path.bounce < ctx.params.maxDepth, in.hit);
     in.path = ray.path;
     in.rayDir = ray.dir;
     in.pad0 = 0.0f;
-    return in;
 }
 } // namespace
 
@@ -180,7 +178,9 @@ void setUpHits(const RenderContext& ctx, const std::vector<RayState>& rays,
                           for (size_t i = r.begin(); i < r.end(); ++i) {
                               const std::uint32_t k = order[i].index;
                               // assembled, then stored whole: one sequential write into the slot
-                              const ShadeInput in = setUpOne(ctx, rays[k], hits[k]);
+                              // (the slot may be write-combined device memory)
+                              ShadeInput in;
+                              setUpOne(ctx, rays[k], hits[k], in);
                               inputs[i] = in;
                               paths[i] = uvec2(in.path.pathId, in.path.bounce);
                           }
@@ -221,16 +221,6 @@ struct Splat {
     uint key;
     vec3 value;
 };
-Splat emittedSplat(const RenderContext& ctx, const RenderParams& rp, const ShadeResult& res,
-                   uvec2 path) {
-    return {filmPosition(ctx, rp, path.x), pathSample(rp, path.x), filmKey(path.x, path.y, false),
-            res.emitted};
-}
-Splat shadowSplat(const RenderContext& ctx, const RenderParams& rp, const ShadeResult& res,
-                  uvec2 path) {
-    return {filmPosition(ctx, rp, path.x), pathSample(rp, path.x), filmKey(path.x, path.y, true),
-            res.shadowContribution};
-}
 // Splats gathered a few dozen at a time: each one's film line is prefetched when it joins, and
 // the adds wait until the batch is full, so that the lines' cache misses overlap instead of
 // stalling one atomic add after another (the sorted order has no pixel locality).
@@ -238,10 +228,27 @@ class SplatBatch {
   public:
     explicit SplatBatch(Film& film) : film_(film) {}
     ~SplatBatch() { flush(); }
-    void push(const Splat& s) {
-        film_.prefetch(s.pos);
-        splats_[count_++] = s;
+    // Field by field into the slot: a Splat assembled and then copied goes through the stack in
+    // pieces that the copy's wider loads straddle, a store-forwarding stall.
+    void push(vec2 pos, uint sample, uint key, vec3 value) {
+        film_.prefetch(pos);
+        Splat& s = splats_[count_++];
+        s.pos = pos;
+        s.sample = sample;
+        s.key = key;
+        s.value = value;
         if (count_ == kSize) flush();
+    }
+    // What a hit emitted, or its unoccluded shadow ray brings, for path (pathId, bounce).
+    void emitted(const RenderContext& ctx, const RenderParams& rp, const ShadeResult& res,
+                 uvec2 path) {
+        push(filmPosition(ctx, rp, path.x), pathSample(rp, path.x), filmKey(path.x, path.y, false),
+             res.emitted);
+    }
+    void shadow(const RenderContext& ctx, const RenderParams& rp, const ShadeResult& res,
+                uvec2 path) {
+        push(filmPosition(ctx, rp, path.x), pathSample(rp, path.x), filmKey(path.x, path.y, true),
+             res.shadowContribution);
     }
     void flush() {
         for (size_t k = 0; k < count_; ++k)
@@ -257,11 +264,7 @@ class SplatBatch {
 };
 void binOne(const RenderParams& rp, RayFormat format, const ShadeResult& res, RayBuffer& buffer) {
     if (!(res.flags & kShadeContinue)) return;
-    RayState ray;
-    ray.origin = res.nextOrigin;
-    ray.dir = res.nextDir;
-    ray.path = res.next;
-    buffer.push(ray, format, roundingBits(rp, ray.path));
+    buffer.push(res.nextOrigin, res.nextDir, res.next, format, roundingBits(rp, res.next));
 }
 } // namespace
 
@@ -274,15 +277,15 @@ void accumulate(const RenderContext& ctx, uint iteration, const ShadeResult* res
                           SplatBatch splats(film);
                           for (size_t i = r.begin(); i < r.end(); ++i)
                               if (results[i].flags & kShadeEmitted)
-                                  splats.push(emittedSplat(ctx, rp, results[i], paths[i]));
+                                  splats.emitted(ctx, rp, results[i], paths[i]);
                       });
     tbb::parallel_for(tbb::blocked_range<size_t>(0, shadowOwner.size(), 1024),
                       [&](const tbb::blocked_range<size_t>& r) {
                           SplatBatch splats(film);
                           for (size_t j = r.begin(); j < r.end(); ++j)
                               if (!occluded[j])
-                                  splats.push(shadowSplat(ctx, rp, results[shadowOwner[j]],
-                                                          paths[shadowOwner[j]]));
+                                  splats.shadow(ctx, rp, results[shadowOwner[j]],
+                                                paths[shadowOwner[j]]);
                       });
 }
 
@@ -296,9 +299,9 @@ void accumulateEscapes(const RenderContext& ctx, uint iteration, const std::vect
                           for (size_t i = r.begin(); i < r.end(); ++i) {
                               const RayState& ray = rays[order[i].index];
                               const uint id = ray.path.pathId;
-                              splats.push({filmPosition(ctx, rp, id), pathSample(rp, id),
-                                           filmKey(id, ray.path.bounce, false),
-                                           escapedRadiance(view, rp, ray.dir, ray.path)});
+                              splats.push(filmPosition(ctx, rp, id), pathSample(rp, id),
+                                          filmKey(id, ray.path.bounce, false),
+                                          escapedRadiance(view, rp, ray.dir, ray.path));
                           }
                       });
 }
@@ -366,7 +369,7 @@ void shadeFused(const RenderContext& ctx, uint iteration, RayFormat format,
                 const size_t n = std::min(kFusedChunk, r.end() - begin);
                 for (size_t i = 0; i < n; ++i) {
                     const std::uint32_t k = order[begin + i].index;
-                    c->in[i] = setUpOne(ctx, rays[k], hits[k]);
+                    setUpOne(ctx, rays[k], hits[k], c->in[i]);
                 }
                 lap(kSetUp);
                 for (size_t i = 0; i < n; ++i)
@@ -384,11 +387,11 @@ void shadeFused(const RenderContext& ctx, uint iteration, RayFormat format,
                 lap(kShadow);
                 for (size_t i = 0; i < n; ++i)
                     if (c->out[i].flags & kShadeEmitted)
-                        splats.push(emittedSplat(ctx, rp, c->out[i], pathOf(c->in[i])));
+                        splats.emitted(ctx, rp, c->out[i], pathOf(c->in[i]));
                 for (size_t j = 0; j < m; ++j)
                     if (!c->occluded[j]) {
                         const size_t i = c->owner[j];
-                        splats.push(shadowSplat(ctx, rp, c->out[i], pathOf(c->in[i])));
+                        splats.shadow(ctx, rp, c->out[i], pathOf(c->in[i]));
                     }
                 splats.flush();
                 lap(kAccumulate);

@@ -371,8 +371,8 @@ PerHit shadeSameHits(ShadingMode mode) {
             float u = unit(rng), v = unit(rng);
             if (u + v > 1.0f) u = 1.0f - u, v = 1.0f - v;
             ShadeInput& in = inputs[i];
-            in.hit = embree.setUpHit(HitRecord{mesh, prim, u, v, 10.0f + 1000.0f * unit(rng)},
-                                     vec3(0.0f, 0.0f, 1.0f), 0u, textures);
+            embree.setUpHit(HitRecord{mesh, prim, u, v, 10.0f + 1000.0f * unit(rng)},
+                            vec3(0.0f, 0.0f, 1.0f), 0u, textures, true, in.hit);
             vec3 d = glm::normalize(vec3(unit(rng) - 0.5f, unit(rng) - 0.5f, unit(rng) - 0.5f));
             if (rng() % 8 != 0 && glm::dot(d, in.hit.ng) > 0.0f)
                 d = -d; // mostly the front, some backs
