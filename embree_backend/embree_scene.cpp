@@ -94,11 +94,19 @@ void EmbreeScene::setUpHit(const HitRecord& h, vec3 dir, uint cone, const Textur
         hit.albedo = textures.albedo(shader, vec2(0.0f), 0.0f);
         return;
     }
+    vec2 uv;
+    float footprint;
+    textureQuery(h, dir, cone, hit, uv, footprint);
+    hit.albedo = textures.albedo(shader, uv, footprint);
+}
+
+void EmbreeScene::textureQuery(const HitRecord& h, vec3 dir, uint cone, const SurfaceHit& hit,
+                               vec2& uv, float& footprint) const {
     // The filter width in texture space: the cone's width at the hit, stretched by the
     // incidence (1/|cos|, at most 1000x at grazing angles) and scaled by the triangle's texture
     // area over its world area (the Delta_0 term of Akenine-Moller et al. 2019's ray-cone LOD).
     const Mesh& mesh = src_.meshes[h.mesh];
-    float footprint = 0.0f;
+    footprint = 0.0f;
     if (!mesh.uvs.empty()) {
         const uvec3 tri = mesh.triangles[h.prim];
         const vec3 p0 = mesh.positions[tri.x];
@@ -111,7 +119,7 @@ void EmbreeScene::setUpHit(const HitRecord& h, vec3 dir, uint cone, const Textur
         if (worldArea > 0.0f)
             footprint = coneWidthAt(cone, h.t) / cosine * std::sqrt(uvArea / worldArea);
     }
-    hit.albedo = textures.albedo(shader, uvAt(h.mesh, h.prim, h.u, h.v), footprint);
+    uv = uvAt(h.mesh, h.prim, h.u, h.v);
 }
 
 vec2 EmbreeScene::uvAt(uint geomID, uint primID, float u, float v) const {

@@ -46,6 +46,14 @@ class EmbreeScene {
     // in place: a returned 72-byte struct is copied through the stack, which stalls.
     void setUpHit(const HitRecord& h, vec3 dir, uint cone, const TextureResolver& textures,
                   bool albedo, SurfaceHit& hit) const;
+    // setUpHit in two halves, for a caller that looks textures up for many hits at once
+    // (TextureResolver::albedos): the world-space hit, albedo 0; then where the hit's texture
+    // is looked up, its uv and its filter footprint in texture space.
+    void setUpGeometry(const HitRecord& h, SurfaceHit& hit) const {
+        surfaceHit(h.mesh, h.prim, h.u, h.v, h.t, hit);
+    }
+    void textureQuery(const HitRecord& h, vec3 dir, uint cone, const SurfaceHit& hit, vec2& uv,
+                      float& footprint) const;
     // Throws if Embree reported an error since the last check.
     void checkError(const char* what) const;
 

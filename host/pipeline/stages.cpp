@@ -159,32 +159,70 @@ size_t sortHits(const Scene& scene, const std::vector<HitRecord>& hits, bool byS
 }
 
 namespace {
-// One hit as the shade stage receives it, written in place. Hits that end their path (max
-// depth) skip the albedo: shading never reads it there.
-void setUpOne(const RenderContext& ctx, const RayState& ray, const HitRecord& hit, ShadeInput& in) {
-    ctx.embree.setUpHit(hit, ray.dir, ray.path.cone, ctx.textures,
-                        ray.path.bounce < ctx.params.maxDepth, in.hit);
-    in.path = ray.path;
-    in.rayDir = ray.dir;
-    in.pad0 = 0.0f;
+// Hits are set up a chunk at a time: a chunk's inputs and results (28 KiB) stay in L1/L2
+// between the fused stages, and its texture lookups go texture by texture.
+constexpr size_t kChunk = 128;
+static_assert(kChunk <= 256, "chunk indices are bytes");
+
+// Hit setup of the sorted hits order[0, n), n <= kChunk, into in[0, n): each hit's geometry and
+// path, then the albedos, a run of hits of one shader at a time, texture by texture
+// (TextureResolver::albedos: the same values as one hit at a time, bit for bit). Hits that end
+// their path (max depth) get no albedo: shading never reads it there.
+void setUpChunk(const RenderContext& ctx, const std::vector<RayState>& rays,
+                const std::vector<HitRecord>& hits, const SortedHit* order, size_t n,
+                ShadeInput* in) {
+    std::uint8_t slot[kChunk]; // the hits that look textures up, in order
+    vec2 uv[kChunk];
+    float footprint[kChunk];
+    vec3 albedo[kChunk];
+    size_t m = 0;
+    for (size_t i = 0; i < n; ++i) {
+        const std::uint32_t k = order[i].index;
+        const RayState& ray = rays[k];
+        ShadeInput& x = in[i];
+        ctx.embree.setUpGeometry(hits[k], x.hit);
+        x.path = ray.path;
+        x.rayDir = ray.dir;
+        x.pad0 = 0.0f;
+        if (ray.path.bounce >= ctx.params.maxDepth) continue;
+        const Shader& shader = ctx.scene.shaders[x.hit.shader];
+        if (shader.texture < 0) {
+            x.hit.albedo = ctx.textures.albedo(shader, vec2(0.0f), 0.0f);
+            continue;
+        }
+        ctx.embree.textureQuery(hits[k], ray.dir, ray.path.cone, x.hit, uv[m], footprint[m]);
+        slot[m++] = std::uint8_t(i);
+    }
+    for (size_t a = 0; a < m;) {
+        const uint shader = in[slot[a]].hit.shader;
+        size_t b = a + 1;
+        while (b < m && in[slot[b]].hit.shader == shader)
+            ++b;
+        ctx.textures.albedos(ctx.scene.shaders[shader], b - a, uv + a, footprint + a, albedo + a);
+        for (size_t j = a; j < b; ++j)
+            in[slot[j]].hit.albedo = albedo[j];
+        a = b;
+    }
 }
 } // namespace
 
 void setUpHits(const RenderContext& ctx, const std::vector<RayState>& rays,
                const std::vector<HitRecord>& hits, const std::vector<SortedHit>& order,
                size_t hitCount, ShadeInput* inputs, uvec2* paths) {
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, hitCount, 1024),
-                      [&](const tbb::blocked_range<size_t>& r) {
-                          for (size_t i = r.begin(); i < r.end(); ++i) {
-                              const std::uint32_t k = order[i].index;
-                              // assembled, then stored whole: one sequential write into the slot
-                              // (the slot may be write-combined device memory)
-                              ShadeInput in;
-                              setUpOne(ctx, rays[k], hits[k], in);
-                              inputs[i] = in;
-                              paths[i] = uvec2(in.path.pathId, in.path.bounce);
-                          }
-                      });
+    tbb::parallel_for(
+        tbb::blocked_range<size_t>(0, hitCount, 1024), [&](const tbb::blocked_range<size_t>& r) {
+            ShadeInput chunk[kChunk];
+            for (size_t begin = r.begin(); begin < r.end(); begin += kChunk) {
+                const size_t n = std::min(kChunk, r.end() - begin);
+                setUpChunk(ctx, rays, hits, &order[begin], n, chunk);
+                // stored whole, in order: the slots may be write-combined
+                // device memory
+                for (size_t i = 0; i < n; ++i) {
+                    inputs[begin + i] = chunk[i];
+                    paths[begin + i] = uvec2(chunk[i].path.pathId, chunk[i].path.bounce);
+                }
+            }
+        });
 }
 
 void shadeRanges(const Scene& scene, const std::vector<SortedHit>& order, size_t hitCount,
@@ -320,9 +358,8 @@ void binContinuations(const RenderContext& ctx, uint iteration, RayFormat format
 }
 
 namespace {
-// The fused stages' working set: one chunk of hits through every per-hit stage. 128 hits keep
-// the inputs and results (28 KiB) within L1/L2 between stages.
-constexpr size_t kFusedChunk = 128;
+// The fused stages' working set: one chunk of hits through every per-hit stage.
+constexpr size_t kFusedChunk = kChunk;
 struct FusedChunk {
     ShadeInput in[kFusedChunk];
     ShadeResult out[kFusedChunk];
@@ -367,10 +404,7 @@ void shadeFused(const RenderContext& ctx, uint iteration, RayFormat format,
             std::uint64_t shadowCount = 0;
             for (size_t begin = r.begin(); begin < r.end(); begin += kFusedChunk) {
                 const size_t n = std::min(kFusedChunk, r.end() - begin);
-                for (size_t i = 0; i < n; ++i) {
-                    const std::uint32_t k = order[begin + i].index;
-                    setUpOne(ctx, rays[k], hits[k], c->in[i]);
-                }
+                setUpChunk(ctx, rays, hits, &order[begin], n, c->in);
                 lap(kSetUp);
                 for (size_t i = 0; i < n; ++i)
                     shadeSurface(view, rp, c->in[i].hit, c->in[i].rayDir, c->in[i].path, c->out[i]);

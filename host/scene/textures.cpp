@@ -199,4 +199,44 @@ vec3 TextureResolver::albedo(const Shader& shader, vec2 uv, float footprint) con
     return value[program.size() - 1] * p.reflectance;
 }
 
+void TextureResolver::albedos(const Shader& shader, size_t n, const vec2* uv,
+                              const float* footprint, vec3* out) const {
+    const ShaderParams& p = shader.params;
+    if (shader.texture < 0) {
+        for (size_t k = 0; k < n; ++k)
+            out[k] = p.colour * p.reflectance;
+        return;
+    }
+    const std::vector<Op>& program = programs_[size_t(shader.texture)];
+    // Every node's values for every hit: nodes x hits, in a per-thread buffer.
+    thread_local std::vector<vec3> values;
+    if (values.size() < program.size() * n) values.resize(program.size() * n);
+    for (size_t i = 0; i < program.size(); ++i) {
+        const Op& op = program[i];
+        vec3* v = &values[i * n];
+        switch (op.type) {
+        case TextureType::Constant: {
+            const vec3 c = scene_.textures[size_t(op.texture)].colour;
+            for (size_t k = 0; k < n; ++k)
+                v[k] = c;
+            break;
+        }
+        case TextureType::Standard:
+            for (size_t k = 0; k < n; ++k)
+                v[k] = lookup(op.texture, uv[k], footprint[k]);
+            break;
+        case TextureType::Layered: {
+            const vec3 *m = &values[size_t(op.mask) * n], *upper = &values[size_t(op.upper) * n],
+                       *lower = &values[size_t(op.lower) * n];
+            for (size_t k = 0; k < n; ++k)
+                v[k] = m[k] * upper[k] + (vec3(1.0f) - m[k]) * lower[k];
+            break;
+        }
+        }
+    }
+    const vec3* root = &values[(program.size() - 1) * n];
+    for (size_t k = 0; k < n; ++k)
+        out[k] = root[k] * p.reflectance;
+}
+
 } // namespace spw

@@ -40,6 +40,13 @@ class TextureResolver {
     // width in texture space (uv units), from the ray cone; it picks the MIP levels (trilinear).
     // Thread-safe.
     vec3 albedo(const Shader& shader, vec2 uv, float footprint) const;
+    // The same for `n` hits of one shader, out[k] = albedo(shader, uv[k], footprint[k]) bit for
+    // bit, evaluated texture by texture: every hit's lookup in one file, then in the next. The
+    // sorted pipeline's hits of a shader arrive together, near each other in texture space, so
+    // consecutive lookups read the same tiles and OpenImageIO's per-thread tile microcache
+    // serves them, where one hit's lookups in turn would switch file every time.
+    void albedos(const Shader& shader, size_t n, const vec2* uv, const float* footprint,
+                 vec3* out) const;
     // True when the scene has image textures (OpenImageIO is in use).
     bool active() const { return impl_ != nullptr; }
     // Throws SceneError (the texture's file and scene line) if an image lookup failed since the

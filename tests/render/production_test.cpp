@@ -71,10 +71,11 @@ TEST_F(ProductionScene, EveryBackendAgreesWithinStandardErrors) {
 // tiles. Read at the finest level (the thesis' regime, --texture-filter finest) the preset's
 // textures are far larger than the cache, and the sorted pipeline reads fewer tiles than the
 // same pipeline unsorted or the depth-first reference. Full-precision rays trace the reference's
-// paths exactly, so all three make the same lookups. Measured (one thread): sorted 1946 tiles,
-// unsorted 2697 (0.72), reference 2402 (0.81); at 64 x 64 pixels the reference's 32-pixel buckets
-// are coherent themselves. (Hits that end their path look nothing up: before that rule the
-// figures were 2598, 3732 and 3743, the difference being those hits' scattered lookups.) With ray
+// paths exactly, so all three make the same lookups. Measured (one thread): sorted 774 tiles,
+// unsorted 2613 (0.30), reference 2404 (0.32). Before camera rays were made a batch at a time,
+// with bounce batches first (which keeps a camera batch's paths together, as depth-first does),
+// sorted read 1946 (0.72 and 0.81); before hits that end their path stopped looking textures up,
+// 2598 against 3732 and 3743. With ray
 // cones (the default) every backend reads a few hundred tiles: the levels the pixels need fit the
 // cache, whatever the order (the next test).
 TEST_F(ProductionScene, SortedBatchesReadFewerTilesThanUnsorted) {
@@ -100,13 +101,14 @@ TEST_F(ProductionScene, SortedBatchesReadFewerTilesThanUnsorted) {
         EXPECT_LE((*t)["peak_cache_bytes"].get<double>(), 1.1 * 1024 * 1024);
         EXPECT_EQ((*t)["files_opened"], 28);
     }
-    EXPECT_LE(s["tiles_read"].get<double>(), 0.75 * u["tiles_read"].get<double>());
-    EXPECT_LE(s["tiles_read"].get<double>(), 0.9 * r["tiles_read"].get<double>());
-    EXPECT_LE(s["bytes_read"].get<double>(), 0.9 * r["bytes_read"].get<double>());
+    EXPECT_LE(s["tiles_read"].get<double>(), 0.5 * u["tiles_read"].get<double>());
+    EXPECT_LE(s["tiles_read"].get<double>(), 0.5 * r["tiles_read"].get<double>());
+    EXPECT_LE(s["bytes_read"].get<double>(), 0.5 * r["bytes_read"].get<double>());
 }
 
 // Ray cones read the levels the pixels need: the same lookups, a fraction of the tiles (measured:
-// 392 against 1949 sorted, 695 against 2375 for the reference).
+// 317 against 774 sorted, 600 against 2404 for the reference; the sorted pipeline's lookups go
+// texture by texture over a shader's hits, so its finest-level reads are already few).
 TEST_F(ProductionScene, RayConesReadAFractionOfTheFinestLevelsTiles) {
     for (BackendKind backend : {BackendKind::Reference, BackendKind::Cpu}) {
         RenderConfig cone;
@@ -118,8 +120,8 @@ TEST_F(ProductionScene, RayConesReadAFractionOfTheFinestLevelsTiles) {
         std::printf("%s: tiles read with cones %d, finest %d\n", backendName(backend),
                     c["tiles_read"].get<int>(), f["tiles_read"].get<int>());
         EXPECT_EQ(c["lookups"], f["lookups"]);
-        EXPECT_LE(c["tiles_read"].get<double>(), f["tiles_read"].get<double>() / 3);
-        EXPECT_LE(c["bytes_read"].get<double>(), f["bytes_read"].get<double>() / 3);
+        EXPECT_LE(c["tiles_read"].get<double>(), f["tiles_read"].get<double>() / 2);
+        EXPECT_LE(c["bytes_read"].get<double>(), f["bytes_read"].get<double>() / 2);
     }
 }
 
