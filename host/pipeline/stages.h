@@ -61,7 +61,9 @@ void traverse(const EmbreeScene& embree, const std::vector<RayState>& rays, bool
 size_t sortHits(const Scene& scene, const std::vector<HitRecord>& hits, bool byShader,
                 std::vector<SortedHit>& order, std::vector<SortedHit>& scratch);
 
-// hit setup: inputs[i] and paths[i] (pathId, bounce) for the i-th hit in `order`.
+// hit setup: inputs[i] and paths[i] (pathId, bounce) for the i-th hit in `order`. Chunk by
+// chunk of 128 hits; within a chunk, each run of one shader's hits looks its textures up
+// texture by texture (TextureResolver::albedos).
 void setUpHits(const RenderContext& ctx, const std::vector<RayState>& rays,
                const std::vector<HitRecord>& hits, const std::vector<SortedHit>& order,
                size_t hitCount, ShadeInput* inputs, uvec2* paths);

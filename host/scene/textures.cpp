@@ -28,6 +28,11 @@ struct TextureResolver::Impl {
     int failedTexture = -1;
     std::string error;
     mutable std::atomic<std::uint64_t> peakCacheBytes{0};
+    bool filtered = true;
+    // One lookup, with the calling thread's OpenImageIO state and the options fetched by the
+    // caller (once per run of lookups).
+    vec3 lookup(int index, vec2 uv, float footprint, OIIO::TextureSystem::Perthread* thread,
+                OIIO::TextureOpt& opt);
     ~Impl() {
         if (system) OIIO::TextureSystem::destroy(system);
     }
@@ -49,7 +54,7 @@ void visit(const Scene& scene, int t, std::vector<int>& slotOf, std::vector<int>
 } // namespace
 
 TextureResolver::TextureResolver(const Scene& scene, double cacheMiB, bool filtered)
-    : scene_(scene), filtered_(filtered) {
+    : scene_(scene) {
     programs_.resize(scene.textures.size());
     for (const Shader& sh : scene.shaders) {
         if (sh.texture < 0 || !programs_[size_t(sh.texture)].empty()) continue;
@@ -71,6 +76,7 @@ TextureResolver::TextureResolver(const Scene& scene, double cacheMiB, bool filte
         standard += t.type == TextureType::Standard;
     if (standard == 0) return;
     impl_ = std::make_unique<Impl>();
+    impl_->filtered = filtered;
     impl_->system = OIIO::TextureSystem::create(false);
     impl_->system->attribute("max_memory_MB", float(cacheMiB));
     // Keep every texture file open if the process may (OpenImageIO's default of 100 made the
@@ -100,26 +106,41 @@ TextureResolver::TextureResolver(const Scene& scene, double cacheMiB, bool filte
 
 TextureResolver::~TextureResolver() = default;
 
-vec3 TextureResolver::lookup(int index, vec2 uv, float footprint) const {
-    const Impl::Image& img = impl_->images[size_t(index)];
+namespace {
+// Every lookup's options: repeating, bilinear within a level, trilinear across levels.
+OIIO::TextureOpt lookupOptions() {
     OIIO::TextureOpt opt;
     opt.swrap = opt.twrap = OIIO::TextureOpt::WrapPeriodic;
     opt.interpmode = OIIO::TextureOpt::InterpBilinear;
     opt.mipmode = OIIO::TextureOpt::MipModeTrilinear;
-    if (!filtered_) footprint = 0.0f; // zero derivatives: the finest level
+    return opt;
+}
+} // namespace
+
+vec3 TextureResolver::lookup(int index, vec2 uv, float footprint) const {
+    OIIO::TextureOpt opt = lookupOptions();
+    return impl_->lookup(index, uv, footprint, impl_->system->get_perthread_info(), opt);
+}
+
+vec3 TextureResolver::Impl::lookup(int index, vec2 uv, float footprint,
+                                   OIIO::TextureSystem::Perthread* thread, OIIO::TextureOpt& opt) {
+    const Image& img = images[size_t(index)];
+    if (!filtered) footprint = 0.0f; // zero derivatives: the finest level
     float rgb[4] = {0, 0, 0, 0};
     int nc = std::min(img.channels, 3);
     // OBJ's v grows upwards, image rows downwards. An isotropic footprint: ds/dx = dt/dy.
-    if (!impl_->system->texture(img.handle, impl_->system->get_perthread_info(), opt, uv.x,
-                                1.0f - uv.y, footprint, 0, 0, footprint, nc, rgb)) {
-        if (!impl_->failed.exchange(true)) {
-            std::lock_guard<std::mutex> lock(impl_->errorMutex);
-            impl_->failedTexture = index;
-            impl_->error = impl_->system->geterror();
+    if (!system->texture(img.handle, thread, opt, uv.x, 1.0f - uv.y, footprint, 0, 0, footprint, nc,
+                         rgb)) {
+        if (!failed.exchange(true)) {
+            std::lock_guard<std::mutex> lock(errorMutex);
+            failedTexture = index;
+            error = system->geterror();
         }
         return vec3(0.0f);
     }
-    vec3 c = nc == 1 ? vec3(rgb[0]) : vec3(rgb[0], rgb[1], rgb[2]);
+    // A one-channel image (a mask) is linearised once, not three times.
+    if (nc == 1) return vec3(img.srgb ? srgbToLinear(rgb[0]) : rgb[0]);
+    vec3 c(rgb[0], rgb[1], rgb[2]);
     if (img.srgb) c = vec3(srgbToLinear(c.x), srgbToLinear(c.y), srgbToLinear(c.z));
     return c;
 }
@@ -208,6 +229,8 @@ void TextureResolver::albedos(const Shader& shader, size_t n, const vec2* uv,
         return;
     }
     const std::vector<Op>& program = programs_[size_t(shader.texture)];
+    OIIO::TextureSystem::Perthread* thread = impl_ ? impl_->system->get_perthread_info() : nullptr;
+    OIIO::TextureOpt opt = lookupOptions();
     // Every node's values for every hit: nodes x hits, in a per-thread buffer.
     thread_local std::vector<vec3> values;
     if (values.size() < program.size() * n) values.resize(program.size() * n);
@@ -223,7 +246,7 @@ void TextureResolver::albedos(const Shader& shader, size_t n, const vec2* uv,
         }
         case TextureType::Standard:
             for (size_t k = 0; k < n; ++k)
-                v[k] = lookup(op.texture, uv[k], footprint[k]);
+                v[k] = impl_->lookup(op.texture, uv[k], footprint[k], thread, opt);
             break;
         case TextureType::Layered: {
             const vec3 *m = &values[size_t(op.mask) * n], *upper = &values[size_t(op.upper) * n],

@@ -69,7 +69,6 @@ class TextureResolver {
     const Scene& scene_;
     std::vector<std::vector<Op>> programs_; // per Scene::textures root used by a shader
     std::unique_ptr<Impl> impl_;
-    bool filtered_;
 };
 
 } // namespace spw
