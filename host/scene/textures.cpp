@@ -117,11 +117,6 @@ OIIO::TextureOpt lookupOptions() {
 }
 } // namespace
 
-vec3 TextureResolver::lookup(int index, vec2 uv, float footprint) const {
-    OIIO::TextureOpt opt = lookupOptions();
-    return impl_->lookup(index, uv, footprint, impl_->system->get_perthread_info(), opt);
-}
-
 vec3 TextureResolver::Impl::lookup(int index, vec2 uv, float footprint,
                                    OIIO::TextureSystem::Perthread* thread, OIIO::TextureOpt& opt) {
     const Image& img = images[size_t(index)];
@@ -190,34 +185,9 @@ TextureStatistics TextureResolver::statistics() const {
 }
 
 vec3 TextureResolver::albedo(const Shader& shader, vec2 uv, float footprint) const {
-    const ShaderParams& p = shader.params;
-    if (shader.texture < 0) return p.colour * p.reflectance;
-    const std::vector<Op>& program = programs_[size_t(shader.texture)];
-    // Most trees have a handful of nodes: a fixed buffer, or a per-thread one for large DAGs.
-    vec3 small[16];
-    thread_local std::vector<vec3> large;
-    vec3* value = small;
-    if (program.size() > 16) {
-        if (large.size() < program.size()) large.resize(program.size());
-        value = large.data();
-    }
-    for (size_t i = 0; i < program.size(); ++i) {
-        const Op& op = program[i];
-        switch (op.type) {
-        case TextureType::Constant:
-            value[i] = scene_.textures[size_t(op.texture)].colour;
-            break;
-        case TextureType::Standard:
-            value[i] = lookup(op.texture, uv, footprint);
-            break;
-        case TextureType::Layered: {
-            const vec3 m = value[op.mask];
-            value[i] = m * value[op.upper] + (vec3(1.0f) - m) * value[op.lower];
-            break;
-        }
-        }
-    }
-    return value[program.size() - 1] * p.reflectance;
+    vec3 out;
+    albedos(shader, 1, &uv, &footprint, &out);
+    return out;
 }
 
 void TextureResolver::albedos(const Shader& shader, size_t n, const vec2* uv,

@@ -40,8 +40,8 @@ class TextureResolver {
     // width in texture space (uv units), from the ray cone; it picks the MIP levels (trilinear).
     // Thread-safe.
     vec3 albedo(const Shader& shader, vec2 uv, float footprint) const;
-    // The same for `n` hits of one shader, out[k] = albedo(shader, uv[k], footprint[k]) bit for
-    // bit, evaluated texture by texture: every hit's lookup in one file, then in the next. The
+    // The same for `n` hits of one shader (each out[k] what that hit alone gets, bit for bit),
+    // evaluated texture by texture: every hit's lookup in one file, then in the next. The
     // sorted pipeline's hits of a shader arrive together, near each other in texture space, so
     // consecutive lookups read the same tiles and OpenImageIO's per-thread tile microcache
     // serves them, where one hit's lookups in turn would switch file every time.
@@ -64,7 +64,6 @@ class TextureResolver {
         int texture;            // index into Scene::textures
         int upper, lower, mask; // Layered: operand slots
     };
-    vec3 lookup(int texture, vec2 uv, float footprint) const;
     struct Impl;
     const Scene& scene_;
     std::vector<std::vector<Op>> programs_; // per Scene::textures root used by a shader
