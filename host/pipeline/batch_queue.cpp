@@ -1,7 +1,6 @@
 #include "host/pipeline/batch_queue.h"
 
 #include <algorithm>
-
 #include <cerrno>
 #include <cstdlib>
 #include <cstring>
