@@ -33,8 +33,7 @@ SpillFile::~SpillFile() {
     if (fd_ >= 0) ::close(fd_);
 }
 
-std::uint64_t SpillFile::write(const std::vector<std::uint8_t>& bytes) {
-    const std::uint64_t offset = end_;
+void SpillFile::write(std::uint64_t offset, const std::vector<std::uint8_t>& bytes) {
     size_t done = 0;
     while (done < bytes.size()) {
         ssize_t n = ::pwrite(fd_, bytes.data() + done, bytes.size() - done, off_t(offset + done));
@@ -44,8 +43,6 @@ std::uint64_t SpillFile::write(const std::vector<std::uint8_t>& bytes) {
                                      "': " + (n < 0 ? std::strerror(errno) : "no space left"));
         done += size_t(n);
     }
-    end_ += bytes.size();
-    return offset;
 }
 
 void SpillFile::read(std::uint64_t offset, std::vector<std::uint8_t>& bytes) {
@@ -87,27 +84,59 @@ SpillFile& BatchQueue::spill() {
 }
 
 void BatchQueue::push(RayBatch&& batch) {
-    std::lock_guard<std::mutex> lock(mutex_);
     Entry e;
     e.size = batch.bytes.size();
-    ++counters_.batchesQueued;
-    if (ramBytes_ + e.size <= budget_) {
-        ramBytes_ += e.size;
-        e.batch = std::move(batch);
-    } else {
-        e.offset = spill().write(batch.bytes);
-        e.spilled = true;
-        counters_.bytesWritten += e.size;
-        ++counters_.batchesSpilled;
-        batch.bytes.clear();
-        batch.bytes.shrink_to_fit();
-        e.batch = std::move(batch);
+    SpillFile* file = nullptr;
+    {
+        std::lock_guard<std::mutex> lock(mutex_);
+        ++counters_.batchesQueued;
+        if (ramBytes_ + e.size <= budget_) {
+            ramBytes_ += e.size;
+            e.batch = std::move(batch);
+            append(std::move(e));
+            return;
+        }
+        file = &spill();
+        e.offset = file->reserve(e.size);
     }
+    // The write, outside the lock; the entry is queued once its bytes are on disk.
+    file->write(e.offset, batch.bytes);
+    recycle(std::move(batch.bytes));
+    batch.bytes = {};
+    e.spilled = true;
+    e.batch = std::move(batch);
+    std::lock_guard<std::mutex> lock(mutex_);
+    counters_.bytesWritten += e.size;
+    ++counters_.batchesSpilled;
+    append(std::move(e));
+}
+
+void BatchQueue::append(Entry&& e) {
+    // Called with the mutex held.
     counters_.peakRamBytes = std::max<std::uint64_t>(
         counters_.peakRamBytes,
         ramBytes_ + std::uint64_t(std::max<std::int64_t>(0, outsideBytes_)));
     entries_.push_back(std::move(e));
     if (entries_.size() == 1) startPrefetch();
+}
+
+std::vector<std::uint8_t> BatchQueue::spareBuffer() {
+    std::vector<std::uint8_t> bytes;
+    std::lock_guard<std::mutex> lock(spareMutex_);
+    if (!spare_.empty()) {
+        bytes.swap(spare_.back());
+        spare_.pop_back();
+    }
+    return bytes;
+}
+
+void BatchQueue::recycle(std::vector<std::uint8_t>&& bytes) {
+    // A few buffers cover the batches in motion at once (one per worker filling a bin, one being
+    // read back, one being decoded); the rest are freed.
+    constexpr size_t kSpareBuffers = 4;
+    bytes.clear();
+    std::lock_guard<std::mutex> lock(spareMutex_);
+    if (spare_.size() < kSpareBuffers && bytes.capacity() > 0) spare_.push_back(std::move(bytes));
 }
 
 void BatchQueue::startPrefetch() {
@@ -116,8 +145,9 @@ void BatchQueue::startPrefetch() {
     const Entry& e = entries_.front();
     SpillFile* file = &spill();
     std::uint64_t offset = e.offset, size = e.size;
-    prefetch_ = std::async(std::launch::async, [file, offset, size] {
-        std::vector<std::uint8_t> bytes(size);
+    prefetch_ = std::async(std::launch::async, [this, file, offset, size] {
+        std::vector<std::uint8_t> bytes = spareBuffer();
+        bytes.resize(size);
         file->read(offset, bytes);
         file->release(offset, size);
         return bytes;
@@ -214,6 +244,7 @@ void DirectionalBins::add(RayBuffer& buffer) {
                     batch.count = batchRays_;
                     batch.bin = b;
                     batch.bytes.swap(bin);
+                    bin = queue_.spareBuffer();
                     full.push_back(std::move(batch));
                 }
             }

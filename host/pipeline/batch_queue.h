@@ -6,12 +6,20 @@
 // start: whatever way the process ends, normal exit, exception, SIGINT, SIGTERM or SIGKILL, the
 // kernel frees it and no file is left behind. Each batch is one large sequential pwrite at the
 // file's end and one pread back; the space of a batch read back is returned with
-// fallocate(PUNCH_HOLE) so the file's disk use stays at what is still queued.
+// fallocate(PUNCH_HOLE) so the file's disk use stays at what is still queued. The write happens
+// outside the queue's lock (its range is reserved under it), so one worker's write holds up
+// neither the others' pushes nor the consumer's pop.
+//
+// Batch buffers are recycled: a batch's bytes, once decoded or written to disk, go back to the
+// queue, which hands them to the bins and to its reads. A batch of 2^15 rays is about 1 MB, above
+// glibc's mmap threshold, so without recycling every batch would map fresh pages and fault each
+// one in.
 #pragma once
 
 #include "host/backend/stats.h"
 #include "host/pipeline/ray_record.h"
 
+#include <atomic>
 #include <cstdint>
 #include <deque>
 #include <future>
@@ -42,8 +50,10 @@ class SpillFile {
     ~SpillFile();
     SpillFile(const SpillFile&) = delete;
     SpillFile& operator=(const SpillFile&) = delete;
-    // Appends; returns the offset. Throws naming the folder on any write error (a full disk).
-    std::uint64_t write(const std::vector<std::uint8_t>& bytes);
+    // The offset of `size` new bytes at the file's end, for write(). Thread-safe.
+    std::uint64_t reserve(std::uint64_t size) { return end_.fetch_add(size); }
+    // Throws naming the folder on any write error (a full disk). Thread-safe.
+    void write(std::uint64_t offset, const std::vector<std::uint8_t>& bytes);
     void read(std::uint64_t offset, std::vector<std::uint8_t>& bytes);
     void release(std::uint64_t offset, std::uint64_t size);
     const std::string& dir() const { return dir_; }
@@ -51,7 +61,7 @@ class SpillFile {
   private:
     std::string dir_;
     int fd_ = -1;
-    std::uint64_t end_ = 0;
+    std::atomic<std::uint64_t> end_{0};
 };
 
 class BatchQueue {
@@ -71,6 +81,10 @@ class BatchQueue {
     void clear();
     // Bytes of rays waiting outside the queue (bins), for the peak-RAM statistic.
     void noteOutsideBytes(std::int64_t delta);
+    // Thread-safe. A batch buffer to fill (empty, its capacity kept from an earlier batch when
+    // one was recycled), and the way back for one that is done with.
+    std::vector<std::uint8_t> spareBuffer();
+    void recycle(std::vector<std::uint8_t>&& bytes);
     QueueCounters counters() const;
 
   private:
@@ -79,6 +93,7 @@ class BatchQueue {
         bool spilled = false;
         std::uint64_t offset = 0, size = 0;
     };
+    void append(Entry&& e); // with the mutex held
     void startPrefetch();
     SpillFile& spill();
 
@@ -90,6 +105,8 @@ class BatchQueue {
     std::unique_ptr<SpillFile> spill_;
     std::future<std::vector<std::uint8_t>> prefetch_; // bytes of entries_.front() when spilled
     QueueCounters counters_;
+    std::mutex spareMutex_;
+    std::vector<std::vector<std::uint8_t>> spare_; // at most kSpareBuffers
 };
 
 // A thread-local buffer of encoded rays, already split by cardinal bin.

@@ -125,6 +125,7 @@ bool SortedRenderer::nextBatch(Film& film, bool flush, bool& camera) {
     if (!batch) return false;
     StageTimer t(times, "decompress");
     decompressRays(*batch, s.rays);
+    queue_->recycle(std::move(batch->bytes));
     return true;
 }
 

@@ -106,7 +106,7 @@ void CameraRays::generate(const RenderContext& ctx, size_t count, Film& film,
     ctx.stats.cameraRays += end - begin;
 }
 
-void decompressRays(RayBatch& batch, std::vector<RayState>& rays) {
+void decompressRays(const RayBatch& batch, std::vector<RayState>& rays) {
     const size_t n = batch.count;
     const size_t recordBytes = rayRecordBytes(batch.format);
     rays.resize(n);
@@ -115,7 +115,6 @@ void decompressRays(RayBatch& batch, std::vector<RayState>& rays) {
                           for (size_t i = r.begin(); i < r.end(); ++i)
                               decodeRay(&batch.bytes[i * recordBytes], batch.format, rays[i]);
                       });
-    std::vector<std::uint8_t>().swap(batch.bytes);
 }
 
 void traverse(const EmbreeScene& embree, const std::vector<RayState>& rays, bool coherent,

@@ -49,8 +49,8 @@ class CameraRays {
     std::uint64_t next_ = 0;
 };
 
-// decompress: the batch's records into `rays`, the records freed.
-void decompressRays(RayBatch& batch, std::vector<RayState>& rays);
+// decompress: the batch's records into `rays` (the records are left for the caller to recycle).
+void decompressRays(const RayBatch& batch, std::vector<RayState>& rays);
 
 // traverse: the rays' closest hits.
 void traverse(const EmbreeScene& embree, const std::vector<RayState>& rays, bool coherent,
