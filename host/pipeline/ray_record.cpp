@@ -15,6 +15,27 @@ namespace {
 
 constexpr double kOctScale = double((1u << 24) - 1);
 
+// Branch-free `c ? a : b` and `a * (s >= 0 ? 1 : -1)`, with exactly their results: bounce
+// directions make such branches coin flips, which cost more than the arithmetic.
+double pick(bool c, double a, double b) {
+    std::uint64_t x, y;
+    std::memcpy(&x, &a, 8);
+    std::memcpy(&y, &b, 8);
+    const std::uint64_t mask = std::uint64_t(0) - std::uint64_t(c);
+    const std::uint64_t r = (x & mask) | (y & ~mask);
+    double out;
+    std::memcpy(&out, &r, 8);
+    return out;
+}
+double signOf(double s, double a) {
+    std::uint64_t x;
+    std::memcpy(&x, &a, 8);
+    x ^= std::uint64_t(!(s >= 0)) << 63;
+    double out;
+    std::memcpy(&out, &x, 8);
+    return out;
+}
+
 void put24(std::uint8_t* p, uint v) {
     p[0] = std::uint8_t(v);
     p[1] = std::uint8_t(v >> 8);
@@ -36,7 +57,8 @@ vec3 octDecode(uint u, uint v) {
     constexpr double kToUnit = 2.0 / kOctScale;
     glm::dvec2 p(double(u) * kToUnit - 1.0, double(v) * kToUnit - 1.0);
     const double z = 1.0 - std::fabs(p.x) - std::fabs(p.y);
-    if (z < 0) p = octahedralFold(p);
+    const glm::dvec2 f = octahedralFold(p);
+    p = glm::dvec2(pick(z < 0, f.x, p.x), pick(z < 0, f.y, p.y));
     const double inv = 1.0 / std::sqrt(p.x * p.x + p.y * p.y + z * z);
     return vec3(float(p.x * inv), float(p.y * inv), float(z * inv));
 }
@@ -71,15 +93,15 @@ template <class T> T get(const std::uint8_t*& p) {
 } // namespace
 
 glm::dvec2 octahedralFold(glm::dvec2 p) {
-    return glm::dvec2((1.0 - std::fabs(p.y)) * (p.x >= 0 ? 1.0 : -1.0),
-                      (1.0 - std::fabs(p.x)) * (p.y >= 0 ? 1.0 : -1.0));
+    return glm::dvec2(signOf(p.x, 1.0 - std::fabs(p.y)), signOf(p.y, 1.0 - std::fabs(p.x)));
 }
 
 glm::dvec2 octahedralMap(vec3 d) {
     const double x = d.x, y = d.y, z = d.z;
     const double inv = 1.0 / (std::fabs(x) + std::fabs(y) + std::fabs(z)); // one division
     const glm::dvec2 p(x * inv, y * inv);
-    return z < 0 ? octahedralFold(p) : p;
+    const glm::dvec2 f = octahedralFold(p);
+    return glm::dvec2(pick(z < 0, f.x, p.x), pick(z < 0, f.y, p.y));
 }
 
 void encodeRay(vec3 origin, vec3 dir, const PathState& path, RayFormat format, uvec4 rounding,
