@@ -36,6 +36,7 @@
 #include "host/backend/render_config.h"
 #include "shared/types.h"
 
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <string>
@@ -71,14 +72,16 @@ glm::dvec2 octahedralMap(vec3 d);
 glm::dvec2 octahedralFold(glm::dvec2 p);
 
 // The cardinal direction bin of a direction: 0..5 for +X, -X, +Y, -Y, +Z, -Z (dominant axis).
-// Written without branches: bounce directions are random, and mispredicted branches here cost
-// more than the arithmetic.
+// In integer arithmetic on the comparisons: bounce directions are random, and mispredicted
+// branches here cost more than the arithmetic (GCC made branches of ternaries and glm::abs).
 inline uint cardinalBin(vec3 d) {
-    const vec3 a = glm::abs(d);
-    const bool x = (a.x >= a.y) & (a.x >= a.z);
-    const bool y = !x & (a.y >= a.z);
-    const float along = x ? d.x : (y ? d.y : d.z);
-    return (x ? 0u : (y ? 2u : 4u)) + (along >= 0.0f ? 0u : 1u);
+    const vec3 a(std::fabs(d.x), std::fabs(d.y), std::fabs(d.z)); // glm::abs branches
+    const uint x = uint(a.x >= a.y) & uint(a.x >= a.z);
+    const uint y = (x ^ 1u) & uint(a.y >= a.z);
+    const uint z = (x | y) ^ 1u;
+    const uint negative =
+        (x & uint(!(d.x >= 0.0f))) | (y & uint(!(d.y >= 0.0f))) | (z & uint(!(d.z >= 0.0f)));
+    return 2u * (y + 2u * z) + negative;
 }
 
 } // namespace spw
