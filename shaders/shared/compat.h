@@ -20,6 +20,7 @@
 #define SPILLWAY_SHARED_COMPAT_H
 
 #ifdef __cplusplus
+#include <cmath>
 #include <cstdint>
 #include <glm/glm.hpp>
 #include <glm/gtc/packing.hpp>
@@ -36,7 +37,20 @@ using glm::vec2;
 using glm::vec3;
 using glm::vec4;
 using uint = std::uint32_t;
-using glm::abs;
+// GLSL's abs clears the sign bit; glm's is `x >= 0 ? x : -x`, which GCC compiles to a branch
+// (it must keep abs(-0.0) = -0.0) that hit and light geometry makes a coin flip.
+inline float abs(float x) {
+    return std::fabs(x);
+}
+inline vec2 abs(vec2 v) {
+    return vec2(std::fabs(v.x), std::fabs(v.y));
+}
+inline vec3 abs(vec3 v) {
+    return vec3(std::fabs(v.x), std::fabs(v.y), std::fabs(v.z));
+}
+inline vec4 abs(vec4 v) {
+    return vec4(std::fabs(v.x), std::fabs(v.y), std::fabs(v.z), std::fabs(v.w));
+}
 using glm::clamp;
 using glm::cross;
 using glm::dot;
