@@ -26,18 +26,14 @@ SHARED_FN vec3 toWorld(vec3 local, vec3 n) {
 // Cosine-weighted hemisphere around +Z through the concentric disk map (Shirley & Chiu 1997).
 SHARED_FN vec3 sampleCosineHemisphere(vec2 u) {
     vec2 d = 2.0f * u - vec2(1.0f, 1.0f);
-    float r;
-    float phi;
     if (d.x == 0.0f && d.y == 0.0f) {
-        r = 0.0f;
-        phi = 0.0f;
-    } else if (abs(d.x) > abs(d.y)) {
-        r = d.x;
-        phi = (kPi / 4.0f) * (d.y / d.x);
-    } else {
-        r = d.y;
-        phi = (kPi / 2.0f) - (kPi / 4.0f) * (d.x / d.y);
+        return vec3(0.0f, 0.0f, 1.0f);
     }
+    // The wedge (|x| > |y| or not) is a coin flip per sample: selects, one division, no branch.
+    bool xMajor = abs(d.x) > abs(d.y);
+    float r = xMajor ? d.x : d.y;
+    float q = (xMajor ? d.y : d.x) / r;
+    float phi = xMajor ? (kPi / 4.0f) * q : (kPi / 2.0f) - (kPi / 4.0f) * q;
     float x = r * cos(phi);
     float y = r * sin(phi);
     return vec3(x, y, sqrt(max(0.0f, 1.0f - x * x - y * y)));
