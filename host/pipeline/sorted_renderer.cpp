@@ -152,6 +152,12 @@ size_t SortedRenderer::traceBatch(bool camera) {
         policy_.record(mode != RaySortMode::Off, since(sortStart), n);
         ctx_.stats.bounceRays += n;
     }
+    if (fused_ && !sortHits_ && ctx_.params.environment == kNoEmitter) {
+        // Nothing to sort and no miss to shade: the fused loop takes the hits in traversal
+        // order and leaves out the misses chunk by chunk (stages.h: shadeFused).
+        s.order.clear();
+        return n;
+    }
     StageTimer t(times, "sort hits");
     return sortHits(ctx_.scene, s.hits, sortHits_, s.order, s.keyTmp);
 }

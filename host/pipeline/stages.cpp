@@ -365,6 +365,7 @@ struct FusedChunk {
     ShadowRay shadows[kFusedChunk];
     std::uint8_t owner[kFusedChunk];
     std::uint8_t occluded[kFusedChunk];
+    SortedHit hits[kFusedChunk]; // the chunk's hits when the batch's hits were not sorted
 };
 uvec2 pathOf(const ShadeInput& in) {
     return uvec2(in.path.pathId, in.path.bounce);
@@ -386,6 +387,7 @@ void shadeFused(const RenderContext& ctx, uint iteration, RayFormat format,
     const auto wallStart = Clock::now();
     std::atomic<std::int64_t> threadNs[kFusedStages] = {};
     std::atomic<std::uint64_t> shadowRays{0};
+    const bool inTraversalOrder = order.empty();
     // Tasks of up to `shading size` hits, each handing its continuation rays to the bins once.
     const size_t grain = batchGrain(hitCount, kFusedChunk, size_t(ctx.scene.settings.shadingSize));
     tbb::parallel_for(
@@ -402,8 +404,15 @@ void shadeFused(const RenderContext& ctx, uint iteration, RayFormat format,
             SplatBatch splats(film);
             std::uint64_t shadowCount = 0;
             for (size_t begin = r.begin(); begin < r.end(); begin += kFusedChunk) {
-                const size_t n = std::min(kFusedChunk, r.end() - begin);
-                setUpChunk(ctx, rays, hits, &order[begin], n, c->in);
+                size_t n = std::min(kFusedChunk, r.end() - begin);
+                const SortedHit* chunk = inTraversalOrder ? c->hits : &order[begin];
+                if (inTraversalOrder) {
+                    size_t h = 0;
+                    for (size_t i = begin; i < begin + n; ++i)
+                        if (hits[i].mesh != kNoHit) c->hits[h++] = {0, std::uint32_t(i)};
+                    n = h;
+                }
+                setUpChunk(ctx, rays, hits, chunk, n, c->in);
                 lap(kSetUp);
                 for (size_t i = 0; i < n; ++i)
                     shadeSurface(view, rp, c->in[i].hit, c->in[i].rayDir, c->in[i].path, c->out[i]);

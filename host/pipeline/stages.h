@@ -96,6 +96,9 @@ void binContinuations(const RenderContext& ctx, uint iteration, RayFormat format
 // (the staged path writes and reads 224 bytes per hit). Same per-hit functions, same arithmetic,
 // same image bit for bit. Each stage's --stats seconds: the loop's wall time shared in
 // proportion to the thread time the stage took.
+// With an empty `order` (the hit sort skipped: no shader sort and no environment for the misses
+// to see), the hits are taken in traversal order from all `hitCount` = rays.size() rays, each
+// chunk leaving out its misses itself.
 void shadeFused(const RenderContext& ctx, uint iteration, RayFormat format,
                 const std::vector<RayState>& rays, const std::vector<HitRecord>& hits,
                 const std::vector<SortedHit>& order, size_t hitCount, Film& film,
