@@ -57,9 +57,37 @@ void SpillFile::read(std::uint64_t offset, std::vector<std::uint8_t>& bytes) {
     }
 }
 
+std::uint64_t SpillFile::reserve(std::uint64_t size) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    // First fit: batches are mostly of one size (2^e rays), so the first free range fits.
+    for (auto it = free_.begin(); it != free_.end(); ++it)
+        if (it->second >= size) {
+            const std::uint64_t offset = it->first;
+            it->first += size;
+            it->second -= size;
+            if (it->second == 0) free_.erase(it);
+            return offset;
+        }
+    const std::uint64_t offset = end_;
+    end_ += size;
+    return offset;
+}
+
 void SpillFile::release(std::uint64_t offset, std::uint64_t size) {
-    // Best effort: a file system without hole punching keeps the space until the file closes.
-    (void)::fallocate(fd_, FALLOC_FL_PUNCH_HOLE | FALLOC_FL_KEEP_SIZE, off_t(offset), off_t(size));
+    if (size == 0) return;
+    std::lock_guard<std::mutex> lock(mutex_);
+    // Kept sorted by offset, neighbours merged, so that freed batches make room for full ones.
+    auto it =
+        std::lower_bound(free_.begin(), free_.end(), std::make_pair(offset, std::uint64_t(0)));
+    it = free_.insert(it, {offset, size});
+    if (std::next(it) != free_.end() && it->first + it->second == std::next(it)->first) {
+        it->second += std::next(it)->second;
+        free_.erase(std::next(it));
+    }
+    if (it != free_.begin() && std::prev(it)->first + std::prev(it)->second == it->first) {
+        std::prev(it)->second += it->second;
+        free_.erase(it);
+    }
 }
 
 // ---------------------------------------------------------------------------- BatchQueue
@@ -177,21 +205,24 @@ std::optional<RayBatch> BatchQueue::pop(StageTimes& times) {
 
 void BatchQueue::clear() {
     std::unique_lock<std::mutex> lock(mutex_);
+    bool frontReleased = false; // a finished prefetch released the front entry's range itself
     if (prefetch_.valid()) {
         lock.unlock();
         try {
-            prefetch_.get(); // its bytes are dropped; it released its range itself
+            prefetch_.get(); // its bytes are dropped
+            frontReleased = true;
         } catch (const std::exception&) {
             // A read error on rays that are being dropped anyway changes nothing.
         }
         lock.lock();
     }
-    for (Entry& e : entries_)
-        if (e.spilled) {
-            spill_->release(e.offset, e.size); // the front one's again: punching twice is harmless
-        } else {
+    for (size_t i = 0; i < entries_.size(); ++i) {
+        const Entry& e = entries_[i];
+        if (!e.spilled)
             ramBytes_ -= e.size;
-        }
+        else if (i > 0 || !frontReleased)
+            spill_->release(e.offset, e.size);
+    }
     entries_.clear();
 }
 

@@ -4,11 +4,13 @@
 // Spilling: all spilled batches share one file in the spill folder, opened with O_TMPFILE (or
 // created and unlinked at once where the file system lacks it), so it has no name from the
 // start: whatever way the process ends, normal exit, exception, SIGINT, SIGTERM or SIGKILL, the
-// kernel frees it and no file is left behind. Each batch is one large sequential pwrite at the
-// file's end and one pread back; the space of a batch read back is returned with
-// fallocate(PUNCH_HOLE) so the file's disk use stays at what is still queued. The write happens
-// outside the queue's lock (its range is reserved under it), so one worker's write holds up
-// neither the others' pushes nor the consumer's pop.
+// kernel frees it and no file is left behind. Each batch is one large pwrite and one pread back.
+// The range of a batch read back is free for the next one (first fit, neighbours merged), so
+// the file stays at the most bytes ever queued on disk at once, and a write lands in pages the
+// kernel already holds for the file rather than new ones it must allocate, account and later
+// drop by punching a hole: pwrite 103 -> 40 us for a 1.1 MB batch, and no fallocate (29 us).
+// The write happens outside the queue's lock (its range is reserved under it), so one worker's
+// write holds up neither the others' pushes nor the consumer's pop.
 //
 // Batch buffers are recycled: a batch's bytes, once decoded or written to disk, go back to the
 // queue, which hands them to the bins and to its reads. A batch of 2^15 rays is about 1 MB, above
@@ -19,7 +21,6 @@
 #include "host/backend/stats.h"
 #include "host/pipeline/ray_record.h"
 
-#include <atomic>
 #include <cstdint>
 #include <deque>
 #include <future>
@@ -50,18 +51,22 @@ class SpillFile {
     ~SpillFile();
     SpillFile(const SpillFile&) = delete;
     SpillFile& operator=(const SpillFile&) = delete;
-    // The offset of `size` new bytes at the file's end, for write(). Thread-safe.
-    std::uint64_t reserve(std::uint64_t size) { return end_.fetch_add(size); }
+    // The offset of `size` bytes for write(): free space a read-back batch left, else the
+    // file's end. Thread-safe.
+    std::uint64_t reserve(std::uint64_t size);
     // Throws naming the folder on any write error (a full disk). Thread-safe.
     void write(std::uint64_t offset, const std::vector<std::uint8_t>& bytes);
     void read(std::uint64_t offset, std::vector<std::uint8_t>& bytes);
+    // The range is free for reserve(). Thread-safe.
     void release(std::uint64_t offset, std::uint64_t size);
     const std::string& dir() const { return dir_; }
 
   private:
     std::string dir_;
     int fd_ = -1;
-    std::atomic<std::uint64_t> end_{0};
+    std::mutex mutex_;
+    std::uint64_t end_ = 0;
+    std::vector<std::pair<std::uint64_t, std::uint64_t>> free_; // (offset, size), by offset
 };
 
 class BatchQueue {

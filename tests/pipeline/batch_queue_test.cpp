@@ -1,6 +1,6 @@
 // The batch queue on its own: batches come back byte for byte and in order whether they stayed
 // in RAM or went through the spill file; the budget decides which; the counters say what moved;
-// and buffers handed back are handed out again rather than freed.
+// buffers handed back are handed out again rather than freed; the spill file reuses its space.
 #include "host/pipeline/batch_queue.h"
 
 #include <gtest/gtest.h>
@@ -46,6 +46,31 @@ TEST(BatchQueue, BatchesComeBackIntactAndInOrderFromRamAndDisk) {
     c = queue.counters();
     EXPECT_EQ(c.bytesRead, 4 * size);
     EXPECT_EQ(c.peakRamBytes, 2 * size);
+}
+
+// The spill file hands out the ranges of batches read back before growing, first fit, with
+// freed neighbours merged so that a full batch fits where two smaller ones were.
+TEST(SpillFile, ReadBackRangesAreReusedAndNeighboursMerged) {
+    const char* tmp = std::getenv("TMPDIR");
+    SpillFile file(tmp && *tmp ? tmp : "/tmp");
+    EXPECT_EQ(file.reserve(100), 0u);
+    EXPECT_EQ(file.reserve(100), 100u);
+    EXPECT_EQ(file.reserve(50), 200u);
+    file.release(100, 100);
+    file.release(0, 100); // merged with [100, 200)
+    EXPECT_EQ(file.reserve(150), 0u);
+    EXPECT_EQ(file.reserve(60), 250u); // [150, 200) is too small: the end
+    EXPECT_EQ(file.reserve(50), 150u); // but fits this one exactly
+    // Bytes written to a reused range read back as written.
+    file.release(0, 150);
+    std::vector<std::uint8_t> out(150), in(150);
+    for (size_t i = 0; i < out.size(); ++i)
+        out[i] = std::uint8_t(i * 13 + 5);
+    const std::uint64_t at = file.reserve(150);
+    EXPECT_EQ(at, 0u);
+    file.write(at, out);
+    file.read(at, in);
+    EXPECT_TRUE(in == out);
 }
 
 TEST(BatchQueue, RecycledBuffersAreHandedOutAgainEmptyWithTheirCapacity) {

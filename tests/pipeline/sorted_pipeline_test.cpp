@@ -400,11 +400,13 @@ TEST(Spill, PeakRaysInRamStayWithinTheBudgetOrSixBatches) {
     }
 }
 
-// A full disk, simulated with a file-size limit (RLIMIT_FSIZE): writes fail with EFBIG.
+// A full disk, simulated with a file-size limit (RLIMIT_FSIZE): writes fail with EFBIG. The
+// spill file reuses the ranges of batches read back, so it only grows to the most bytes queued
+// on disk at once: the limit, 512 KiB, is below one 2^15-ray batch (1.1 MB).
 TEST(Spill, FullDiskExitsOneNamingTheFolder) {
     TempDir dir, spill;
     const std::string scene = heavyScene(dir);
-    const CommandResult r = runShell("bash -c 'ulimit -f 4096; exec " + binary() + " render " +
+    const CommandResult r = runShell("bash -c 'ulimit -f 512; exec " + binary() + " render " +
                                      scene + " --quiet --memory-budget 0.5 --spill-dir " +
                                      spill.path() + " -o " + dir.file("x.exr") + "'");
     const std::string& out = r.output;
