@@ -7,6 +7,7 @@
 #include <fcntl.h>
 #include <stdexcept>
 #include <unistd.h>
+#include <utility>
 
 namespace spw {
 
@@ -96,7 +97,12 @@ BatchQueue::BatchQueue(std::uint64_t budgetBytes, std::string spillDir)
     : budget_(budgetBytes), spillDir_(std::move(spillDir)) {}
 
 BatchQueue::~BatchQueue() {
-    if (prefetch_.valid()) prefetch_.wait();
+    {
+        std::lock_guard<std::mutex> lock(mutex_);
+        stop_ = true;
+    }
+    wake_.notify_all();
+    if (reader_.joinable()) reader_.join();
 }
 
 SpillFile& BatchQueue::spill() {
@@ -168,18 +174,47 @@ void BatchQueue::recycle(std::vector<std::uint8_t>&& bytes) {
 }
 
 void BatchQueue::startPrefetch() {
-    // Called with the mutex held; reads the front entry's bytes on another thread.
-    if (entries_.empty() || !entries_.front().spilled || prefetch_.valid()) return;
+    if (entries_.empty() || !entries_.front().spilled || ahead_.state != ReadAhead::kIdle) return;
     const Entry& e = entries_.front();
-    SpillFile* file = &spill();
-    std::uint64_t offset = e.offset, size = e.size;
-    prefetch_ = std::async(std::launch::async, [this, file, offset, size] {
-        std::vector<std::uint8_t> bytes = spareBuffer();
-        bytes.resize(size);
-        file->read(offset, bytes);
-        file->release(offset, size);
-        return bytes;
-    });
+    ahead_.state = ReadAhead::kQueued;
+    ahead_.file = &spill();
+    ahead_.offset = e.offset;
+    ahead_.size = e.size;
+    if (!reader_.joinable()) reader_ = std::thread([this] { readerLoop(); });
+    wake_.notify_one();
+}
+
+void BatchQueue::readerLoop() {
+    std::unique_lock<std::mutex> lock(mutex_);
+    for (;;) {
+        wake_.wait(lock, [&] { return stop_ || ahead_.state == ReadAhead::kQueued; });
+        if (stop_) return;
+        ahead_.state = ReadAhead::kReading;
+        SpillFile& file = *ahead_.file;
+        const std::uint64_t offset = ahead_.offset, size = ahead_.size;
+        lock.unlock();
+        std::vector<std::uint8_t> bytes;
+        std::exception_ptr error;
+        try {
+            bytes = readBack(file, offset, size);
+        } catch (...) {
+            error = std::current_exception();
+        }
+        lock.lock();
+        ahead_.bytes = std::move(bytes);
+        ahead_.error = error;
+        ahead_.state = ReadAhead::kDone;
+        done_.notify_all();
+    }
+}
+
+std::vector<std::uint8_t> BatchQueue::readBack(SpillFile& file, std::uint64_t offset,
+                                               std::uint64_t size) {
+    std::vector<std::uint8_t> bytes = spareBuffer();
+    bytes.resize(size);
+    file.read(offset, bytes);
+    file.release(offset, size);
+    return bytes;
 }
 
 std::optional<RayBatch> BatchQueue::pop(StageTimes& times) {
@@ -188,13 +223,21 @@ std::optional<RayBatch> BatchQueue::pop(StageTimes& times) {
     Entry e = std::move(entries_.front());
     entries_.pop_front();
     if (e.spilled) {
-        // The front entry, when spilled, always has its prefetch in flight (startPrefetch runs
-        // whenever an entry becomes the front), so this waits only if the disk is slower than
-        // the processing of the previous batch.
         StageTimer t(times, "load");
-        lock.unlock();
-        e.batch.bytes = prefetch_.get(); // rethrows a read error
-        lock.lock();
+        if (ahead_.state == ReadAhead::kQueued) {
+            // The reader has not got to it: read it here rather than wait for the reader to be
+            // scheduled (it finds nothing to do).
+            ahead_.state = ReadAhead::kIdle;
+            SpillFile& file = *ahead_.file;
+            lock.unlock();
+            e.batch.bytes = readBack(file, e.offset, e.size);
+            lock.lock();
+        } else {
+            done_.wait(lock, [&] { return ahead_.state == ReadAhead::kDone; });
+            ahead_.state = ReadAhead::kIdle;
+            if (ahead_.error) std::rethrow_exception(std::exchange(ahead_.error, nullptr));
+            e.batch.bytes = std::move(ahead_.bytes);
+        }
         counters_.bytesRead += e.size;
     } else {
         ramBytes_ -= e.size;
@@ -205,17 +248,13 @@ std::optional<RayBatch> BatchQueue::pop(StageTimes& times) {
 
 void BatchQueue::clear() {
     std::unique_lock<std::mutex> lock(mutex_);
-    bool frontReleased = false; // a finished prefetch released the front entry's range itself
-    if (prefetch_.valid()) {
-        lock.unlock();
-        try {
-            prefetch_.get(); // its bytes are dropped
-            frontReleased = true;
-        } catch (const std::exception&) {
-            // A read error on rays that are being dropped anyway changes nothing.
-        }
-        lock.lock();
-    }
+    done_.wait(lock, [&] { return ahead_.state != ReadAhead::kReading; });
+    // A finished read-back released the front entry's range itself; its bytes are dropped, and
+    // so is a read error on rays that are being dropped anyway.
+    const bool frontReleased = ahead_.state == ReadAhead::kDone && !ahead_.error;
+    ahead_.state = ReadAhead::kIdle;
+    ahead_.error = nullptr;
+    std::vector<std::uint8_t>().swap(ahead_.bytes);
     for (size_t i = 0; i < entries_.size(); ++i) {
         const Entry& e = entries_[i];
         if (!e.spilled)

@@ -21,12 +21,14 @@
 #include "host/backend/stats.h"
 #include "host/pipeline/ray_record.h"
 
+#include <condition_variable>
 #include <cstdint>
 #include <deque>
-#include <future>
+#include <exception>
 #include <mutex>
 #include <optional>
 #include <string>
+#include <thread>
 #include <vector>
 
 namespace spw {
@@ -77,8 +79,9 @@ class BatchQueue {
 
     // Thread-safe. Keeps the batch in RAM if it fits the budget, else spills it.
     void push(RayBatch&& batch);
-    // Not thread-safe with itself (one consumer). The next batch, loaded; prefetches the one
-    // after it when that one is on disk.
+    // Not thread-safe with itself (one consumer). The next batch, loaded. A spilled batch at
+    // the front is read ahead by the queue's reader thread; if that thread has not started on
+    // it when it is wanted (two busy cores), the consumer reads it itself rather than wait.
     std::optional<RayBatch> pop(StageTimes& times);
     bool empty() const;
     // Drops every queued batch (a stopped render): waits for a read in flight, frees the spill
@@ -98,8 +101,19 @@ class BatchQueue {
         bool spilled = false;
         std::uint64_t offset = 0, size = 0;
     };
+    // The read-ahead of entries_.front() when it is spilled (all under the mutex).
+    struct ReadAhead {
+        enum State { kIdle, kQueued, kReading, kDone } state = kIdle;
+        SpillFile* file = nullptr;
+        std::uint64_t offset = 0, size = 0;
+        std::vector<std::uint8_t> bytes;
+        std::exception_ptr error;
+    };
     void append(Entry&& e); // with the mutex held
-    void startPrefetch();
+    void startPrefetch();   // with the mutex held
+    void readerLoop();
+    // Reads [offset, offset + size) into a spare buffer and frees the range in the file.
+    std::vector<std::uint8_t> readBack(SpillFile& file, std::uint64_t offset, std::uint64_t size);
     SpillFile& spill();
 
     mutable std::mutex mutex_;
@@ -108,7 +122,10 @@ class BatchQueue {
     std::int64_t outsideBytes_ = 0;
     std::string spillDir_;
     std::unique_ptr<SpillFile> spill_;
-    std::future<std::vector<std::uint8_t>> prefetch_; // bytes of entries_.front() when spilled
+    ReadAhead ahead_;
+    std::condition_variable wake_, done_; // the reader's work, and its result
+    bool stop_ = false;
+    std::thread reader_; // started with the first spill
     QueueCounters counters_;
     std::mutex spareMutex_;
     std::vector<std::vector<std::uint8_t>> spare_; // at most kSpareBuffers
