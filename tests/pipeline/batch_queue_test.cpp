@@ -48,6 +48,35 @@ TEST(BatchQueue, BatchesComeBackIntactAndInOrderFromRamAndDisk) {
     EXPECT_EQ(c.peakRamBytes, 2 * size);
 }
 
+// Many spilled batches through the reader thread and the consumer's own reads, the queue
+// never more than three deep (as the renderer keeps it): every batch back intact, in order,
+// the file's ranges reused, and a clear() with a read in flight leaving the queue usable.
+TEST(BatchQueue, SpilledBatchesSurviveReadAheadAndTakeOver) {
+    const char* tmp = std::getenv("TMPDIR");
+    BatchQueue queue(0, tmp ? tmp : "");
+    StageTimes times;
+    const size_t size = 64 * 1024;
+    std::uint8_t next = 0, expected = 0;
+    for (int round = 0; round < 200; ++round) {
+        while (next - expected < 3)
+            queue.push(patternBatch(size, next++));
+        std::optional<RayBatch> b = queue.pop(times);
+        ASSERT_TRUE(b);
+        ASSERT_TRUE(b->bytes == patternBatch(size, expected).bytes) << "batch " << round;
+        ++expected;
+        queue.recycle(std::move(b->bytes));
+    }
+    queue.clear();
+    EXPECT_TRUE(queue.empty());
+    queue.push(patternBatch(size, 7));
+    std::optional<RayBatch> b = queue.pop(times);
+    ASSERT_TRUE(b);
+    EXPECT_TRUE(b->bytes == patternBatch(size, 7).bytes);
+    const QueueCounters c = queue.counters();
+    EXPECT_EQ(c.batchesSpilled, 203u);  // 3 + 199 in the loop, then one more
+    EXPECT_EQ(c.bytesRead, 201 * size); // the two cleared batches were never read
+}
+
 // The spill file hands out the ranges of batches read back before growing, first fit, with
 // freed neighbours merged so that a full batch fits where two smaller ones were.
 TEST(SpillFile, ReadBackRangesAreReusedAndNeighboursMerged) {
