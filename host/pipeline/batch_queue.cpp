@@ -254,7 +254,8 @@ void BatchQueue::clear() {
     const bool frontReleased = ahead_.state == ReadAhead::kDone && !ahead_.error;
     ahead_.state = ReadAhead::kIdle;
     ahead_.error = nullptr;
-    std::vector<std::uint8_t>().swap(ahead_.bytes);
+    recycle(std::move(ahead_.bytes));
+    ahead_.bytes = {};
     for (size_t i = 0; i < entries_.size(); ++i) {
         const Entry& e = entries_[i];
         if (!e.spilled)

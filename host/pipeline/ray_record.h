@@ -36,7 +36,6 @@
 #include "host/backend/render_config.h"
 #include "shared/types.h"
 
-#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <string>
@@ -73,9 +72,10 @@ glm::dvec2 octahedralFold(glm::dvec2 p);
 
 // The cardinal direction bin of a direction: 0..5 for +X, -X, +Y, -Y, +Z, -Z (dominant axis).
 // In integer arithmetic on the comparisons: bounce directions are random, and mispredicted
-// branches here cost more than the arithmetic (GCC made branches of ternaries and glm::abs).
+// branches here cost more than the arithmetic (GCC made branches of the ternaries this was).
+// abs is the shared code's (shared/compat.h), a sign-bit clear, not glm's branch.
 inline uint cardinalBin(vec3 d) {
-    const vec3 a(std::fabs(d.x), std::fabs(d.y), std::fabs(d.z)); // glm::abs branches
+    const vec3 a = spw::abs(d);
     const uint x = uint(a.x >= a.y) & uint(a.x >= a.z);
     const uint y = (x ^ 1u) & uint(a.y >= a.z);
     const uint z = (x | y) ^ 1u;
