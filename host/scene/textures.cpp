@@ -2,24 +2,33 @@
 
 #include "host/image/image_io.h"
 
-#include <OpenImageIO/texture.h>
+#include <OpenImageIO/half.h>
+#include <OpenImageIO/imagecache.h>
 
 #include <sys/resource.h>
+#include <tbb/enumerable_thread_specific.h>
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cmath>
+#include <cstring>
 #include <mutex>
 #include <stdexcept>
 
 namespace spw {
 
 struct TextureResolver::Impl {
-    OIIO::TextureSystem* system = nullptr;
+    OIIO::ImageCache* cache = nullptr;
+    struct Level {
+        int x = 0, y = 0, width = 1, height = 1; // the data window
+    };
     struct Image {
-        OIIO::TextureSystem::TextureHandle* handle = nullptr;
+        OIIO::ImageCache::ImageHandle* handle = nullptr;
         bool srgb = false;
         int channels = 3;
+        float finest = 1.0f;       // the finest level's larger side, texels
+        std::vector<Level> levels; // finest first
     };
     std::vector<Image> images; // parallel to Scene::textures (only Standard entries are used)
     // The first failed lookup, reported after the iteration (a lookup cannot throw mid-batch).
@@ -28,15 +37,208 @@ struct TextureResolver::Impl {
     int failedTexture = -1;
     std::string error;
     mutable std::atomic<std::uint64_t> peakCacheBytes{0};
+    std::atomic<std::uint64_t> lookups{0};
     bool filtered = true;
-    // One lookup, with the calling thread's OpenImageIO state and the options fetched by the
-    // caller (once per run of lookups).
-    vec3 lookup(int index, vec2 uv, float footprint, OIIO::TextureSystem::Perthread* thread,
-                OIIO::TextureOpt& opt);
+    // Each thread's OpenImageIO state (its tile microcache and counters), made by this cache
+    // and destroyed before it. With OpenImageIO's own per-thread state (get_perthread_info),
+    // whose life is the thread's, a render after another in one process (TBB's workers live
+    // on) aborted inside OpenImageIO, its tile accounting gone negative, in 19 of 20 runs of
+    // the TextureFilter tests.
+    tbb::enumerable_thread_specific<OIIO::ImageCache::Perthread*> threads{nullptr};
+    OIIO::ImageCache::Perthread* thread() {
+        OIIO::ImageCache::Perthread*& mine = threads.local();
+        if (!mine) mine = cache->create_thread_info();
+        return mine;
+    }
+    void fail(int index) {
+        if (failed.exchange(true)) return;
+        std::lock_guard<std::mutex> lock(errorMutex);
+        failedTexture = index;
+        error = cache->geterror();
+        if (error.empty()) error = "a tile could not be read";
+    }
     ~Impl() {
-        if (system) OIIO::TextureSystem::destroy(system);
+        if (!cache) return;
+        for (OIIO::ImageCache::Perthread* t : threads)
+            if (t) cache->destroy_thread_info(t);
+        OIIO::ImageCache::destroy(cache);
     }
 };
+
+namespace {
+
+// The texels of one image that one run of lookups reads, through OpenImageIO's tile cache. It
+// holds the last tile it read at each MIP level (a reference, released when it moves on or is
+// destroyed), so that consecutive lookups in the same tile, the common case for sorted hits, do
+// not go back to the cache.
+class TexelReader {
+  public:
+    using Impl = TextureResolver::Impl;
+    TexelReader(Impl& impl, OIIO::ImageCache::Perthread* thread, int index)
+        : impl_(impl), thread_(thread), index_(index), image_(impl.images[size_t(index)]) {}
+    ~TexelReader() {
+        for (Held& h : held_)
+            if (h.tile) impl_.cache->release_tile(h.tile);
+    }
+    TexelReader(const TexelReader&) = delete;
+    TexelReader& operator=(const TexelReader&) = delete;
+
+    // The filtered value at (s, t) (image space: t grows downwards) for a footprint of
+    // `footprint` (uv units): bilinear within a level, blended between the two levels whose texels
+    // bracket the footprint's size (trilinear); the finest level alone for footprints under a
+    // texel. Repeats in both directions.
+    vec3 lookup(float s, float t, float footprint) {
+        const float texels = footprint * image_.finest;
+        const int last = int(image_.levels.size()) - 1;
+        if (!(texels > 1.0f) || last == 0) return bilinear(0, s, t);
+        const float lod = std::log2(texels);
+        if (!(lod < float(last))) return bilinear(last, s, t); // an infinite footprint too
+        const int level = int(lod);
+        const float blend = lod - float(level);
+        const vec3 fine = bilinear(level, s, t), coarse = bilinear(level + 1, s, t);
+        return fine + blend * (coarse - fine);
+    }
+
+  private:
+    struct Held {
+        OIIO::ImageCache::Tile* tile = nullptr;
+        int x0 = 0, y0 = 0, x1 = 0, y1 = 0; // the tile's pixels, [x0, x1) x [y0, y1)
+        const unsigned char* pixels = nullptr;
+        size_t pixelBytes = 0, rowBytes = 0;
+        OIIO::TypeDesc::BASETYPE type = OIIO::TypeDesc::UINT8;
+        bool holds(int x, int y) const { return x >= x0 && x < x1 && y >= y0 && y < y1; }
+        const unsigned char* at(int x, int y) const {
+            return pixels + size_t(y - y0) * rowBytes + size_t(x - x0) * pixelBytes;
+        }
+    };
+
+    static int wrap(int i, int n) {
+        i %= n;
+        return i < 0 ? i + n : i;
+    }
+
+    vec3 bilinear(int levelIndex, float s, float t) {
+        const Impl::Level& level = image_.levels[size_t(levelIndex)];
+        // Periodic: only the fraction matters, and it keeps far coordinates exact.
+        s -= std::floor(s);
+        t -= std::floor(t);
+        if (!(s >= 0.0f && s <= 1.0f)) s = 0.0f; // a NaN coordinate reads texel 0
+        if (!(t >= 0.0f && t <= 1.0f)) t = 0.0f;
+        // Texel centres at (i + 0.5) / width.
+        const float x = s * float(level.width) - 0.5f, y = t * float(level.height) - 0.5f;
+        const float xf = std::floor(x), yf = std::floor(y);
+        const float ax = x - xf, ay = y - yf;
+        const int x0 = wrap(int(xf), level.width) + level.x,
+                  y0 = wrap(int(yf), level.height) + level.y;
+        const int x1 = x0 + 1 == level.x + level.width ? level.x : x0 + 1;
+        const int y1 = y0 + 1 == level.y + level.height ? level.y : y0 + 1;
+        vec3 a, b, c, d;
+        const Held& h = held_[size_t(levelIndex)];
+        if (h.holds(x0, y0) && h.holds(x1, y1)) {
+            // The common case: all four texels in the tile the previous lookup read.
+            a = decode(h, h.at(x0, y0)), b = decode(h, h.at(x1, y0));
+            c = decode(h, h.at(x0, y1)), d = decode(h, h.at(x1, y1));
+        } else {
+            a = texel(levelIndex, x0, y0), b = texel(levelIndex, x1, y0);
+            c = texel(levelIndex, x0, y1), d = texel(levelIndex, x1, y1);
+        }
+        const vec3 top = a + ax * (b - a), bottom = c + ax * (d - c);
+        return top + ay * (bottom - top);
+    }
+
+    // The texel at (x, y) of a level (data window coordinates), through the tile held for it.
+    vec3 texel(int levelIndex, int x, int y) {
+        Held& h = held_[size_t(levelIndex)];
+        if (!h.holds(x, y)) {
+            if (h.tile) impl_.cache->release_tile(h.tile);
+            h = Held{};
+            h.tile = impl_.cache->get_tile(image_.handle, thread_, 0, levelIndex, x, y, 0);
+            if (!h.tile) {
+                impl_.fail(index_);
+                return vec3(0.0f);
+            }
+            const OIIO::ROI roi = impl_.cache->tile_roi(h.tile);
+            OIIO::TypeDesc format;
+            h.pixels = static_cast<const unsigned char*>(impl_.cache->tile_pixels(h.tile, format));
+            h.x0 = roi.xbegin, h.x1 = roi.xend, h.y0 = roi.ybegin, h.y1 = roi.yend;
+            h.type = OIIO::TypeDesc::BASETYPE(format.basetype);
+            h.pixelBytes = format.size() * size_t(roi.nchannels());
+            h.rowBytes = h.pixelBytes * size_t(roi.width());
+            if (!h.pixels || !h.holds(x, y)) {
+                impl_.fail(index_);
+                h.x1 = h.x0, h.y1 = h.y0; // holds nothing
+                return vec3(0.0f);
+            }
+        }
+        return decode(h, h.at(x, y));
+    }
+
+    // The pixel at p as linear values: its first three channels (a one-channel image's value
+    // in all three), 8- and 16-bit integers in [0, 1], sRGB-encoded images linearised per texel,
+    // before filtering (8-bit ones through a table). The cache keeps 8- and 16-bit integers,
+    // half and float as they are in the file, and anything else as float.
+    vec3 decode(const Held& h, const unsigned char* p) const {
+        float v[3] = {0.0f, 0.0f, 0.0f};
+        const int nc = std::min(image_.channels, 3);
+        if (h.type == OIIO::TypeDesc::UINT8) {
+            const float* table = image_.srgb ? srgbTable().data() : unormTable().data();
+            for (int c = 0; c < nc; ++c)
+                v[c] = table[p[c]];
+        } else {
+            for (int c = 0; c < nc; ++c)
+                v[c] = image_.srgb ? srgbToLinear(channel(p, c, h.type)) : channel(p, c, h.type);
+        }
+        return nc == 1 ? vec3(v[0]) : vec3(v[0], v[1], v[2]);
+    }
+
+    static const std::array<float, 256>& unormTable() {
+        static const std::array<float, 256> table = [] {
+            std::array<float, 256> t{};
+            for (int i = 0; i < 256; ++i)
+                t[size_t(i)] = float(i) * (1.0f / 255.0f);
+            return t;
+        }();
+        return table;
+    }
+    static const std::array<float, 256>& srgbTable() {
+        static const std::array<float, 256> table = [] {
+            std::array<float, 256> t{};
+            for (int i = 0; i < 256; ++i)
+                t[size_t(i)] = srgbToLinear(float(i) * (1.0f / 255.0f));
+            return t;
+        }();
+        return table;
+    }
+
+    // Channel c of a pixel of a format other than 8-bit.
+    static float channel(const unsigned char* p, int c, OIIO::TypeDesc::BASETYPE type) {
+        switch (type) {
+        case OIIO::TypeDesc::UINT16: {
+            std::uint16_t u;
+            std::memcpy(&u, p + 2 * c, 2);
+            return float(u) * (1.0f / 65535.0f);
+        }
+        case OIIO::TypeDesc::HALF: {
+            half h;
+            std::memcpy(&h, p + 2 * c, 2);
+            return float(h);
+        }
+        default: {
+            float f;
+            std::memcpy(&f, p + 4 * c, 4);
+            return f;
+        }
+        }
+    }
+
+    Impl& impl_;
+    OIIO::ImageCache::Perthread* thread_;
+    int index_;
+    const Impl::Image& image_;
+    std::array<Held, 32> held_{};
+};
+
+} // namespace
 
 namespace {
 
@@ -77,13 +279,13 @@ TextureResolver::TextureResolver(const Scene& scene, double cacheMiB, bool filte
     if (standard == 0) return;
     impl_ = std::make_unique<Impl>();
     impl_->filtered = filtered;
-    impl_->system = OIIO::TextureSystem::create(false);
-    impl_->system->attribute("max_memory_MB", float(cacheMiB));
+    impl_->cache = OIIO::ImageCache::create(false);
+    impl_->cache->attribute("max_memory_MB", float(cacheMiB));
     // Keep every texture file open if the process may (OpenImageIO's default of 100 made the
     // production scene's 448 files re-open 1400 times a render), half the descriptors at most.
     rlimit files{};
     const rlim_t allowed = getrlimit(RLIMIT_NOFILE, &files) == 0 ? files.rlim_cur / 2 : 100;
-    impl_->system->attribute(
+    impl_->cache->attribute(
         "max_open_files",
         int(std::clamp<rlim_t>(rlim_t(standard) + 16, 100, std::max<rlim_t>(allowed, 100))));
     impl_->images.resize(scene.textures.size());
@@ -92,53 +294,27 @@ TextureResolver::TextureResolver(const Scene& scene, double cacheMiB, bool filte
         if (t.type != TextureType::Standard) continue;
         Impl::Image& img = impl_->images[i];
         OIIO::ustring name(t.path);
-        img.handle = impl_->system->get_texture_handle(name);
+        img.handle = impl_->cache->get_image_handle(name);
         const OIIO::ImageSpec* spec =
-            img.handle ? impl_->system->imagespec(img.handle, nullptr, 0) : nullptr;
-        if (!spec)
+            img.handle ? impl_->cache->imagespec(img.handle, nullptr, 0, 0) : nullptr;
+        if (!spec || spec->width < 1 || spec->height < 1)
             throw std::runtime_error("cannot read texture '" + t.path +
-                                     "': " + impl_->system->geterror());
+                                     "': " + impl_->cache->geterror());
         img.channels = spec->nchannels;
         std::string cs = spec->get_string_attribute("oiio:ColorSpace");
         img.srgb = cs == "sRGB" || (cs.empty() && spec->format == OIIO::TypeDesc::UINT8);
+        img.finest = float(std::max(spec->width, spec->height));
+        // Its MIP levels, as many as the file has (an image without them is its own only level).
+        for (int level = 0; level < 32; ++level) {
+            const OIIO::ImageSpec* ls =
+                level == 0 ? spec : impl_->cache->imagespec(img.handle, nullptr, 0, level);
+            if (!ls || ls->width < 1 || ls->height < 1) break;
+            img.levels.push_back({ls->x, ls->y, ls->width, ls->height});
+        }
     }
 }
 
 TextureResolver::~TextureResolver() = default;
-
-namespace {
-// Every lookup's options: repeating, bilinear within a level, trilinear across levels.
-OIIO::TextureOpt lookupOptions() {
-    OIIO::TextureOpt opt;
-    opt.swrap = opt.twrap = OIIO::TextureOpt::WrapPeriodic;
-    opt.interpmode = OIIO::TextureOpt::InterpBilinear;
-    opt.mipmode = OIIO::TextureOpt::MipModeTrilinear;
-    return opt;
-}
-} // namespace
-
-vec3 TextureResolver::Impl::lookup(int index, vec2 uv, float footprint,
-                                   OIIO::TextureSystem::Perthread* thread, OIIO::TextureOpt& opt) {
-    const Image& img = images[size_t(index)];
-    if (!filtered) footprint = 0.0f; // zero derivatives: the finest level
-    float rgb[4] = {0, 0, 0, 0};
-    int nc = std::min(img.channels, 3);
-    // OBJ's v grows upwards, image rows downwards. An isotropic footprint: ds/dx = dt/dy.
-    if (!system->texture(img.handle, thread, opt, uv.x, 1.0f - uv.y, footprint, 0, 0, footprint, nc,
-                         rgb)) {
-        if (!failed.exchange(true)) {
-            std::lock_guard<std::mutex> lock(errorMutex);
-            failedTexture = index;
-            error = system->geterror();
-        }
-        return vec3(0.0f);
-    }
-    // A one-channel image (a mask) is linearised once, not three times.
-    if (nc == 1) return vec3(img.srgb ? srgbToLinear(rgb[0]) : rgb[0]);
-    vec3 c(rgb[0], rgb[1], rgb[2]);
-    if (img.srgb) c = vec3(srgbToLinear(c.x), srgbToLinear(c.y), srgbToLinear(c.z));
-    return c;
-}
 
 void TextureResolver::checkErrors() const {
     if (!impl_ || !impl_->failed.load()) return;
@@ -153,7 +329,7 @@ void TextureResolver::checkErrors() const {
 void TextureResolver::noteCacheUse() const {
     if (!impl_) return;
     long long used = 0;
-    impl_->system->getattribute("stat:cache_memory_used", OIIO::TypeDesc::INT64, &used);
+    impl_->cache->getattribute("stat:cache_memory_used", OIIO::TypeDesc::INT64, &used);
     std::uint64_t seen = impl_->peakCacheBytes.load();
     while (std::uint64_t(used) > seen && !impl_->peakCacheBytes.compare_exchange_weak(seen, used)) {
     }
@@ -163,17 +339,17 @@ TextureStatistics TextureResolver::statistics() const {
     TextureStatistics s;
     if (!impl_) return s;
     noteCacheUse();
-    OIIO::TextureSystem& ts = *impl_->system;
+    OIIO::ImageCache& ic = *impl_->cache;
     // OpenImageIO answers a counter only when asked in its own type, int64 for some, int for
     // others (and the choice has moved between versions): ask in both.
     auto count = [&](const char* name) {
         long long wide = 0;
-        if (ts.getattribute(name, OIIO::TypeDesc::INT64, &wide)) return std::uint64_t(wide);
+        if (ic.getattribute(name, OIIO::TypeDesc::INT64, &wide)) return std::uint64_t(wide);
         int narrow = 0;
-        if (ts.getattribute(name, OIIO::TypeDesc::INT, &narrow)) return std::uint64_t(narrow);
+        if (ic.getattribute(name, OIIO::TypeDesc::INT, &narrow)) return std::uint64_t(narrow);
         return std::uint64_t(0);
     };
-    s.lookups = count("stat:texture_queries");
+    s.lookups = impl_->lookups.load();
     s.tilesRead = count("stat:tiles_created");
     s.bytesRead = count("stat:bytes_read");
     s.filesOpened = count("stat:open_files_created");
@@ -199,8 +375,7 @@ void TextureResolver::albedos(const Shader& shader, size_t n, const vec2* uv,
         return;
     }
     const std::vector<Op>& program = programs_[size_t(shader.texture)];
-    OIIO::TextureSystem::Perthread* thread = impl_ ? impl_->system->get_perthread_info() : nullptr;
-    OIIO::TextureOpt opt = lookupOptions();
+    OIIO::ImageCache::Perthread* thread = impl_ ? impl_->thread() : nullptr;
     // Every node's values for every hit: nodes x hits, in a per-thread buffer.
     thread_local std::vector<vec3> values;
     if (values.size() < program.size() * n) values.resize(program.size() * n);
@@ -214,10 +389,16 @@ void TextureResolver::albedos(const Shader& shader, size_t n, const vec2* uv,
                 v[k] = c;
             break;
         }
-        case TextureType::Standard:
-            for (size_t k = 0; k < n; ++k)
-                v[k] = impl_->lookup(op.texture, uv[k], footprint[k], thread, opt);
+        case TextureType::Standard: {
+            TexelReader reader(*impl_, thread, op.texture);
+            for (size_t k = 0; k < n; ++k) {
+                // OBJ's v grows upwards, image rows downwards. The footprint is isotropic.
+                const float width = impl_->filtered ? footprint[k] : 0.0f;
+                v[k] = reader.lookup(uv[k].x, 1.0f - uv[k].y, width);
+            }
+            impl_->lookups.fetch_add(n, std::memory_order_relaxed);
             break;
+        }
         case TextureType::Layered: {
             const vec3 *m = &values[size_t(op.mask) * n], *upper = &values[size_t(op.upper) * n],
                        *lower = &values[size_t(op.lower) * n];

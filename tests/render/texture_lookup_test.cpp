@@ -1,0 +1,135 @@
+// The texture lookups (host/scene/textures.cpp filter on OpenImageIO's cached tiles) against
+// OpenImageIO's own TextureSystem as the oracle: bilinear at the finest level, repeating, on
+// images whose tiles do not divide them (edge tiles), on untiled images, in 16-bit, half and
+// float; and 8-bit images (sRGB unless they say otherwise) linearised per texel before filtering,
+// where OpenImageIO would filter the encoded values.
+#include "host/scene/textures.h"
+#include "test_util.h"
+
+#include <OpenImageIO/imageio.h>
+#include <OpenImageIO/texture.h>
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <random>
+
+namespace spw::test {
+namespace {
+
+// A W x H RGB image of `type` with pseudo-random texels in [0, 1], tiled (tile x tile) or not.
+void writeNoise(const std::string& path, int w, int h, OIIO::TypeDesc type, int tile) {
+    auto out = OIIO::ImageOutput::create(path);
+    ASSERT_TRUE(out) << OIIO::geterror();
+    OIIO::ImageSpec spec(w, h, 3, type);
+    if (tile) spec.tile_width = spec.tile_height = tile;
+    std::mt19937 rng(w * 7919 + h);
+    std::uniform_real_distribution<float> u(0.0f, 1.0f);
+    std::vector<float> pixels(size_t(w) * size_t(h) * 3);
+    for (float& p : pixels)
+        p = u(rng);
+    ASSERT_TRUE(out->open(path, spec)) << out->geterror();
+    ASSERT_TRUE(out->write_image(OIIO::TypeDesc::FLOAT, pixels.data())) << out->geterror();
+    ASSERT_TRUE(out->close()) << out->geterror();
+}
+
+Scene texturedScene(const TempDir& dir, const std::string& image) {
+    return loadScene(dir.write("t.yaml", "shader:\n  type: Lambert\n  texture: {type: Standard, "
+                                         "string: " +
+                                             image + "}\n"));
+}
+
+// OpenImageIO's bilinear lookup at the finest level, repeating (its t grows downwards; ours is
+// OBJ's v, growing upwards).
+vec3 oracle(OIIO::TextureSystem& ts, const std::string& path, vec2 uv) {
+    OIIO::TextureOpt opt;
+    opt.swrap = opt.twrap = OIIO::TextureOpt::WrapPeriodic;
+    opt.interpmode = OIIO::TextureOpt::InterpBilinear;
+    opt.mipmode = OIIO::TextureOpt::MipModeOneLevel;
+    float rgb[3] = {0, 0, 0};
+    EXPECT_TRUE(ts.texture(OIIO::ustring(path), opt, uv.x, 1.0f - uv.y, 0, 0, 0, 0, 3, rgb))
+        << ts.geterror();
+    return vec3(rgb[0], rgb[1], rgb[2]);
+}
+
+TEST(TextureLookup, BilinearAgreesWithOpenImageIOOnEdgeTilesUntiledAndEveryFormat) {
+    TempDir dir;
+    struct Case {
+        const char* file;
+        OIIO::TypeDesc type;
+        int width, height, tile;
+    };
+    const Case cases[] = {
+        {"u16-tiled.tif", OIIO::TypeDesc::UINT16, 100, 60, 16},
+        {"half-tiled.exr", OIIO::TypeDesc::HALF, 37, 53, 16},
+        {"float-untiled.exr", OIIO::TypeDesc::FLOAT, 29, 31, 0},
+    };
+    OIIO::TextureSystem* ts = OIIO::TextureSystem::create(false);
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<float> coord(-2.0f, 3.0f);
+    for (const Case& c : cases) {
+        const std::string path = dir.file(c.file);
+        writeNoise(path, c.width, c.height, c.type, c.tile);
+        const Scene scene = texturedScene(dir, c.file);
+        const TextureResolver textures(scene, 1.0);
+        double worst = 0;
+        for (int i = 0; i < 2000; ++i) {
+            const vec2 uv(coord(rng), coord(rng));
+            const vec3 ours = textures.albedo(scene.shaders[0], uv, 0.0f);
+            const vec3 theirs = oracle(*ts, path, uv);
+            for (int k = 0; k < 3; ++k)
+                worst = std::max(worst, double(std::fabs(ours[k] - theirs[k])));
+        }
+        std::printf("%s: worst |ours - OpenImageIO| %.2g\n", c.file, worst);
+        EXPECT_LE(worst, 1e-4) << c.file; // float rounding of the two bilinear forms
+        EXPECT_EQ(textures.statistics().lookups, 2000u) << c.file;
+        textures.checkErrors();
+    }
+    OIIO::TextureSystem::destroy(ts);
+}
+
+// An 8-bit sRGB image: each texel is linearised, then the texels are blended. Halfway between
+// two texels of 0 and 255 the value is 0.5 (linear), not the 0.214 of linearising the blended
+// code 127.5.
+TEST(TextureLookup, EightBitSrgbTexelsAreLinearisedBeforeTheyAreBlended) {
+    TempDir dir;
+    {
+        auto out = OIIO::ImageOutput::create(dir.file("bw.png"));
+        ASSERT_TRUE(out);
+        OIIO::ImageSpec spec(2, 1, 3, OIIO::TypeDesc::UINT8);
+        const unsigned char px[6] = {0, 0, 0, 255, 255, 255};
+        ASSERT_TRUE(out->open(dir.file("bw.png"), spec));
+        ASSERT_TRUE(out->write_image(OIIO::TypeDesc::UINT8, px));
+        ASSERT_TRUE(out->close());
+    }
+    const Scene scene = texturedScene(dir, "bw.png");
+    const TextureResolver textures(scene, 1.0);
+    // Texel centres at u = 0.25 and 0.75; the edge u = 0.5 between them.
+    EXPECT_FLOAT_EQ(textures.albedo(scene.shaders[0], vec2(0.25f, 0.5f), 0.0f).x, 0.0f);
+    EXPECT_FLOAT_EQ(textures.albedo(scene.shaders[0], vec2(0.75f, 0.5f), 0.0f).x, 1.0f);
+    EXPECT_FLOAT_EQ(textures.albedo(scene.shaders[0], vec2(0.5f, 0.5f), 0.0f).y, 0.5f);
+    // Repeating: u = 0 lies halfway between the last texel and the first.
+    EXPECT_FLOAT_EQ(textures.albedo(scene.shaders[0], vec2(0.0f, 0.5f), 0.0f).z, 0.5f);
+}
+
+// A texture file that is readable when the scene loads but whose pixels are not: the lookup
+// returns black for the iteration and checkErrors() names the file and its scene line.
+TEST(TextureLookup, UnreadablePixelsAreReportedWithTheSceneLine) {
+    TempDir dir;
+    writeNoise(dir.file("n.tif"), 64, 64, OIIO::TypeDesc::UINT16, 16);
+    const Scene scene = texturedScene(dir, "n.tif");
+    const TextureResolver textures(scene, 1.0);
+    // Cut the file after its header: its tiles are gone.
+    std::filesystem::resize_file(dir.file("n.tif"), 600);
+    const vec3 a = textures.albedo(scene.shaders[0], vec2(0.5f), 0.0f);
+    EXPECT_EQ(a, vec3(0.0f));
+    try {
+        textures.checkErrors();
+        FAIL() << "no error reported";
+    } catch (const SceneError& e) {
+        EXPECT_NE(std::string(e.what()).find("n.tif"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("t.yaml:3"), std::string::npos) << e.what();
+    }
+}
+
+} // namespace
+} // namespace spw::test
