@@ -7,6 +7,7 @@
 
 #include <sys/resource.h>
 #include <tbb/enumerable_thread_specific.h>
+#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <array>
@@ -29,6 +30,7 @@ struct TextureResolver::Impl {
         int channels = 3;
         float finest = 1.0f;       // the finest level's larger side, texels
         std::vector<Level> levels; // finest first
+        size_t firstHeld = 0;      // its levels' slots in ThreadState::held
     };
     std::vector<Image> images; // parallel to Scene::textures (only Standard entries are used)
     // The first failed lookup, reported after the iteration (a lookup cannot throw mid-batch).
@@ -39,16 +41,56 @@ struct TextureResolver::Impl {
     mutable std::atomic<std::uint64_t> peakCacheBytes{0};
     std::atomic<std::uint64_t> lookups{0};
     bool filtered = true;
-    // Each thread's OpenImageIO state (its tile microcache and counters), made by this cache
-    // and destroyed before it. With OpenImageIO's own per-thread state (get_perthread_info),
-    // whose life is the thread's, a render after another in one process (TBB's workers live
-    // on) aborted inside OpenImageIO, its tile accounting gone negative, in 19 of 20 runs of
-    // the TextureFilter tests.
-    tbb::enumerable_thread_specific<OIIO::ImageCache::Perthread*> threads{nullptr};
-    OIIO::ImageCache::Perthread* thread() {
-        OIIO::ImageCache::Perthread*& mine = threads.local();
-        if (!mine) mine = cache->create_thread_info();
+    // A tile a thread holds a reference to (so the cache cannot evict it), with what reading its
+    // pixels needs.
+    struct Held {
+        OIIO::ImageCache::Tile* tile = nullptr;
+        int x0 = 0, y0 = 0, x1 = 0, y1 = 0; // the tile's pixels, [x0, x1) x [y0, y1)
+        const unsigned char* pixels = nullptr;
+        size_t pixelBytes = 0, rowBytes = 0;
+        OIIO::TypeDesc::BASETYPE type = OIIO::TypeDesc::UINT8;
+        bool holds(int x, int y) const { return x >= x0 && x < x1 && y >= y0 && y < y1; }
+        const unsigned char* at(int x, int y) const {
+            return pixels + size_t(y - y0) * rowBytes + size_t(x - x0) * pixelBytes;
+        }
+        size_t bytes() const { return rowBytes * size_t(y1 - y0); }
+    };
+    // What each thread keeps between lookups: its OpenImageIO state (made by this cache and
+    // destroyed before it), and the last tile it read of each image's each MIP level, so that
+    // the next lookup near the last one, in any image, finds its texels without asking the
+    // cache. A sorted run of hits and a depth-first tracer's neighbouring pixels both gain.
+    // The tiles a thread holds are bounded by `heldLimit` bytes: past it, it lets them all go.
+    // (OpenImageIO's own per-thread state, whose life is the thread's, was tried first: a render
+    // after another in one process, TBB's workers living on, aborted inside OpenImageIO, its
+    // tile accounting gone negative, in 19 of 20 runs of the TextureFilter tests.)
+    struct ThreadState {
+        OIIO::ImageCache::Perthread* oiio = nullptr;
+        std::vector<Held> held;             // Image::firstHeld + level
+        std::vector<std::uint32_t> holding; // the slots of `held` with a tile
+        size_t heldBytes = 0;
+    };
+    tbb::enumerable_thread_specific<ThreadState> threads;
+    size_t heldSlots = 0, heldLimit = 0;
+    ThreadState& thread() {
+        ThreadState& mine = threads.local();
+        if (!mine.oiio) {
+            mine.oiio = cache->create_thread_info();
+            mine.held.resize(heldSlots);
+        }
         return mine;
+    }
+    void letGo(ThreadState& t, std::uint32_t keep = ~0u) {
+        for (std::uint32_t slot : t.holding) {
+            if (slot == keep) continue;
+            cache->release_tile(t.held[slot].tile);
+            t.held[slot] = Held{};
+        }
+        t.holding.clear();
+        t.heldBytes = 0;
+        if (keep != ~0u && t.held[keep].tile) {
+            t.holding.push_back(keep);
+            t.heldBytes = t.held[keep].bytes();
+        }
     }
     void fail(int index) {
         if (failed.exchange(true)) return;
@@ -59,29 +101,24 @@ struct TextureResolver::Impl {
     }
     ~Impl() {
         if (!cache) return;
-        for (OIIO::ImageCache::Perthread* t : threads)
-            if (t) cache->destroy_thread_info(t);
+        for (ThreadState& t : threads) {
+            letGo(t);
+            if (t.oiio) cache->destroy_thread_info(t.oiio);
+        }
         OIIO::ImageCache::destroy(cache);
     }
 };
 
 namespace {
 
-// The texels of one image that one run of lookups reads, through OpenImageIO's tile cache. It
-// holds the last tile it read at each MIP level (a reference, released when it moves on or is
-// destroyed), so that consecutive lookups in the same tile, the common case for sorted hits, do
-// not go back to the cache.
+// The texels of one image that a run of lookups reads, through the tiles the thread holds.
 class TexelReader {
   public:
     using Impl = TextureResolver::Impl;
-    TexelReader(Impl& impl, OIIO::ImageCache::Perthread* thread, int index)
-        : impl_(impl), thread_(thread), index_(index), image_(impl.images[size_t(index)]) {}
-    ~TexelReader() {
-        for (Held& h : held_)
-            if (h.tile) impl_.cache->release_tile(h.tile);
-    }
-    TexelReader(const TexelReader&) = delete;
-    TexelReader& operator=(const TexelReader&) = delete;
+    using Held = Impl::Held;
+    TexelReader(Impl& impl, Impl::ThreadState& thread, int index)
+        : impl_(impl), thread_(thread), index_(index), image_(impl.images[size_t(index)]),
+          held_(thread.held.data() + image_.firstHeld) {}
 
     // The filtered value at (s, t) (image space: t grows downwards) for a footprint of
     // `footprint` (uv units): bilinear within a level, blended between the two levels whose texels
@@ -100,18 +137,6 @@ class TexelReader {
     }
 
   private:
-    struct Held {
-        OIIO::ImageCache::Tile* tile = nullptr;
-        int x0 = 0, y0 = 0, x1 = 0, y1 = 0; // the tile's pixels, [x0, x1) x [y0, y1)
-        const unsigned char* pixels = nullptr;
-        size_t pixelBytes = 0, rowBytes = 0;
-        OIIO::TypeDesc::BASETYPE type = OIIO::TypeDesc::UINT8;
-        bool holds(int x, int y) const { return x >= x0 && x < x1 && y >= y0 && y < y1; }
-        const unsigned char* at(int x, int y) const {
-            return pixels + size_t(y - y0) * rowBytes + size_t(x - x0) * pixelBytes;
-        }
-    };
-
     static int wrap(int i, int n) {
         i %= n;
         return i < 0 ? i + n : i;
@@ -150,9 +175,15 @@ class TexelReader {
     vec3 texel(int levelIndex, int x, int y) {
         Held& h = held_[size_t(levelIndex)];
         if (!h.holds(x, y)) {
-            if (h.tile) impl_.cache->release_tile(h.tile);
+            const auto slot = std::uint32_t(image_.firstHeld + size_t(levelIndex));
+            if (h.tile) {
+                impl_.cache->release_tile(h.tile);
+                thread_.heldBytes -= h.bytes();
+            } else {
+                thread_.holding.push_back(slot);
+            }
             h = Held{};
-            h.tile = impl_.cache->get_tile(image_.handle, thread_, 0, levelIndex, x, y, 0);
+            h.tile = impl_.cache->get_tile(image_.handle, thread_.oiio, 0, levelIndex, x, y, 0);
             if (!h.tile) {
                 impl_.fail(index_);
                 return vec3(0.0f);
@@ -169,6 +200,8 @@ class TexelReader {
                 h.x1 = h.x0, h.y1 = h.y0; // holds nothing
                 return vec3(0.0f);
             }
+            thread_.heldBytes += h.bytes();
+            if (thread_.heldBytes > impl_.heldLimit) impl_.letGo(thread_, slot);
         }
         return decode(h, h.at(x, y));
     }
@@ -232,10 +265,10 @@ class TexelReader {
     }
 
     Impl& impl_;
-    OIIO::ImageCache::Perthread* thread_;
+    Impl::ThreadState& thread_;
     int index_;
     const Impl::Image& image_;
-    std::array<Held, 32> held_{};
+    Held* held_; // this image's levels' slots in the thread's table
 };
 
 } // namespace
@@ -311,7 +344,12 @@ TextureResolver::TextureResolver(const Scene& scene, double cacheMiB, bool filte
             if (!ls || ls->width < 1 || ls->height < 1) break;
             img.levels.push_back({ls->x, ls->y, ls->width, ls->height});
         }
+        img.firstHeld = impl_->heldSlots;
+        impl_->heldSlots += img.levels.size();
     }
+    // The tiles the threads hold together stay within a quarter of the cache.
+    const int workers = std::max(1, tbb::this_task_arena::max_concurrency());
+    impl_->heldLimit = size_t(cacheMiB * 1048576.0 / 4.0) / size_t(workers);
 }
 
 TextureResolver::~TextureResolver() = default;
@@ -375,7 +413,7 @@ void TextureResolver::albedos(const Shader& shader, size_t n, const vec2* uv,
         return;
     }
     const std::vector<Op>& program = programs_[size_t(shader.texture)];
-    OIIO::ImageCache::Perthread* thread = impl_ ? impl_->thread() : nullptr;
+    Impl::ThreadState* thread = impl_ ? &impl_->thread() : nullptr;
     // Every node's values for every hit: nodes x hits, in a per-thread buffer.
     thread_local std::vector<vec3> values;
     if (values.size() < program.size() * n) values.resize(program.size() * n);
@@ -390,7 +428,7 @@ void TextureResolver::albedos(const Shader& shader, size_t n, const vec2* uv,
             break;
         }
         case TextureType::Standard: {
-            TexelReader reader(*impl_, thread, op.texture);
+            TexelReader reader(*impl_, *thread, op.texture);
             for (size_t k = 0; k < n; ++k) {
                 // OBJ's v grows upwards, image rows downwards. The footprint is isotropic.
                 const float width = impl_->filtered ? footprint[k] : 0.0f;
