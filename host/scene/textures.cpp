@@ -81,7 +81,7 @@ struct TextureResolver::Impl {
     }
     void letGo(ThreadState& t, std::uint32_t keep = ~0u) {
         for (std::uint32_t slot : t.holding) {
-            if (slot == keep) continue;
+            if (slot == keep || !t.held[slot].tile) continue;
             cache->release_tile(t.held[slot].tile);
             t.held[slot] = Held{};
         }
@@ -185,6 +185,9 @@ class TexelReader {
             h = Held{};
             h.tile = impl_.cache->get_tile(image_.handle, thread_.oiio, 0, levelIndex, x, y, 0);
             if (!h.tile) {
+                // The slot holds nothing now (a slot is listed while it holds a tile).
+                thread_.holding.erase(
+                    std::find(thread_.holding.begin(), thread_.holding.end(), slot));
                 impl_.fail(index_);
                 return vec3(0.0f);
             }
