@@ -137,10 +137,9 @@ class TexelReader {
     }
 
   private:
-    static int wrap(int i, int n) {
-        i %= n;
-        return i < 0 ? i + n : i;
-    }
+    // A texel index on a periodic level of n texels, for the i in [-1, n - 1] that bilinear()
+    // makes from a coordinate in [0, 1] (no division on this path).
+    static int wrap(int i, int n) { return i < 0 ? i + n : i; }
 
     vec3 bilinear(int levelIndex, float s, float t) {
         const Impl::Level& level = image_.levels[size_t(levelIndex)];
@@ -217,9 +216,9 @@ class TexelReader {
         float v[3] = {0.0f, 0.0f, 0.0f};
         const int nc = std::min(image_.channels, 3);
         if (h.type == OIIO::TypeDesc::UINT8) {
-            const float* table = image_.srgb ? srgbTable().data() : unormTable().data();
+            const std::array<float, 256>& srgb = srgbTable();
             for (int c = 0; c < nc; ++c)
-                v[c] = table[p[c]];
+                v[c] = image_.srgb ? srgb[p[c]] : float(p[c]) * (1.0f / 255.0f);
         } else {
             for (int c = 0; c < nc; ++c)
                 v[c] = image_.srgb ? srgbToLinear(channel(p, c, h.type)) : channel(p, c, h.type);
@@ -227,15 +226,6 @@ class TexelReader {
         return nc == 1 ? vec3(v[0]) : vec3(v[0], v[1], v[2]);
     }
 
-    static const std::array<float, 256>& unormTable() {
-        static const std::array<float, 256> table = [] {
-            std::array<float, 256> t{};
-            for (int i = 0; i < 256; ++i)
-                t[size_t(i)] = float(i) * (1.0f / 255.0f);
-            return t;
-        }();
-        return table;
-    }
     static const std::array<float, 256>& srgbTable() {
         static const std::array<float, 256> table = [] {
             std::array<float, 256> t{};
