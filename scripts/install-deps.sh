@@ -10,6 +10,7 @@ packages=(
   libopenexr-dev                           # float EXR through OpenImageIO
   libyaml-cpp-dev                          # the scene format
   libglm-dev                               # vector math shared by C++ and GLSL
+  libhwy-dev                               # SIMD shading of Lambert hits (Google Highway)
   nlohmann-json3-dev                       # --stats JSON and reading it back in tests
   libtinyobjloader-dev                     # OBJ meshes
   libglfw3-dev libgl-dev libx11-dev        # the --preview window (GLFW, OpenGL, X11)

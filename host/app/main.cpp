@@ -114,6 +114,8 @@ sorted pipeline options (cpu and vulkan backends):
   --stages MODE         fused (default; cpu: hit setup, shade, shadow, accumulate and bin run
                         chunk by chunk of 128 hits, in cache) or separate (each stage over the
                         whole batch in turn, as the vulkan backend runs them)
+  --simd-shading on|off cpu: shade Lambert hits 4, 8 or 16 at a time in SIMD registers (default
+                        on, where every light is a triangle; the image is the same either way)
 
 Ctrl-C (SIGINT) or SIGTERM stops the render at the next batch boundary, writes the image of
 every completed iteration (and --stats, --error-csv) and exits 130 or 143; a second one exits
@@ -296,6 +298,11 @@ int renderCommand(const std::vector<std::string>& args, spw::Ranks* ranks) {
             if (v != "fused" && v != "separate")
                 throw UsageError("--stages takes fused or separate, not '" + v + "'");
             config.pipeline.fuseStages = v == "fused";
+        } else if (a == "--simd-shading") {
+            std::string v = value();
+            if (v != "on" && v != "off")
+                throw UsageError("--simd-shading takes on or off, not '" + v + "'");
+            config.pipeline.simdShading = v == "on";
         } else if (!a.empty() && a[0] == '-')
             throw UsageError("unknown option '" + a + "'");
         else if (scenePath.empty())

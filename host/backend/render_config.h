@@ -67,6 +67,9 @@ struct PipelineConfig {
     // The cpu engine's per-hit stages fused chunk by chunk (stages.h: shadeFused); false runs
     // them one whole batch after another, as the Vulkan engine must (the ablation).
     bool fuseStages = true;
+    // The cpu engine shades Lambert hits SIMD-wide (simd_shading.h); false: shadeSurface() hit by
+    // hit (the ablation; the image is the same to the bit).
+    bool simdShading = true;
 };
 
 // Every parse* throws std::invalid_argument naming the value and the choices.
@@ -103,11 +106,11 @@ struct RenderConfig {
     // the render keeps every completed iteration. Set from a signal handler (the CLI's).
     // kStopByWindow when the preview window was closed, else the signal's number.
     const std::atomic<int>* stop = nullptr;
-    std::optional<double> textureCacheMiB; // overrides settings: texture cache
+    std::optional<double> textureCacheMiB;   // overrides settings: texture cache
     std::optional<double> adaptiveThreshold; // overrides settings: adaptive threshold
     // A partial render: only samples [first, second) of the spp (iteration boundaries).
     std::optional<std::pair<int, int>> sampleRange;
-    std::optional<int> adaptiveMinSamples;   // overrides settings: adaptive min samples
+    std::optional<int> adaptiveMinSamples; // overrides settings: adaptive min samples
     TextureFilter textureFilter = TextureFilter::Cone;
 };
 

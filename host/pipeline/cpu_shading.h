@@ -1,6 +1,6 @@
-// The C++ shading engine: the same shadeSurface() the Vulkan kernels run, in TBB tasks of
-// `shading size` hits, shaded at submit in one slot (TBB already keeps every core busy, so there
-// is nothing to overlap).
+// The C++ shading engine: the same shadeSurface() the Vulkan kernels run (its Lambert hits in
+// SIMD registers, simd_shading.h), in TBB tasks of `shading size` hits, shaded at submit in one
+// slot (TBB already keeps every core busy, so there is nothing to overlap).
 #pragma once
 
 #include "host/backend/backend.h"
@@ -11,5 +11,9 @@
 namespace spw {
 
 std::unique_ptr<ShadingEngine> makeCpuShading(const RenderContext& ctx);
+
+// Whether the cpu engine (and the fused stages) shade Lambert hits SIMD-wide: asked for
+// (PipelineConfig::simdShading) and possible for the scene (simdShadingApplies).
+bool usesSimdShading(const RenderContext& ctx);
 
 } // namespace spw

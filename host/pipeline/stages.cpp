@@ -1,7 +1,9 @@
 #include "host/pipeline/stages.h"
 
+#include "host/pipeline/cpu_shading.h"
 #include "host/pipeline/parallel.h"
 #include "host/pipeline/radix_sort.h"
+#include "host/pipeline/simd_shading.h"
 #include "shared/path.h"
 
 #include <tbb/blocked_range.h>
@@ -388,6 +390,7 @@ void shadeFused(const RenderContext& ctx, uint iteration, RayFormat format,
     std::atomic<std::int64_t> threadNs[kFusedStages] = {};
     std::atomic<std::uint64_t> shadowRays{0};
     const bool inTraversalOrder = order.empty();
+    const bool simd = usesSimdShading(ctx);
     // Tasks of up to `shading size` hits, each handing its continuation rays to the bins once.
     const size_t grain = batchGrain(hitCount, kFusedChunk, size_t(ctx.scene.settings.shadingSize));
     tbb::parallel_for(
@@ -414,8 +417,7 @@ void shadeFused(const RenderContext& ctx, uint iteration, RayFormat format,
                 }
                 setUpChunk(ctx, rays, hits, chunk, n, c->in);
                 lap(kSetUp);
-                for (size_t i = 0; i < n; ++i)
-                    shadeSurface(view, rp, c->in[i].hit, c->in[i].rayDir, c->in[i].path, c->out[i]);
+                shadeHits(view, rp, simd, c->in, n, c->out);
                 lap(kShade);
                 size_t m = 0;
                 for (size_t i = 0; i < n; ++i)

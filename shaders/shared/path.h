@@ -93,6 +93,26 @@ SHARED_FN vec3 escapedRadiance(SCENE_PARAM RenderParams rp, vec3 rayDir, PathSta
     return st.beta * environmentRadiance(SCENE_ARG rp, e, rayDir) * w;
 }
 
+// Step 1 of shadeSurface: what the hit's emitter sends back along the ray (r.emitted, with
+// kShadeEmitted set in r.flags when it counts), weighted against having sampled it from the
+// previous vertex. r.emitted and r.flags must be zero on entry.
+SHARED_FN void addEmission(SCENE_PARAM RenderParams rp, SurfaceHit hit, vec3 wo, PathState st,
+                           INOUT(ShadeResult) r) {
+    if (hit.emitter == kNoEmitter) return;
+    Emitter e = EMITTER(hit.emitter);
+    float cosLight = emitterCosine(e, wo);
+    if (!(cosLight > 0.0f)) return;
+    float w = 1.0f;
+    bool sampledByBsdf = st.bounce > 0u && (st.flags & kPathSpecular) == 0u;
+    if (sampledByBsdf && rp.strategy == kStrategyLight) w = 0.0f;
+    if (sampledByBsdf && rp.strategy == kStrategyMis) {
+        float lightPdf = emitterSolidAnglePdf(e, hit.t, cosLight);
+        w = powerHeuristic(st.prevPdf, lightPdf);
+    }
+    r.emitted = st.beta * e.radiance * w;
+    if (w > 0.0f) r.flags |= kShadeEmitted;
+}
+
 SHARED_FN void shadeSurface(SCENE_PARAM RenderParams rp, SurfaceHit hit, vec3 rayDir, PathState st,
                             OUT(ShadeResult) r) {
     r.flags = 0u;
@@ -111,21 +131,7 @@ SHARED_FN void shadeSurface(SCENE_PARAM RenderParams rp, SurfaceHit hit, vec3 ra
     uint sampleIndex = pathSample(rp, st.pathId);
 
     // 1. Emission seen by this ray, weighted against having sampled it from the previous vertex.
-    if (hit.emitter != kNoEmitter) {
-        Emitter e = EMITTER(hit.emitter);
-        float cosLight = emitterCosine(e, wo);
-        if (cosLight > 0.0f) {
-            float w = 1.0f;
-            bool sampledByBsdf = st.bounce > 0u && (st.flags & kPathSpecular) == 0u;
-            if (sampledByBsdf && rp.strategy == kStrategyLight) w = 0.0f;
-            if (sampledByBsdf && rp.strategy == kStrategyMis) {
-                float lightPdf = emitterSolidAnglePdf(e, hit.t, cosLight);
-                w = powerHeuristic(st.prevPdf, lightPdf);
-            }
-            r.emitted = st.beta * e.radiance * w;
-            if (w > 0.0f) r.flags |= kShadeEmitted;
-        }
-    }
+    addEmission(SCENE_ARG rp, hit, wo, st, r);
 
     if (st.bounce >= rp.maxDepth || sh.model == kModelNull) return;
 

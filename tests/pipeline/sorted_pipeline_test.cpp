@@ -131,7 +131,8 @@ TEST(SortedPipeline, CompactRaysAgreeWithReferenceOnClosedEnclosure) {
 }
 
 // The film must not depend on how rays were batched, sorted, spilled or scheduled, nor on
-// whether the per-hit stages ran fused or one after another. The Cornell
+// whether the per-hit stages ran fused or one after another, nor on whether the Lambert hits
+// were shaded SIMD-wide or one at a time (the box is all Lambert). The Cornell
 // box at max depth 16: bounce rays go through the bins, the queue and (with a small budget) the
 // spill file and back many times, so a read-back that corrupted one bit would change the image.
 TEST(SortedPipeline, ImageIsIndependentOfBatchingSortingBudgetAndThreads) {
@@ -151,6 +152,7 @@ TEST(SortedPipeline, ImageIsIndependentOfBatchingSortingBudgetAndThreads) {
         return result->stats.extra["batches_spilled"].get<long>();
     };
     EXPECT_EQ(variant("the same again", [](RenderConfig&) {}), 0);
+    EXPECT_NE(render(scene, base)->stats.extra["simd_shading"], "off");
     variant("bin exponent 8", [](RenderConfig& c) { c.pipeline.binExponent = 8; });
     variant("bin exponent 16", [](RenderConfig& c) { c.pipeline.binExponent = 16; });
     variant("2 threads", [](RenderConfig& c) { c.threads = 2; });
@@ -179,6 +181,12 @@ TEST(SortedPipeline, ImageIsIndependentOfBatchingSortingBudgetAndThreads) {
         c.pipeline.fuseStages = false;
         c.threads = 2;
         c.pipeline.hitSort = HitSortMode::On;
+    });
+    // shadeSurface() hit by hit instead of the SIMD kernel for the Lambert hits.
+    variant("scalar shading", [](RenderConfig& c) { c.pipeline.simdShading = false; });
+    variant("scalar shading, separate stages", [](RenderConfig& c) {
+        c.pipeline.simdShading = false;
+        c.pipeline.fuseStages = false;
     });
 }
 

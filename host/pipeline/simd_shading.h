@@ -1,0 +1,34 @@
+// Shading a run of hits SIMD-wide: the cpu engine's shade step, where the sort has made the work
+// homogeneous. Hits of the Lambert model (the diffuse surfaces most scenes are made of) go
+// through a structure-of-arrays kernel that runs shadeSurface()'s arithmetic on 4, 8 or 16
+// hits at once, in the widest instruction set the processor has (Google Highway's dynamic
+// dispatch: SSE4, AVX2 or AVX-512); every other hit goes through shadeSurface() itself.
+//
+// The kernel is shadeSurface() to the bit: the same operations in the same order, each rounded
+// once (no fused multiply-add), so an image does not depend on which hits were shaded
+// together, on the instruction set, or on whether the kernel ran at all
+// (SimdShading.LambertHitsAreShadeSurfaceToTheBit). What stays scalar, per hit: the random
+// numbers, the emitter pick (a binary search), the cosine-hemisphere sample (libm's sin and cos)
+// and the emission of an emitter that was hit.
+#pragma once
+
+#include "shared/scene_access.h"
+#include "shared/shade_io.h"
+
+#include <cstddef>
+
+namespace spw {
+
+// Whether the kernel can shade this scene's Lambert hits: every emitter next-event estimation
+// picks is a triangle (point lights and the environment take shadeSurface()).
+bool simdShadingApplies(const SceneView& view);
+
+// out[i] = shadeSurface(view, rp, in[i]) for i in [0, n); `simd` false shades every hit with
+// shadeSurface() (for scenes simdShadingApplies() refuses, and to compare).
+void shadeHits(const SceneView& view, const RenderParams& rp, bool simd, const ShadeInput* in,
+               size_t n, ShadeResult* out);
+
+// The instruction set the kernel runs in on this machine ("AVX3", "AVX2", "SSE4", ...).
+const char* simdShadingTarget();
+
+} // namespace spw

@@ -1,0 +1,201 @@
+// The SIMD Lambert kernel (host/pipeline/simd_shading.h) against shadeSurface(), hit by hit and
+// bit by bit, on random hits that reach every branch: both sides of the surface, shading normals
+// on the wrong side, emitters seen from behind and one- and two-sided, every strategy and
+// sampler, paths before min depth, past it and at max depth, and Lambert hits mixed with other
+// models in runs that are not a multiple of the vector width.
+#include "host/pipeline/simd_shading.h"
+
+#include "shared/path.h"
+
+#include <gtest/gtest.h>
+#include <hwy/targets.h>
+
+#include <cstring>
+#include <random>
+#include <set>
+#include <string>
+#include <vector>
+
+namespace spw {
+namespace {
+
+struct Fixture {
+    std::vector<ShaderParams> shaders;
+    std::vector<Emitter> emitters;
+    std::vector<float> cdf;
+    SceneView view() const {
+        SceneView v;
+        v.shaders = shaders.data();
+        v.emitters = emitters.data();
+        v.emitterCdf = cdf.data();
+        v.emitterCount = uint(cdf.size());
+        return v;
+    }
+};
+
+vec3 unitVector(std::mt19937& rng) {
+    std::normal_distribution<float> g;
+    return normalize(vec3(g(rng), g(rng), g(rng)));
+}
+
+Fixture makeFixture(std::mt19937& rng, int emitters) {
+    Fixture f;
+    std::uniform_real_distribution<float> u(0.0f, 1.0f);
+    for (uint model : {kModelLambert, kModelLambert, kModelConductor, kModelLambert, kModelNull}) {
+        ShaderParams sh{};
+        sh.model = model;
+        sh.colour = vec3(0.8f);
+        sh.reflectance = 1.0f;
+        sh.alpha = 0.3f;
+        sh.ior = 1.5f;
+        f.shaders.push_back(sh);
+    }
+    float total = 0.0f;
+    for (int i = 0; i < emitters; ++i) {
+        Emitter e{};
+        e.type = kEmitterTriangle;
+        e.p0 = vec3(u(rng), 2.0f + u(rng), u(rng)) * 3.0f;
+        e.e1 = vec3(u(rng) - 0.5f, 0.1f * u(rng), u(rng) - 0.5f) * 2.0f;
+        e.e2 = vec3(u(rng) - 0.5f, 0.1f * u(rng), u(rng) - 0.5f) * 2.0f;
+        e.normal = normalize(cross(e.e1, e.e2));
+        e.area = 0.5f * length(cross(e.e1, e.e2));
+        e.twoSided = i % 2 == 0 ? 1u : 0u;
+        e.radiance = vec3(5.0f * u(rng), 4.0f, 3.0f * u(rng));
+        e.pickPdf = 0.2f + u(rng);
+        total += e.pickPdf;
+        f.emitters.push_back(e);
+    }
+    float sum = 0.0f;
+    for (Emitter& e : f.emitters) {
+        e.pickPdf /= total;
+        sum += e.pickPdf;
+        f.cdf.push_back(sum);
+    }
+    if (!f.cdf.empty()) f.cdf.back() = 1.0f;
+    return f;
+}
+
+std::vector<ShadeInput> randomHits(std::mt19937& rng, const Fixture& f, size_t n) {
+    std::uniform_real_distribution<float> u(0.0f, 1.0f);
+    std::vector<ShadeInput> hits(n);
+    for (size_t i = 0; i < n; ++i) {
+        ShadeInput& in = hits[i];
+        SurfaceHit& h = in.hit;
+        h.p = vec3(u(rng), u(rng), u(rng)) * 4.0f - 1.0f;
+        h.t = 0.1f + 5.0f * u(rng);
+        h.ng = unitVector(rng);
+        // Mostly a shading normal near ng, sometimes one beyond the geometric surface.
+        h.ns = u(rng) < 0.1f ? -h.ng : normalize(h.ng + 0.3f * unitVector(rng));
+        h.shader = uint(i * 7 % f.shaders.size());
+        h.emitter = !f.emitters.empty() && u(rng) < 0.1f ? uint(i % f.emitters.size()) : kNoEmitter;
+        h.albedo = vec3(u(rng), u(rng), u(rng));
+        h.offset = 1e-6f * (1.0f + u(rng));
+        in.rayDir = unitVector(rng);
+        PathState& st = in.path;
+        st.beta = u(rng) < 0.05f ? vec3(0.0f) : vec3(u(rng), u(rng), u(rng)) * 2.0f;
+        st.prevPdf = u(rng) < 0.2f ? 0.0f : 3.0f * u(rng);
+        st.pathId = uint(rng() % 100000u);
+        st.bounce = uint(rng() % 9u);
+        st.flags = u(rng) < 0.2f ? kPathSpecular : 0u;
+        st.cone = uint(rng() & 0xFFFFu);
+    }
+    return hits;
+}
+
+// How many results have each flag, so that a test can check it exercised them.
+struct FlagCounts {
+    size_t emitted = 0, shadow = 0, next = 0;
+};
+
+FlagCounts compareWithShadeSurface(const SceneView& view, const RenderParams& rp,
+                                   const std::vector<ShadeInput>& hits, const char* what) {
+    std::vector<ShadeResult> simd(hits.size()), scalar(hits.size());
+    std::memset(simd.data(), 0xAB, simd.size() * sizeof(ShadeResult));
+    shadeHits(view, rp, true, hits.data(), hits.size(), simd.data());
+    shadeHits(view, rp, false, hits.data(), hits.size(), scalar.data());
+    FlagCounts counts;
+    size_t mismatches = 0;
+    for (size_t i = 0; i < hits.size(); ++i) {
+        if (std::memcmp(&simd[i], &scalar[i], sizeof(ShadeResult)) != 0 && ++mismatches <= 3)
+            ADD_FAILURE() << what << ": hit " << i << " (model "
+                          << view.shaders[hits[i].hit.shader].model << ", bounce "
+                          << hits[i].path.bounce << ") flags " << simd[i].flags << " against "
+                          << scalar[i].flags << ", next dir " << simd[i].nextDir.x << " against "
+                          << scalar[i].nextDir.x << ", shadow " << simd[i].shadowContribution.x
+                          << " against " << scalar[i].shadowContribution.x;
+        counts.emitted += (scalar[i].flags & kShadeEmitted) != 0;
+        counts.shadow += (scalar[i].flags & kShadeShadow) != 0;
+        counts.next += (scalar[i].flags & kShadeContinue) != 0;
+    }
+    EXPECT_EQ(mismatches, 0u) << what << ": of " << hits.size() << " hits";
+    return counts;
+}
+
+void expectLambertHitsAreShadeSurface();
+
+RenderParams params(uint strategy, uint sampling, uint emitters) {
+    RenderParams rp{};
+    rp.seed = 7;
+    rp.iteration = 3;
+    rp.samplesPerIteration = 4;
+    rp.minDepth = 2;
+    rp.maxDepth = 6;
+    rp.threshold = 0.5f;
+    rp.strategy = strategy;
+    rp.emitterCount = emitters;
+    rp.sampling = sampling;
+    rp.environment = kNoEmitter;
+    return rp;
+}
+
+// In every instruction set this machine has that the kernel was compiled for (SSE4, AVX2,
+// AVX-512, and Highway's portable 128-bit emulation).
+TEST(SimdShading, LambertHitsAreShadeSurfaceToTheBit) {
+    std::vector<int64_t> targets = hwy::SupportedAndGeneratedTargets();
+    ASSERT_FALSE(targets.empty());
+    std::set<std::string> ran;
+    for (int64_t target : targets) {
+        hwy::SetSupportedTargetsForTest(target);
+        ran.insert(simdShadingTarget());
+        SCOPED_TRACE(simdShadingTarget());
+        expectLambertHitsAreShadeSurface();
+    }
+    hwy::SetSupportedTargetsForTest(0);
+    EXPECT_EQ(ran.size(), targets.size()); // each target ran its own code
+}
+
+void expectLambertHitsAreShadeSurface() {
+    std::mt19937 rng(2024);
+    for (int emitters : {3, 1, 0}) {
+        const Fixture f = makeFixture(rng, emitters);
+        ASSERT_TRUE(simdShadingApplies(f.view()));
+        // 1003 hits: blocks of 64 Lambert hits and a ragged last one.
+        const std::vector<ShadeInput> hits = randomHits(rng, f, 1003);
+        for (uint strategy : {kStrategyMis, kStrategyLight, kStrategyBsdf})
+            for (uint sampling : {kSamplerIndependent, kSamplerSobol}) {
+                const std::string what = std::to_string(emitters) + " emitters, strategy " +
+                                         std::to_string(strategy) + ", sampler " +
+                                         std::to_string(sampling);
+                const FlagCounts c = compareWithShadeSurface(
+                    f.view(), params(strategy, sampling, uint(emitters)), hits, what.c_str());
+                // The comparison reached every outcome it can have here.
+                EXPECT_GT(c.next, 200u) << what;
+                if (emitters > 0 && strategy != kStrategyBsdf) EXPECT_GT(c.shadow, 100u) << what;
+                if (emitters > 0) EXPECT_GT(c.emitted, 5u) << what;
+            }
+    }
+}
+
+TEST(SimdShading, RunsInTheWidestInstructionSetAndOnlyWhereEveryLightIsATriangle) {
+    EXPECT_STRNE(simdShadingTarget(), "");
+    std::mt19937 rng(5);
+    Fixture f = makeFixture(rng, 2);
+    EXPECT_TRUE(simdShadingApplies(f.view()));
+    f.emitters[1].type = kEmitterPoint;
+    EXPECT_FALSE(simdShadingApplies(f.view()));
+    f.emitters[1].type = kEmitterEnvironment;
+    EXPECT_FALSE(simdShadingApplies(f.view()));
+}
+
+} // namespace
+} // namespace spw
