@@ -24,7 +24,7 @@ constexpr size_t kMaxLanes = 16;
 struct Floats {
     alignas(64) float v[kBlock];
 };
-struct Masks { // all bits set, or none
+struct Uints { // masks (all bits set, or none) and integers
     alignas(64) std::uint32_t v[kBlock];
 };
 struct Vec3s {
@@ -36,19 +36,21 @@ struct Vec3s {
 struct LambertLanes {
     Vec3s p, ng, ns, albedo, wo, beta; // the hit, -rayDir, the path's throughput
     Floats offset;
-    Masks live;                           // bounce < max depth: the path goes on from here
-    Masks roulette;                       // bounce >= min depth
-    Floats uLightY, uLightZ, uLightW;     // rand4(kDimLight); x picked the emitter
-    Vec3s local;                          // sampleCosineHemisphere(rand4(kDimBsdf).xy)
-    Vec3s e0, e1, e2, eNormal, eRadiance; // the picked emitter (a triangle)
+    Uints live;                                // bounce < max depth: the path goes on from here
+    Uints roulette;                            // bounce >= min depth
+    Uints pixel, sampleIndex, bounce;          // what the path's random numbers are a function of
+    Floats uLightX, uLightY, uLightZ, uLightW; // rand4(kDimLight), made by RandomLanes
+    Floats uBsdfX, uBsdfY;                     // rand4(kDimBsdf).xy, made by RandomLanes
+    Vec3s local;                               // sampleCosineHemisphere(uBsdf)
+    Vec3s e0, e1, e2, eNormal, eRadiance;      // the picked emitter (a triangle)
     Floats ePickPdf, eArea;
-    Masks eTwoSided;
+    Uints eTwoSided;
 };
 static_assert(sizeof(LambertLanes) % sizeof(Floats) == 0, "rows only");
 
 // What the kernel writes; shadeHits() puts it into the ShadeResults.
 struct LambertResults {
-    Masks shadow, next; // kShadeShadow, kShadeContinue
+    Uints shadow, next; // kShadeShadow, kShadeContinue
     Vec3s shadowOrigin, shadowDir, shadowContribution, nextOrigin, nextDir, nextBeta;
     Floats shadowTmax, nextPdf;
 };
@@ -69,7 +71,7 @@ using DU = hn::RebindToUnsigned<D>;
 using V = hn::Vec<D>;
 using M = hn::Mask<D>;
 using simd_shading::Floats;
-using simd_shading::Masks;
+using simd_shading::Uints;
 using simd_shading::Vec3s;
 
 struct V3 {
@@ -79,7 +81,7 @@ struct V3 {
 HWY_INLINE V load(const Floats& a, size_t i) {
     return hn::Load(D(), a.v + i);
 }
-HWY_INLINE M loadMask(const Masks& a, size_t i) {
+HWY_INLINE M loadMask(const Uints& a, size_t i) {
     return hn::MaskFromVec(hn::BitCast(D(), hn::Load(DU(), a.v + i)));
 }
 HWY_INLINE V3 load(const Vec3s& a, size_t i) {
@@ -88,7 +90,7 @@ HWY_INLINE V3 load(const Vec3s& a, size_t i) {
 HWY_INLINE void store(V v, Floats& a, size_t i) {
     hn::Store(v, D(), a.v + i);
 }
-HWY_INLINE void store(M m, Masks& a, size_t i) {
+HWY_INLINE void store(M m, Uints& a, size_t i) {
     hn::Store(hn::BitCast(DU(), hn::VecFromMask(D(), m)), DU(), a.v + i);
 }
 // The vector where m holds, zero elsewhere (shadeSurface's results start zeroed).
@@ -172,6 +174,110 @@ HWY_INLINE V3 toWorld(V3 local, V3 n) { // makeFrame, then local.x t + local.y b
                   hn::Mul(hn::Neg(s), n.x)};
     const V3 b = {c, hn::Add(s, hn::Mul(hn::Mul(n.y, n.y), a)), hn::Neg(n.y)};
     return add(add(mul(t, local.x), mul(b, local.y)), mul(n, local.z));
+}
+
+// --- rand4 (shared/rng.h) ----------------------------------------------------------------------
+using VU = hn::Vec<DU>;
+struct U4 {
+    VU x, y, z, w;
+};
+
+HWY_INLINE VU loadU(const Uints& a, size_t i) {
+    return hn::Load(DU(), a.v + i);
+}
+HWY_INLINE U4 pcg4d(U4 v) {
+    const DU du;
+    const VU mul = hn::Set(du, 1664525u), inc = hn::Set(du, 1013904223u);
+    v = {hn::Add(hn::Mul(v.x, mul), inc), hn::Add(hn::Mul(v.y, mul), inc),
+         hn::Add(hn::Mul(v.z, mul), inc), hn::Add(hn::Mul(v.w, mul), inc)};
+    for (int round = 0; round < 2; ++round) {
+        v.x = hn::Add(v.x, hn::Mul(v.y, v.w));
+        v.y = hn::Add(v.y, hn::Mul(v.z, v.x));
+        v.z = hn::Add(v.z, hn::Mul(v.x, v.y));
+        v.w = hn::Add(v.w, hn::Mul(v.y, v.z));
+        if (round == 0)
+            v = {hn::Xor(v.x, hn::ShiftRight<16>(v.x)), hn::Xor(v.y, hn::ShiftRight<16>(v.y)),
+                 hn::Xor(v.z, hn::ShiftRight<16>(v.z)), hn::Xor(v.w, hn::ShiftRight<16>(v.w))};
+    }
+    return v;
+}
+template <int kShift>
+HWY_INLINE VU swapBits(VU x, std::uint32_t low) { // bits in `low` up kShift, the others down
+    const DU du;
+    return hn::Or(hn::ShiftLeft<kShift>(hn::And(x, hn::Set(du, low))),
+                  hn::ShiftRight<kShift>(hn::And(x, hn::Set(du, ~low))));
+}
+HWY_INLINE VU bitfieldReverse(VU x) {
+    x = hn::Or(hn::ShiftLeft<16>(x), hn::ShiftRight<16>(x));
+    x = swapBits<8>(x, 0x00FF00FFu);
+    x = swapBits<4>(x, 0x0F0F0F0Fu);
+    x = swapBits<2>(x, 0x33333333u);
+    return swapBits<1>(x, 0x55555555u);
+}
+HWY_INLINE VU laineKarrasPermutation(VU x, VU seed) {
+    const DU du;
+    x = hn::Add(x, seed);
+    for (std::uint32_t m : {0x6c50b47cu, 0xb82f1e52u, 0xc7afe638u, 0x8d22f6e6u})
+        x = hn::Xor(x, hn::Mul(x, hn::Set(du, m)));
+    return x;
+}
+// sobolReversedColumns: the XOR of the byte tables' entries for r's four bytes.
+HWY_INLINE void sobolReversedColumns(VU r, VU& x, VU& y, VU& z) {
+    const DU du;
+    const hn::RebindToSigned<DU> di;
+    const std::uint32_t* table = &kSobolByteTables.t[0][0].x;
+    x = y = z = hn::Zero(du);
+    for (int byte = 0; byte < 4; ++byte) {
+        const VU value = hn::And(hn::ShiftRightSame(r, 8 * byte), hn::Set(du, 0xFFu));
+        // uvec3 t[4][256]: entry (byte, value) starts at 3 (256 byte + value).
+        const auto index = hn::BitCast(
+            di, hn::Mul(hn::Add(value, hn::Set(du, 256u * std::uint32_t(byte))), hn::Set(du, 3u)));
+        x = hn::Xor(x, hn::GatherIndex(du, table, index));
+        y = hn::Xor(y, hn::GatherIndex(du, table + 1, index));
+        z = hn::Xor(z, hn::GatherIndex(du, table + 2, index));
+    }
+}
+HWY_INLINE U4 scrambledSobol4(VU sampleIndex, U4 key) {
+    const U4 seeds = pcg4d(key);
+    const VU shuffleSeed = hn::Xor(hn::Xor(seeds.x, seeds.y), hn::Xor(seeds.z, seeds.w));
+    const VU r = laineKarrasPermutation(bitfieldReverse(sampleIndex), shuffleSeed);
+    U4 x;
+    x.x = bitfieldReverse(r);
+    sobolReversedColumns(r, x.y, x.z, x.w);
+    return {bitfieldReverse(laineKarrasPermutation(x.x, seeds.x)),
+            bitfieldReverse(laineKarrasPermutation(x.y, seeds.y)),
+            bitfieldReverse(laineKarrasPermutation(x.z, seeds.z)),
+            bitfieldReverse(laineKarrasPermutation(x.w, seeds.w))};
+}
+HWY_INLINE V uintToUnit(VU x) {
+    const D d;
+    const hn::RebindToSigned<D> di;
+    return hn::Mul(hn::ConvertTo(d, hn::BitCast(di, hn::ShiftRight<8>(x))),
+                   hn::Set(d, 1.0f / 16777216.0f));
+}
+HWY_INLINE U4 rand4(uint sampling, uint seed, VU pixel, VU sampleIndex, VU bounce, uint group) {
+    const DU du;
+    const VU dimension = hn::Or(hn::ShiftLeft<8>(bounce), hn::Set(du, group));
+    if (sampling == kSamplerSobol)
+        return scrambledSobol4(sampleIndex,
+                               {pixel, dimension, hn::Set(du, seed), hn::Set(du, 0x50B01u)});
+    return pcg4d({pixel, sampleIndex, dimension, hn::Set(du, seed)});
+}
+
+// The lanes' rand4(kDimLight) and rand4(kDimBsdf).xy, for lanes [0, count).
+void RandomLanes(simd_shading::LambertLanes& lanes, size_t count, uint sampling, uint seed) {
+    for (size_t i = 0; i < count; i += hn::Lanes(D())) {
+        const VU pixel = loadU(lanes.pixel, i), sampleIndex = loadU(lanes.sampleIndex, i);
+        const VU bounce = loadU(lanes.bounce, i);
+        const U4 light = rand4(sampling, seed, pixel, sampleIndex, bounce, kDimLight);
+        store(uintToUnit(light.x), lanes.uLightX, i);
+        store(uintToUnit(light.y), lanes.uLightY, i);
+        store(uintToUnit(light.z), lanes.uLightZ, i);
+        store(uintToUnit(light.w), lanes.uLightW, i);
+        const U4 bsdf = rand4(sampling, seed, pixel, sampleIndex, bounce, kDimBsdf);
+        store(uintToUnit(bsdf.x), lanes.uBsdfX, i);
+        store(uintToUnit(bsdf.y), lanes.uBsdfY, i);
+    }
 }
 
 // Steps 2 and 3 of shadeSurface for lanes [0, count), count a multiple of the vector width.
@@ -270,6 +376,7 @@ HWY_AFTER_NAMESPACE();
 #if HWY_ONCE
 namespace spw {
 HWY_EXPORT(ShadeLambertLanes);
+HWY_EXPORT(RandomLanes);
 HWY_EXPORT(TargetName);
 
 using simd_shading::kBlock;
@@ -292,7 +399,7 @@ std::uint32_t mask(bool b) {
 }
 
 // Lane k from hit `in`: what the kernel reads, and (scalar) the emission into `out`.
-void fillLane(const SceneView& scene, const RenderParams& rp, bool nee, const ShadeInput& in,
+void fillLane(const SceneView& scene, const RenderParams& rp, const ShadeInput& in,
               LambertLanes& lanes, size_t k, ShadeResult& out) {
     const SurfaceHit& hit = in.hit;
     const PathState& st = in.path;
@@ -310,22 +417,23 @@ void fillLane(const SceneView& scene, const RenderParams& rp, bool nee, const Sh
     const bool live = st.bounce < rp.maxDepth;
     lanes.live.v[k] = mask(live);
     lanes.roulette.v[k] = mask(st.bounce >= rp.minDepth);
-    vec4 uLight(0.0f);
-    vec3 local(0.0f, 0.0f, 1.0f);
-    if (live) {
-        const uint pixel = pathPixel(rp, st.pathId);
-        const uint sampleIndex = pathSample(rp, st.pathId);
-        uLight = rand4(rp.sampling, rp.seed, pixel, sampleIndex, st.bounce, kDimLight);
-        const vec4 uBsdf = rand4(rp.sampling, rp.seed, pixel, sampleIndex, st.bounce, kDimBsdf);
-        local = sampleCosineHemisphere(vec2(uBsdf.x, uBsdf.y));
-    }
-    lanes.uLightY.v[k] = uLight.y;
-    lanes.uLightZ.v[k] = uLight.z;
-    lanes.uLightW.v[k] = uLight.w;
-    set(lanes.local, k, local);
+    lanes.pixel.v[k] = pathPixel(rp, st.pathId);
+    lanes.sampleIndex.v[k] = pathSample(rp, st.pathId);
+    lanes.bounce.v[k] = st.bounce;
+}
+
+// Lane k's BSDF sample and emitter, from the random numbers RandomLanes made (zeros where the
+// path ends here or nothing is sampled, so that the kernel reads defined values).
+void sampleLane(const SceneView& scene, const RenderParams& rp, bool nee, LambertLanes& lanes,
+                size_t k) {
     static const Emitter kNone{};
-    const Emitter& e =
-        nee && live ? scene.emitters[pickEmitter(scene, rp.emitterCount, uLight.x)] : kNone;
+    const bool live = lanes.live.v[k] != 0u;
+    set(lanes.local, k,
+        live ? sampleCosineHemisphere(vec2(lanes.uBsdfX.v[k], lanes.uBsdfY.v[k]))
+             : vec3(0.0f, 0.0f, 1.0f));
+    const Emitter& e = nee && live
+                           ? scene.emitters[pickEmitter(scene, rp.emitterCount, lanes.uLightX.v[k])]
+                           : kNone;
     set(lanes.e0, k, e.p0);
     set(lanes.e1, k, e.e1);
     set(lanes.e2, k, e.e2);
@@ -390,6 +498,9 @@ void shadeHits(const SceneView& view, const RenderParams& rp, bool simd, const S
     auto run = [&] {
         const size_t end = (count + kMaxLanes - 1) / kMaxLanes * kMaxLanes;
         padLanes(lanes, count, end);
+        HWY_DYNAMIC_DISPATCH(RandomLanes)(lanes, end, rp.sampling, rp.seed);
+        for (size_t k = 0; k < end; ++k)
+            sampleLane(view, rp, nee, lanes, k);
         HWY_DYNAMIC_DISPATCH(ShadeLambertLanes)(lanes, end, nee, mis, rp.threshold, results);
         for (size_t k = 0; k < count; ++k) {
             const ShadeInput& hit = in[hitOf[k]];
@@ -402,7 +513,7 @@ void shadeHits(const SceneView& view, const RenderParams& rp, bool simd, const S
             shadeSurface(view, rp, in[i].hit, in[i].rayDir, in[i].path, out[i]);
             continue;
         }
-        fillLane(view, rp, nee, in[i], lanes, count, out[i]);
+        fillLane(view, rp, in[i], lanes, count, out[i]);
         hitOf[count++] = std::uint32_t(i);
         if (count == kBlock) run();
     }
