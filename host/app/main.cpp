@@ -388,9 +388,11 @@ int renderCommand(const std::vector<std::string>& args, spw::Ranks* ranks) {
 
     if (quiet) progressMode = "none";
     if (progressMode == "auto") progressMode = isatty(STDERR_FILENO) ? "bar" : "none";
+    // Under mpirun at most four updates a second (progress.h says why).
     spw::ProgressBar progress(progressMode == "none"  ? spw::ProgressBar::Style::None
                               : progressMode == "bar" ? spw::ProgressBar::Style::Bar
-                                                      : spw::ProgressBar::Style::Lines);
+                                                      : spw::ProgressBar::Style::Lines,
+                              ranks ? 0.25 : 0.0);
     const spw::SamplingPlan plan = spw::planSampling(scene.image, config.spp);
     const int sppPerIteration = plan.sampleBase * plan.sampleBase;
     if (const std::string why = spw::partialRenderProblem(scene, config, plan); !why.empty())

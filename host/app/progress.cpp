@@ -15,6 +15,8 @@ void ProgressBar::update(int done, int total, int sppDone, int sppTotal,
     if (style_ == Style::None) return;
     double elapsed =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+    if (lastDrawn_ && elapsed - *lastDrawn_ < minInterval_ && done < total) return;
+    lastDrawn_ = elapsed;
     double eta = done > 0 ? elapsed * (total - done) / done : 0.0;
     char error[32] = "-";
     if (relMse) std::snprintf(error, sizeof error, "%.3g", *relMse);
