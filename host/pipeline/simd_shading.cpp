@@ -41,7 +41,6 @@ struct LambertLanes {
     Uints pixel, sampleIndex, bounce;          // what the path's random numbers are a function of
     Floats uLightX, uLightY, uLightZ, uLightW; // rand4(kDimLight), made by RandomLanes
     Floats uBsdfX, uBsdfY;                     // rand4(kDimBsdf).xy, made by RandomLanes
-    Vec3s local;                               // sampleCosineHemisphere(uBsdf)
     Vec3s e0, e1, e2, eNormal, eRadiance;      // the picked emitter (a triangle)
     Floats ePickPdf, eArea;
     Uints eTwoSided;
@@ -164,6 +163,40 @@ HWY_INLINE V surfaceOffset(V3 p, V3 v0, V3 v1, V3 v2, V3 n) {
     const V3 m = gmax(gmax(abs(v0), abs(v1)), gmax(abs(v2), abs(p)));
     return hn::Add(hn::Mul(dot(m, abs(n)), hn::Set(D(), kOffsetRelative)),
                    hn::Set(D(), kOffsetAbsolute));
+}
+HWY_INLINE V sinQuarterPi(V x) {
+    const D d;
+    const V z = hn::Mul(x, x);
+    const V p = hn::Sub(
+        hn::Mul(hn::Add(hn::Mul(hn::Set(d, -1.9515295891e-4f), z), hn::Set(d, 8.3321608736e-3f)),
+                z),
+        hn::Set(d, 1.6666654611e-1f));
+    return hn::Add(hn::Mul(hn::Mul(p, z), x), x);
+}
+HWY_INLINE V cosQuarterPi(V x) {
+    const D d;
+    const V z = hn::Mul(x, x);
+    const V p = hn::Add(hn::Mul(hn::Sub(hn::Mul(hn::Set(d, 2.443315711809948e-5f), z),
+                                        hn::Set(d, 1.388731625493765e-3f)),
+                                z),
+                        hn::Set(d, 4.166664568298827e-2f));
+    return hn::Add(hn::Sub(hn::Mul(hn::Mul(p, z), z), hn::Mul(hn::Set(d, 0.5f), z)),
+                   hn::Set(d, 1.0f));
+}
+HWY_INLINE V3 sampleCosineHemisphere(V ux, V uy) {
+    const D d;
+    const V zero = hn::Zero(d), one = hn::Set(d, 1.0f);
+    const V dx = hn::Sub(hn::Mul(hn::Set(d, 2.0f), ux), one);
+    const V dy = hn::Sub(hn::Mul(hn::Set(d, 2.0f), uy), one);
+    const M xMajor = hn::Gt(hn::Abs(dx), hn::Abs(dy));
+    const V r = hn::IfThenElse(xMajor, dx, dy);
+    const V theta = hn::Mul(hn::Set(d, kPi / 4.0f), hn::Div(hn::IfThenElse(xMajor, dy, dx), r));
+    const V c = cosQuarterPi(theta), s = sinQuarterPi(theta);
+    const V x = hn::Mul(r, hn::IfThenElse(xMajor, c, s));
+    const V y = hn::Mul(r, hn::IfThenElse(xMajor, s, c));
+    const V z = hn::Sqrt(gmax(zero, hn::Sub(hn::Sub(one, hn::Mul(x, x)), hn::Mul(y, y))));
+    const M centre = hn::And(hn::Eq(dx, zero), hn::Eq(dy, zero));
+    return select(centre, V3{zero, zero, one}, V3{x, y, z});
 }
 HWY_INLINE V3 toWorld(V3 local, V3 n) { // makeFrame, then local.x t + local.y b + local.z n
     const V one = hn::Set(D(), 1.0f);
@@ -347,7 +380,7 @@ void ShadeLambertLanes(const simd_shading::LambertLanes& in, size_t count, bool 
         store(shadowing, out.shadow, i);
 
         // 3. Continuation: lambertSample, then Russian roulette.
-        const V3 local = load(in.local, i);
+        const V3 local = sampleCosineHemisphere(load(in.uBsdfX, i), load(in.uBsdfY, i));
         const V3 world = toWorld(local, n);
         const V3 wi = mul(world, hn::Div(one, hn::Sqrt(dot(world, world))));
         M next = hn::And(live, hn::Not(hn::Or(hn::Le(hn::Mul(ngDotWo, dot(ng, wi)), zero),
@@ -422,16 +455,12 @@ void fillLane(const SceneView& scene, const RenderParams& rp, const ShadeInput& 
     lanes.bounce.v[k] = st.bounce;
 }
 
-// Lane k's BSDF sample and emitter, from the random numbers RandomLanes made (zeros where the
-// path ends here or nothing is sampled, so that the kernel reads defined values).
-void sampleLane(const SceneView& scene, const RenderParams& rp, bool nee, LambertLanes& lanes,
-                size_t k) {
+// Lane k's emitter, picked with the random number RandomLanes made (zeros where the path ends
+// here or nothing is sampled, so that the kernel reads defined values).
+void pickLaneEmitter(const SceneView& scene, const RenderParams& rp, bool nee, LambertLanes& lanes,
+                     size_t k) {
     static const Emitter kNone{};
-    const bool live = lanes.live.v[k] != 0u;
-    set(lanes.local, k,
-        live ? sampleCosineHemisphere(vec2(lanes.uBsdfX.v[k], lanes.uBsdfY.v[k]))
-             : vec3(0.0f, 0.0f, 1.0f));
-    const Emitter& e = nee && live
+    const Emitter& e = nee && lanes.live.v[k] != 0u
                            ? scene.emitters[pickEmitter(scene, rp.emitterCount, lanes.uLightX.v[k])]
                            : kNone;
     set(lanes.e0, k, e.p0);
@@ -500,7 +529,7 @@ void shadeHits(const SceneView& view, const RenderParams& rp, bool simd, const S
         padLanes(lanes, count, end);
         HWY_DYNAMIC_DISPATCH(RandomLanes)(lanes, end, rp.sampling, rp.seed);
         for (size_t k = 0; k < end; ++k)
-            sampleLane(view, rp, nee, lanes, k);
+            pickLaneEmitter(view, rp, nee, lanes, k);
         HWY_DYNAMIC_DISPATCH(ShadeLambertLanes)(lanes, end, nee, mis, rp.threshold, results);
         for (size_t k = 0; k < count; ++k) {
             const ShadeInput& hit = in[hitOf[k]];

@@ -23,6 +23,21 @@ SHARED_FN vec3 toWorld(vec3 local, vec3 n) {
     return local.x * t + local.y * b + local.z * n;
 }
 
+// sin and cos of x in [-pi/4, pi/4], as the polynomials of Cephes' sinf and cosf (Moshier
+// 1992; within 2 ulp of the true values there): multiplies and adds alone, so that the
+// scalar shading, the SIMD kernel (host/pipeline/simd_shading.cpp) and the Vulkan kernels
+// compute the same thing, without a libm call.
+SHARED_FN float sinQuarterPi(float x) {
+    float z = x * x;
+    return ((-1.9515295891e-4f * z + 8.3321608736e-3f) * z - 1.6666654611e-1f) * z * x + x;
+}
+SHARED_FN float cosQuarterPi(float x) {
+    float z = x * x;
+    return ((2.443315711809948e-5f * z - 1.388731625493765e-3f) * z + 4.166664568298827e-2f) * z *
+               z -
+           0.5f * z + 1.0f;
+}
+
 // Cosine-weighted hemisphere around +Z through the concentric disk map (Shirley & Chiu 1997).
 SHARED_FN vec3 sampleCosineHemisphere(vec2 u) {
     vec2 d = 2.0f * u - vec2(1.0f, 1.0f);
@@ -30,12 +45,15 @@ SHARED_FN vec3 sampleCosineHemisphere(vec2 u) {
         return vec3(0.0f, 0.0f, 1.0f);
     }
     // The wedge (|x| > |y| or not) is a coin flip per sample: selects, one division, no branch.
+    // The angle is theta = pi/4 q in the x-major wedges and pi/2 - theta in the others, where
+    // cos and sin trade places: both within [-pi/4, pi/4].
     bool xMajor = abs(d.x) > abs(d.y);
     float r = xMajor ? d.x : d.y;
-    float q = (xMajor ? d.y : d.x) / r;
-    float phi = xMajor ? (kPi / 4.0f) * q : (kPi / 2.0f) - (kPi / 4.0f) * q;
-    float x = r * cos(phi);
-    float y = r * sin(phi);
+    float theta = (kPi / 4.0f) * ((xMajor ? d.y : d.x) / r);
+    float c = cosQuarterPi(theta);
+    float s = sinQuarterPi(theta);
+    float x = r * (xMajor ? c : s);
+    float y = r * (xMajor ? s : c);
     return vec3(x, y, sqrt(max(0.0f, 1.0f - x * x - y * y)));
 }
 

@@ -36,6 +36,37 @@ TEST(Lambert, SampledDirectionsFollowThePdf) {
     }
 }
 
+// The cosine-hemisphere sample's sin and cos (shared/sampling.h: polynomials, no libm) within
+// 2 ulp of the true values over their whole domain [-pi/4, pi/4], and the concentric map exact
+// where it has closed forms: a sample's disk radius is max(|2u - 1|), and the points on the
+// diagonals and axes land on the rays at 45 degrees and 0 degrees.
+TEST(Lambert, HemisphereSampleSinAndCosAreWithin2Ulp) {
+    double worst = 0.0;
+    for (int i = -100000; i <= 100000; ++i) {
+        const float x = float(i) * (kPi / 4.0f) / 100000.0f;
+        const double s = std::sin(double(x)), c = std::cos(double(x));
+        const double ulpS = std::max(std::abs(s), 1e-30) * std::pow(2.0, -23);
+        const double ulpC = std::abs(c) * std::pow(2.0, -23);
+        worst = std::max(
+            {worst, std::abs(sinQuarterPi(x) - s) / ulpS, std::abs(cosQuarterPi(x) - c) / ulpC});
+    }
+    EXPECT_LE(worst, 2.0);
+    std::mt19937 rng(3);
+    std::uniform_real_distribution<float> u(0.0f, 1.0f);
+    for (int i = 0; i < 10000; ++i) {
+        const vec2 v(u(rng), u(rng));
+        const vec3 h = sampleCosineHemisphere(v);
+        const float radius = std::max(std::abs(2.0f * v.x - 1.0f), std::abs(2.0f * v.y - 1.0f));
+        EXPECT_NEAR(std::hypot(h.x, h.y), radius, 3e-7f * radius + 1e-7f) << v.x << " " << v.y;
+        EXPECT_NEAR(glm::length(h), 1.0f, 3e-7f);
+    }
+    const vec3 diagonal = sampleCosineHemisphere(vec2(1.0f, 1.0f));
+    EXPECT_NEAR(diagonal.x, std::sqrt(0.5f), 1e-7f);
+    EXPECT_NEAR(diagonal.y, std::sqrt(0.5f), 1e-7f);
+    EXPECT_EQ(sampleCosineHemisphere(vec2(0.75f, 0.5f)), vec3(0.5f, 0.0f, std::sqrt(0.75f)));
+    EXPECT_EQ(sampleCosineHemisphere(vec2(0.5f, 0.5f)), vec3(0.0f, 0.0f, 1.0f));
+}
+
 // A shading normal tilted far from ng: samples below the geometric surface are absorbed and
 // eval gives 0 there, so sampling and evaluation still agree and nothing is negative.
 TEST(Lambert, TiltedShadingNormalStaysConsistent) {
