@@ -9,18 +9,18 @@
 
 SHARED_BEGIN
 
-// Index of the emitter whose CDF interval holds u (binary search, first cdf > u).
+// Index of the emitter whose CDF interval holds u: the first cdf > u (the last entry is 1 > u).
+// A binary search whose steps depend on the count alone and whose halving is a select, not a
+// branch: which half u falls in is a coin flip the CPU would mispredict half the time.
 SHARED_FN uint pickEmitter(SCENE_PARAM uint count, float u) {
-    uint lo = 0u;
-    uint hi = count - 1u;
-    while (lo < hi) {
-        uint mid = (lo + hi) >> 1u;
-        if (EMITTER_CDF(mid) > u)
-            hi = mid;
-        else
-            lo = mid + 1u;
+    uint base = 0u;
+    uint len = count;
+    while (len > 1u) {
+        uint step = len >> 1u;
+        base = EMITTER_CDF(base + step) <= u ? base + step : base;
+        len -= step;
     }
-    return lo;
+    return EMITTER_CDF(base) <= u ? base + 1u : base;
 }
 
 // Cosine at the emitter between its normal and the direction back to the receiver, 0 if the

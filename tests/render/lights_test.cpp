@@ -280,3 +280,37 @@ TEST(Environment, MisHasLowerVarianceThanEitherStrategyOnAGlossyObject) {
 
 } // namespace
 } // namespace spw::test
+
+namespace spw::test {
+namespace {
+
+// The emitter pick (a branch-free binary search) is the first CDF entry above u, as
+// std::upper_bound finds it, for every count, with emitters of zero power (repeated entries)
+// and u on the entries themselves.
+TEST(Lights, EmitterPickIsTheFirstCdfEntryAboveU) {
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+    for (uint count = 1; count <= 40; ++count) {
+        std::vector<float> cdf(count);
+        float sum = 0.0f;
+        for (float& c : cdf)
+            c = sum += unit(rng) < 0.2f ? 0.0f : unit(rng);
+        for (float& c : cdf)
+            c /= sum;
+        cdf.back() = 1.0f;
+        SceneView view;
+        view.emitterCdf = cdf.data();
+        std::vector<float> us = {0.0f, kOneMinusEpsilon};
+        for (float c : cdf)
+            if (c < 1.0f) us.push_back(c);
+        for (int i = 0; i < 200; ++i)
+            us.push_back(unit(rng));
+        for (float u : us)
+            ASSERT_EQ(pickEmitter(view, count, u),
+                      uint(std::upper_bound(cdf.begin(), cdf.end(), u) - cdf.begin()))
+                << count << " emitters, u " << u;
+    }
+}
+
+} // namespace
+} // namespace spw::test
