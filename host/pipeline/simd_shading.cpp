@@ -31,21 +31,30 @@ struct Vec3s {
     Floats x, y, z;
 };
 
-// The kernel's inputs for up to kBlock Lambert hits, a row per field. Every row is kBlock
-// 4-byte values and nothing else, so padding a block copies rows (padLanes).
+// Every struct of lanes below is rows of kBlock 4-byte values and nothing else, so padding a
+// block copies rows (padLanes).
+
+// The random numbers of up to kBlock hits: what they are a function of, and what
+// MakeRandomNumbers makes of it.
+struct RandomLanes {
+    Uints pixel, sampleIndex, bounce;
+    Floats uLightX, uLightY, uLightZ, uLightW; // rand4(kDimLight)
+    Floats uBsdfX, uBsdfY, uBsdfZ;             // rand4(kDimBsdf).xyz
+};
+
+// The kernel's inputs for up to kBlock Lambert hits.
 struct LambertLanes {
     Vec3s p, ng, ns, albedo, wo, beta; // the hit, -rayDir, the path's throughput
     Floats offset;
-    Uints live;                                // bounce < max depth: the path goes on from here
-    Uints roulette;                            // bounce >= min depth
-    Uints pixel, sampleIndex, bounce;          // what the path's random numbers are a function of
-    Floats uLightX, uLightY, uLightZ, uLightW; // rand4(kDimLight), made by RandomLanes
-    Floats uBsdfX, uBsdfY;                     // rand4(kDimBsdf).xy, made by RandomLanes
-    Vec3s e0, e1, e2, eNormal, eRadiance;      // the picked emitter (a triangle)
+    Uints live;     // bounce < max depth: the path goes on from here
+    Uints roulette; // bounce >= min depth
+    RandomLanes random;
+    Vec3s e0, e1, e2, eNormal, eRadiance; // the picked emitter (a triangle)
     Floats ePickPdf, eArea;
     Uints eTwoSided;
 };
 static_assert(sizeof(LambertLanes) % sizeof(Floats) == 0, "rows only");
+static_assert(sizeof(RandomLanes) % sizeof(Floats) == 0, "rows only");
 
 // What the kernel writes; shadeHits() puts it into the ShadeResults.
 struct LambertResults {
@@ -297,8 +306,8 @@ HWY_INLINE U4 rand4(uint sampling, uint seed, VU pixel, VU sampleIndex, VU bounc
     return pcg4d({pixel, sampleIndex, dimension, hn::Set(du, seed)});
 }
 
-// The lanes' rand4(kDimLight) and rand4(kDimBsdf).xy, for lanes [0, count).
-void RandomLanes(simd_shading::LambertLanes& lanes, size_t count, uint sampling, uint seed) {
+// The lanes' rand4(kDimLight) and rand4(kDimBsdf).xyz, for lanes [0, count).
+void MakeRandomNumbers(simd_shading::RandomLanes& lanes, size_t count, uint sampling, uint seed) {
     for (size_t i = 0; i < count; i += hn::Lanes(D())) {
         const VU pixel = loadU(lanes.pixel, i), sampleIndex = loadU(lanes.sampleIndex, i);
         const VU bounce = loadU(lanes.bounce, i);
@@ -310,6 +319,7 @@ void RandomLanes(simd_shading::LambertLanes& lanes, size_t count, uint sampling,
         const U4 bsdf = rand4(sampling, seed, pixel, sampleIndex, bounce, kDimBsdf);
         store(uintToUnit(bsdf.x), lanes.uBsdfX, i);
         store(uintToUnit(bsdf.y), lanes.uBsdfY, i);
+        store(uintToUnit(bsdf.z), lanes.uBsdfZ, i);
     }
 }
 
@@ -333,9 +343,9 @@ void ShadeLambertLanes(const simd_shading::LambertLanes& in, size_t count, bool 
         if (!hn::AllFalse(d, shadowing)) {
             const V3 e0 = load(in.e0, i), e1 = load(in.e1, i), e2 = load(in.e2, i);
             const V3 eNormal = load(in.eNormal, i);
-            const V su = hn::Sqrt(load(in.uLightY, i)); // sampleTriangle
+            const V su = hn::Sqrt(load(in.random.uLightY, i)); // sampleTriangle
             const V bx = hn::Sub(one, su);
-            const V by = hn::Mul(load(in.uLightZ, i), su);
+            const V by = hn::Mul(load(in.random.uLightZ, i), su);
             const V3 q = add(add(e0, mul(e1, bx)), mul(e2, by)); // emitterPoint
             const V3 dq = sub(q, p);
             const V dist = hn::Sqrt(dot(dq, dq));
@@ -380,7 +390,8 @@ void ShadeLambertLanes(const simd_shading::LambertLanes& in, size_t count, bool 
         store(shadowing, out.shadow, i);
 
         // 3. Continuation: lambertSample, then Russian roulette.
-        const V3 local = sampleCosineHemisphere(load(in.uBsdfX, i), load(in.uBsdfY, i));
+        const V3 local =
+            sampleCosineHemisphere(load(in.random.uBsdfX, i), load(in.random.uBsdfY, i));
         const V3 world = toWorld(local, n);
         const V3 wi = mul(world, hn::Div(one, hn::Sqrt(dot(world, world))));
         M next = hn::And(live, hn::Not(hn::Or(hn::Le(hn::Mul(ngDotWo, dot(ng, wi)), zero),
@@ -388,7 +399,7 @@ void ShadeLambertLanes(const simd_shading::LambertLanes& in, size_t count, bool 
         V3 nextBeta = mul(beta, albedo);
         const V q = gmin(one, hn::Div(maxComponent(nextBeta), hn::Set(d, threshold)));
         const M roulette = loadMask(in.roulette, i);
-        next = hn::And(next, hn::Or(hn::Not(roulette), hn::Lt(load(in.uLightW, i), q)));
+        next = hn::And(next, hn::Or(hn::Not(roulette), hn::Lt(load(in.random.uLightW, i), q)));
         nextBeta = select(roulette, div(nextBeta, q), nextBeta);
         next = hn::And(next, hn::Gt(maxComponent(nextBeta), zero));
         store(next, out.next, i);
@@ -409,7 +420,7 @@ HWY_AFTER_NAMESPACE();
 #if HWY_ONCE
 namespace spw {
 HWY_EXPORT(ShadeLambertLanes);
-HWY_EXPORT(RandomLanes);
+HWY_EXPORT(MakeRandomNumbers);
 HWY_EXPORT(TargetName);
 
 using simd_shading::kBlock;
@@ -431,6 +442,14 @@ std::uint32_t mask(bool b) {
     return b ? ~0u : 0u;
 }
 
+// Lane k of `lanes`: what path st's random numbers at this bounce are a function of.
+void setRandomLane(const RenderParams& rp, const PathState& st, simd_shading::RandomLanes& lanes,
+                   size_t k) {
+    lanes.pixel.v[k] = pathPixel(rp, st.pathId);
+    lanes.sampleIndex.v[k] = pathSample(rp, st.pathId);
+    lanes.bounce.v[k] = st.bounce;
+}
+
 // Lane k from hit `in`: what the kernel reads, and (scalar) the emission into `out`.
 void fillLane(const SceneView& scene, const RenderParams& rp, const ShadeInput& in,
               LambertLanes& lanes, size_t k, ShadeResult& out) {
@@ -450,19 +469,18 @@ void fillLane(const SceneView& scene, const RenderParams& rp, const ShadeInput& 
     const bool live = st.bounce < rp.maxDepth;
     lanes.live.v[k] = mask(live);
     lanes.roulette.v[k] = mask(st.bounce >= rp.minDepth);
-    lanes.pixel.v[k] = pathPixel(rp, st.pathId);
-    lanes.sampleIndex.v[k] = pathSample(rp, st.pathId);
-    lanes.bounce.v[k] = st.bounce;
+    setRandomLane(rp, st, lanes.random, k);
 }
 
-// Lane k's emitter, picked with the random number RandomLanes made (zeros where the path ends
+// Lane k's emitter, picked with the random number MakeRandomNumbers made (zeros where the path ends
 // here or nothing is sampled, so that the kernel reads defined values).
 void pickLaneEmitter(const SceneView& scene, const RenderParams& rp, bool nee, LambertLanes& lanes,
                      size_t k) {
     static const Emitter kNone{};
-    const Emitter& e = nee && lanes.live.v[k] != 0u
-                           ? scene.emitters[pickEmitter(scene, rp.emitterCount, lanes.uLightX.v[k])]
-                           : kNone;
+    const Emitter& e =
+        nee && lanes.live.v[k] != 0u
+            ? scene.emitters[pickEmitter(scene, rp.emitterCount, lanes.random.uLightX.v[k])]
+            : kNone;
     set(lanes.e0, k, e.p0);
     set(lanes.e1, k, e.e1);
     set(lanes.e2, k, e.e2);
@@ -474,9 +492,9 @@ void pickLaneEmitter(const SceneView& scene, const RenderParams& rp, bool nee, L
 }
 
 // Lanes [count, end) copies of lane 0, so that whole vectors read defined values.
-void padLanes(LambertLanes& lanes, size_t count, size_t end) {
+template <class Lanes> void padLanes(Lanes& lanes, size_t count, size_t end) {
     auto* rows = reinterpret_cast<unsigned char*>(&lanes);
-    for (size_t row = 0; row < sizeof(LambertLanes); row += sizeof(simd_shading::Floats))
+    for (size_t row = 0; row < sizeof(Lanes); row += sizeof(simd_shading::Floats))
         for (size_t k = count; k < end; ++k)
             std::memcpy(rows + row + 4 * k, rows + row, 4);
 }
@@ -520,14 +538,33 @@ void shadeHits(const SceneView& view, const RenderParams& rp, bool simd, const S
     }
     const bool nee = rp.emitterCount > 0u && rp.strategy != kStrategyBsdf;
     const bool mis = rp.strategy == kStrategyMis;
+    auto roundUp = [](size_t count) { return (count + kMaxLanes - 1) / kMaxLanes * kMaxLanes; };
+    // The other models' hits that go on: shadeSurface with their random numbers made here.
+    simd_shading::RandomLanes others;
+    std::uint32_t otherOf[kBlock];
+    size_t otherCount = 0;
+    auto runOthers = [&] {
+        const size_t end = roundUp(otherCount);
+        padLanes(others, otherCount, end);
+        HWY_DYNAMIC_DISPATCH(MakeRandomNumbers)(others, end, rp.sampling, rp.seed);
+        for (size_t k = 0; k < otherCount; ++k) {
+            const ShadeInput& hit = in[otherOf[k]];
+            const vec4 uLight(others.uLightX.v[k], others.uLightY.v[k], others.uLightZ.v[k],
+                              others.uLightW.v[k]);
+            const vec4 uBsdf(others.uBsdfX.v[k], others.uBsdfY.v[k], others.uBsdfZ.v[k], 0.0f);
+            shadeSurfaceWith(view, rp, hit.hit, hit.rayDir, hit.path, uLight, uBsdf,
+                             out[otherOf[k]]);
+        }
+        otherCount = 0;
+    };
     LambertLanes lanes;
     LambertResults results;
     std::uint32_t hitOf[kBlock];
     size_t count = 0;
     auto run = [&] {
-        const size_t end = (count + kMaxLanes - 1) / kMaxLanes * kMaxLanes;
+        const size_t end = roundUp(count);
         padLanes(lanes, count, end);
-        HWY_DYNAMIC_DISPATCH(RandomLanes)(lanes, end, rp.sampling, rp.seed);
+        HWY_DYNAMIC_DISPATCH(MakeRandomNumbers)(lanes.random, end, rp.sampling, rp.seed);
         for (size_t k = 0; k < end; ++k)
             pickLaneEmitter(view, rp, nee, lanes, k);
         HWY_DYNAMIC_DISPATCH(ShadeLambertLanes)(lanes, end, nee, mis, rp.threshold, results);
@@ -538,8 +575,16 @@ void shadeHits(const SceneView& view, const RenderParams& rp, bool simd, const S
         count = 0;
     };
     for (size_t i = 0; i < n; ++i) {
-        if (view.shaders[in[i].hit.shader].model != kModelLambert) {
-            shadeSurface(view, rp, in[i].hit, in[i].rayDir, in[i].path, out[i]);
+        const ShaderParams& sh = view.shaders[in[i].hit.shader];
+        if (sh.model != kModelLambert) {
+            if (!shadeGoesOn(rp, sh, in[i].path)) {
+                shadeSurfaceWith(view, rp, in[i].hit, in[i].rayDir, in[i].path, vec4(0.0f),
+                                 vec4(0.0f), out[i]);
+                continue;
+            }
+            setRandomLane(rp, in[i].path, others, otherCount);
+            otherOf[otherCount++] = std::uint32_t(i);
+            if (otherCount == kBlock) runOthers();
             continue;
         }
         fillLane(view, rp, in[i], lanes, count, out[i]);
@@ -547,6 +592,7 @@ void shadeHits(const SceneView& view, const RenderParams& rp, bool simd, const S
         if (count == kBlock) run();
     }
     if (count > 0) run();
+    if (otherCount > 0) runOthers();
 }
 
 const char* simdShadingTarget() {

@@ -2,14 +2,15 @@
 // homogeneous. Hits of the Lambert model (the diffuse surfaces most scenes are made of) go
 // through a structure-of-arrays kernel that runs shadeSurface()'s arithmetic on 4, 8 or 16
 // hits at once, in the widest instruction set the processor has (Google Highway's dynamic
-// dispatch: SSE4, AVX2 or AVX-512); every other hit goes through shadeSurface() itself.
+// dispatch: SSE4, AVX2 or AVX-512); every other hit goes through shadeSurfaceWith(), with its
+// random numbers made SIMD-wide too (the scrambled Sobol sequence is most of a rand4's cost).
 //
 // The kernel is shadeSurface() to the bit: the same operations in the same order, each rounded
 // once (no fused multiply-add), so an image does not depend on which hits were shaded
 // together, on the instruction set, or on whether the kernel ran at all
-// (SimdShading.LambertHitsAreShadeSurfaceToTheBit). What stays scalar, per hit: the random
-// numbers, the emitter pick (a binary search), the cosine-hemisphere sample (libm's sin and cos)
-// and the emission of an emitter that was hit.
+// (SimdShading.LambertHitsAreShadeSurfaceToTheBit). What stays scalar, per hit: the emitter
+// pick (a binary search), gathering the emitter and the hit into rows, and the emission of an
+// emitter that was hit.
 #pragma once
 
 #include "shared/scene_access.h"

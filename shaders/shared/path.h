@@ -113,8 +113,16 @@ SHARED_FN void addEmission(SCENE_PARAM RenderParams rp, SurfaceHit hit, vec3 wo,
     if (w > 0.0f) r.flags |= kShadeEmitted;
 }
 
-SHARED_FN void shadeSurface(SCENE_PARAM RenderParams rp, SurfaceHit hit, vec3 rayDir, PathState st,
-                            OUT(ShadeResult) r) {
+// Whether the path goes on from a hit of shader sh: it samples a light and its BSDF.
+SHARED_FN bool shadeGoesOn(RenderParams rp, ShaderParams sh, PathState st) {
+    return st.bounce < rp.maxDepth && sh.model != kModelNull;
+}
+
+// shadeSurface with the path's random numbers for this bounce given: uLight = rand4(kDimLight),
+// uBsdf = rand4(kDimBsdf) (read only where shadeGoesOn), so that a caller can make them many at
+// a time (host/pipeline/simd_shading.cpp).
+SHARED_FN void shadeSurfaceWith(SCENE_PARAM RenderParams rp, SurfaceHit hit, vec3 rayDir,
+                                PathState st, vec4 uLight, vec4 uBsdf, OUT(ShadeResult) r) {
     r.flags = 0u;
     r.emitted = vec3(0.0f);
     r.shadowContribution = vec3(0.0f);
@@ -127,15 +135,11 @@ SHARED_FN void shadeSurface(SCENE_PARAM RenderParams rp, SurfaceHit hit, vec3 ra
 
     ShaderParams sh = SHADER(hit.shader);
     vec3 wo = -rayDir;
-    uint pixel = pathPixel(rp, st.pathId);
-    uint sampleIndex = pathSample(rp, st.pathId);
 
     // 1. Emission seen by this ray, weighted against having sampled it from the previous vertex.
     addEmission(SCENE_ARG rp, hit, wo, st, r);
 
-    if (st.bounce >= rp.maxDepth || sh.model == kModelNull) return;
-
-    vec4 uLight = rand4(rp.sampling, rp.seed, pixel, sampleIndex, st.bounce, kDimLight);
+    if (!shadeGoesOn(rp, sh, st)) return;
 
     // 2. Next-event estimation: one emitter picked by power, one point on it (or direction to
     //    it). A BSDF of delta lobes only can never reach the sampled point: no shadow ray.
@@ -161,7 +165,6 @@ SHARED_FN void shadeSurface(SCENE_PARAM RenderParams rp, SurfaceHit hit, vec3 ra
     }
 
     // 3. Continuation: sample the BSDF, then Russian roulette once min depth bounces are done.
-    vec4 uBsdf = rand4(rp.sampling, rp.seed, pixel, sampleIndex, st.bounce, kDimBsdf);
     vec3 wi;
     vec3 weight;
     float pdf;
@@ -186,6 +189,20 @@ SHARED_FN void shadeSurface(SCENE_PARAM RenderParams rp, SurfaceHit hit, vec3 ra
     r.next.cone =
         packCone(coneWidthAt(st.cone, hit.t), coneSpread(st.cone) + bsdfConeSpread(sh, specular));
     r.flags |= kShadeContinue;
+}
+
+// One bounce (the comment at the top of this file), its random numbers made here.
+SHARED_FN void shadeSurface(SCENE_PARAM RenderParams rp, SurfaceHit hit, vec3 rayDir, PathState st,
+                            OUT(ShadeResult) r) {
+    vec4 uLight = vec4(0.0f);
+    vec4 uBsdf = vec4(0.0f);
+    if (shadeGoesOn(rp, SHADER(hit.shader), st)) {
+        uint pixel = pathPixel(rp, st.pathId);
+        uint sampleIndex = pathSample(rp, st.pathId);
+        uLight = rand4(rp.sampling, rp.seed, pixel, sampleIndex, st.bounce, kDimLight);
+        uBsdf = rand4(rp.sampling, rp.seed, pixel, sampleIndex, st.bounce, kDimBsdf);
+    }
+    shadeSurfaceWith(SCENE_ARG rp, hit, rayDir, st, uLight, uBsdf, r);
 }
 
 SHARED_END
