@@ -20,7 +20,7 @@ SHARED_FN uint pickEmitter(SCENE_PARAM uint count, float u) {
         base = EMITTER_CDF(base + step) <= u ? base + step : base;
         len -= step;
     }
-    return EMITTER_CDF(base) <= u ? base + 1u : base;
+    return base + uint(EMITTER_CDF(base) <= u);
 }
 
 // Cosine at the emitter between its normal and the direction back to the receiver, 0 if the
