@@ -17,8 +17,9 @@ are noisy; ratios travel, absolute seconds do not).
                                finest level) and cone (the default). Writes
                                out/production/bench.json.
   scripts/bench.py incore      in-core speed: the Cornell box at 64 and 256 spp and the
-                               1M-triangle scene; reference, cpu (fused stages), cpu with
-                               separate stages, vulkan; runs alternate between configurations and
+                               1M-triangle scene; reference, cpu (fused stages, SIMD shading),
+                               cpu with separate stages, cpu with scalar shading
+                               (--simd-shading off), vulkan; runs alternate between configurations and
                                the best of N is kept. Per configuration: render seconds, ratio to
                                the reference, rays per second per core, and Embree's own rate on
                                the same rays (the cpu backend's traverse and shadow stages, which
@@ -141,6 +142,7 @@ def bench_incore(spillway, repeat, baseline):
     configs = [("reference", spillway, ["--backend", "reference"]),
                ("cpu", spillway, ["--backend", "cpu"]),
                ("cpu, separate stages", spillway, ["--backend", "cpu", "--stages", "separate"]),
+               ("cpu, scalar shading", spillway, ["--backend", "cpu", "--simd-shading", "off"]),
                ("vulkan", spillway, ["--backend", "vulkan"])]
     if baseline:
         configs += [("baseline reference", baseline, ["--backend", "reference"]),
