@@ -177,6 +177,10 @@ void setUpChunk(const RenderContext& ctx, const std::vector<RayState>& rays,
     float footprint[kChunk];
     vec3 albedo[kChunk];
     size_t m = 0;
+    for (size_t i = 0; i < n; ++i)
+        ctx.embree.prefetchTriangle(hits[order[i].index]);
+    for (size_t i = 0; i < n; ++i)
+        ctx.embree.prefetchVertices(hits[order[i].index]);
     for (size_t i = 0; i < n; ++i) {
         const std::uint32_t k = order[i].index;
         const RayState& ray = rays[k];
