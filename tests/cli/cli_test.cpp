@@ -88,6 +88,7 @@ const BadUsage kBadUsages[] = {
     {"ThreadsZero", "{scene} -o {out} --quiet --threads 0", "--threads"},
     {"SeedNegative", "{scene} -o {out} --quiet --seed -1", "--seed"},
     {"UnknownBackend", "{scene} -o {out} --quiet --backend nonsense", "nonsense"},
+    {"SimdShadingNeitherOnNorOff", "{scene} -o {out} --quiet --simd-shading maybe", "maybe"},
     {"NoScene", "-o {out} --quiet", "scene"},
     {"TwoScenes", "{scene} {scene} -o {out} --quiet", "more than one"},
     {"JpgOutput", "{scene} -o {dir}/out.jpg --quiet --spp 1", "out.jpg"},
@@ -179,6 +180,27 @@ std::vector<float> renderWithSeed(const TempDir& dir, const std::string& name,
         runSpillway("render " + cornellBox() + " --spp 1 --quiet --seed " + seed + " -o " + out);
     EXPECT_EQ(r.status, 0) << r.output;
     return readImage(out).rgb;
+}
+
+// --simd-shading: the cpu backend names the instruction set its kernel ran in, or "off"; the
+// image is the same either way.
+TEST(Cli, SimdShadingIsReportedAndChangesNoPixel) {
+    TempDir dir;
+    const std::string common = "render " + cornellBox() + " --backend cpu --spp 2 --quiet ";
+    for (const char* mode : {"on", "off"}) {
+        CommandResult r = runSpillway(common + "--simd-shading " + mode + " -o " +
+                                      dir.file(std::string(mode) + ".exr") + " --stats " +
+                                      dir.file(std::string(mode) + ".json"));
+        ASSERT_EQ(r.status, 0) << r.output;
+    }
+    auto simd = [&](const char* mode) {
+        std::ifstream in(dir.file(std::string(mode) + ".json"));
+        return nlohmann::json::parse(in)["simd_shading"].get<std::string>();
+    };
+    EXPECT_EQ(simd("off"), "off");
+    EXPECT_NE(simd("on"), "off");
+    EXPECT_FALSE(simd("on").empty());
+    EXPECT_TRUE(samePixels(dir.file("on.exr"), dir.file("off.exr")));
 }
 
 TEST(Cli, SameSeedReproducesTheImageBitForBit) {
