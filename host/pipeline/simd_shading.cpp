@@ -10,6 +10,7 @@
 
 #include "shared/path.h"
 
+#include <algorithm>
 #include <cstdint>
 #include <cstring>
 
@@ -323,6 +324,19 @@ void MakeRandomNumbers(simd_shading::RandomLanes& lanes, size_t count, uint samp
     }
 }
 
+// rand4(sampling, seed, pixel[i], sampleIndex[i], bounce, group) for lanes [0, count).
+void MakeRand4(const Uints& pixel, const Uints& sampleIndex, size_t count, uint sampling, uint seed,
+               uint bounce, uint group, Floats& x, Floats& y, Floats& z, Floats& w) {
+    const VU bounces = hn::Set(DU(), bounce);
+    for (size_t i = 0; i < count; i += hn::Lanes(D())) {
+        const U4 u = rand4(sampling, seed, loadU(pixel, i), loadU(sampleIndex, i), bounces, group);
+        store(uintToUnit(u.x), x, i);
+        store(uintToUnit(u.y), y, i);
+        store(uintToUnit(u.z), z, i);
+        store(uintToUnit(u.w), w, i);
+    }
+}
+
 // Steps 2 and 3 of shadeSurface for lanes [0, count), count a multiple of the vector width.
 void ShadeLambertLanes(const simd_shading::LambertLanes& in, size_t count, bool nee, bool mis,
                        float threshold, simd_shading::LambertResults& out) {
@@ -421,6 +435,7 @@ HWY_AFTER_NAMESPACE();
 namespace spw {
 HWY_EXPORT(ShadeLambertLanes);
 HWY_EXPORT(MakeRandomNumbers);
+HWY_EXPORT(MakeRand4);
 HWY_EXPORT(TargetName);
 
 using simd_shading::kBlock;
@@ -593,6 +608,24 @@ void shadeHits(const SceneView& view, const RenderParams& rp, bool simd, const S
     }
     if (count > 0) run();
     if (otherCount > 0) runOthers();
+}
+
+void rand4Many(uint sampling, uint seed, uint bounce, uint group, const uint* pixel,
+               const uint* sampleIndex, size_t n, vec4* out) {
+    simd_shading::Uints pixels, samples;
+    simd_shading::Floats x, y, z, w;
+    for (size_t begin = 0; begin < n; begin += kBlock) {
+        const size_t count = std::min(kBlock, n - begin);
+        const size_t end = (count + kMaxLanes - 1) / kMaxLanes * kMaxLanes;
+        for (size_t k = 0; k < end; ++k) { // the padding repeats the last lane
+            pixels.v[k] = pixel[begin + std::min(k, count - 1)];
+            samples.v[k] = sampleIndex[begin + std::min(k, count - 1)];
+        }
+        HWY_DYNAMIC_DISPATCH(MakeRand4)
+        (pixels, samples, end, sampling, seed, bounce, group, x, y, z, w);
+        for (size_t k = 0; k < count; ++k)
+            out[begin + k] = vec4(x.v[k], y.v[k], z.v[k], w.v[k]);
+    }
 }
 
 const char* simdShadingTarget() {

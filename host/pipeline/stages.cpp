@@ -83,7 +83,31 @@ void CameraRays::generate(const RenderContext& ctx, size_t count, Film& film,
         1;
     const size_t last =
         size_t(std::lower_bound(tileStart_.begin(), tileStart_.end(), end) - tileStart_.begin());
+    const CameraModel& camera = ctx.camera;
+    const bool random = camera.usesRandomNumbers();
     tbb::parallel_for(first, last, [&](size_t t) {
+        // The tile's rays a block at a time: their random numbers made SIMD-wide (rand4Many),
+        // then the rays.
+        constexpr size_t kBlock = 64;
+        uint pixel[kBlock], sampleIndex[kBlock], sample[kBlock];
+        std::uint64_t ray[kBlock];
+        vec4 u[kBlock];
+        size_t pending = 0;
+        auto flush = [&] {
+            if (random)
+                rand4Many(camera.sampling(), rp_.seed, kBounceCamera, kDimCamera, pixel,
+                          sampleIndex, pending, u);
+            for (size_t j = 0; j < pending; ++j) {
+                const uint x = pixel[j] % uint(width_), y = pixel[j] / uint(width_);
+                const CameraRay cr = camera.generate(x, y, sample[j], random ? u[j] : vec4(0.0f));
+                film.addSample(cr.filmPos, sampleIndex[j]);
+                RayState& r = rays[size_t(ray[j] - begin)];
+                r.origin = cr.origin;
+                r.dir = cr.dir;
+                r.path = cameraPath(rp_, pixel[j], sample[j], spread);
+            }
+            pending = 0;
+        };
         const int x0 = int(t % size_t(tilesX_)) * tile_, y0 = int(t / size_t(tilesX_)) * tile_;
         std::uint64_t k = tileStart_[t]; // the index of the tile's next ray
         for (int y = y0; y < std::min(height_, y0 + tile_) && k < end; ++y)
@@ -95,15 +119,14 @@ void CameraRays::generate(const RenderContext& ctx, size_t count, Film& film,
                 }
                 for (uint s = 0; s < spi; ++s, ++k) {
                     if (k < begin || k >= end) continue;
-                    const uint index = rp_.iteration * spi + s;
-                    CameraRay cr = ctx.camera.generate(uint(x), uint(y), s, index, rp_.seed);
-                    film.addSample(cr.filmPos, index);
-                    RayState& r = rays[size_t(k - begin)];
-                    r.origin = cr.origin;
-                    r.dir = cr.dir;
-                    r.path = cameraPath(rp_, uint(y * width_ + x), s, spread);
+                    pixel[pending] = uint(y * width_ + x);
+                    sampleIndex[pending] = rp_.iteration * spi + s;
+                    sample[pending] = s;
+                    ray[pending] = k;
+                    if (++pending == kBlock) flush();
                 }
             }
+        flush();
     });
     ctx.stats.cameraRays += end - begin;
 }

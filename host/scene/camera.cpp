@@ -16,14 +16,23 @@ CameraModel::CameraModel(const Scene& scene, int sampleBase)
     eye_ = vec3(cam_.cameraToWorld[3]);
 }
 
+vec4 CameraModel::randomNumbers(uint x, uint y, uint sampleIndex, uint seed) const {
+    return rand4(sampling(), seed, y * uint(width_) + x, sampleIndex, kBounceCamera, kDimCamera);
+}
+
 vec2 CameraModel::filmPosition(uint x, uint y, uint sample, uint sampleIndex, uint seed) const {
+    // The Grid sampler's place in the pixel needs no random number.
+    return filmPosition(x, y, sample,
+                        sampler_ == SamplerType::Grid ? vec4(0.0f)
+                                                      : randomNumbers(x, y, sampleIndex, seed));
+}
+
+vec2 CameraModel::filmPosition(uint x, uint y, uint sample, vec4 u) const {
     vec2 offset;
     uint cx = sample % uint(base_), cy = sample / uint(base_);
     if (sampler_ == SamplerType::Grid) {
         offset = (vec2(float(cx), float(cy)) + 0.5f) / float(base_);
     } else {
-        vec4 u = rand4(dimensionSampler(sampler_), seed, y * uint(width_) + x, sampleIndex,
-                       kBounceCamera, kDimCamera);
         if (sampler_ == SamplerType::Stratified)
             offset = (vec2(float(cx), float(cy)) + vec2(u.x, u.y)) / float(base_);
         else
@@ -39,17 +48,25 @@ vec2 CameraModel::filmPosition(uint x, uint y, uint sample, uint sampleIndex, ui
     return p;
 }
 
+bool CameraModel::usesRandomNumbers() const {
+    return sampler_ != SamplerType::Grid ||
+           (cam_.type == CameraType::ThinLens && cam_.apertureRadius > 0.0f);
+}
+
 CameraRay CameraModel::generate(uint x, uint y, uint sample, uint sampleIndex, uint seed) const {
+    return generate(x, y, sample,
+                    usesRandomNumbers() ? randomNumbers(x, y, sampleIndex, seed) : vec4(0.0f));
+}
+
+CameraRay CameraModel::generate(uint x, uint y, uint sample, vec4 u) const {
     CameraRay r;
-    r.filmPos = filmPosition(x, y, sample, sampleIndex, seed);
+    r.filmPos = filmPosition(x, y, sample, u);
     // Film plane at z = -1 in camera space, +Y up, pixel rows going down.
     float sx = (2.0f * r.filmPos.x / float(width_) - 1.0f) * tanX_;
     float sy = (1.0f - 2.0f * r.filmPos.y / float(height_)) * tanY_;
     vec3 d(sx, sy, -1.0f);
     vec3 o(0.0f);
     if (cam_.type == CameraType::ThinLens && cam_.apertureRadius > 0.0f) {
-        vec4 u = rand4(dimensionSampler(sampler_), seed, y * uint(width_) + x, sampleIndex,
-                       kBounceCamera, kDimCamera);
         vec2 lens = sampleConcentricDisk(vec2(u.z, u.w)) * cam_.apertureRadius;
         vec3 focus = d * cam_.focalDistance;
         o = vec3(lens, 0.0f);

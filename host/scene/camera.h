@@ -29,6 +29,15 @@ class CameraModel {
     // `sampleIndex` the render-wide one that keys the random numbers.
     CameraRay generate(uint x, uint y, uint sample, uint sampleIndex, uint seed) const;
     vec2 filmPosition(uint x, uint y, uint sample, uint sampleIndex, uint seed) const;
+    // The same with the sample's random numbers given: u = randomNumbers(x, y, sampleIndex, seed)
+    // (for a caller that makes many at once).
+    CameraRay generate(uint x, uint y, uint sample, vec4 u) const;
+    vec2 filmPosition(uint x, uint y, uint sample, vec4 u) const;
+    // The camera's random numbers: whether it reads any (not a Grid pinhole), and what they are,
+    // rand4(sampling(), seed, pixel, sampleIndex, kBounceCamera, kDimCamera).
+    bool usesRandomNumbers() const;
+    uint sampling() const { return dimensionSampler(sampler_); }
+    vec4 randomNumbers(uint x, uint y, uint sampleIndex, uint seed) const;
     // The angle (radians) one pixel subtends at the image centre: camera rays' cone spread
     // (shared/cone.h).
     float pixelSpread() const { return 2.0f * tanX_ / float(width_); }
