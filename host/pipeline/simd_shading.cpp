@@ -1,6 +1,6 @@
-// The SIMD Lambert kernel (simd_shading.h). Highway compiles the part between
-// HWY_BEFORE_NAMESPACE and HWY_AFTER_NAMESPACE once per instruction set (this file includes itself
-// through foreach_target.h) and picks the best the processor has at the first call.
+// The SIMD Lambert kernel and the SIMD random numbers (simd_shading.h). Highway compiles the part
+// between HWY_BEFORE_NAMESPACE and HWY_AFTER_NAMESPACE once per instruction set (this file includes
+// itself through foreach_target.h) and picks the best the processor has at the first call.
 //
 // The kernel mirrors shadeSurface() (shared/path.h) for the Lambert model (shared/lambert.h)
 // and triangle emitters line by line; each helper below names the shared function it stands for.
@@ -174,22 +174,19 @@ HWY_INLINE V surfaceOffset(V3 p, V3 v0, V3 v1, V3 v2, V3 n) {
     return hn::Add(hn::Mul(dot(m, abs(n)), hn::Set(D(), kOffsetRelative)),
                    hn::Set(D(), kOffsetAbsolute));
 }
+// Horner's step a z + b.
+HWY_INLINE V horner(V a, V z, float b) {
+    return hn::Add(hn::Mul(a, z), hn::Set(D(), b));
+}
 HWY_INLINE V sinQuarterPi(V x) {
-    const D d;
     const V z = hn::Mul(x, x);
-    const V p = hn::Sub(
-        hn::Mul(hn::Add(hn::Mul(hn::Set(d, -1.9515295891e-4f), z), hn::Set(d, 8.3321608736e-3f)),
-                z),
-        hn::Set(d, 1.6666654611e-1f));
+    const V p = horner(horner(hn::Set(D(), kSinS7), z, kSinS5), z, kSinS3);
     return hn::Add(hn::Mul(hn::Mul(p, z), x), x);
 }
 HWY_INLINE V cosQuarterPi(V x) {
     const D d;
     const V z = hn::Mul(x, x);
-    const V p = hn::Add(hn::Mul(hn::Sub(hn::Mul(hn::Set(d, 2.443315711809948e-5f), z),
-                                        hn::Set(d, 1.388731625493765e-3f)),
-                                z),
-                        hn::Set(d, 4.166664568298827e-2f));
+    const V p = horner(horner(hn::Set(d, kCosC8), z, kCosC6), z, kCosC4);
     return hn::Add(hn::Sub(hn::Mul(hn::Mul(p, z), z), hn::Mul(hn::Set(d, 0.5f), z)),
                    hn::Set(d, 1.0f));
 }
@@ -456,6 +453,10 @@ vec3 get(const simd_shading::Vec3s& a, size_t k) {
 std::uint32_t mask(bool b) {
     return b ? ~0u : 0u;
 }
+// Lanes [0, count) rounded up to whole vectors of the widest instruction set.
+size_t wholeVectors(size_t count) {
+    return (count + kMaxLanes - 1) / kMaxLanes * kMaxLanes;
+}
 
 // Lane k of `lanes`: what path st's random numbers at this bounce are a function of.
 void setRandomLane(const RenderParams& rp, const PathState& st, simd_shading::RandomLanes& lanes,
@@ -553,13 +554,12 @@ void shadeHits(const SceneView& view, const RenderParams& rp, bool simd, const S
     }
     const bool nee = rp.emitterCount > 0u && rp.strategy != kStrategyBsdf;
     const bool mis = rp.strategy == kStrategyMis;
-    auto roundUp = [](size_t count) { return (count + kMaxLanes - 1) / kMaxLanes * kMaxLanes; };
     // The other models' hits that go on: shadeSurface with their random numbers made here.
     simd_shading::RandomLanes others;
     std::uint32_t otherOf[kBlock];
     size_t otherCount = 0;
     auto runOthers = [&] {
-        const size_t end = roundUp(otherCount);
+        const size_t end = wholeVectors(otherCount);
         padLanes(others, otherCount, end);
         HWY_DYNAMIC_DISPATCH(MakeRandomNumbers)(others, end, rp.sampling, rp.seed);
         for (size_t k = 0; k < otherCount; ++k) {
@@ -577,7 +577,7 @@ void shadeHits(const SceneView& view, const RenderParams& rp, bool simd, const S
     std::uint32_t hitOf[kBlock];
     size_t count = 0;
     auto run = [&] {
-        const size_t end = roundUp(count);
+        const size_t end = wholeVectors(count);
         padLanes(lanes, count, end);
         HWY_DYNAMIC_DISPATCH(MakeRandomNumbers)(lanes.random, end, rp.sampling, rp.seed);
         for (size_t k = 0; k < end; ++k)
@@ -616,7 +616,7 @@ void rand4Many(uint sampling, uint seed, uint bounce, uint group, const uint* pi
     simd_shading::Floats x, y, z, w;
     for (size_t begin = 0; begin < n; begin += kBlock) {
         const size_t count = std::min(kBlock, n - begin);
-        const size_t end = (count + kMaxLanes - 1) / kMaxLanes * kMaxLanes;
+        const size_t end = wholeVectors(count);
         for (size_t k = 0; k < end; ++k) { // the padding repeats the last lane
             pixels.v[k] = pixel[begin + std::min(k, count - 1)];
             samples.v[k] = sampleIndex[begin + std::min(k, count - 1)];

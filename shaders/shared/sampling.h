@@ -27,15 +27,21 @@ SHARED_FN vec3 toWorld(vec3 local, vec3 n) {
 // 1992; within 2 ulp of the true values there): multiplies and adds alone, so that the
 // scalar shading, the SIMD kernel (host/pipeline/simd_shading.cpp) and the Vulkan kernels
 // compute the same thing, without a libm call.
+// sin x = x + x z (S3 + z (S5 + z S7)) and cos x = 1 - z / 2 + z^2 (C4 + z (C6 + z C8)),
+// z = x^2, evaluated as written below (the SIMD kernel repeats the order).
+const float kSinS3 = -1.6666654611e-1f;
+const float kSinS5 = 8.3321608736e-3f;
+const float kSinS7 = -1.9515295891e-4f;
+const float kCosC4 = 4.166664568298827e-2f;
+const float kCosC6 = -1.388731625493765e-3f;
+const float kCosC8 = 2.443315711809948e-5f;
 SHARED_FN float sinQuarterPi(float x) {
     float z = x * x;
-    return ((-1.9515295891e-4f * z + 8.3321608736e-3f) * z - 1.6666654611e-1f) * z * x + x;
+    return ((kSinS7 * z + kSinS5) * z + kSinS3) * z * x + x;
 }
 SHARED_FN float cosQuarterPi(float x) {
     float z = x * x;
-    return ((2.443315711809948e-5f * z - 1.388731625493765e-3f) * z + 4.166664568298827e-2f) * z *
-               z -
-           0.5f * z + 1.0f;
+    return ((kCosC8 * z + kCosC6) * z + kCosC4) * z * z - 0.5f * z + 1.0f;
 }
 
 // Cosine-weighted hemisphere around +Z through the concentric disk map (Shirley & Chiu 1997).
