@@ -1,5 +1,6 @@
 #include "host/pipeline/sorted_renderer.h"
 
+#include "host/pipeline/cpu_shading.h"
 #include "host/pipeline/stages.h"
 
 #include <algorithm>
@@ -42,6 +43,7 @@ SortedRenderer::SortedRenderer(const RenderContext& ctx, const PipelineConfig& c
       policy_(config.raySort, size_t(1) << binExponentOf(ctx, config)),
       scratch_(std::make_unique<Scratch>()),
       fused_(config.fuseStages && shading_->shadesOnHostThreads()),
+      simdShading_(fused_ && usesSimdShading(ctx)),
       sortHits_(config.sortsHits() && (config.hitSort == HitSortMode::On ||
                                        !shading_->shadesOnHostThreads() || ctx.textures.active())) {
     const double budgetMiB = config.memoryBudgetMiB.value_or(ctx.scene.settings.memoryBudgetMiB);
@@ -166,7 +168,8 @@ void SortedRenderer::runFusedBatch(bool camera, uint iteration, Film& film) {
     Scratch& s = *scratch_;
     const size_t hitCount = traceBatch(camera);
     escapes(iteration, hitCount, film);
-    shadeFused(ctx_, iteration, config_.rayFormat, s.rays, s.hits, s.order, hitCount, film, *bins_);
+    shadeFused(ctx_, iteration, config_.rayFormat, simdShading_, s.rays, s.hits, s.order, hitCount,
+               film, *bins_);
 }
 
 void SortedRenderer::startBatch(bool camera, int slot, uint iteration, Film& film) {

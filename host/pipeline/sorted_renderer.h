@@ -51,7 +51,8 @@ class SortedRenderer : public Backend {
     RaySortPolicy policy_;
     std::unique_ptr<Scratch> scratch_;
     bool fused_;
-    bool sortHits_; // the hit sort's auto rule applied (render_config.h: HitSortMode)
+    bool simdShading_; // the fused loop's Lambert hits SIMD-wide (cpu_shading.h: usesSimdShading)
+    bool sortHits_;    // the hit sort's auto rule applied (render_config.h: HitSortMode)
     std::uint64_t batchesProcessed_ = 0;
 };
 

@@ -1,6 +1,5 @@
 #include "host/pipeline/stages.h"
 
-#include "host/pipeline/cpu_shading.h"
 #include "host/pipeline/parallel.h"
 #include "host/pipeline/radix_sort.h"
 #include "host/pipeline/simd_shading.h"
@@ -89,7 +88,7 @@ void CameraRays::generate(const RenderContext& ctx, size_t count, Film& film,
         // The tile's rays a block at a time: their random numbers made SIMD-wide (rand4Many),
         // then the rays.
         constexpr size_t kBlock = 64;
-        uint pixel[kBlock], sampleIndex[kBlock], sample[kBlock];
+        uint x[kBlock], y[kBlock], pixel[kBlock], sampleIndex[kBlock], sample[kBlock];
         std::uint64_t ray[kBlock];
         vec4 u[kBlock];
         size_t pending = 0;
@@ -98,8 +97,8 @@ void CameraRays::generate(const RenderContext& ctx, size_t count, Film& film,
                 rand4Many(camera.sampling(), rp_.seed, kBounceCamera, kDimCamera, pixel,
                           sampleIndex, pending, u);
             for (size_t j = 0; j < pending; ++j) {
-                const uint x = pixel[j] % uint(width_), y = pixel[j] / uint(width_);
-                const CameraRay cr = camera.generate(x, y, sample[j], random ? u[j] : vec4(0.0f));
+                const CameraRay cr =
+                    camera.generate(x[j], y[j], sample[j], random ? u[j] : vec4(0.0f));
                 film.addSample(cr.filmPos, sampleIndex[j]);
                 RayState& r = rays[size_t(ray[j] - begin)];
                 r.origin = cr.origin;
@@ -110,16 +109,18 @@ void CameraRays::generate(const RenderContext& ctx, size_t count, Film& film,
         };
         const int x0 = int(t % size_t(tilesX_)) * tile_, y0 = int(t / size_t(tilesX_)) * tile_;
         std::uint64_t k = tileStart_[t]; // the index of the tile's next ray
-        for (int y = y0; y < std::min(height_, y0 + tile_) && k < end; ++y)
-            for (int x = x0; x < std::min(width_, x0 + tile_) && k < end; ++x) {
-                if (!film.sampling(x, y)) continue; // adaptive sampling: converged
-                if (k + spi <= begin) {             // the batch starts after this pixel
+        for (int py = y0; py < std::min(height_, y0 + tile_) && k < end; ++py)
+            for (int px = x0; px < std::min(width_, x0 + tile_) && k < end; ++px) {
+                if (!film.sampling(px, py)) continue; // adaptive sampling: converged
+                if (k + spi <= begin) {               // the batch starts after this pixel
                     k += spi;
                     continue;
                 }
                 for (uint s = 0; s < spi; ++s, ++k) {
                     if (k < begin || k >= end) continue;
-                    pixel[pending] = uint(y * width_ + x);
+                    x[pending] = uint(px);
+                    y[pending] = uint(py);
+                    pixel[pending] = uint(py * width_ + px);
                     sampleIndex[pending] = rp_.iteration * spi + s;
                     sample[pending] = s;
                     ray[pending] = k;
@@ -406,7 +407,7 @@ const char* const kFusedStageNames[kFusedStages] = {"hit setup", "shade", "shado
                                                     "bin"};
 } // namespace
 
-void shadeFused(const RenderContext& ctx, uint iteration, RayFormat format,
+void shadeFused(const RenderContext& ctx, uint iteration, RayFormat format, bool simd,
                 const std::vector<RayState>& rays, const std::vector<HitRecord>& hits,
                 const std::vector<SortedHit>& order, size_t hitCount, Film& film,
                 DirectionalBins& bins) {
@@ -417,7 +418,6 @@ void shadeFused(const RenderContext& ctx, uint iteration, RayFormat format,
     std::atomic<std::int64_t> threadNs[kFusedStages] = {};
     std::atomic<std::uint64_t> shadowRays{0};
     const bool inTraversalOrder = order.empty();
-    const bool simd = usesSimdShading(ctx);
     // Tasks of up to `shading size` hits, each handing its continuation rays to the bins once.
     const size_t grain = batchGrain(hitCount, kFusedChunk, size_t(ctx.scene.settings.shadingSize));
     tbb::parallel_for(

@@ -98,8 +98,10 @@ void binContinuations(const RenderContext& ctx, uint iteration, RayFormat format
 // proportion to the thread time the stage took.
 // With an empty `order` (the hit sort skipped: no shader sort and no environment for the misses
 // to see), the hits are taken in traversal order from all `hitCount` = rays.size() rays, each
-// chunk leaving out its misses itself.
-void shadeFused(const RenderContext& ctx, uint iteration, RayFormat format,
+// chunk leaving out its misses itself. `simd`: Lambert hits through the SIMD kernel
+// (simd_shading.h: shadeHits; the caller decides once per render, cpu_shading.h:
+// usesSimdShading).
+void shadeFused(const RenderContext& ctx, uint iteration, RayFormat format, bool simd,
                 const std::vector<RayState>& rays, const std::vector<HitRecord>& hits,
                 const std::vector<SortedHit>& order, size_t hitCount, Film& film,
                 DirectionalBins& bins);
