@@ -20,41 +20,131 @@
 //                   estimation (the shadow-ray code is removed);
 //   1 kTextured     false: no shader is textured, so the albedo is the shader's constant
 //                   colour x reflectance (the same product the host's TextureResolver computes)
-//                   and the host-resolved per-hit albedo is not read.
+//                   and the host-resolved per-hit albedo is not read;
+//   2 kSampling, 3 kStrategy  RenderParams' sampler and MIS strategy, fixed for the render: the
+//                   other samplers' and strategies' code is dropped;
+//   4 kEmitterKinds bit 1 << kEmitter* for each kind of emitter in the scene: with one kind, the
+//                   others' light sampling (the environment's CDF searches, point lights) is
+//                   dropped.
+// Why it matters on lavapipe: it runs 8 invocations as the lanes of one vector and executes both
+// sides of every if, masked, whatever the lanes decide; code a uniform condition switches off
+// still costs its full time there. Constants make the condition known to the compiler instead.
 //
 // Bindings (set 0): 0 shader table, 1 emitters, 2 emitter CDF, 3 the environment's map and
-// CDFs (shared/lights.h; 4 unread bytes without a map), 4 inputs, 5 results; 4 and 5 are bound as a window of the batch's buffers (within maxStorageBufferRange) and
-// ShadePush.offset is relative to it. Dispatches are 1D, or 2D when the range needs more than
-// maxComputeWorkGroupCount[0] workgroups; the linear index covers both.
+// CDFs (shared/lights.h; 4 unread bytes without a map), 4 inputs, 5 results. 0-4 are uniform
+// texel buffers of 32-bit unsigned words (R32G32B32A32_UINT, or R32_UINT for 2 and 3), read with
+// texelFetch and turned back into the shared structs field by field; 5 is a storage buffer written
+// as whole uvec4s. Why not storage buffers throughout: on lavapipe (Mesa 22.3) every storage
+// buffer access whose address differs between lanes is a loop over the 8 lanes with a branch per
+// lane and one scalar load per component, while a texel fetch is a vector gather; the stores are
+// fewest as 7 whole uvec4s per record. (Measured: README, "Fifth round".) The unpacking below
+// follows the byte layout that host/vk/shared_layout.cpp pins for the C++ side.
+// 4 and 5 are bound as a window of the batch's buffers (within maxStorageBufferRange and
+// maxTexelBufferElements) and ShadePush.offset is relative to it. Dispatches are 1D, or 2D when
+// the range needs more than maxComputeWorkGroupCount[0] workgroups; the linear index covers both.
 #extension GL_EXT_scalar_block_layout : require
 
+#include "shared/rng.h"
 #include "shared/shade_io.h"
 
 layout(local_size_x = kShadeWorkgroupSize, local_size_y = 1, local_size_z = 1) in;
 
 layout(constant_id = 0) const bool kHasEmitters = true;
 layout(constant_id = 1) const bool kTextured = true;
+layout(constant_id = 2) const uint kSampling = kSamplerIndependent;
+layout(constant_id = 3) const uint kStrategy = kStrategyMis;
+layout(constant_id = 4) const uint kEmitterKinds = 7u;
 
-layout(scalar, set = 0, binding = 0) readonly buffer ShaderTable { ShaderParams shaderTable[]; };
-layout(scalar, set = 0, binding = 1) readonly buffer EmitterTable { Emitter emitterTable[]; };
-layout(scalar, set = 0, binding = 2) readonly buffer EmitterCdf { float emitterCdf[]; };
-layout(scalar, set = 0, binding = 3) readonly buffer EnvironmentData { float environmentData[]; };
-layout(scalar, set = 0, binding = 4) readonly buffer Inputs { ShadeInput inputs[]; };
-layout(scalar, set = 0, binding = 5) writeonly buffer Results { ShadeResult results[]; };
+layout(set = 0, binding = 0) uniform usamplerBuffer shaderTable; // 3 texels per ShaderParams
+layout(set = 0, binding = 1) uniform usamplerBuffer emitterTable; // 5 texels per Emitter
+layout(set = 0, binding = 2) uniform usamplerBuffer emitterCdf;
+layout(set = 0, binding = 3) uniform usamplerBuffer environmentData;
+layout(set = 0, binding = 4) uniform usamplerBuffer inputs; // 7 texels per ShadeInput
+layout(std430, set = 0, binding = 5) writeonly buffer Results { uvec4 results[]; }; // 7 per ShadeResult
 layout(scalar, push_constant) uniform Push { ShadePush pc; };
 
+uvec4 fetch(usamplerBuffer table, uint texel) { return texelFetch(table, int(texel)); }
+
 ShaderParams kernelShader(uint i) {
-    ShaderParams s = shaderTable[i];
+    uvec4 w0 = fetch(shaderTable, 3u * i), w1 = fetch(shaderTable, 3u * i + 1u),
+          w2 = fetch(shaderTable, 3u * i + 2u);
+    ShaderParams s;
+    s.emission = uintBitsToFloat(w0.xyz);
+    s.model = w0.w;
+    s.colour = uintBitsToFloat(w1.xyz);
+    s.reflectance = uintBitsToFloat(w1.w);
+    s.flags = w2.x;
+    s.ior = uintBitsToFloat(w2.y);
+    s.alpha = uintBitsToFloat(w2.z);
+    s.pad0 = w2.w;
 #ifdef SPW_KERNEL_MODEL
     s.model = SPW_KERNEL_MODEL;
 #endif
     return s;
 }
 
+Emitter kernelEmitter(uint i) {
+    uvec4 w0 = fetch(emitterTable, 5u * i), w1 = fetch(emitterTable, 5u * i + 1u),
+          w2 = fetch(emitterTable, 5u * i + 2u), w3 = fetch(emitterTable, 5u * i + 3u),
+          w4 = fetch(emitterTable, 5u * i + 4u);
+    Emitter e;
+    e.p0 = uintBitsToFloat(w0.xyz);
+    e.area = uintBitsToFloat(w0.w);
+    e.e1 = uintBitsToFloat(w1.xyz);
+    e.pickPdf = uintBitsToFloat(w1.w);
+    e.e2 = uintBitsToFloat(w2.xyz);
+    e.twoSided = w2.w;
+    e.normal = uintBitsToFloat(w3.xyz);
+    e.type = w3.w;
+    e.radiance = uintBitsToFloat(w4.xyz);
+    e.pad1 = uintBitsToFloat(w4.w);
+    if (kEmitterKinds == (1u << kEmitterTriangle)) e.type = kEmitterTriangle;
+    if (kEmitterKinds == (1u << kEmitterPoint)) e.type = kEmitterPoint;
+    if (kEmitterKinds == (1u << kEmitterEnvironment)) e.type = kEmitterEnvironment;
+    return e;
+}
+
+ShadeInput loadInput(uint i) {
+    uint t = 7u * i;
+    uvec4 w[7] = uvec4[7](fetch(inputs, t), fetch(inputs, t + 1u), fetch(inputs, t + 2u),
+                          fetch(inputs, t + 3u), fetch(inputs, t + 4u), fetch(inputs, t + 5u),
+                          fetch(inputs, t + 6u));
+    ShadeInput r;
+    r.hit.p = uintBitsToFloat(w[0].xyz);
+    r.hit.t = uintBitsToFloat(w[0].w);
+    r.hit.ng = uintBitsToFloat(w[1].xyz);
+    r.hit.shader = w[1].w;
+    r.hit.ns = uintBitsToFloat(w[2].xyz);
+    r.hit.emitter = w[2].w;
+    r.hit.albedo = uintBitsToFloat(w[3].xyz);
+    r.hit.offset = uintBitsToFloat(w[3].w);
+    r.path.beta = uintBitsToFloat(w[4].xyz);
+    r.path.prevPdf = uintBitsToFloat(w[4].w);
+    r.path.pathId = w[5].x;
+    r.path.bounce = w[5].y;
+    r.path.flags = w[5].z;
+    r.path.cone = w[5].w;
+    r.rayDir = uintBitsToFloat(w[6].xyz);
+    r.pad0 = uintBitsToFloat(w[6].w);
+    return r;
+}
+
+void storeResult(uint i, ShadeResult r) {
+    uint o = 7u * i;
+    results[o] = uvec4(r.flags, floatBitsToUint(r.emitted));
+    results[o + 1u] = uvec4(floatBitsToUint(r.shadowOrigin), floatBitsToUint(r.shadowTmax));
+    results[o + 2u] = uvec4(floatBitsToUint(r.shadowDir), floatBitsToUint(r.shadowContribution.x));
+    results[o + 3u] = uvec4(floatBitsToUint(r.shadowContribution.yz),
+                            floatBitsToUint(r.nextOrigin.xy));
+    results[o + 4u] = uvec4(floatBitsToUint(r.nextOrigin.z), floatBitsToUint(r.nextDir));
+    results[o + 5u] = uvec4(floatBitsToUint(r.next.beta), floatBitsToUint(r.next.prevPdf));
+    results[o + 6u] = uvec4(r.next.pathId, r.next.bounce, r.next.flags, r.next.cone);
+}
+
 #define SHADER(i) kernelShader(i)
-#define EMITTER(i) emitterTable[i]
-#define EMITTER_CDF(i) emitterCdf[i]
-#define ENVIRONMENT_DATA(i) environmentData[i]
+#define EMITTER(i) kernelEmitter(i)
+#define EMITTER_CDF(i) uintBitsToFloat(fetch(emitterCdf, i).x)
+#define ENVIRONMENT_DATA(i) uintBitsToFloat(fetch(environmentData, i).x)
 #include "shared/path.h"
 
 void main() {
@@ -62,17 +152,19 @@ void main() {
                  gl_LocalInvocationIndex;
     if (local >= pc.count) return;
     uint i = pc.offset + local;
-    ShadeInput record = inputs[i];
+    ShadeInput record = loadInput(i);
     RenderParams rp = pc.params;
+    rp.sampling = kSampling;
+    rp.strategy = kStrategy;
     if (!kHasEmitters) {
         record.hit.emitter = kNoEmitter;
         rp.emitterCount = 0u;
     }
     if (!kTextured) {
-        ShaderParams s = shaderTable[record.hit.shader];
+        ShaderParams s = kernelShader(record.hit.shader);
         record.hit.albedo = s.colour * s.reflectance;
     }
     ShadeResult r;
     shadeSurface(rp, record.hit, record.rayDir, record.path, r);
-    results[i] = r;
+    storeResult(i, r);
 }

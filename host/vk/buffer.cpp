@@ -63,7 +63,7 @@ Buffer::~Buffer() {
 HostArray::HostArray(const Context& context, VkDeviceSize bytes, Direction direction,
                      bool forceStaging)
     : direction_(direction) {
-    bytes = std::max<VkDeviceSize>(bytes, 4);
+    bytes = std::max<VkDeviceSize>(bytes, 16); // a texel buffer holds at least one RGBA32 texel
     const bool upload = direction == Direction::Upload;
     constexpr VkMemoryPropertyFlags kLocal = VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT;
     constexpr VkMemoryPropertyFlags kHost =
@@ -71,7 +71,10 @@ HostArray::HostArray(const Context& context, VkDeviceSize bytes, Direction direc
     // In place: device-local and host-visible (and, to be read back, host-cached).
     const VkMemoryPropertyFlags inPlace =
         kLocal | kHost | (upload ? 0 : VK_MEMORY_PROPERTY_HOST_CACHED_BIT);
-    const VkBufferUsageFlags storage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
+    // What the kernels read is bound as uniform texel buffers, what they write as storage buffers
+    // (shaders/shade_kernel.glsl says why).
+    const VkBufferUsageFlags storage =
+        upload ? VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT : VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
     bool direct = false;
     if (!forceStaging) {
         for (uint32_t i = 0; i < context.memory().memoryTypeCount; ++i)

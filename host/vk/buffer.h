@@ -53,7 +53,8 @@ class Buffer {
 class HostArray {
   public:
     enum class Direction { Upload, Download };
-    // A storage buffer of `bytes` (at least 4) the host fills (Upload) or reads (Download).
+    // A buffer of `bytes` (at least 16) the host fills (Upload: kernels read it as a uniform texel
+    // buffer) or reads (Download: kernels write it as a storage buffer).
     HostArray(const Context& context, VkDeviceSize bytes, Direction direction, bool forceStaging);
 
     void* host() const { return staging_ ? staging_->mapped() : device_->mapped(); }

@@ -4,6 +4,7 @@
 #include "host/vk/spirv.h"
 #include "shared/shade_io.h"
 
+#include <iterator>
 #include <stdexcept>
 
 namespace spw::vk {
@@ -15,7 +16,7 @@ ShadingPipelines::ShadingPipelines(const Context& context, const std::vector<std
         VkDescriptorSetLayoutBinding bindings[kBindings]{};
         for (uint32_t b = 0; b < kBindings; ++b) {
             bindings[b].binding = b;
-            bindings[b].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+            bindings[b].descriptorType = bindingType(b);
             bindings[b].descriptorCount = 1;
             bindings[b].stageFlags = VK_SHADER_STAGE_COMPUTE_BIT;
         }
@@ -34,11 +35,15 @@ ShadingPipelines::ShadingPipelines(const Context& context, const std::vector<std
         layoutInfo.pPushConstantRanges = &push;
         SPW_VK_CHECK(vkCreatePipelineLayout(device_, &layoutInfo, nullptr, &layout_));
 
-        const VkBool32 values[2] = {spec.hasEmitters ? VK_TRUE : VK_FALSE,
-                                    spec.textured ? VK_TRUE : VK_FALSE};
-        const VkSpecializationMapEntry entries[2] = {{0, 0, sizeof(VkBool32)},
-                                                     {1, sizeof(VkBool32), sizeof(VkBool32)}};
-        VkSpecializationInfo specInfo{2, entries, sizeof(values), values};
+        // Every constant is 32 bits wide (VkBool32 or uint).
+        const uint32_t values[] = {spec.hasEmitters ? VK_TRUE : VK_FALSE,
+                                   spec.textured ? VK_TRUE : VK_FALSE, spec.sampling, spec.strategy,
+                                   spec.emitterKinds};
+        constexpr uint32_t kConstants = uint32_t(std::size(values));
+        VkSpecializationMapEntry entries[kConstants];
+        for (uint32_t i = 0; i < kConstants; ++i)
+            entries[i] = {i, uint32_t(i * sizeof(uint32_t)), sizeof(uint32_t)};
+        VkSpecializationInfo specInfo{kConstants, entries, sizeof(values), values};
 
         for (const std::string& name : kernels) {
             const SpirvKernel* spirv = findSpirvKernel(name);

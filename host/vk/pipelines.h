@@ -15,9 +15,14 @@
 namespace spw::vk {
 
 // Values of the kernels' specialisation constants.
+// What a render fixes for all its hits, given to the kernels as specialisation constants so that
+// the driver drops the code a scene does not use (shaders/shade_kernel.glsl).
 struct KernelSpecialization {
-    bool hasEmitters = true; // constant_id 0: emission and next-event estimation
-    bool textured = true;    // constant_id 1: per-hit albedo resolved by the host
+    bool hasEmitters = true;   // constant_id 0: emission and next-event estimation
+    bool textured = true;      // constant_id 1: per-hit albedo resolved by the host
+    uint32_t sampling = 0;     // constant_id 2: RenderParams::sampling
+    uint32_t strategy = 0;     // constant_id 3: RenderParams::strategy
+    uint32_t emitterKinds = 7; // constant_id 4: bit 1 << kEmitter* for each kind in the scene
 };
 
 class ShadingPipelines {
@@ -36,7 +41,14 @@ class ShadingPipelines {
     VkPipeline pipeline(size_t i) const { return pipelines_[i]; }
     const std::vector<std::string>& names() const { return names_; }
 
+    // Bindings 0-4 (the scene's tables and the inputs) are uniform texel buffers, 5 (the results)
+    // a storage buffer: shaders/shade_kernel.glsl says why.
     static constexpr uint32_t kBindings = 6;
+    static constexpr uint32_t kResultsBinding = 5;
+    static constexpr VkDescriptorType bindingType(uint32_t binding) {
+        return binding == kResultsBinding ? VK_DESCRIPTOR_TYPE_STORAGE_BUFFER
+                                          : VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER;
+    }
 
   private:
     void release();

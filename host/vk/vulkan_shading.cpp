@@ -41,6 +41,23 @@ void barrier(VkCommandBuffer cmd, VkPipelineStageFlags src, VkAccessFlags srcAcc
     vkCmdPipelineBarrier(cmd, src, dst, 0, 1, &b, 0, nullptr, 0, nullptr);
 }
 
+// A view of `range` bytes of `buffer` from `offset` as texels of `format`, for a uniform texel
+// buffer binding.
+VkBufferView makeTexelView(VkDevice device, VkBuffer buffer, VkFormat format, VkDeviceSize offset,
+                           VkDeviceSize range) {
+    auto info = zeroed<VkBufferViewCreateInfo>(VK_STRUCTURE_TYPE_BUFFER_VIEW_CREATE_INFO);
+    info.buffer = buffer;
+    info.format = format;
+    info.offset = offset;
+    info.range = range;
+    VkBufferView view = VK_NULL_HANDLE;
+    SPW_VK_CHECK(vkCreateBufferView(device, &info, nullptr, &view));
+    return view;
+}
+
+// The words of a record as texels: R32G32B32A32_UINT, 16 bytes each.
+constexpr VkDeviceSize kTexelBytes = 16;
+
 class VulkanShading : public ShadingEngine {
   public:
     VulkanShading(const RenderContext& ctx, const PipelineConfig& pipeline, vk::Context& context);
@@ -60,6 +77,7 @@ class VulkanShading : public ShadingEngine {
         size_t count = 0;    // records of the batch in the slot
         VkDescriptorPool descriptors = VK_NULL_HANDLE;
         std::vector<VkDescriptorSet> windows; // one per binding window of the buffers
+        std::vector<VkBufferView> inputViews; // the inputs' texel view of each window
         VkCommandBuffer cmd = VK_NULL_HANDLE;
         VkFence fence = VK_NULL_HANDLE;
         bool inFlight = false;
@@ -67,6 +85,7 @@ class VulkanShading : public ShadingEngine {
     };
 
     void release();
+    void releaseViews(Slot& slot);
     void grow(Slot& slot, size_t count);
     void recordDispatches(VkCommandBuffer cmd, const Slot& slot,
                           const std::vector<ShadeRange>& ranges);
@@ -81,6 +100,7 @@ class VulkanShading : public ShadingEngine {
     VulkanConfig config_;
     StageTimes& stages_;
     std::unique_ptr<HostArray> shaderTable_, emitterTable_, emitterCdf_, environment_;
+    VkBufferView tableViews_[4] = {}; // bindings 0-3: the tables above as texel buffers
     std::unique_ptr<vk::ShadingPipelines> pipelines_;
     int modelPipeline_[kModelCount];
     int megakernel_ = -1;
@@ -91,7 +111,7 @@ class VulkanShading : public ShadingEngine {
     size_t windowRecords_ = 0; // records per binding window (within maxStorageBufferRange)
     uint32_t maxGroupsX_ = 0, maxGroupsY_ = 0;
     bool timestamps_ = false;
-    bool texturedSpec_ = true, emitterSpec_ = true;
+    vk::KernelSpecialization spec_;
 
     // counters for --stats
     std::uint64_t dispatches_ = 0, submits_ = 0, maxBatch_ = 0, windowsUsed_ = 0,
@@ -123,8 +143,13 @@ VulkanShading::VulkanShading(const RenderContext& ctx, const PipelineConfig& pip
             used[sh.params.model] = true;
             textured = textured || sh.texture >= 0;
         }
-        emitterSpec_ = view.emitterCount > 0;
-        texturedSpec_ = textured;
+        spec_.hasEmitters = view.emitterCount > 0;
+        spec_.textured = textured;
+        spec_.sampling = ctx.params.sampling;
+        spec_.strategy = ctx.params.strategy;
+        spec_.emitterKinds = 0;
+        for (const Emitter& e : ctx.lights.emitters())
+            spec_.emitterKinds |= 1u << e.type;
         std::vector<std::string> kernels;
         if (pipeline.sortsHits()) {
             for (const SurfaceModelInfo& m : kSurfaceModels)
@@ -138,21 +163,24 @@ VulkanShading::VulkanShading(const RenderContext& ctx, const PipelineConfig& pip
         }
 
         // Binding windows: the input and result buffers are bound in ranges of windowRecords_
-        // records, each within maxStorageBufferRange and starting at an offset aligned to
-        // minStorageBufferOffsetAlignment for both record sizes.
-        const VkDeviceSize maxRange =
-            config_.maxBindingBytes
-                ? std::min<VkDeviceSize>(config_.maxBindingBytes, limits.maxStorageBufferRange)
-                : limits.maxStorageBufferRange;
-        const size_t align =
+        // records: the inputs' within maxTexelBufferElements, the results' within
+        // maxStorageBufferRange, each starting at an offset aligned to
+        // minTexelBufferOffsetAlignment and minStorageBufferOffsetAlignment respectively.
+        const VkDeviceSize texelRange = VkDeviceSize(limits.maxTexelBufferElements) * kTexelBytes;
+        VkDeviceSize maxRange = std::min<VkDeviceSize>(limits.maxStorageBufferRange, texelRange);
+        if (config_.maxBindingBytes) maxRange = std::min(maxRange, config_.maxBindingBytes);
+        const size_t inputAlign =
+            size_t(std::max<VkDeviceSize>(limits.minTexelBufferOffsetAlignment, 1));
+        const size_t resultAlign =
             size_t(std::max<VkDeviceSize>(limits.minStorageBufferOffsetAlignment, 1));
-        const size_t step = std::lcm(std::lcm(sizeof(ShadeInput), align) / sizeof(ShadeInput),
-                                     std::lcm(sizeof(ShadeResult), align) / sizeof(ShadeResult));
+        const size_t step =
+            std::lcm(std::lcm(sizeof(ShadeInput), inputAlign) / sizeof(ShadeInput),
+                     std::lcm(sizeof(ShadeResult), resultAlign) / sizeof(ShadeResult));
         const size_t largest = std::max(sizeof(ShadeInput), sizeof(ShadeResult));
         windowRecords_ = size_t(maxRange / largest) / step * step;
         if (windowRecords_ == 0)
-            throw std::runtime_error("maxStorageBufferRange " + std::to_string(maxRange) +
-                                     " holds no shading record");
+            throw std::runtime_error("the device's buffer bindings (maxStorageBufferRange, " +
+                                     std::string("maxTexelBufferElements) hold no shading record"));
         maxGroupsX_ = config_.maxGroupsX
                           ? std::min(config_.maxGroupsX, limits.maxComputeWorkGroupCount[0])
                           : limits.maxComputeWorkGroupCount[0];
@@ -183,26 +211,40 @@ VulkanShading::VulkanShading(const RenderContext& ctx, const PipelineConfig& pip
         // The scene's tables, uploaded once.
         {
             const auto start = std::chrono::steady_clock::now();
-            auto table = [&](const void* data, size_t bytes, const char* what) {
-                if (bytes > limits.maxStorageBufferRange)
-                    throw std::runtime_error(std::string("the scene's ") + what + " table (" +
-                                             std::to_string(bytes) +
-                                             " bytes) exceeds the device's maxStorageBufferRange");
+            auto table = [&](const void* data, size_t bytes, size_t texelBytes, const char* what) {
+                if (bytes / texelBytes > limits.maxTexelBufferElements)
+                    throw std::runtime_error(
+                        std::string("the scene's ") + what + " table (" +
+                        std::to_string(bytes / texelBytes) +
+                        " texels) exceeds the device's maxTexelBufferElements (" +
+                        std::to_string(limits.maxTexelBufferElements) + ")");
                 auto a = std::make_unique<HostArray>(vk_, bytes, HostArray::Direction::Upload,
                                                      config_.forceStaging);
                 if (bytes) std::memcpy(a->host(), data, bytes);
                 bufferBytes_ += a->size();
                 return a;
             };
-            shaderTable_ =
-                table(view.shaders, scene.shaders.size() * sizeof(ShaderParams), "shader");
+            static_assert(sizeof(ShaderParams) % kTexelBytes == 0 &&
+                              sizeof(Emitter) % kTexelBytes == 0,
+                          "the kernels fetch ShaderParams and Emitter as whole texels");
+            shaderTable_ = table(view.shaders, scene.shaders.size() * sizeof(ShaderParams),
+                                 kTexelBytes, "shader");
             const SceneLights& lights = ctx.lights;
-            emitterTable_ =
-                table(view.emitters, lights.emitters().size() * sizeof(Emitter), "emitter");
-            emitterCdf_ = table(view.emitterCdf, view.emitterCount * sizeof(float), "emitter CDF");
-            // The environment's map and CDFs; a constant environment (or none) binds 4 bytes.
+            emitterTable_ = table(view.emitters, lights.emitters().size() * sizeof(Emitter),
+                                  kTexelBytes, "emitter");
+            emitterCdf_ = table(view.emitterCdf, view.emitterCount * sizeof(float), sizeof(float),
+                                "emitter CDF");
+            // The environment's map and CDFs; a constant environment (or none) binds 16 bytes.
             environment_ = table(lights.environmentData().data(),
-                                 lights.environmentData().size() * sizeof(float), "environment");
+                                 lights.environmentData().size() * sizeof(float), sizeof(float),
+                                 "environment");
+            const HostArray* tables[4] = {shaderTable_.get(), emitterTable_.get(),
+                                          emitterCdf_.get(), environment_.get()};
+            const VkFormat formats[4] = {VK_FORMAT_R32G32B32A32_UINT, VK_FORMAT_R32G32B32A32_UINT,
+                                         VK_FORMAT_R32_UINT, VK_FORMAT_R32_UINT};
+            for (int b = 0; b < 4; ++b)
+                tableViews_[b] =
+                    makeTexelView(device_, tables[b]->device(), formats[b], 0, VK_WHOLE_SIZE);
             if (shaderTable_->staged()) {
                 VkCommandBuffer cmd = slots_[0].cmd;
                 auto begin =
@@ -224,8 +266,7 @@ VulkanShading::VulkanShading(const RenderContext& ctx, const PipelineConfig& pip
         // dispatch, and that belongs here, not in the first batch's timing.
         {
             const auto start = std::chrono::steady_clock::now();
-            pipelines_ = std::make_unique<vk::ShadingPipelines>(
-                vk_, kernels, vk::KernelSpecialization{emitterSpec_, texturedSpec_});
+            pipelines_ = std::make_unique<vk::ShadingPipelines>(vk_, kernels, spec_);
             Slot& s = slots_[0];
             grow(s, kMinCapacity);
             auto begin =
@@ -255,7 +296,12 @@ void VulkanShading::release() {
     for (Slot& s : slots_) {
         if (s.fence) vkDestroyFence(device_, s.fence, nullptr);
         if (s.descriptors) vkDestroyDescriptorPool(device_, s.descriptors, nullptr);
+        releaseViews(s);
         s = Slot{};
+    }
+    for (VkBufferView& v : tableViews_) {
+        if (v) vkDestroyBufferView(device_, v, nullptr);
+        v = VK_NULL_HANDLE;
     }
     if (queries_) vkDestroyQueryPool(device_, queries_, nullptr);
     queries_ = VK_NULL_HANDLE;
@@ -277,6 +323,12 @@ void VulkanShading::submitAndWait(VkCommandBuffer cmd, VkFence fence) {
     SPW_VK_CHECK(vkResetFences(device_, 1, &fence));
 }
 
+void VulkanShading::releaseViews(Slot& s) {
+    for (VkBufferView v : s.inputViews)
+        vkDestroyBufferView(device_, v, nullptr);
+    s.inputViews.clear();
+}
+
 // Sizes the slot's buffers to at least `count` records (the next power of two: batches are
 // 2^e rays) and writes one descriptor set per binding window.
 void VulkanShading::grow(Slot& s, size_t count) {
@@ -287,6 +339,7 @@ void VulkanShading::grow(Slot& s, size_t count) {
     if (s.descriptors) vkDestroyDescriptorPool(device_, s.descriptors, nullptr);
     s.descriptors = VK_NULL_HANDLE;
     s.windows.clear();
+    releaseViews(s);
     if (s.inputs) bufferBytes_ -= s.inputs->size() + s.results->size();
     s.inputs.reset();
     s.results.reset();
@@ -299,13 +352,14 @@ void VulkanShading::grow(Slot& s, size_t count) {
     s.capacity = capacity;
 
     const uint32_t windows = uint32_t((capacity + windowRecords_ - 1) / windowRecords_);
-    VkDescriptorPoolSize size{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
-                              windows * vk::ShadingPipelines::kBindings};
+    const VkDescriptorPoolSize sizes[2] = {
+        {VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, windows * (vk::ShadingPipelines::kBindings - 1)},
+        {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, windows}};
     auto poolInfo =
         zeroed<VkDescriptorPoolCreateInfo>(VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO);
     poolInfo.maxSets = windows;
-    poolInfo.poolSizeCount = 1;
-    poolInfo.pPoolSizes = &size;
+    poolInfo.poolSizeCount = 2;
+    poolInfo.pPoolSizes = sizes;
     SPW_VK_CHECK(vkCreateDescriptorPool(device_, &poolInfo, nullptr, &s.descriptors));
     std::vector<VkDescriptorSetLayout> layouts(windows, pipelines_->setLayout());
     auto alloc =
@@ -318,22 +372,24 @@ void VulkanShading::grow(Slot& s, size_t count) {
     for (uint32_t w = 0; w < windows; ++w) {
         const size_t first = size_t(w) * windowRecords_;
         const size_t records = std::min(windowRecords_, capacity - first);
-        VkDescriptorBufferInfo infos[vk::ShadingPipelines::kBindings] = {
-            {shaderTable_->device(), 0, VK_WHOLE_SIZE},
-            {emitterTable_->device(), 0, VK_WHOLE_SIZE},
-            {emitterCdf_->device(), 0, VK_WHOLE_SIZE},
-            {environment_->device(), 0, VK_WHOLE_SIZE},
-            {s.inputs->device(), first * sizeof(ShadeInput), records * sizeof(ShadeInput)},
-            {s.results->device(), first * sizeof(ShadeResult), records * sizeof(ShadeResult)},
-        };
+        s.inputViews.push_back(
+            makeTexelView(device_, s.inputs->device(), VK_FORMAT_R32G32B32A32_UINT,
+                          first * sizeof(ShadeInput), records * sizeof(ShadeInput)));
+        const VkBufferView views[5] = {tableViews_[0], tableViews_[1], tableViews_[2],
+                                       tableViews_[3], s.inputViews.back()};
+        const VkDescriptorBufferInfo results{s.results->device(), first * sizeof(ShadeResult),
+                                             records * sizeof(ShadeResult)};
         VkWriteDescriptorSet writes[vk::ShadingPipelines::kBindings];
         for (uint32_t b = 0; b < vk::ShadingPipelines::kBindings; ++b) {
             writes[b] = zeroed<VkWriteDescriptorSet>(VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET);
             writes[b].dstSet = s.windows[w];
             writes[b].dstBinding = b;
             writes[b].descriptorCount = 1;
-            writes[b].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
-            writes[b].pBufferInfo = &infos[b];
+            writes[b].descriptorType = vk::ShadingPipelines::bindingType(b);
+            if (b == vk::ShadingPipelines::kResultsBinding)
+                writes[b].pBufferInfo = &results;
+            else
+                writes[b].pTexelBufferView = &views[b];
         }
         vkUpdateDescriptorSets(device_, vk::ShadingPipelines::kBindings, writes, 0, nullptr);
     }
@@ -514,7 +570,17 @@ void VulkanShading::publishStats(RenderStats& stats) {
     v["driver"] = d.driver;
     v["api"] = d.api;
     v["pipelines"] = pipelines_->names();
-    v["specialization"] = {{"emitters", emitterSpec_}, {"textures", texturedSpec_}};
+    nlohmann::json kinds = nlohmann::json::array();
+    const char* kindNames[] = {"triangle", "point", "environment"};
+    for (uint k = 0; k < 3; ++k)
+        if (spec_.emitterKinds & (1u << k)) kinds.push_back(kindNames[k]);
+    v["specialization"] = {{"emitters", spec_.hasEmitters},
+                           {"textures", spec_.textured},
+                           {"sampler", spec_.sampling == kSamplerSobol ? "sobol" : "pcg"},
+                           {"strategy", spec_.strategy == kStrategyMis     ? "mis"
+                                        : spec_.strategy == kStrategyLight ? "light"
+                                                                           : "bsdf"},
+                           {"emitter_kinds", kinds}};
     v["memory"] = {{"inputs", slots_[0].inputs->mode()},
                    {"results", slots_[0].results->mode()},
                    {"scene", shaderTable_->mode()}};

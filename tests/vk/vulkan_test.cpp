@@ -232,9 +232,30 @@ TEST(VulkanVsCpu, SobolSamplerAgreesUpToFloatRounding) {
     scene.sampler = SamplerType::Sobol;
     auto result = expectVulkanMatchesCpu(scene, 8, "Cornell box, Sobol", 1e-5);
     EXPECT_EQ(result->stats.extra["sampler"], "Sobol");
+    EXPECT_EQ(result->stats.extra["vulkan"]["specialization"]["sampler"], "sobol");
 }
 
-// Scenes lit only by point lights, and only by an environment map: both kernels' new branches
+// The sampling strategy is a specialisation constant of the kernels (the others' code dropped):
+// light sampling alone and BSDF sampling alone against cpu, which reads it from RenderParams.
+TEST(VulkanVsCpu, EachSamplingStrategyAgreesUpToFloatRounding) {
+    Scene scene = smallCornell(24);
+    for (const auto& [strategy, name] :
+         {std::pair{kStrategyLight, "light"}, std::pair{kStrategyBsdf, "bsdf"}}) {
+        RenderConfig vkCfg = validatedVulkan(8);
+        vkCfg.strategy = strategy;
+        RenderConfig cpuCfg = vkCfg;
+        cpuCfg.backend = BackendKind::Cpu;
+        std::vector<std::vector<float>> v, c;
+        auto result = renderValidated(scene, vkCfg, &v);
+        render(scene, cpuCfg,
+               [&](int, int, const Film& film) { c.push_back(film.lastIterationImage()); });
+        expectSameUpToRounding(name, v, c, 24, 24, 1e-5);
+        EXPECT_EQ(result->stats.extra["vulkan"]["specialization"]["strategy"], name);
+        EXPECT_GT(mean(result->film->image()), 0.01) << name;
+    }
+}
+
+// Scenes lit only by point lights, only by an environment map, and by both: the kernels' branches
 // (shared/path.h's sampleEmitter) against cpu, and the environment map's buffer bound and read.
 TEST(VulkanVsCpu, PointLightsAndEnvironmentMapAgreeUpToFloatRounding) {
     TempDir dir;
@@ -251,13 +272,20 @@ TEST(VulkanVsCpu, PointLightsAndEnvironmentMapAgreeUpToFloatRounding) {
         "  - {type: Conductor, colour: [0.9, 0.6, 0.3], alpha: 0.2}\n"
         "objects:\n  - {filename: floor.obj, shader: 1}\n"
         "  - {filename: cube.obj, shader: 0, scale: 0.3, translation: [0.3, 0.3, 0]}\n";
-    for (const std::string lights :
-         {"lights:\n  - {type: Point, position: [0.5, 1.5, 0.5], intensity: 2}\n"
-          "  - {type: Point, position: [-1, 0.5, 1], intensity: 1, colour: [0.2, 0.4, 1]}\n",
-          "light: {type: Environment, string: sky.exr}\n"}) {
-        const Scene scene = loadScene(dir.write("lights.yaml", common + lights));
+    // One kind of emitter lets the kernels drop the other kinds' light sampling (the
+    // specialisation's emitter_kinds); both kinds together keep both.
+    const std::string point = "  - {type: Point, position: [0.5, 1.5, 0.5], intensity: 2}\n"
+                              "  - {type: Point, position: [-1, 0.5, 1], intensity: 1, "
+                              "colour: [0.2, 0.4, 1]}\n";
+    const std::string environment = "  - {type: Environment, string: sky.exr}\n";
+    for (const auto& [lights, kinds] :
+         {std::pair{point, nlohmann::json({"point"})},
+          std::pair{environment, nlohmann::json({"environment"})},
+          std::pair{point + environment, nlohmann::json({"point", "environment"})}}) {
+        const Scene scene = loadScene(dir.write("lights.yaml", common + "lights:\n" + lights));
         auto result = expectVulkanMatchesCpu(scene, 16, lights.c_str(), 1e-4);
         EXPECT_GT(mean(result->film->image()), 0.01) << lights;
+        EXPECT_EQ(result->stats.extra["vulkan"]["specialization"]["emitter_kinds"], kinds);
     }
 }
 
@@ -494,6 +522,7 @@ TEST(VulkanPipelines, NoEmittersSpecialisesNextEventEstimationAway) {
                                "shader: {type: Lambert}\n"));
     auto v = renderValidated(scene, validatedVulkan(2));
     EXPECT_EQ(v->stats.extra["vulkan"]["specialization"]["emitters"], false);
+    EXPECT_EQ(v->stats.extra["vulkan"]["specialization"]["emitter_kinds"], nlohmann::json::array());
     EXPECT_EQ(v->stats.extra["vulkan"]["pipelines"], nlohmann::json({"lambert"}));
     EXPECT_EQ(mean(v->film->image()), 0.0);
 }
