@@ -174,7 +174,15 @@ size_t sortHits(const Scene& scene, const std::vector<HitRecord>& hits, bool byS
                       });
     const size_t hitCount = parallelCount(n, [&](size_t i) { return order[i].key != kMissKey; });
     if (byShader) {
-        radixSort(order, scratch);
+        // The misses go behind the hits first, in their order, and the radix sort sorts the hits
+        // alone: the misses' all-ones key would make every byte of the keys vary and cost all
+        // eight passes. The order is the one a sort of all the keys gives, as it is stable.
+        scratch.resize(n);
+        size_t hit = 0, miss = hitCount;
+        for (const SortedHit& k : order)
+            (k.key != kMissKey ? scratch[hit++] : scratch[miss++]) = k;
+        order.swap(scratch);
+        radixSort(order, scratch, hitCount);
     } else {
         // No sort: keep traversal order, just move the misses out.
         std::stable_partition(order.begin(), order.end(),
