@@ -43,6 +43,7 @@
 // maxTexelBufferElements) and ShadePush.offset is relative to it. Dispatches are 1D, or 2D when
 // the range needs more than maxComputeWorkGroupCount[0] workgroups; the linear index covers both.
 #extension GL_EXT_scalar_block_layout : require
+#extension GL_EXT_control_flow_attributes : require
 
 #include "shared/rng.h"
 #include "shared/shade_io.h"

@@ -123,8 +123,16 @@ inline uvec3 sobolReversedColumns(uint r) {
            t.t[3][r >> 24u];
 }
 #else
+// The kernels: every column, selected by a mask of its bit. A loop over the set bits would run on
+// lavapipe until the lane with the most bits is done, and index the columns per lane; unrolled,
+// the indices are constants and the columns immediates (shade_kernel.glsl enables [[unroll]]).
 uvec3 sobolReversedColumns(uint r) {
-    return sobolReversedColumnsLoop(r);
+    uvec3 x = uvec3(0u);
+    [[unroll]] for (uint p = 0u; p < 32u; ++p) {
+        uint m = 0u - ((r >> p) & 1u);
+        x ^= uvec3(kSobolReversed[p], kSobolReversed[32u + p], kSobolReversed[64u + p]) & m;
+    }
+    return x;
 }
 #endif
 
