@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numeric>
 
 namespace spw {
 namespace {
@@ -29,6 +30,16 @@ uint textureOrder(const Mesh& mesh, uint primitive, float u, float v) {
     const uvec3 t = mesh.triangles[primitive];
     const vec2 uv = (1.0f - u - v) * mesh.uvs[t.x] + u * mesh.uvs[t.y] + v * mesh.uvs[t.z];
     return spreadBits(wrapped16(uv.x)) | spreadBits(wrapped16(uv.y)) << 1;
+}
+
+ShaderOrder::ShaderOrder(const Scene& scene) : shaderAt(scene.shaders.size()) {
+    std::iota(shaderAt.begin(), shaderAt.end(), 0u);
+    std::stable_sort(shaderAt.begin(), shaderAt.end(), [&](uint a, uint b) {
+        return scene.shaders[a].params.model < scene.shaders[b].params.model;
+    });
+    rank.resize(shaderAt.size());
+    for (uint r = 0; r < uint(shaderAt.size()); ++r)
+        rank[shaderAt[r]] = r;
 }
 
 std::vector<ShaderRun> shaderRuns(const std::vector<SortedHit>& keys, size_t hitCount) {

@@ -1,7 +1,9 @@
-// Hit sorting: each hit's key packs (shader, object, texture order) into 12 + 20 + 32 bits, so
-// that a radix sort of the keys groups a batch's hits by shader, and within a shader by object
-// and then by where they fall in texture space (coherent texture reads); misses take the
-// all-ones key and sort last.
+// Hit sorting: each hit's key packs (shader rank, object, texture order) into 12 + 20 + 32 bits,
+// so that a radix sort of the keys groups a batch's hits by surface model and shader, and within
+// a shader by object and then by where they fall in texture space (coherent texture reads);
+// misses take the all-ones key and sort last. The shader's rank (ShaderOrder) puts the shaders
+// of one surface model next to each other: each model's hits are one contiguous range, one
+// dispatch of its kernel on the vulkan backend, whatever the order of the scene's shaders.
 // The loader's kMaxShaders and kMaxObjects keep every hit's key distinct from a miss's.
 #pragma once
 
@@ -34,9 +36,16 @@ inline uint shaderOfKey(std::uint64_t key) {
     return uint(key >> 52);
 }
 
+// The shaders' places in the hit sort: by surface model, then by index.
+struct ShaderOrder {
+    explicit ShaderOrder(const Scene& scene);
+    std::vector<uint> rank;     // rank[shader]: what the sort key holds
+    std::vector<uint> shaderAt; // shaderAt[rank]: the shader
+};
+
 // A run of sorted hits that share one shader: [begin, begin + count).
 struct ShaderRun {
-    uint shader;
+    uint shader; // what the keys hold: the shader's rank where they were made by ShaderOrder
     size_t begin, count;
 };
 

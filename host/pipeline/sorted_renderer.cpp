@@ -45,7 +45,8 @@ SortedRenderer::SortedRenderer(const RenderContext& ctx, const PipelineConfig& c
       fused_(config.fuseStages && shading_->shadesOnHostThreads()),
       simdShading_(fused_ && usesSimdShading(ctx)),
       sortHits_(config.sortsHits() && (config.hitSort == HitSortMode::On ||
-                                       !shading_->shadesOnHostThreads() || ctx.textures.active())) {
+                                       !shading_->shadesOnHostThreads() || ctx.textures.active())),
+      shaderOrder_(ctx.scene) {
     const double budgetMiB = config.memoryBudgetMiB.value_or(ctx.scene.settings.memoryBudgetMiB);
     const uint exponent = binExponentOf(ctx, config);
     // The budget covers every ray waiting in RAM: the six bins fill up to one batch each, and
@@ -161,7 +162,7 @@ size_t SortedRenderer::traceBatch(bool camera) {
         return n;
     }
     StageTimer t(times, "sort hits");
-    return sortHits(ctx_.scene, s.hits, sortHits_, s.order, s.keyTmp);
+    return sortHits(ctx_.scene, shaderOrder_, s.hits, sortHits_, s.order, s.keyTmp);
 }
 
 void SortedRenderer::runFusedBatch(bool camera, uint iteration, Film& film) {
@@ -187,7 +188,7 @@ void SortedRenderer::startBatch(bool camera, int slot, uint iteration, Film& fil
     }
     {
         StageTimer t(times, "shade");
-        shadeRanges(ctx_.scene, s.order, flight.hitCount, sortHits_, s.ranges);
+        shadeRanges(ctx_.scene, shaderOrder_, s.order, flight.hitCount, sortHits_, s.ranges);
         shading_->submit(slot, s.ranges);
     }
 }

@@ -53,6 +53,7 @@ class SortedRenderer : public Backend {
     bool fused_;
     bool simdShading_; // the fused loop's Lambert hits SIMD-wide (cpu_shading.h: usesSimdShading)
     bool sortHits_;    // the hit sort's auto rule applied (render_config.h: HitSortMode)
+    ShaderOrder shaderOrder_; // the shaders' ranks in the hit sort (hit_sort.h)
     std::uint64_t batchesProcessed_ = 0;
 };
 

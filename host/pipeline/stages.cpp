@@ -153,8 +153,8 @@ void traverse(const EmbreeScene& embree, const std::vector<RayState>& rays, bool
                    coherent, hits);
 }
 
-size_t sortHits(const Scene& scene, const std::vector<HitRecord>& hits, bool byShader,
-                std::vector<SortedHit>& order, std::vector<SortedHit>& scratch) {
+size_t sortHits(const Scene& scene, const ShaderOrder& shaders, const std::vector<HitRecord>& hits,
+                bool byShader, std::vector<SortedHit>& order, std::vector<SortedHit>& scratch) {
     const size_t n = hits.size();
     order.resize(n);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, n, batchGrain(n, 1024, kParallelGrain)),
@@ -164,7 +164,7 @@ size_t sortHits(const Scene& scene, const std::vector<HitRecord>& hits, bool byS
                               std::uint64_t key = kMissKey;
                               if (h.mesh != kNoHit && byShader) {
                                   const Mesh& mesh = scene.meshes[h.mesh];
-                                  key = hitSortKey(uint(mesh.shader), h.mesh,
+                                  key = hitSortKey(shaders.rank[size_t(mesh.shader)], h.mesh,
                                                    textureOrder(mesh, h.prim, h.u, h.v));
                               } else if (h.mesh != kNoHit) {
                                   key = 0;
@@ -262,13 +262,20 @@ void setUpHits(const RenderContext& ctx, const std::vector<RayState>& rays,
         });
 }
 
-void shadeRanges(const Scene& scene, const std::vector<SortedHit>& order, size_t hitCount,
-                 bool byShader, std::vector<ShadeRange>& ranges) {
+void shadeRanges(const Scene& scene, const ShaderOrder& shaders,
+                 const std::vector<SortedHit>& order, size_t hitCount, bool byShader,
+                 std::vector<ShadeRange>& ranges) {
     ranges.clear();
     if (byShader) {
-        // The sort keys carry the shader in their top bits.
-        for (const ShaderRun& run : shaderRuns(order, hitCount))
-            ranges.push_back({scene.shaders[run.shader].params.model, run.begin, run.count});
+        // The sort keys carry the shader's rank in their top bits, and the ranks put the shaders
+        // of one surface model next to each other: their runs make one range.
+        for (const ShaderRun& run : shaderRuns(order, hitCount)) {
+            const uint model = scene.shaders[shaders.shaderAt[run.shader]].params.model;
+            if (!ranges.empty() && ranges.back().model == model)
+                ranges.back().count += run.count;
+            else
+                ranges.push_back({model, run.begin, run.count});
+        }
     } else if (hitCount > 0) {
         ranges.push_back({kMixedModels, 0, hitCount});
     }

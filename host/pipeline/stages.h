@@ -56,10 +56,10 @@ void decompressRays(const RayBatch& batch, std::vector<RayState>& rays);
 void traverse(const EmbreeScene& embree, const std::vector<RayState>& rays, bool coherent,
               std::vector<HitRecord>& hits);
 
-// sort hits: one SortedHit per ray, the hits first (by shader, object, texture order when
+// sort hits: one SortedHit per ray, the hits first (by shader rank, object, texture order when
 // `byShader`, else in traversal order), the misses after them. Returns the number of hits.
-size_t sortHits(const Scene& scene, const std::vector<HitRecord>& hits, bool byShader,
-                std::vector<SortedHit>& order, std::vector<SortedHit>& scratch);
+size_t sortHits(const Scene& scene, const ShaderOrder& shaders, const std::vector<HitRecord>& hits,
+                bool byShader, std::vector<SortedHit>& order, std::vector<SortedHit>& scratch);
 
 // hit setup: inputs[i] and paths[i] (pathId, bounce) for the i-th hit in `order`. Chunk by
 // chunk of 128 hits; within a chunk, each run of one shader's hits looks its textures up
@@ -68,9 +68,10 @@ void setUpHits(const RenderContext& ctx, const std::vector<RayState>& rays,
                const std::vector<HitRecord>& hits, const std::vector<SortedHit>& order,
                size_t hitCount, ShadeInput* inputs, uvec2* paths);
 
-// shade: the ranges the engine shades, one per shader run (by shader) or one over every hit.
-void shadeRanges(const Scene& scene, const std::vector<SortedHit>& order, size_t hitCount,
-                 bool byShader, std::vector<ShadeRange>& ranges);
+// shade: the ranges the engine shades, one per surface model (by shader) or one over every hit.
+void shadeRanges(const Scene& scene, const ShaderOrder& shaders,
+                 const std::vector<SortedHit>& order, size_t hitCount, bool byShader,
+                 std::vector<ShadeRange>& ranges);
 
 // shadow: the shadow rays the shading made, and for each the hit it belongs to.
 void gatherShadowRays(const ShadeResult* results, size_t hitCount,

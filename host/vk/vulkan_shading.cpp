@@ -89,7 +89,9 @@ class VulkanShading : public ShadingEngine {
     void grow(Slot& slot, size_t count);
     void recordDispatches(VkCommandBuffer cmd, const Slot& slot,
                           const std::vector<ShadeRange>& ranges);
-    void recordDispatch(VkCommandBuffer cmd, VkDescriptorSet set, uint32_t offset, uint32_t count);
+    // `bound`: the set bound in `cmd` so far (VK_NULL_HANDLE: none), updated.
+    void recordDispatch(VkCommandBuffer cmd, VkDescriptorSet set, VkDescriptorSet& bound,
+                        uint32_t offset, uint32_t count);
     void submitAndWait(VkCommandBuffer cmd, VkFence fence);
     void readTimestamps();
     int pipelineFor(uint model) const;
@@ -273,9 +275,10 @@ VulkanShading::VulkanShading(const RenderContext& ctx, const PipelineConfig& pip
                 zeroed<VkCommandBufferBeginInfo>(VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO);
             begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
             SPW_VK_CHECK(vkBeginCommandBuffer(s.cmd, &begin));
+            VkDescriptorSet bound = VK_NULL_HANDLE;
             for (size_t i = 0; i < pipelines_->size(); ++i) {
                 vkCmdBindPipeline(s.cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipelines_->pipeline(i));
-                recordDispatch(s.cmd, s.windows[0], 0, 0);
+                recordDispatch(s.cmd, s.windows[0], bound, 0, 0);
             }
             SPW_VK_CHECK(vkEndCommandBuffer(s.cmd));
             submitAndWait(s.cmd, s.fence);
@@ -419,10 +422,15 @@ int VulkanShading::pipelineFor(uint model) const {
 
 // One dispatch of `count` records from `offset` in the bound window: 1D, or 2D when the range
 // needs more workgroups than one dimension allows.
-void VulkanShading::recordDispatch(VkCommandBuffer cmd, VkDescriptorSet set, uint32_t offset,
-                                   uint32_t count) {
-    vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipelines_->layout(), 0, 1, &set,
-                            0, nullptr);
+// The set is bound only when it changes: binding another pipeline of the same layout keeps it,
+// and on lavapipe every bind re-derives the texel buffers' state for the next dispatch.
+void VulkanShading::recordDispatch(VkCommandBuffer cmd, VkDescriptorSet set, VkDescriptorSet& bound,
+                                   uint32_t offset, uint32_t count) {
+    if (set != bound) {
+        vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipelines_->layout(), 0, 1,
+                                &set, 0, nullptr);
+        bound = set;
+    }
     ShadePush push{};
     push.params = params_;
     push.offset = offset;
@@ -443,6 +451,7 @@ void VulkanShading::recordDispatches(VkCommandBuffer cmd, const Slot& s,
     const std::uint64_t perDispatch =
         std::uint64_t(maxGroupsX_) * maxGroupsY_ * kShadeWorkgroupSize;
     int bound = -1;
+    VkDescriptorSet boundSet = VK_NULL_HANDLE;
     for (const ShadeRange& r : ranges) {
         if (r.count == 0) continue;
         const int p = pipelineFor(r.model);
@@ -457,7 +466,7 @@ void VulkanShading::recordDispatches(VkCommandBuffer cmd, const Slot& s,
             const size_t w = begin / windowRecords_;
             const size_t windowEnd = std::min(end, (w + 1) * windowRecords_);
             const size_t count = size_t(std::min<std::uint64_t>(windowEnd - begin, perDispatch));
-            recordDispatch(cmd, s.windows[w], uint32_t(begin - w * windowRecords_),
+            recordDispatch(cmd, s.windows[w], boundSet, uint32_t(begin - w * windowRecords_),
                            uint32_t(count));
             ++dispatches_;
             if (w > 0) windowsUsed_ = std::max<std::uint64_t>(windowsUsed_, w + 1);

@@ -41,6 +41,28 @@ std::vector<KeyIndex> keysOf(const std::vector<Hit>& hits) {
     return keys;
 }
 
+// The shaders' ranks in the hit sort: by surface model, then by index within a model, and
+// shaderAt the inverse of rank.
+TEST(HitSort, ShaderRanksGroupEachSurfaceModel) {
+    Scene scene;
+    const uint models[] = {kModelLambert,   kModelConductor, kModelLambert,   kModelNull,
+                           kModelConductor, kModelLambert,   kModelDielectric};
+    for (uint m : models) {
+        Shader sh;
+        sh.params.model = m;
+        scene.shaders.push_back(sh);
+    }
+    const ShaderOrder order(scene);
+    ASSERT_EQ(order.shaderAt.size(), scene.shaders.size());
+    for (size_t r = 0; r < order.shaderAt.size(); ++r) {
+        EXPECT_EQ(order.rank[order.shaderAt[r]], r);
+        if (r == 0) continue;
+        const uint a = order.shaderAt[r - 1], b = order.shaderAt[r];
+        const uint ma = models[a], mb = models[b];
+        EXPECT_TRUE(ma < mb || (ma == mb && a < b)) << "rank " << r;
+    }
+}
+
 // radixSort(items, scratch, count) sorts the first count items as std::stable_sort does and
 // leaves the rest alone, whether its passes end in `items` or in `scratch` (one varying byte is
 // one pass, two are two).

@@ -510,6 +510,49 @@ TEST(VulkanPipelines, OneSurfaceModelCreatesExactlyOnePipeline) {
     EXPECT_EQ(v->stats.extra["vulkan"]["pipelines"], nlohmann::json({"lambert"}));
 }
 
+// Shaders of two models listed alternately: the hit sort ranks the shaders by model, so that each
+// model's hits are one range and one dispatch per batch (at most one per pipeline per submit;
+// sorted by shader index, the three Lambert shaders would be three ranges split by the two
+// Conductors). The image is still the cpu backend's.
+TEST(VulkanPipelines, EachSurfaceModelIsOneDispatchPerBatch) {
+    TempDir dir;
+    const std::string box = sourceDir() + "/scenes/cornell-box/";
+    const Scene scene = loadScene(
+        dir.write("alternate.yaml",
+                  "image: {width: 16, height: 16}\n"
+                  "camera: {look at: {eye: [278, 273, -800], target: [278, 273, 0]}, fov: 39.3}\n"
+                  "shaders:\n"
+                  "  - {type: Lambert, colour: [0.725, 0.71, 0.68]}\n"
+                  "  - {type: Conductor, colour: [0.95, 0.64, 0.54], alpha: 0.3}\n"
+                  "  - {type: Lambert, colour: [0.63, 0.065, 0.05]}\n"
+                  "  - {type: Conductor, colour: [0.9, 0.9, 0.9], alpha: 0.1}\n"
+                  "  - {type: Lambert, colour: [0.14, 0.45, 0.091]}\n"
+                  "objects:\n"
+                  "  - {filename: " +
+                      box +
+                      "white.obj, shader: 0}\n"
+                      "  - {filename: " +
+                      box +
+                      "red.obj, shader: 2}\n"
+                      "  - {filename: " +
+                      box +
+                      "green.obj, shader: 4}\n"
+                      "  - {filename: " +
+                      box +
+                      "blocks.obj, shader: 1}\n"
+                      "  - {filename: " +
+                      box +
+                      "blocks.obj, shader: 3, translation: [0, 0, -200]}\n"
+                      "light: {type: Quad, translation: [278, 548.7, 279.5], rotation: [90, 0, 0], "
+                      "scale: [130, 105], intensity: 1, colour: [17, 12, 4]}\n"));
+    auto v = expectVulkanMatchesCpu(scene, 4, "alternating models", 1e-5);
+    const nlohmann::json& vs = v->stats.extra["vulkan"];
+    const size_t pipelines = vs["pipelines"].size();
+    EXPECT_GE(pipelines, 2u);
+    EXPECT_LE(vs["dispatches"].get<std::uint64_t>(),
+              vs["submits"].get<std::uint64_t>() * pipelines);
+}
+
 // No emitter: the kernels are specialised without emission and next-event estimation, and the
 // image is black on both backends, exactly.
 TEST(VulkanPipelines, NoEmittersSpecialisesNextEventEstimationAway) {
