@@ -3,7 +3,9 @@
 // a shader by object and then by where they fall in texture space (coherent texture reads);
 // misses take the all-ones key and sort last. The shader's rank (ShaderOrder) puts the shaders
 // of one surface model next to each other: each model's hits are one contiguous range, one
-// dispatch of its kernel on the vulkan backend, whatever the order of the scene's shaders.
+// dispatch of its kernel on the vulkan backend, whatever the order of the scene's shaders. Object
+// and texture order only pay where textures are read; elsewhere the pipeline keys (shader rank,
+// 0, 0) and the hits keep their traversal order within a shader (stages.h: sortHits).
 // The loader's kMaxShaders and kMaxObjects keep every hit's key distinct from a miss's.
 #pragma once
 

@@ -154,7 +154,8 @@ void traverse(const EmbreeScene& embree, const std::vector<RayState>& rays, bool
 }
 
 size_t sortHits(const Scene& scene, const ShaderOrder& shaders, const std::vector<HitRecord>& hits,
-                bool byShader, std::vector<SortedHit>& order, std::vector<SortedHit>& scratch) {
+                bool byShader, bool inTextureOrder, std::vector<SortedHit>& order,
+                std::vector<SortedHit>& scratch) {
     const size_t n = hits.size();
     order.resize(n);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, n, batchGrain(n, 1024, kParallelGrain)),
@@ -164,8 +165,10 @@ size_t sortHits(const Scene& scene, const ShaderOrder& shaders, const std::vecto
                               std::uint64_t key = kMissKey;
                               if (h.mesh != kNoHit && byShader) {
                                   const Mesh& mesh = scene.meshes[h.mesh];
-                                  key = hitSortKey(shaders.rank[size_t(mesh.shader)], h.mesh,
-                                                   textureOrder(mesh, h.prim, h.u, h.v));
+                                  key = inTextureOrder
+                                            ? hitSortKey(shaders.rank[size_t(mesh.shader)], h.mesh,
+                                                         textureOrder(mesh, h.prim, h.u, h.v))
+                                            : hitSortKey(shaders.rank[size_t(mesh.shader)], 0, 0);
                               } else if (h.mesh != kNoHit) {
                                   key = 0;
                               }

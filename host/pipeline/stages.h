@@ -56,10 +56,13 @@ void decompressRays(const RayBatch& batch, std::vector<RayState>& rays);
 void traverse(const EmbreeScene& embree, const std::vector<RayState>& rays, bool coherent,
               std::vector<HitRecord>& hits);
 
-// sort hits: one SortedHit per ray, the hits first (by shader rank, object, texture order when
-// `byShader`, else in traversal order), the misses after them. Returns the number of hits.
+// sort hits: one SortedHit per ray, the hits first, the misses after them. With `byShader` the
+// hits go by shader rank (ShaderOrder), then by object and texture order where
+// `inTextureOrder`, else in traversal order within a shader; without, in traversal order.
+// Returns the number of hits.
 size_t sortHits(const Scene& scene, const ShaderOrder& shaders, const std::vector<HitRecord>& hits,
-                bool byShader, std::vector<SortedHit>& order, std::vector<SortedHit>& scratch);
+                bool byShader, bool inTextureOrder, std::vector<SortedHit>& order,
+                std::vector<SortedHit>& scratch);
 
 // hit setup: inputs[i] and paths[i] (pathId, bounce) for the i-th hit in `order`. Chunk by
 // chunk of 128 hits; within a chunk, each run of one shader's hits looks its textures up
