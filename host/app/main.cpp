@@ -112,8 +112,9 @@ sorted pipeline options (cpu and vulkan backends):
                         model) or megakernel (unsorted hits, one uber-shader switching per hit)
   --ray-format F        compact (34-byte rays, default) or full (50 bytes, every bit kept)
   --stages MODE         fused (default; cpu: hit setup, shade, shadow, accumulate and bin run
-                        chunk by chunk of 128 hits, in cache) or separate (each stage over the
-                        whole batch in turn, as the vulkan backend runs them)
+                        chunk by chunk of 128 hits, in cache; vulkan: shadow, accumulate and
+                        bin, after the device shaded the batch) or separate (each stage over
+                        the whole batch in turn)
   --simd-shading on|off cpu: shade Lambert hits 4, 8 or 16 at a time in SIMD registers (default
                         on, where every light is a triangle; the image is the same either way)
 

@@ -205,6 +205,11 @@ void SortedRenderer::finishBatch(int slot, uint iteration, Film& film) {
         StageTimer t(times, "shade wait");
         shading_->finish(slot);
     }
+    if (config_.fuseStages) {
+        finishFused(ctx_, iteration, config_.rayFormat, results, flight.paths.data(),
+                    flight.hitCount, film, *bins_);
+        return;
+    }
     {
         StageTimer t(times, "shadow");
         gatherShadowRays(results, flight.hitCount, s.shadowOwner, s.shadows);
@@ -244,7 +249,9 @@ void SortedRenderer::publishStats() {
     x["shading"] = shadingModeName(sortHits_ ? ShadingMode::Sorted : ShadingMode::Megakernel);
     x["batches_ray_sorted"] = policy_.sortedBatches();
     x["batches_ray_unsorted_measured"] = policy_.unsortedBatches();
-    x["stages"] = fused_ ? "fused" : "separate";
+    // fused: every per-hit stage chunk by chunk; fused after shading: shadow, accumulate and bin
+    // (an engine that shades elsewhere); separate: each stage over the whole batch.
+    x["stages"] = fused_ ? "fused" : config_.fuseStages ? "fused after shading" : "separate";
     shading_->publishStats(ctx_.stats);
 }
 

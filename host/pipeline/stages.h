@@ -110,4 +110,12 @@ void shadeFused(const RenderContext& ctx, uint iteration, RayFormat format, bool
                 const std::vector<SortedHit>& order, size_t hitCount, Film& film,
                 DirectionalBins& bins);
 
+// The stages after shading fused, for an engine that shades elsewhere (vulkan): shadow, accumulate
+// and bin run one after another on chunks of 128 results, as in shadeFused, instead of each
+// stage streaming over the whole batch (gatherShadowRays, accumulate, binContinuations: the
+// staged path, kept for --fuse-stages off). Same image bit for bit.
+void finishFused(const RenderContext& ctx, uint iteration, RayFormat format,
+                 const ShadeResult* results, const uvec2* paths, size_t hitCount, Film& film,
+                 DirectionalBins& bins);
+
 } // namespace spw

@@ -180,8 +180,12 @@ void expectLambertHitsAreShadeSurface() {
                     f.view(), params(strategy, sampling, uint(emitters)), hits, what.c_str());
                 // The comparison reached every outcome it can have here.
                 EXPECT_GT(c.next, 200u) << what;
-                if (emitters > 0 && strategy != kStrategyBsdf) EXPECT_GT(c.shadow, 100u) << what;
-                if (emitters > 0) EXPECT_GT(c.emitted, 5u) << what;
+                if (emitters > 0 && strategy != kStrategyBsdf) {
+                    EXPECT_GT(c.shadow, 100u) << what;
+                }
+                if (emitters > 0) {
+                    EXPECT_GT(c.emitted, 5u) << what;
+                }
             }
     }
 }

@@ -592,9 +592,10 @@ TEST(VulkanMegakernel, MatchesCpuAndBuildsOnlyTheUberShader) {
 
 // Staging copies (what a discrete GPU without resizable BAR takes), 2D dispatches (more
 // workgroups than one dimension allows) and ranges split across binding windows (buffers larger
-// than maxStorageBufferRange), forced on with tiny limits, and tiny batches (more submits per
-// iteration than the timestamp pool holds): the image is bit for bit the one of the plain path,
-// as each hit's arithmetic is unchanged and the film does not depend on batching.
+// than maxStorageBufferRange), forced on with tiny limits, tiny batches (more submits per
+// iteration than the timestamp pool holds) and the stages after shading run separately: the
+// image is bit for bit the one of the plain path, as each hit's arithmetic is unchanged and the
+// film does not depend on batching or on the order of its splats.
 TEST(VulkanBuffers, StagingTwoDimensionalAndWindowedDispatchesGiveTheSameImage) {
     Scene scene = smallCornell(24);
     RenderConfig plain = validatedVulkan(4);
@@ -623,6 +624,17 @@ TEST(VulkanBuffers, StagingTwoDimensionalAndWindowedDispatchesGiveTheSameImage) 
     const std::vector<float> ic = c->film->image();
     EXPECT_EQ(std::memcmp(ia.data(), ic.data(), ia.size() * sizeof(float)), 0);
     EXPECT_GT(c->stats.extra["vulkan"]["submits"].get<int>(), 512);
+
+    // The stages after shading, each over the whole batch instead of chunk by chunk.
+    RenderConfig separate = plain;
+    separate.pipeline.fuseStages = false;
+    auto d = renderValidated(scene, separate);
+    const std::vector<float> id = d->film->image();
+    EXPECT_EQ(std::memcmp(ia.data(), id.data(), ia.size() * sizeof(float)), 0);
+    EXPECT_EQ(d->stats.extra["stages"], "separate");
+    EXPECT_EQ(a->stats.extra["stages"], "fused after shading");
+    EXPECT_EQ(a->stats.shadowRays, d->stats.shadowRays);
+    EXPECT_GT(a->stats.shadowRays, 0u);
 }
 
 // --- the registry --------------------------------------------------------------------------
