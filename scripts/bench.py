@@ -24,8 +24,8 @@ are noisy; ratios travel, absolute seconds do not).
                                the reference, rays per second per core, and Embree's own rate on
                                the same rays (the cpu backend's traverse and shadow stages, which
                                do nothing but Embree calls), the share of the render in Embree,
-                               and the stage seconds. --baseline PATH adds another build's cpu
-                               and reference (before/after in one run). Writes
+                               and the stage seconds. --baseline PATH adds another build's
+                               reference, cpu and vulkan (before/after in one run). Writes
                                out/bench/incore.json.
   scripts/bench.py mpi         distributed rendering: 1 process x 2 threads against mpirun -np 2
                                x 1 thread (--threads T: the process's; --ranks R1,R2,...: rank
@@ -146,7 +146,8 @@ def bench_incore(spillway, repeat, baseline):
                ("vulkan", spillway, ["--backend", "vulkan"])]
     if baseline:
         configs += [("baseline reference", baseline, ["--backend", "reference"]),
-                    ("baseline cpu", baseline, ["--backend", "cpu"])]
+                    ("baseline cpu", baseline, ["--backend", "cpu"]),
+                    ("baseline vulkan", baseline, ["--backend", "vulkan"])]
     results = []
     for title, scene, extra in scenes:
         best = {}
