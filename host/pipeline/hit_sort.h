@@ -1,7 +1,8 @@
 // Hit sorting: each hit's key packs (shader rank, object, texture order) into 12 + 20 + 32 bits,
 // so that a radix sort of the keys groups a batch's hits by surface model and shader, and within
 // a shader by object and then by where they fall in texture space (coherent texture reads);
-// misses take the all-ones key and sort last. The shader's rank (ShaderOrder) puts the shaders
+// misses sort last (stages.h: sortHits gives them the rank after the last shader's; kMissKey, the
+// all-ones key, where hits are not sorted). The shader's rank (ShaderOrder) puts the shaders
 // of one surface model next to each other: each model's hits are one contiguous range, one
 // dispatch of its kernel on the vulkan backend, whatever the order of the scene's shaders. Object
 // and texture order only pay where textures are read; elsewhere the pipeline keys (shader rank,

@@ -7,18 +7,16 @@
 
 namespace spw {
 
-void radixSort(std::vector<KeyIndex>& items, std::vector<KeyIndex>& scratch, size_t count) {
-    const size_t n = count;
+void radixSort(std::vector<KeyIndex>& items, std::vector<KeyIndex>& scratch) {
+    const size_t n = items.size();
     if (n < 2) return;
-    // The passes swap the two vectors: both get the unsorted tail.
-    scratch.resize(items.size());
-    std::copy(items.begin() + std::ptrdiff_t(n), items.end(), scratch.begin() + std::ptrdiff_t(n));
+    scratch.resize(n);
     // Below this size one thread sorts faster than the task overhead of splitting.
     const size_t chunk = std::max<size_t>(1 << 14, (n + 31) / 32);
     const size_t chunks = (n + chunk - 1) / chunk;
     std::uint64_t all_or = 0, all_and = ~0ull;
-    for (size_t i = 0; i < n; ++i)
-        all_or |= items[i].key, all_and &= items[i].key;
+    for (const KeyIndex& k : items)
+        all_or |= k.key, all_and &= k.key;
     const std::uint64_t varying = all_or ^ all_and;
     std::vector<std::array<size_t, 256>> hist(chunks);
     for (int shift = 0; shift < 64; shift += 8) {

@@ -3,7 +3,6 @@
 // cost only the passes they need.
 #pragma once
 
-#include <cstddef>
 #include <cstdint>
 #include <vector>
 
@@ -14,11 +13,7 @@ struct KeyIndex {
     std::uint32_t index;
 };
 
-// Sorts items[0, count) by key, stably, and leaves the items after them as they are (count
-// defaults to all). `scratch` is resized as needed and may be reused across calls.
-void radixSort(std::vector<KeyIndex>& items, std::vector<KeyIndex>& scratch, size_t count);
-inline void radixSort(std::vector<KeyIndex>& items, std::vector<KeyIndex>& scratch) {
-    radixSort(items, scratch, items.size());
-}
+// Sorts `items` by key, stably. `scratch` is resized as needed and may be reused across calls.
+void radixSort(std::vector<KeyIndex>& items, std::vector<KeyIndex>& scratch);
 
 } // namespace spw

@@ -158,11 +158,16 @@ size_t sortHits(const Scene& scene, const ShaderOrder& shaders, const std::vecto
                 std::vector<SortedHit>& scratch) {
     const size_t n = hits.size();
     order.resize(n);
+    // Sorted, the misses take the rank after the last shader's: behind every hit, and varying
+    // no byte of the keys that the hits' ranks do not (the all-ones key would make all eight
+    // vary, eight radix passes instead of one or a few).
+    const std::uint64_t missKey =
+        byShader ? hitSortKey(uint(shaders.shaderAt.size()), 0, 0) : kMissKey;
     tbb::parallel_for(tbb::blocked_range<size_t>(0, n, batchGrain(n, 1024, kParallelGrain)),
                       [&](const tbb::blocked_range<size_t>& r) {
                           for (size_t i = r.begin(); i < r.end(); ++i) {
                               const HitRecord& h = hits[i];
-                              std::uint64_t key = kMissKey;
+                              std::uint64_t key = missKey;
                               if (h.mesh != kNoHit && byShader) {
                                   const Mesh& mesh = scene.meshes[h.mesh];
                                   key = inTextureOrder
@@ -175,17 +180,9 @@ size_t sortHits(const Scene& scene, const ShaderOrder& shaders, const std::vecto
                               order[i] = {key, std::uint32_t(i)};
                           }
                       });
-    const size_t hitCount = parallelCount(n, [&](size_t i) { return order[i].key != kMissKey; });
+    const size_t hitCount = parallelCount(n, [&](size_t i) { return order[i].key != missKey; });
     if (byShader) {
-        // The misses go behind the hits first, in their order, and the radix sort sorts the hits
-        // alone: the misses' all-ones key would make every byte of the keys vary and cost all
-        // eight passes. The order is the one a sort of all the keys gives, as it is stable.
-        scratch.resize(n);
-        size_t hit = 0, miss = hitCount;
-        for (const SortedHit& k : order)
-            (k.key != kMissKey ? scratch[hit++] : scratch[miss++]) = k;
-        order.swap(scratch);
-        radixSort(order, scratch, hitCount);
+        radixSort(order, scratch);
     } else {
         // No sort: keep traversal order, just move the misses out.
         std::stable_partition(order.begin(), order.end(),

@@ -63,31 +63,6 @@ TEST(HitSort, ShaderRanksGroupEachSurfaceModel) {
     }
 }
 
-// radixSort(items, scratch, count) sorts the first count items as std::stable_sort does and
-// leaves the rest alone, whether its passes end in `items` or in `scratch` (one varying byte is
-// one pass, two are two).
-TEST(RadixSort, SortsAPrefixStablyAndLeavesTheTailAlone) {
-    std::mt19937 rng(7);
-    for (std::uint64_t mask : {0xFFull, 0xFF0000FFull, 0x0F0F0F0F0F0F0F0Full}) {
-        for (size_t count : {size_t(0), size_t(1), size_t(1000), size_t(70000)}) {
-            std::vector<KeyIndex> items(count + 333), scratch(5);
-            for (size_t i = 0; i < items.size(); ++i)
-                items[i] = {(std::uint64_t(rng()) << 32 | rng()) & mask, std::uint32_t(i)};
-            for (size_t i = count; i < items.size(); ++i)
-                items[i].key = ~0ull - i; // not in order: must stay as it is
-            std::vector<KeyIndex> expected = items;
-            std::stable_sort(expected.begin(), expected.begin() + std::ptrdiff_t(count),
-                             [](const KeyIndex& a, const KeyIndex& b) { return a.key < b.key; });
-            radixSort(items, scratch, count);
-            ASSERT_EQ(items.size(), expected.size());
-            for (size_t i = 0; i < items.size(); ++i) {
-                ASSERT_EQ(items[i].key, expected[i].key) << "mask " << mask << " at " << i;
-                ASSERT_EQ(items[i].index, expected[i].index) << "mask " << mask << " at " << i;
-            }
-        }
-    }
-}
-
 TEST(HitSort, KeysSortIntoOneContiguousRunPerShaderWithMissesLast) {
     for (uint shaders : {1u, 3u, 40u, uint(kMaxShaders)}) {
         std::vector<Hit> hits = randomHits(100000, shaders, shaders);
