@@ -24,6 +24,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <random>
 #include <set>
 #include <sys/wait.h>
@@ -150,11 +151,14 @@ void expectSameUpToRounding(const char* what, const std::vector<std::vector<floa
                              rounding * mean(c));
 }
 
-// Renders `scene` on vulkan (under validation) and on cpu with the same settings and asserts
-// that they agree up to `rounding` (expectSameUpToRounding). Returns the vulkan render.
-std::unique_ptr<RenderResult> expectVulkanMatchesCpu(const Scene& scene, int spp, const char* what,
-                                                     double rounding) {
+// Renders `scene` on vulkan (under validation) and on cpu with the same settings (`configure`
+// changes both) and asserts that they agree up to `rounding` (expectSameUpToRounding). Returns
+// the vulkan render.
+std::unique_ptr<RenderResult>
+expectVulkanMatchesCpu(const Scene& scene, int spp, const char* what, double rounding,
+                       const std::function<void(RenderConfig&)>& configure = nullptr) {
     RenderConfig vkCfg = validatedVulkan(spp);
+    if (configure) configure(vkCfg);
     RenderConfig cpuCfg = vkCfg;
     cpuCfg.backend = BackendKind::Cpu;
     std::vector<std::vector<float>> v, c;
@@ -241,15 +245,8 @@ TEST(VulkanVsCpu, EachSamplingStrategyAgreesUpToFloatRounding) {
     Scene scene = smallCornell(24);
     for (const auto& [strategy, name] :
          {std::pair{kStrategyLight, "light"}, std::pair{kStrategyBsdf, "bsdf"}}) {
-        RenderConfig vkCfg = validatedVulkan(8);
-        vkCfg.strategy = strategy;
-        RenderConfig cpuCfg = vkCfg;
-        cpuCfg.backend = BackendKind::Cpu;
-        std::vector<std::vector<float>> v, c;
-        auto result = renderValidated(scene, vkCfg, &v);
-        render(scene, cpuCfg,
-               [&](int, int, const Film& film) { c.push_back(film.lastIterationImage()); });
-        expectSameUpToRounding(name, v, c, 24, 24, 1e-5);
+        auto result = expectVulkanMatchesCpu(scene, 8, name, 1e-5,
+                                             [&](RenderConfig& c) { c.strategy = strategy; });
         EXPECT_EQ(result->stats.extra["vulkan"]["specialization"]["strategy"], name);
         EXPECT_GT(mean(result->film->image()), 0.01) << name;
     }
@@ -303,37 +300,31 @@ TEST(VulkanVsCpu, ClosedEnclosureAgreesUpToFloatRounding) {
 
 // Every registered model in one scene: Lambert walls, a rough and a polished Conductor, a rough
 // and a smooth Dielectric, and the quad light's Null.
+// The Cornell box's camera, meshes and quad light at 16 x 16, with `shaders` (YAML list items)
+// and `objects`: each a mesh of scenes/cornell-box/ and its keys, "white.obj, shader: 0".
+Scene boxWith(const TempDir& dir, const std::string& shaders,
+              const std::vector<std::string>& objects) {
+    std::string yaml = "image: {width: 16, height: 16}\n"
+                       "camera: {look at: {eye: [278, 273, -800], target: [278, 273, 0]}, "
+                       "fov: 39.3}\n"
+                       "shaders:\n" +
+                       shaders + "objects:\n";
+    for (const std::string& o : objects)
+        yaml += "  - {filename: " + sourceDir() + "/scenes/cornell-box/" + o + "}\n";
+    yaml += "light: {type: Quad, translation: [278, 548.7, 279.5], rotation: [90, 0, 0], "
+            "scale: [130, 105], intensity: 1, colour: [17, 12, 4]}\n";
+    return loadScene(dir.write("box.yaml", yaml));
+}
+
 Scene everyModelScene(const TempDir& dir) {
-    const std::string box = sourceDir() + "/scenes/cornell-box/";
-    return loadScene(
-        dir.write("models.yaml",
-                  "image: {width: 16, height: 16}\n"
-                  "camera: {look at: {eye: [278, 273, -800], target: [278, 273, 0]}, fov: 39.3}\n"
-                  "shaders:\n"
-                  "  - {type: Lambert, colour: [0.725, 0.71, 0.68]}\n"
-                  "  - {type: Conductor, colour: [0.95, 0.64, 0.54], alpha: 0.3}\n"
-                  "  - {type: Conductor, colour: [0.9, 0.9, 0.9]}\n"
-                  "  - {type: Dielectric, ior: 1.5, alpha: 0.2}\n"
-                  "  - {type: Dielectric, ior: 1.33}\n"
-                  "objects:\n"
-                  "  - {filename: " +
-                      box +
-                      "white.obj, shader: 0}\n"
-                      "  - {filename: " +
-                      box +
-                      "red.obj, shader: 1}\n"
-                      "  - {filename: " +
-                      box +
-                      "green.obj, shader: 2}\n"
-                      "  - {filename: " +
-                      box +
-                      "blocks.obj, shader: 3}\n"
-                      "  - {filename: " +
-                      box +
-                      "blocks.obj, shader: 4}\n"
-                      "light: {type: Quad, translation: [278, 548.7, 279.5], rotation: [90, 0, 0], "
-                      "scale: [130, 105], "
-                      "intensity: 1, colour: [17, 12, 4]}\n"));
+    return boxWith(dir,
+                   "  - {type: Lambert, colour: [0.725, 0.71, 0.68]}\n"
+                   "  - {type: Conductor, colour: [0.95, 0.64, 0.54], alpha: 0.3}\n"
+                   "  - {type: Conductor, colour: [0.9, 0.9, 0.9]}\n"
+                   "  - {type: Dielectric, ior: 1.5, alpha: 0.2}\n"
+                   "  - {type: Dielectric, ior: 1.33}\n",
+                   {"white.obj, shader: 0", "red.obj, shader: 1", "green.obj, shader: 2",
+                    "blocks.obj, shader: 3", "blocks.obj, shader: 4"});
 }
 
 // |a - b| over the vector's size, in float epsilons (2^-23): a direction or a position rounded
@@ -516,35 +507,15 @@ TEST(VulkanPipelines, OneSurfaceModelCreatesExactlyOnePipeline) {
 // Conductors). The image is still the cpu backend's.
 TEST(VulkanPipelines, EachSurfaceModelIsOneDispatchPerBatch) {
     TempDir dir;
-    const std::string box = sourceDir() + "/scenes/cornell-box/";
-    const Scene scene = loadScene(
-        dir.write("alternate.yaml",
-                  "image: {width: 16, height: 16}\n"
-                  "camera: {look at: {eye: [278, 273, -800], target: [278, 273, 0]}, fov: 39.3}\n"
-                  "shaders:\n"
-                  "  - {type: Lambert, colour: [0.725, 0.71, 0.68]}\n"
-                  "  - {type: Conductor, colour: [0.95, 0.64, 0.54], alpha: 0.3}\n"
-                  "  - {type: Lambert, colour: [0.63, 0.065, 0.05]}\n"
-                  "  - {type: Conductor, colour: [0.9, 0.9, 0.9], alpha: 0.1}\n"
-                  "  - {type: Lambert, colour: [0.14, 0.45, 0.091]}\n"
-                  "objects:\n"
-                  "  - {filename: " +
-                      box +
-                      "white.obj, shader: 0}\n"
-                      "  - {filename: " +
-                      box +
-                      "red.obj, shader: 2}\n"
-                      "  - {filename: " +
-                      box +
-                      "green.obj, shader: 4}\n"
-                      "  - {filename: " +
-                      box +
-                      "blocks.obj, shader: 1}\n"
-                      "  - {filename: " +
-                      box +
-                      "blocks.obj, shader: 3, translation: [0, 0, -200]}\n"
-                      "light: {type: Quad, translation: [278, 548.7, 279.5], rotation: [90, 0, 0], "
-                      "scale: [130, 105], intensity: 1, colour: [17, 12, 4]}\n"));
+    const Scene scene =
+        boxWith(dir,
+                "  - {type: Lambert, colour: [0.725, 0.71, 0.68]}\n"
+                "  - {type: Conductor, colour: [0.95, 0.64, 0.54], alpha: 0.3}\n"
+                "  - {type: Lambert, colour: [0.63, 0.065, 0.05]}\n"
+                "  - {type: Conductor, colour: [0.9, 0.9, 0.9], alpha: 0.1}\n"
+                "  - {type: Lambert, colour: [0.14, 0.45, 0.091]}\n",
+                {"white.obj, shader: 0", "red.obj, shader: 2", "green.obj, shader: 4",
+                 "blocks.obj, shader: 1", "blocks.obj, shader: 3, translation: [0, 0, -200]"});
     auto v = expectVulkanMatchesCpu(scene, 4, "alternating models", 1e-5);
     const nlohmann::json& vs = v->stats.extra["vulkan"];
     const size_t pipelines = vs["pipelines"].size();
@@ -576,15 +547,9 @@ TEST(VulkanPipelines, NoEmittersSpecialisesNextEventEstimationAway) {
 // backend's; only the megakernel pipeline is built.
 TEST(VulkanMegakernel, MatchesCpuAndBuildsOnlyTheUberShader) {
     Scene scene = smallCornell(24);
-    RenderConfig vkCfg = validatedVulkan(8);
-    vkCfg.pipeline.shading = ShadingMode::Megakernel;
-    RenderConfig cpuCfg = vkCfg;
-    cpuCfg.backend = BackendKind::Cpu;
-    std::vector<std::vector<float>> vi, ci;
-    auto v = renderValidated(scene, vkCfg, &vi);
-    render(scene, cpuCfg,
-           [&](int, int, const Film& film) { ci.push_back(film.lastIterationImage()); });
-    expectSameUpToRounding("megakernel Cornell box", vi, ci, 24, 24, 3e-5); // measured 3.5e-6
+    auto v = expectVulkanMatchesCpu(
+        scene, 8, "megakernel Cornell box", 3e-5, // measured 3.5e-6
+        [](RenderConfig& c) { c.pipeline.shading = ShadingMode::Megakernel; });
     EXPECT_EQ(v->stats.extra["vulkan"]["pipelines"], nlohmann::json({"megakernel"}));
     EXPECT_EQ(v->stats.extra["shading"], "megakernel");
     EXPECT_EQ(v->stats.extra["hit_sort"], false);
