@@ -110,7 +110,7 @@ class VulkanShading : public ShadingEngine {
     VkQueryPool queries_ = VK_NULL_HANDLE;
     uint32_t queriesUsed_ = 0; // written since the last read; the pool is reset when this is 0
     Slot slots_[kSlots];
-    size_t windowRecords_ = 0; // records per binding window (within maxStorageBufferRange)
+    size_t windowRecords_ = 0; // records per binding window (within the device's limits)
     uint32_t maxGroupsX_ = 0, maxGroupsY_ = 0;
     bool timestamps_ = false;
     vk::KernelSpecialization spec_;
@@ -181,8 +181,8 @@ VulkanShading::VulkanShading(const RenderContext& ctx, const PipelineConfig& pip
         const size_t largest = std::max(sizeof(ShadeInput), sizeof(ShadeResult));
         windowRecords_ = size_t(maxRange / largest) / step * step;
         if (windowRecords_ == 0)
-            throw std::runtime_error("the device's buffer bindings (maxStorageBufferRange, " +
-                                     std::string("maxTexelBufferElements) hold no shading record"));
+            throw std::runtime_error("the device's maxStorageBufferRange or "
+                                     "maxTexelBufferElements holds no shading record");
         maxGroupsX_ = config_.maxGroupsX
                           ? std::min(config_.maxGroupsX, limits.maxComputeWorkGroupCount[0])
                           : limits.maxComputeWorkGroupCount[0];
@@ -422,8 +422,7 @@ int VulkanShading::pipelineFor(uint model) const {
 
 // One dispatch of `count` records from `offset` in the bound window: 1D, or 2D when the range
 // needs more workgroups than one dimension allows.
-// The set is bound only when it changes: binding another pipeline of the same layout keeps it,
-// and on lavapipe every bind re-derives the texel buffers' state for the next dispatch.
+// The set is bound only when it changes: binding another pipeline of the same layout keeps it.
 void VulkanShading::recordDispatch(VkCommandBuffer cmd, VkDescriptorSet set, VkDescriptorSet& bound,
                                    uint32_t offset, uint32_t count) {
     if (set != bound) {
