@@ -245,8 +245,9 @@ TEST(VulkanVsCpu, EachSamplingStrategyAgreesUpToFloatRounding) {
     Scene scene = smallCornell(24);
     for (const auto& [strategy, name] :
          {std::pair{kStrategyLight, "light"}, std::pair{kStrategyBsdf, "bsdf"}}) {
+        const uint chosen = strategy; // C++17 lambdas cannot capture a structured binding
         auto result = expectVulkanMatchesCpu(scene, 8, name, 1e-5,
-                                             [&](RenderConfig& c) { c.strategy = strategy; });
+                                             [&](RenderConfig& c) { c.strategy = chosen; });
         EXPECT_EQ(result->stats.extra["vulkan"]["specialization"]["strategy"], name);
         EXPECT_GT(mean(result->film->image()), 0.01) << name;
     }
