@@ -37,7 +37,7 @@
 // as whole uvec4s. Why not storage buffers throughout: on lavapipe (Mesa 22.3) every storage
 // buffer access whose address differs between lanes is a loop over the 8 lanes with a branch per
 // lane and one scalar load per component, while a texel fetch is a vector gather; the stores are
-// fewest as 7 whole uvec4s per record. (Measured: README, "Fifth round".) The unpacking below
+// fewest as 7 whole uvec4s per record. (Measured: docs/performance-log.md, "Fifth round".) The unpacking below
 // follows the byte layout that host/vk/shared_layout.cpp pins for the C++ side.
 // 4 and 5 are bound as a window of the batch's buffers (within maxStorageBufferRange and
 // maxTexelBufferElements) and ShadePush.offset is relative to it. Dispatches are 1D, or 2D when

@@ -30,7 +30,7 @@ namespace {
 // (ctest runs one test per process), as a listener may not add failures itself. The one test
 // that provokes a message on purpose (to show the layer is live) is exempt. In the sanitized
 // build only the Vulkan* tests ask for the layer (and run without leak detection): LeakSanitizer
-// reports the layer's allocations after the loader has unloaded it (README, "Tests").
+// reports the layer's allocations after the loader has unloaded it (docs/testing.md).
 class ValidationListener : public ::testing::EmptyTestEventListener {
     std::uint64_t before_ = 0;
     bool failed_ = false;

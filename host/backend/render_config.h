@@ -61,9 +61,7 @@ struct PipelineConfig {
     ShadingMode shading = ShadingMode::Sorted;
     // Hits may be sorted only for sorted shading (the renderer applies the auto rule).
     bool sortsHits() const { return hitSort != HitSortMode::Off && shading == ShadingMode::Sorted; }
-    std::optional<int> binExponent;        // overrides settings: bin exponent
-    std::optional<double> memoryBudgetMiB; // overrides settings: memory budget
-    std::string spillDir;                  // empty: the system temp folder
+    std::string spillDir; // empty: the system temp folder
     // The cpu engine's per-hit stages fused chunk by chunk (stages.h: shadeFused); false runs
     // them one whole batch after another, as the Vulkan engine must (the ablation).
     bool fuseStages = true;
@@ -88,13 +86,14 @@ struct VulkanConfig {
 
 constexpr int kStopByWindow = -1; // RenderConfig::stop's value when the preview window closed
 
+// The scene's settings (seed, budgets, adaptive sampling) are not here: the CLI's overrides of
+// them are applied to the scene once it is loaded (host/scene/settings_table.h).
 struct RenderConfig {
     // The library's default stays cpu so that callers that do not ask for a device never
     // initialise Vulkan; the CLI's default is auto.
     BackendKind backend = BackendKind::Cpu;
     int threads = 0;                        // 0: every core
     std::optional<int> spp;                 // overrides sample base and iterations
-    std::optional<std::uint32_t> seed;      // overrides settings.seed
     uint strategy = kStrategyMis;           // light/BSDF sampling ablation (tests, benchmarks)
     PipelineConfig pipeline;                // the sorted backends' knobs
     VulkanConfig vulkan;                    // the vulkan backend's knobs
@@ -106,11 +105,8 @@ struct RenderConfig {
     // the render keeps every completed iteration. Set from a signal handler (the CLI's).
     // kStopByWindow when the preview window was closed, else the signal's number.
     const std::atomic<int>* stop = nullptr;
-    std::optional<double> textureCacheMiB;   // overrides settings: texture cache
-    std::optional<double> adaptiveThreshold; // overrides settings: adaptive threshold
     // A partial render: only samples [first, second) of the spp (iteration boundaries).
     std::optional<std::pair<int, int>> sampleRange;
-    std::optional<int> adaptiveMinSamples; // overrides settings: adaptive min samples
     TextureFilter textureFilter = TextureFilter::Cone;
 };
 

@@ -32,23 +32,20 @@ using Clock = std::chrono::steady_clock;
 double since(Clock::time_point t) {
     return std::chrono::duration<double>(Clock::now() - t).count();
 }
-uint binExponentOf(const RenderContext& ctx, const PipelineConfig& config) {
-    return uint(config.binExponent.value_or(ctx.scene.settings.binExponent));
-}
 } // namespace
 
 SortedRenderer::SortedRenderer(const RenderContext& ctx, const PipelineConfig& config,
                                std::unique_ptr<ShadingEngine> shading)
     : ctx_(ctx), config_(config), shading_(std::move(shading)),
-      policy_(config.raySort, size_t(1) << binExponentOf(ctx, config)),
+      policy_(config.raySort, size_t(1) << uint(ctx.scene.settings.binExponent)),
       scratch_(std::make_unique<Scratch>()),
       fused_(config.fuseStages && shading_->shadesOnHostThreads()),
       simdShading_(fused_ && usesSimdShading(ctx)),
       sortHits_(config.sortsHits() && (config.hitSort == HitSortMode::On ||
                                        !shading_->shadesOnHostThreads() || ctx.textures.active())),
       shaderOrder_(ctx.scene) {
-    const double budgetMiB = config.memoryBudgetMiB.value_or(ctx.scene.settings.memoryBudgetMiB);
-    const uint exponent = binExponentOf(ctx, config);
+    const double budgetMiB = ctx.scene.settings.memoryBudgetMiB;
+    const uint exponent = uint(ctx.scene.settings.binExponent);
     // The budget covers every ray waiting in RAM: the six bins fill up to one batch each, and
     // the queue keeps the rest of the budget (none when six batches already exceed it, so that
     // every batch spills). Peak rays in RAM <= max(budget, six batches), as --help states.

@@ -91,7 +91,7 @@ CheckpointKey checkpointKey(const Scene& scene, const RenderConfig& config, int 
     CheckpointKey k;
     k.version = SPILLWAY_VERSION;
     k.sceneHash = sceneHash(scene);
-    k.seed = config.seed.value_or(scene.settings.seed);
+    k.seed = scene.settings.seed;
     k.width = scene.image.width;
     k.height = scene.image.height;
     k.sampleBase = sampleBase;
@@ -102,8 +102,8 @@ CheckpointKey checkpointKey(const Scene& scene, const RenderConfig& config, int 
     k.textureFilter = filterName(config.textureFilter);
     k.strategy = config.strategy;
     k.sampler = samplerName(scene.sampler);
-    k.adaptiveThreshold = config.adaptiveThreshold.value_or(scene.settings.adaptiveThreshold);
-    k.adaptiveMinSamples = config.adaptiveMinSamples.value_or(scene.settings.adaptiveMinSamples);
+    k.adaptiveThreshold = scene.settings.adaptiveThreshold;
+    k.adaptiveMinSamples = scene.settings.adaptiveMinSamples;
     return k;
 }
 

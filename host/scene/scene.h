@@ -33,7 +33,7 @@ class SceneError : public std::runtime_error {
 };
 
 // The ranges of the scene format that keep every ray Embree sees valid and every product of the
-// shading math finite in float (README, "Notes on the scene format").
+// shading math finite in float (docs/scene-format.md).
 // Every position, after its transforms, lies within this many units of the camera: squared
 // distances stay below 1e31, far inside float, and ray origins far inside Embree's 1.8e18.
 constexpr double kMaxDistance = 1e15;
@@ -157,7 +157,7 @@ struct Scene {
     Settings settings;
     Camera camera;
     Filter filter;
-    SamplerType sampler = SamplerType::Sobol; // measured best: README, "Convergence"
+    SamplerType sampler = SamplerType::Sobol; // measured best: docs/performance.md, "Samplers"
     std::vector<Shader> shaders; // scene shaders first, then one emissive Null per quad light
     std::vector<Texture> textures;
     std::vector<Mesh> meshes; // objects first, then the quad lights' geometry

@@ -3,6 +3,7 @@
 #include "host/image/image_io.h"
 #include "host/scene/obj_mesh.h"
 #include "host/scene/scene.h"
+#include "host/scene/settings_table.h"
 #include "host/scene/surface_models.h"
 
 #include <OpenImageIO/imageio.h>
@@ -192,29 +193,17 @@ void readImage(const Reader& rd, const YAML::Node& n, ImageSettings& img) {
                        " samples per pixel exceeds 2^32");
 }
 
+// Every key under `settings:`, read by the one table (host/scene/settings_table.h).
 void readSettings(const Reader& rd, const YAML::Node& n, Settings& s) {
-    rd.checkKeys(n, "settings",
-                 {"min depth", "max depth", "threshold", "bucket size", "shading size",
-                  "bin exponent", "memory budget", "texture cache", "seed", "adaptive threshold",
-                  "adaptive min samples"});
-    if (n["min depth"]) s.minDepth = int(rd.integer(n["min depth"], "min depth", 0, kMaxDepth));
-    if (n["max depth"]) s.maxDepth = int(rd.integer(n["max depth"], "max depth", 0, kMaxDepth));
-    if (n["threshold"]) s.threshold = float(rd.number(n["threshold"], "threshold", 0.0, 1e30));
-    if (n["bucket size"]) s.bucketSize = int(rd.integer(n["bucket size"], "bucket size", 1, 4096));
-    if (n["shading size"])
-        s.shadingSize = int(rd.integer(n["shading size"], "shading size", 1, 1 << 24));
-    if (n["bin exponent"])
-        s.binExponent = int(rd.integer(n["bin exponent"], "bin exponent", 4, 24));
-    if (n["memory budget"])
-        s.memoryBudgetMiB = rd.number(n["memory budget"], "memory budget", 1.0 / 1024, 1 << 20);
-    if (n["texture cache"])
-        s.textureCacheMiB = rd.number(n["texture cache"], "texture cache", 1.0, 1 << 20);
-    if (n["seed"]) s.seed = std::uint32_t(rd.integer(n["seed"], "seed", 0, 0xFFFFFFFFLL));
-    if (n["adaptive threshold"])
-        s.adaptiveThreshold = rd.number(n["adaptive threshold"], "adaptive threshold", 0.0, 1e9);
-    if (n["adaptive min samples"])
-        s.adaptiveMinSamples =
-            int(rd.integer(n["adaptive min samples"], "adaptive min samples", 2, 1 << 24));
+    std::vector<std::string> keys;
+    for (const SettingSpec& spec : settingsTable())
+        keys.push_back(spec.key);
+    rd.checkKeys(n, "settings", keys);
+    for (const SettingSpec& spec : settingsTable())
+        if (const YAML::Node v = n[spec.key])
+            spec.set(s, spec.integer ? double(rd.integer(v, spec.key, (long long)spec.lo,
+                                                         (long long)spec.hi))
+                                     : rd.number(v, spec.key, spec.lo, spec.hi));
 }
 
 // Reads the camera and returns its position in the file's coordinates: the scene's origin.

@@ -36,7 +36,7 @@ const Reference& highSppReference(int size) {
     RenderConfig cfg;
     cfg.backend = BackendKind::Reference;
     cfg.spp = size < 48 ? 16384 : 4096;
-    cfg.seed = 12345; // independent of the test renders' random numbers
+    scene.settings.seed = 12345; // independent of the test renders' random numbers
     auto result = render(scene, cfg);
     return refs[size] = Reference{ImageRGB{size, size, result->film->image()},
                                   result->film->halfBufferRelMse()};
@@ -56,7 +56,7 @@ Series convergence(const std::string& backend, std::uint32_t seed, int size, int
     RenderConfig cfg;
     cfg.backend = parseBackend(backend);
     cfg.spp = firstSpp * 16;
-    cfg.seed = seed;
+    scene.settings.seed = seed;
     Series s{};
     size_t k = 0;
     auto result = render(scene, cfg, [&](int done, int, const Film& film) {

@@ -60,8 +60,9 @@ TEST(SortedPipeline, FullPrecisionRaysGiveTheReferenceImageBitForBit) {
         RenderConfig cpu = ref;
         cpu.backend = BackendKind::Cpu;
         cpu.pipeline.rayFormat = RayFormat::Full;
-        cpu.pipeline.binExponent = 10;
-        const std::vector<float> a = renderImage(scene, ref), b = renderImage(scene, cpu);
+        Scene binned = scene; // small batches: many of them
+        binned.settings.binExponent = 10;
+        const std::vector<float> a = renderImage(scene, ref), b = renderImage(binned, cpu);
         EXPECT_GT(mean(a), 0.0);
         EXPECT_TRUE(sameBits(a, b)) << scene.file;
     }
@@ -81,8 +82,9 @@ TEST(SortedPipeline, CompactCameraRaysAreTheReferencesToTheBit) {
     ref.strategy = kStrategyLight;
     RenderConfig cpu = ref;
     cpu.backend = BackendKind::Cpu;
-    cpu.pipeline.binExponent = 10;
-    auto result = render(scene, cpu);
+    Scene binned = scene;
+    binned.settings.binExponent = 10;
+    auto result = render(binned, cpu);
     EXPECT_EQ(result->stats.extra["ray_format"], "compact");
     EXPECT_GT(result->stats.bounceRays.load(), 40u * 40u * 8u / 2u);
     const std::vector<float> a = renderImage(scene, ref);
@@ -101,9 +103,10 @@ void expectAgreesWithReference(const Scene& scene, int iterations, const std::st
     ref.spp = iterations * scene.image.samplesPerIteration();
     RenderConfig cpu = ref;
     cpu.backend = BackendKind::Cpu;
-    cpu.pipeline.binExponent = 10;
+    Scene binned = scene;
+    binned.settings.binExponent = 10;
     expectNoPairedDifference(
-        pairedDifference(iterationImages(scene, cpu), iterationImages(scene, ref)),
+        pairedDifference(iterationImages(binned, cpu), iterationImages(scene, ref)),
         scene.image.width, scene.image.height, what);
 }
 
@@ -141,33 +144,37 @@ TEST(SortedPipeline, ImageIsIndependentOfBatchingSortingBudgetAndThreads) {
     RenderConfig base;
     base.spp = 8;
     base.threads = 1;
-    base.pipeline.binExponent = 12;
+    scene.settings.binExponent = 12;
     const std::vector<float> expected = renderImage(scene, base);
-    // Returns the batches spilled.
+    // Returns the batches spilled. `change` edits the configuration, or the scene's settings.
     auto variant = [&](const char* what, auto change) {
         RenderConfig cfg = base;
-        change(cfg);
-        auto result = render(scene, cfg);
+        Scene changed = scene;
+        if constexpr (std::is_invocable_v<decltype(change), RenderConfig&>)
+            change(cfg);
+        else
+            change(changed.settings, cfg);
+        auto result = render(changed, cfg);
         EXPECT_TRUE(sameBits(expected, result->film->image())) << what;
         return result->stats.extra["batches_spilled"].get<long>();
     };
     EXPECT_EQ(variant("the same again", [](RenderConfig&) {}), 0);
     EXPECT_NE(render(scene, base)->stats.extra["simd_shading"], "off");
-    variant("bin exponent 8", [](RenderConfig& c) { c.pipeline.binExponent = 8; });
-    variant("bin exponent 16", [](RenderConfig& c) { c.pipeline.binExponent = 16; });
+    variant("bin exponent 8", [](Settings& s, RenderConfig&) { s.binExponent = 8; });
+    variant("bin exponent 16", [](Settings& s, RenderConfig&) { s.binExponent = 16; });
     variant("2 threads", [](RenderConfig& c) { c.threads = 2; });
     // 64 KiB: less than six 2^12-ray batches (768 KiB), so every batch goes through the disk.
     EXPECT_GT(
-        variant("64 KiB budget", [](RenderConfig& c) { c.pipeline.memoryBudgetMiB = 1.0 / 16; }),
+        variant("64 KiB budget", [](Settings& s, RenderConfig&) { s.memoryBudgetMiB = 1.0 / 16; }),
         0);
-    EXPECT_EQ(variant("1 GiB budget", [](RenderConfig& c) { c.pipeline.memoryBudgetMiB = 1024.0; }),
-              0);
+    EXPECT_EQ(
+        variant("1 GiB budget", [](Settings& s, RenderConfig&) { s.memoryBudgetMiB = 1024.0; }), 0);
     // 32 KiB: less than six 2^8-ray batches (52 KiB).
     EXPECT_GT(variant("32 KiB budget, 2 threads, exponent 8",
-                      [](RenderConfig& c) {
-                          c.pipeline.memoryBudgetMiB = 1.0 / 32;
+                      [](Settings& s, RenderConfig& c) {
+                          s.memoryBudgetMiB = 1.0 / 32;
                           c.threads = 2;
-                          c.pipeline.binExponent = 8;
+                          s.binExponent = 8;
                       }),
               100);
     variant("morton ray sort", [](RenderConfig& c) { c.pipeline.raySort = RaySortMode::Morton; });
@@ -215,12 +222,11 @@ TEST(SortedPipeline, ThreadBufferLargerThanABatch) {
     scene.image.sampleBase = 8;
     scene.image.iterations = 1;
     scene.settings.maxDepth = 2;
-    RenderConfig small;
-    small.pipeline.binExponent = 8;
-    auto result = render(scene, small);
-    RenderConfig large;
-    large.pipeline.binExponent = 16;
-    EXPECT_TRUE(sameBits(result->film->image(), renderImage(scene, large)));
+    scene.settings.binExponent = 8;
+    auto result = render(scene, RenderConfig{});
+    Scene large = scene;
+    large.settings.binExponent = 16;
+    EXPECT_TRUE(sameBits(result->film->image(), renderImage(large, RenderConfig{})));
     EXPECT_GE(result->stats.extra["batches_processed"].get<int>(), 64 * 64 * 64 / 256);
 }
 

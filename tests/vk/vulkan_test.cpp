@@ -564,8 +564,8 @@ TEST(VulkanMegakernel, MatchesCpuAndBuildsOnlyTheUberShader) {
 // film does not depend on batching or on the order of its splats.
 TEST(VulkanBuffers, StagingTwoDimensionalAndWindowedDispatchesGiveTheSameImage) {
     Scene scene = smallCornell(24);
+    scene.settings.binExponent = 12;
     RenderConfig plain = validatedVulkan(4);
-    plain.pipeline.binExponent = 12;
     auto a = renderValidated(scene, plain);
     RenderConfig odd = plain;
     odd.vulkan.forceStaging = true;
@@ -584,9 +584,9 @@ TEST(VulkanBuffers, StagingTwoDimensionalAndWindowedDispatchesGiveTheSameImage) 
     for (const char* stage : {"upload", "dispatch", "download"})
         EXPECT_GT(b->stats.stages.get(stage), 0.0) << stage;
 
-    RenderConfig tiny = plain;
-    tiny.pipeline.binExponent = 4; // 16-ray batches
-    auto c = renderValidated(scene, tiny);
+    Scene tiny = scene;
+    tiny.settings.binExponent = 4; // 16-ray batches
+    auto c = renderValidated(tiny, plain);
     const std::vector<float> ic = c->film->image();
     EXPECT_EQ(std::memcmp(ia.data(), ic.data(), ia.size() * sizeof(float)), 0);
     EXPECT_GT(c->stats.extra["vulkan"]["submits"].get<int>(), 512);

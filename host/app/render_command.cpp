@@ -1,0 +1,239 @@
+#include "host/app/render_command.h"
+
+#include "host/app/error_csv.h"
+#include "host/app/interrupt.h"
+#include "host/app/preview.h"
+#include "host/app/progress.h"
+#include "host/app/render_options.h"
+#include "host/app/usage.h"
+#include "host/app/usage_error.h"
+#include "host/image/image_io.h"
+#include "host/image/output_file.h"
+#include "host/render/render.h"
+
+#include <tbb/info.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cstdio>
+#include <exception>
+#include <filesystem>
+#include <functional>
+#include <thread>
+#include <unistd.h>
+
+namespace spw {
+namespace {
+
+// A distributed render's outputs are rank 0's: the other ranks only render. Ranks sharing a host
+// share its cores, unless --threads says otherwise; where mpirun bound a rank to fewer cores than
+// its share (one core each, its default for two ranks), those.
+void fitToRank(RenderOptions& o, Ranks* ranks, bool writes) {
+    if (ranks && o.preview && writes)
+        std::fprintf(stderr, "spillway: --preview shows rank 0's film, which holds every "
+                             "rank's samples after each iteration\n");
+    if (!writes) {
+        o.preview = false;
+        o.errorCsvPath.clear();
+        o.referencePath.clear();
+        o.progress = "none";
+    }
+    if (ranks && o.config.threads == 0 && ranks->ranksOnHost() > 1)
+        o.config.threads =
+            std::max(1, std::min(tbb::info::default_concurrency(),
+                                 int(std::thread::hardware_concurrency()) / ranks->ranksOnHost()));
+}
+
+std::optional<Checkpoint> readResume(const RenderOptions& o) {
+    if (o.resumePath.empty()) return std::nullopt;
+    try {
+        return readCheckpoint(o.resumePath);
+    } catch (const std::exception& e) {
+        throw UsageError(std::string("--resume: ") + e.what());
+    }
+}
+
+Scene loadForRender(const RenderOptions& o, bool writes) {
+    Scene scene = loadScene(o.scenePath);
+    applyOverrides(o, scene);
+    for (const Mesh& m : scene.meshes)
+        if (m.droppedTriangles > 0 && writes)
+            std::fprintf(stderr, "spillway: warning: %s: dropped %d zero-area triangle%s\n",
+                         m.name.c_str(), m.droppedTriangles, m.droppedTriangles == 1 ? "" : "s");
+    return scene;
+}
+
+std::unique_ptr<ErrorCsv> openErrorCsv(const RenderOptions& o, const Scene& scene) {
+    if (o.errorCsvPath.empty()) return nullptr;
+    std::optional<ImageRGB> reference;
+    if (!o.referencePath.empty()) {
+        try {
+            reference = readImage(o.referencePath);
+        } catch (const std::exception& e) {
+            throw UsageError(e.what());
+        }
+        if (reference->width != scene.image.width || reference->height != scene.image.height)
+            throw UsageError(
+                "reference '" + o.referencePath + "' is " + std::to_string(reference->width) + "x" +
+                std::to_string(reference->height) + ", the scene renders " +
+                std::to_string(scene.image.width) + "x" + std::to_string(scene.image.height));
+    }
+    return std::make_unique<ErrorCsv>(o.errorCsvPath, std::move(reference));
+}
+
+// --progress auto: a bar on a terminal, nothing otherwise.
+ProgressBar::Style progressStyle(std::string& mode) {
+    if (mode == "auto") mode = isatty(STDERR_FILENO) ? "bar" : "none";
+    return mode == "none"  ? ProgressBar::Style::None
+           : mode == "bar" ? ProgressBar::Style::Bar
+                           : ProgressBar::Style::Lines;
+}
+
+// The checkpoint's key is checked here, before any work, for exit 2; the render reuses it.
+CheckpointOptions checkpointOptions(const RenderOptions& o, const Scene& scene,
+                                    const SamplingPlan& plan,
+                                    const std::optional<Checkpoint>& resume) {
+    CheckpointOptions checkpoints{o.checkpointPath, o.checkpointInterval,
+                                  resume ? &*resume : nullptr, std::nullopt};
+    if (o.checkpointPath.empty()) return checkpoints;
+    checkpoints.key = checkpointKey(scene, o.config, plan.sampleBase);
+    const std::string why = resume ? checkpointMismatch(*checkpoints.key, resume->key) : "";
+    if (!why.empty())
+        throw UsageError("--resume " + o.resumePath +
+                         ": the checkpoint is of another render: " + why);
+    return checkpoints;
+}
+
+std::unique_ptr<PreviewWindow> openPreview(const RenderOptions& o, const Scene& scene) {
+    if (!o.preview) return nullptr;
+    try {
+        return std::make_unique<PreviewWindow>(
+            scene.image.width, scene.image.height,
+            "Spillway: " + std::filesystem::path(o.scenePath).filename().string());
+    } catch (const std::runtime_error& e) {
+        throw UsageError(e.what()); // no display: said before any work, exit 2
+    }
+}
+
+// The render, with the preview window on this thread (GLFW's rule) and the render on its own.
+std::unique_ptr<RenderResult>
+renderBesideWindow(PreviewWindow& preview, InterruptGuard& interrupt,
+                   const std::function<std::unique_ptr<RenderResult>()>& run) {
+    std::unique_ptr<RenderResult> result;
+    std::exception_ptr failure;
+    std::atomic<bool> finished{false};
+    std::thread worker([&] {
+        try {
+            result = run();
+        } catch (...) {
+            failure = std::current_exception();
+        }
+        finished = true;
+        preview.wake();
+    });
+    while (!finished)
+        if (!preview.pump(0.1)) interrupt.requestStop(kStopByWindow);
+    worker.join();
+    if (failure) std::rethrow_exception(failure);
+    return result;
+}
+
+void warnAboutSamples(const RenderStats& stats) {
+    if (stats.nonFiniteSamples > 0)
+        std::fprintf(stderr, "spillway: warning: %llu non-finite samples were dropped\n",
+                     (unsigned long long)stats.nonFiniteSamples);
+    if (stats.saturatedSamples > 0)
+        std::fprintf(stderr,
+                     "spillway: warning: %llu sample values exceeded the film's range (at least "
+                     "2^16 times the brightest emitter) and were clamped: the image is darker "
+                     "than it should be where they landed\n",
+                     (unsigned long long)stats.saturatedSamples);
+}
+
+// Every output is written whole, and flushed, before any is given its name: a failure in any of
+// them leaves none (host/image/output_file.h).
+void writeOutputs(const RenderOptions& o, const Scene& scene, RenderResult& result,
+                  ErrorCsv* errorCsv) {
+    OutputFile image(o.output);
+    {
+        StageTimer t(result.stats.stages, "write image");
+        const std::vector<unsigned char> bytes =
+            encodeImage(o.output, {scene.image.width, scene.image.height, result.film->image()});
+        image.write(bytes.data(), bytes.size());
+        image.flush();
+    }
+    std::unique_ptr<OutputFile> stats;
+    if (!o.statsPath.empty()) {
+        stats = std::make_unique<OutputFile>(o.statsPath);
+        stats->write(result.stats.toJson().dump(2) + "\n");
+        stats->flush();
+    }
+    if (errorCsv) errorCsv->flush();
+    warnAboutSamples(result.stats);
+    image.commit();
+    if (stats) stats->commit();
+    if (errorCsv) errorCsv->commit();
+}
+
+} // namespace
+
+int renderCommand(const std::vector<std::string>& args, Ranks* ranks) {
+    RenderOptions o = parseRenderOptions(args);
+    if (o.help) {
+        std::fputs(usageText().c_str(), stdout);
+        return 0;
+    }
+    const bool writes = !ranks || ranks->rank() == 0;
+    // Every output path is checked before any work, so that a typo costs no render.
+    for (const std::string* path : {&o.output, &o.statsPath, &o.errorCsvPath, &o.checkpointPath})
+        if (!path->empty() && writes) checkWritable(*path);
+    fitToRank(o, ranks, writes);
+    const std::optional<Checkpoint> resume = readResume(o);
+    const Scene scene = loadForRender(o, writes);
+    const std::unique_ptr<ErrorCsv> errorCsv = openErrorCsv(o, scene);
+    // Under mpirun at most four updates a second (progress.h says why).
+    ProgressBar progress(progressStyle(o.progress), ranks ? 0.25 : 0.0);
+    const SamplingPlan plan = planSampling(scene.image, o.config.spp);
+    const int sppPerIteration = plan.sampleBase * plan.sampleBase;
+    if (const std::string why = partialRenderProblem(scene, o.config, plan); !why.empty())
+        throw UsageError(why); // before any work, for exit 2
+    InterruptGuard interrupt;
+    o.config.stop = interrupt.flag();
+    const CheckpointOptions checkpoints = checkpointOptions(o, scene, plan, resume);
+    std::unique_ptr<PreviewWindow> preview = openPreview(o, scene);
+
+    auto onIteration = [&](const IterationInfo& info, const Film& film) {
+        if (errorCsv) errorCsv->addRow(info.done, info.spp, info.renderSeconds, film);
+        if (o.progress == "none" && !preview) return;
+        const std::optional<double> relMse = film.halfBufferRelMseEstimate(); // O(pixels)
+        progress.update(info.done, info.total, info.spp, info.total * sppPerIteration, relMse);
+        if (preview) {
+            char status[96];
+            std::snprintf(status, sizeof status, "%d/%d spp, %.1f s, relMSE %s", info.spp,
+                          info.total * sppPerIteration, info.renderSeconds,
+                          relMse ? std::to_string(*relMse).c_str() : "-");
+            preview->publish(film.image(), status);
+        }
+    };
+    auto run = [&] { return renderWithProgress(scene, o.config, onIteration, checkpoints, ranks); };
+    std::unique_ptr<RenderResult> result =
+        preview ? renderBesideWindow(*preview, interrupt, run) : run();
+    preview.reset();
+    progress.finish();
+
+    // Closing the preview window is a normal way to end a render: exit 0.
+    const int signal = std::max(0, interrupt.signal());
+    const int status = signal != 0 ? 128 + signal : 0;
+    if (!writes) return status;
+    if (interrupt.signal() != 0 && result->stats.iterations == 0) {
+        std::fprintf(stderr, "spillway: stopped before an iteration completed; nothing written\n");
+        return status;
+    }
+    if (signal != 0)
+        std::fprintf(stderr, "spillway: stopped by signal %d after %d spp; writing them\n", signal,
+                     result->stats.spp);
+    writeOutputs(o, scene, *result, errorCsv.get());
+    return status;
+}
+
+} // namespace spw

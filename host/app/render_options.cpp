@@ -1,0 +1,353 @@
+#include "host/app/render_options.h"
+
+#include "host/app/usage_error.h"
+#include "host/image/image_io.h"
+
+#include <cctype>
+#include <cmath>
+#include <filesystem>
+#include <sstream>
+
+namespace spw {
+namespace {
+
+enum class Section { Render, Pipeline, Settings };
+
+struct CliOption {
+    const char* name;  // "--spp"
+    const char* alias; // "-o", or nullptr
+    const char* value; // the value's placeholder, or nullptr for a switch
+    Section section;
+    const char* help;
+    double lo, hi; // the range of a numeric value
+    void (*apply)(RenderOptions&, const CliOption&, const std::string& value);
+};
+
+long long integerValue(const CliOption& o, const std::string& v) {
+    size_t used = 0;
+    long long n = 0;
+    try {
+        n = std::stoll(v, &used);
+    } catch (const std::exception&) {
+        used = 0;
+    }
+    const std::string flag = o.name;
+    if (used != v.size() || v.empty())
+        throw UsageError(flag + " takes an integer, not '" + v + "'");
+    if (n < (long long)o.lo || n > (long long)o.hi)
+        throw UsageError(flag + " must be in [" + std::to_string((long long)o.lo) + ", " +
+                         std::to_string((long long)o.hi) + "]");
+    return n;
+}
+
+double numberValue(const CliOption& o, const std::string& v) {
+    size_t used = 0;
+    double x = 0;
+    try {
+        x = std::stod(v, &used);
+    } catch (const std::exception&) {
+        used = 0;
+    }
+    const std::string flag = o.name;
+    if (used != v.size() || v.empty() || !std::isfinite(x))
+        throw UsageError(flag + " takes a number, not '" + v + "'");
+    if (x < o.lo || x > o.hi)
+        throw UsageError(flag + " must be in [" + std::to_string(o.lo) + ", " +
+                         std::to_string(o.hi) + "]");
+    return x;
+}
+
+// A named choice through the library's parser, its error turned into a usage error.
+template <class Parse> auto choice(const CliOption& o, const std::string& v, Parse parse) {
+    try {
+        return parse(v);
+    } catch (const std::invalid_argument& e) {
+        throw UsageError(std::string(o.name) + ": " + e.what());
+    }
+}
+
+// One of `words` ("a|b|c"), or a usage error listing them.
+std::string oneOf(const CliOption& o, const std::string& v, const std::string& words,
+                  const std::string& listed) {
+    std::istringstream in(words);
+    for (std::string w; std::getline(in, w, '|');)
+        if (v == w) return v;
+    throw UsageError(std::string(o.name) + " takes " + listed + ", not '" + v + "'");
+}
+
+std::pair<int, int> sampleRange(const CliOption& o, const std::string& v) {
+    const size_t colon = v.find(':');
+    if (colon == std::string::npos)
+        throw UsageError("--samples takes A:B (sample indices A <= s < B), not '" + v + "'");
+    return {int(integerValue(o, v.substr(0, colon))), int(integerValue(o, v.substr(colon + 1)))};
+}
+
+using O = RenderOptions;
+using C = CliOption;
+using S = std::string;
+constexpr double k24 = 1 << 24;
+
+// The options that are not scene settings, in --help's order.
+const std::vector<CliOption> kOwnOptions = {
+    {"--output", "-o", "FILE", Section::Render,
+     "image to write: .exr (linear float) or .png (8-bit sRGB); default: the scene's name "
+     "with .exr, in the current folder",
+     0, 0, [](O& r, const C&, const S& v) { r.output = v; }},
+    {"--spp", nullptr, "N", Section::Render,
+     "total samples per pixel (overrides sample base x iterations)", 1, k24,
+     [](O& r, const C& o, const S& v) { r.config.spp = int(integerValue(o, v)); }},
+    {"--backend", nullptr, "NAME", Section::Render,
+     "auto (default: a real GPU where one is usable, else cpu), vulkan (the sorted deferred "
+     "pipeline, shading as Vulkan compute; on a machine without a GPU, lavapipe's software "
+     "emulation), cpu (the same, shading in C++) or reference (a plain depth-first path "
+     "tracer on Embree)",
+     0, 0, [](O& r, const C& o, const S& v) { r.config.backend = choice(o, v, parseBackend); }},
+    {"--device", nullptr, "N|NAME", Section::Render,
+     "the Vulkan device: its index in `spillway devices` or part of its name (default: the "
+     "first usable one; with auto, a GPU, see `spillway devices`, or the device the Vulkan "
+     "driver variables name)",
+     0, 0, [](O& r, const C&, const S& v) { r.config.vulkan.device = v; }},
+    {"--threads", nullptr, "N", Section::Render, "worker threads (default: every core)", 1, 1024,
+     [](O& r, const C& o, const S& v) { r.config.threads = int(integerValue(o, v)); }},
+    {"--sampler", nullptr, "TYPE", Section::Render,
+     "Independent, Grid, Stratified or Sobol (overrides the scene's sampler)", 0, 0,
+     [](O& r, const C&, const S& v) {
+         r.sampler = parseSampler(v);
+         if (!r.sampler)
+             throw UsageError("--sampler takes Independent, Grid, Stratified or Sobol, not '" + v +
+                              "'");
+     }},
+    {"--stats", nullptr, "FILE.json", Section::Render,
+     "write render statistics (rays, stage seconds, ...) as JSON", 0, 0,
+     [](O& r, const C&, const S& v) { r.statsPath = v; }},
+    {"--quiet", nullptr, nullptr, Section::Render, "no progress bar", 0, 0,
+     [](O& r, const C&, const S&) { r.quiet = true; }},
+    {"--progress", nullptr, "MODE", Section::Render,
+     "auto (default: a bar on a terminal, nothing otherwise), bar, lines (a line per "
+     "iteration, for logs) or none; --quiet is none",
+     0, 0,
+     [](O& r, const C& o, const S& v) {
+         r.progress = oneOf(o, v, "auto|bar|lines|none", "auto, bar, lines or none");
+     }},
+    {"--error-csv", nullptr, "FILE.csv", Section::Render,
+     "after every iteration, a row: seconds, spp, relMSE estimated from two half buffers, "
+     "and with --reference the compare metrics",
+     0, 0, [](O& r, const C&, const S& v) { r.errorCsvPath = v; }},
+    {"--reference", nullptr, "REF.exr", Section::Render, "the reference image for --error-csv", 0,
+     0, [](O& r, const C&, const S& v) { r.referencePath = v; }},
+    {"--time-limit", nullptr, "SECONDS", Section::Render,
+     "stop after the iteration that crosses this render time", 1e-3, 1e9,
+     [](O& r, const C& o, const S& v) { r.config.timeLimitSeconds = numberValue(o, v); }},
+    {"--target-error", nullptr, "E", Section::Render,
+     "stop after the first iteration whose relMSE, estimated from two half buffers (the "
+     "--error-csv estimate), is at or below E",
+     0, 1e9, [](O& r, const C& o, const S& v) { r.config.targetError = numberValue(o, v); }},
+    {"--checkpoint", nullptr, "FILE.exr", Section::Render,
+     "write the render's exact state (an EXR of the image so far, with the film's sums bit "
+     "for bit in extra channels) at the end, however the render stops, and every "
+     "--checkpoint-interval SECONDS of rendering",
+     0, 0, [](O& r, const C&, const S& v) { r.checkpointPath = v; }},
+    {"--checkpoint-interval", nullptr, "SECONDS", Section::Render,
+     "also write the checkpoint every this many seconds of rendering", 1e-3, 1e9,
+     [](O& r, const C& o, const S& v) { r.checkpointInterval = numberValue(o, v); }},
+    {"--resume", nullptr, "FILE.exr", Section::Render,
+     "continue a checkpointed render (same scene and image settings; more --spp may be asked "
+     "for) to the image it would have made uninterrupted; checkpoints go back to FILE unless "
+     "--checkpoint names another",
+     0, 0, [](O& r, const C&, const S& v) { r.resumePath = v; }},
+    {"--samples", nullptr, "A:B", Section::Render,
+     "a partial render: only sample indices A <= s < B of the --spp N render (A and B on "
+     "iteration boundaries), written with --partial",
+     0, k24, [](O& r, const C& o, const S& v) { r.config.sampleRange = sampleRange(o, v); }},
+    {"--partial", nullptr, "PART.exr", Section::Render,
+     "where a partial render's exact sums go, for `spillway merge`", 0, 0,
+     [](O& r, const C&, const S& v) { r.partialPath = v; }},
+    {"--preview", nullptr, nullptr, Section::Render,
+     "a window showing the image as iterations complete (+/- exposure, 0 reset; closing it, "
+     "Esc or q stop the render as Ctrl-C does, but exit 0); without a display: exit 2 before "
+     "rendering",
+     0, 0, [](O& r, const C&, const S&) { r.preview = true; }},
+    {"--texture-filter", nullptr, "F", Section::Render,
+     "cone (default: lookups read the MIP levels each hit's ray-cone footprint needs, "
+     "trilinear) or finest (always the finest level)",
+     0, 0,
+     [](O& r, const C& o, const S& v) {
+         r.config.textureFilter = choice(o, v, parseTextureFilter);
+     }},
+    {"--spill-dir", nullptr, "DIR", Section::Pipeline,
+     "where spilled batches go (default: the system temp folder)", 0, 0,
+     [](O& r, const C&, const S& v) { r.config.pipeline.spillDir = v; }},
+    {"--ray-sort", nullptr, "MODE", Section::Pipeline,
+     "auto (sort only where it measures faster), morton, median or off", 0, 0,
+     [](O& r, const C& o, const S& v) {
+         r.config.pipeline.raySort = choice(o, v, parseRaySortMode);
+     }},
+    {"--hit-sort", nullptr, "MODE", Section::Pipeline,
+     "sort hits by (shader, object, texture order) before shading: auto (default: for vulkan "
+     "always, for cpu where the scene has image textures), on or off",
+     0, 0,
+     [](O& r, const C& o, const S& v) {
+         r.config.pipeline.hitSort = choice(o, v, parseHitSortMode);
+     }},
+    {"--shading", nullptr, "MODE", Section::Pipeline,
+     "sorted (default: one dispatch per shader range, one kernel per surface model) or "
+     "megakernel (unsorted hits, one uber-shader switching per hit)",
+     0, 0,
+     [](O& r, const C& o, const S& v) {
+         r.config.pipeline.shading = choice(o, v, parseShadingMode);
+     }},
+    {"--ray-format", nullptr, "F", Section::Pipeline,
+     "compact (34-byte rays, default) or full (50 bytes, every bit kept)", 0, 0,
+     [](O& r, const C& o, const S& v) {
+         r.config.pipeline.rayFormat = choice(o, v, parseRayFormat);
+     }},
+    {"--stages", nullptr, "MODE", Section::Pipeline,
+     "fused (default; cpu: hit setup, shade, shadow, accumulate and bin run chunk by chunk "
+     "of 128 hits, in cache; vulkan: shadow, accumulate and bin, after the device shaded the "
+     "batch) or separate (each stage over the whole batch in turn)",
+     0, 0,
+     [](O& r, const C& o, const S& v) {
+         r.config.pipeline.fuseStages =
+             oneOf(o, v, "fused|separate", "fused or separate") == "fused";
+     }},
+    {"--simd-shading", nullptr, "on|off", Section::Pipeline,
+     "cpu: shade Lambert hits 4, 8 or 16 at a time in SIMD registers (default on, where every "
+     "light is a triangle; the image is the same either way)",
+     0, 0,
+     [](O& r, const C& o, const S& v) {
+         r.config.pipeline.simdShading = oneOf(o, v, "on|off", "on or off") == "on";
+     }},
+};
+
+// The options that override a scene setting: one per settings-table entry with a flag.
+const std::vector<CliOption>& settingOptions() {
+    static const std::vector<CliOption> options = [] {
+        std::vector<CliOption> o;
+        for (const SettingSpec& s : settingsTable()) {
+            if (!s.flag) continue;
+            o.push_back({s.flag, nullptr, s.integer ? "N" : "X", Section::Settings, s.help, s.lo,
+                         s.hi, [](O& r, const C& opt, const S& v) {
+                             const SettingSpec* spec = settingForFlag(opt.name);
+                             r.settings.emplace_back(spec, spec->integer
+                                                               ? double(integerValue(opt, v))
+                                                               : numberValue(opt, v));
+                         }});
+        }
+        return o;
+    }();
+    return options;
+}
+
+const CliOption* findOption(const std::string& arg) {
+    for (const auto* table : {&kOwnOptions, &settingOptions()})
+        for (const CliOption& o : *table)
+            if (arg == o.name || (o.alias && arg == o.alias)) return &o;
+    return nullptr;
+}
+
+// How the options go together, checked before any work so that a mistake costs no render.
+void checkRelations(RenderOptions& r) {
+    if (r.scenePath.empty()) throw UsageError("render needs a scene file");
+    if (r.output.empty()) r.output = std::filesystem::path(r.scenePath).stem().string() + ".exr";
+    if (!isSupportedOutput(r.output))
+        throw UsageError("output '" + r.output + "' must end in .exr or .png");
+    if (r.quiet) r.progress = "none";
+    if (!r.referencePath.empty() && r.errorCsvPath.empty())
+        throw UsageError("--reference goes with --error-csv");
+    if (!r.partialPath.empty() && !r.config.sampleRange)
+        throw UsageError("--partial goes with --samples A:B");
+    if (r.config.sampleRange && r.partialPath.empty())
+        throw UsageError("--samples A:B goes with --partial PART.exr, where its sums go");
+    if (!r.partialPath.empty()) {
+        if (!r.checkpointPath.empty())
+            throw UsageError("--partial is the render's checkpoint: give it or --checkpoint");
+        r.checkpointPath = r.partialPath; // a partial is the checkpoint of its samples
+    }
+    if (!r.resumePath.empty() && r.checkpointPath.empty()) r.checkpointPath = r.resumePath;
+    if (r.checkpointInterval > 0 && r.checkpointPath.empty())
+        throw UsageError("--checkpoint-interval goes with --checkpoint");
+    if (!r.checkpointPath.empty()) {
+        std::string ext = std::filesystem::path(r.checkpointPath).extension().string();
+        for (char& c : ext)
+            c = char(std::tolower(static_cast<unsigned char>(c)));
+        if (ext != ".exr")
+            throw UsageError("checkpoint '" + r.checkpointPath + "' must end in .exr");
+    }
+}
+
+// `text` wrapped to lines of at most `width` characters, each after `indent`.
+std::string wrap(const std::string& text, size_t indent, size_t width) {
+    std::istringstream words(text);
+    std::string out, line;
+    for (std::string w; words >> w;) {
+        if (!line.empty() && line.size() + 1 + w.size() > width) {
+            out += line + "\n" + std::string(indent, ' ');
+            line.clear();
+        }
+        line += (line.empty() ? "" : " ") + w;
+    }
+    return out + line + "\n";
+}
+
+std::string helpSection(Section section) {
+    constexpr size_t column = 24, width = 94;
+    std::string out;
+    for (const auto* table : {&kOwnOptions, &settingOptions()})
+        for (const CliOption& o : *table) {
+            if (o.section != section) continue;
+            std::string head = "  ";
+            if (o.alias) head += std::string(o.alias) + ", ";
+            head += o.name;
+            if (o.value) head += std::string(" ") + o.value;
+            std::string help = o.help;
+            if (section == Section::Settings)
+                help += std::string(" (settings: ") + settingForFlag(o.name)->key + ")";
+            head += head.size() < column ? std::string(column - head.size(), ' ')
+                                         : "\n" + std::string(column, ' ');
+            out += head + wrap(help, column, width - column);
+        }
+    return out;
+}
+
+} // namespace
+
+RenderOptions parseRenderOptions(const std::vector<std::string>& args) {
+    RenderOptions r;
+    for (size_t i = 0; i < args.size(); ++i) {
+        const std::string& a = args[i];
+        if (a == "-h" || a == "--help") {
+            r.help = true;
+            return r;
+        }
+        if (const CliOption* o = findOption(a)) {
+            std::string v;
+            if (o->value) {
+                if (i + 1 >= args.size()) throw UsageError(a + " needs a value");
+                v = args[++i];
+            }
+            o->apply(r, *o, v);
+        } else if (!a.empty() && a[0] == '-')
+            throw UsageError("unknown option '" + a + "'");
+        else if (r.scenePath.empty())
+            r.scenePath = a;
+        else
+            throw UsageError("more than one scene given ('" + r.scenePath + "', '" + a + "')");
+    }
+    checkRelations(r);
+    return r;
+}
+
+std::string renderOptionsHelp() {
+    return "render options:\n" + helpSection(Section::Render) +
+           "\nsorted pipeline options (cpu and vulkan backends):\n" +
+           helpSection(Section::Pipeline) +
+           "\nscene settings (docs/scene-format.md, `settings:`), overridden:\n" +
+           helpSection(Section::Settings);
+}
+
+void applyOverrides(const RenderOptions& options, Scene& scene) {
+    applySettingOverrides(scene.settings, options.settings);
+    if (options.sampler) scene.sampler = *options.sampler;
+}
+
+} // namespace spw
