@@ -17,6 +17,7 @@ packages=(
   xvfb x11-apps x11-utils                  # its test: a virtual display, xwd, xwininfo
   libopenmpi-dev openmpi-bin               # distributed rendering (mpirun -np N spillway render)
   libgtest-dev                             # the test suite
+  clang-format                             # the test that sources are formatted (.clang-format)
   libvulkan-dev mesa-vulkan-drivers vulkan-validationlayers glslc glslang-tools
   python3 python3-numpy python3-matplotlib # convergence plots
 )

@@ -39,23 +39,19 @@ if [ "$mode" = all ] || [ "$mode" = --asan ]; then
     lvp_lib="$(sed -n 's/.*"library_path": *"\([^"]*\)".*/\1/p' "$lvp_icd")"
     if [ -n "$lvp_lib" ]; then export LD_PRELOAD="$lvp_lib${LD_PRELOAD:+ $LD_PRELOAD}"; fi
   fi
-  # Everything but the Vulkan* tests with LeakSanitizer on. The Vulkan* tests run the Khronos
-  # validation layer, which the loader unloads at vkDestroyInstance: LeakSanitizer then reports
-  # the layer's allocations from an "<unknown module>" that no suppression can name, so those
-  # tests run under ASan and UBSan with leak detection off (the other suites' vulkan-backend
-  # renders, without the layer, keep it on).
-  # Three statistical tests are left to the Release run: they repeat code paths the rest of the
+  # The ctest labels (CMakeLists.txt) pick the groups. `core` runs with LeakSanitizer on.
+  # `unloads-drivers` (Vulkan*, Preview.*, Mpi.*) runs under ASan and UBSan with leak detection
+  # off: the Khronos validation layer, Mesa's OpenGL driver (through GLFW's glfwTerminate) and
+  # Open MPI's components (at MPI_Finalize; 4.1.4 has no switch to keep them) are unloaded
+  # before exit, and LeakSanitizer then reports what they still held from an "<unknown module>"
+  # that no suppression can name. The other suites' vulkan-backend renders, without the layer,
+  # keep leak detection on.
+  # `long-statistics` is left to the Release run: those tests repeat code paths the rest of the
   # suite already runs under the sanitizers, for ten times the samples, and would take 10 of the
   # sanitized run's 12 CPU-minutes (measured: 259, 251 and 123 s under ASan).
-  slow='^Convergence\.|StiffEnclosure\.ReachesLeOverOneMinusAlbedo/0\.999'
-  # The Preview.* tests likewise: GLFW's glfwTerminate unloads Mesa's OpenGL driver, and what
-  # its globals held (240 bytes) is then reported from an "<unknown module>" in the same way.
-  # And the Mpi.* tests: Open MPI loads its components with dlopen and unloads them at
-  # MPI_Finalize, after which what they still held is reported the same way (Open MPI 4.1.4 has
-  # no switch to keep them loaded).
   ASAN_OPTIONS="detect_leaks=1:$asan" ctest --test-dir "$root/build-asan" --output-on-failure \
-    --parallel "$(nproc)" --timeout 900 -E "^Vulkan|^Preview\.|^Mpi\.|$slow"
+    --parallel "$(nproc)" --timeout 900 -L '^core$'
   ASAN_OPTIONS="detect_leaks=0:$asan" ctest --test-dir "$root/build-asan" --output-on-failure \
-    --parallel "$(nproc)" --timeout 900 -R '^Vulkan|^Preview\.|^Mpi\.'
+    --parallel "$(nproc)" --timeout 900 -L '^unloads-drivers$'
 
 fi

@@ -21,6 +21,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdarg>
 #include <cstdio>
@@ -358,7 +359,14 @@ TEST_P(StiffEnclosure, ReachesLeOverOneMinusAlbedo) {
     }
 }
 
-INSTANTIATE_TEST_SUITE_P(Extreme, StiffEnclosure, ::testing::Values(0.99, 0.999));
+// Named by the albedo's digits (Albedo0_99, Albedo0_999): CMakeLists.txt labels the second.
+INSTANTIATE_TEST_SUITE_P(Extreme, StiffEnclosure, ::testing::Values(0.99, 0.999),
+                         [](const ::testing::TestParamInfo<double>& info) {
+                             std::string name = "Albedo" + std::to_string(info.param);
+                             name.erase(name.find_last_not_of('0') + 1);
+                             std::replace(name.begin(), name.end(), '.', '_');
+                             return name;
+                         });
 
 // ---- pin-point light -------------------------------------------------------------------------
 
