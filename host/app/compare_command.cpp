@@ -57,11 +57,17 @@ void printTable(const std::string& pathA, const std::string& pathB, const ImageM
                 formatValue(m.meanB[1]).c_str(), formatValue(m.meanB[2]).c_str());
 }
 
-int runCompare(const std::vector<std::string>& args) {
+struct CompareOptions {
     std::vector<std::string> files;
     std::vector<Threshold> thresholds;
     std::string heatmapPath;
     bool json = false;
+    bool help = false;
+};
+
+// `--opt value` or `--opt=value`.
+CompareOptions parseCompareOptions(const std::vector<std::string>& args) {
+    CompareOptions o;
     for (std::size_t i = 0; i < args.size(); ++i) {
         std::string a = args[i], inlineValue;
         bool hasInline = false;
@@ -76,95 +82,115 @@ int runCompare(const std::vector<std::string>& args) {
             return args[++i];
         };
         if (a == "-h" || a == "--help") {
-            std::fputs(compareUsage(), stdout);
-            return 0;
+            o.help = true;
+            return o;
         } else if (a == "--json") {
-            json = true;
+            o.json = true;
         } else if (a == "--heatmap") {
-            heatmapPath = value();
-            std::string ext = std::filesystem::path(heatmapPath).extension().string();
+            o.heatmapPath = value();
+            std::string ext = std::filesystem::path(o.heatmapPath).extension().string();
             std::transform(ext.begin(), ext.end(), ext.begin(),
                            [](unsigned char c) { return char(std::tolower(c)); });
-            if (ext != ".png") throw UsageError("--heatmap '" + heatmapPath + "' must end in .png");
+            if (ext != ".png")
+                throw UsageError("--heatmap '" + o.heatmapPath + "' must end in .png");
         } else if (a == "--threshold") {
             try {
-                thresholds.push_back(parseThreshold(value()));
+                o.thresholds.push_back(parseThreshold(value()));
             } catch (const std::invalid_argument& e) {
                 throw UsageError(std::string("--threshold: ") + e.what());
             }
         } else if (a.size() > 1 && a[0] == '-') {
             throw UsageError("unknown option '" + a + "'");
         } else {
-            files.push_back(a);
+            o.files.push_back(a);
         }
     }
-    if (files.size() != 2)
+    if (o.files.size() != 2)
         throw UsageError("compare takes two images, A and the reference B (" +
-                         std::to_string(files.size()) + " given)");
+                         std::to_string(o.files.size()) + " given)");
+    return o;
+}
 
-    const ImageRGB a = readInput(files[0]);
-    const ImageRGB b = readInput(files[1]);
-    if (a.width != b.width || a.height != b.height)
-        throw std::runtime_error("image sizes differ: '" + files[0] + "' is " +
-                                 std::to_string(a.width) + "x" + std::to_string(a.height) + ", '" +
-                                 files[1] + "' is " + std::to_string(b.width) + "x" +
-                                 std::to_string(b.height));
-    const ImageMetrics m = compareImages(a, b);
-
-    HeatmapInfo heat;
-    if (!heatmapPath.empty()) heat = writeHeatmap(heatmapPath, a, b);
-
+// Each --threshold's verdict: as JSON, as a line of the table, and as a failure message.
+struct Verdicts {
     bool passed = true;
-    nlohmann::json verdicts = nlohmann::json::array();
+    nlohmann::json json = nlohmann::json::array();
     std::vector<std::string> lines, failures;
+};
+
+Verdicts judge(const ImageMetrics& m, const std::vector<Threshold>& thresholds) {
+    Verdicts v;
     for (const Threshold& t : thresholds) {
         const bool ok = meetsThreshold(m, t);
         const bool lowerBound = isLowerBound(t.metric);
-        const double v = metricValue(m, t.metric);
-        passed = passed && ok;
-        nlohmann::json j = {{"metric", t.metric},
-                            {"bound", t.bound},
-                            {"kind", lowerBound ? "min" : "max"},
-                            {"value", std::isfinite(v) ? nlohmann::json(v) : nlohmann::json()},
-                            {"passed", ok}};
-        verdicts.push_back(j);
-        const std::string bound = formatValue(t.bound), value = formatValue(v);
-        lines.push_back("threshold " + t.metric + (lowerBound ? " >= " : " <= ") + bound + ": " +
-                        (ok ? "pass" : "FAIL") + " (" + value + ")");
+        const double x = metricValue(m, t.metric);
+        v.passed = v.passed && ok;
+        v.json.push_back({{"metric", t.metric},
+                          {"bound", t.bound},
+                          {"kind", lowerBound ? "min" : "max"},
+                          {"value", std::isfinite(x) ? nlohmann::json(x) : nlohmann::json()},
+                          {"passed", ok}});
+        const std::string bound = formatValue(t.bound), value = formatValue(x);
+        v.lines.push_back("threshold " + t.metric + (lowerBound ? " >= " : " <= ") + bound + ": " +
+                          (ok ? "pass" : "FAIL") + " (" + value + ")");
         if (!ok)
-            failures.push_back(t.metric + " = " + value +
-                               (lowerBound ? " is below the bound " : " exceeds the bound ") +
-                               bound);
+            v.failures.push_back(t.metric + " = " + value +
+                                 (lowerBound ? " is below the bound " : " exceeds the bound ") +
+                                 bound);
     }
+    return v;
+}
 
-    if (json) {
+void printReport(const CompareOptions& o, const ImageMetrics& m, const HeatmapInfo& heat,
+                 const Verdicts& v) {
+    if (o.json) {
         nlohmann::json out = toJson(m);
-        out["a"] = files[0];
-        out["b"] = files[1];
-        out["thresholds"] = verdicts;
-        out["passed"] = passed;
-        if (!heatmapPath.empty())
-            out["heatmap"] = {{"path", heatmapPath},
+        out["a"] = o.files[0];
+        out["b"] = o.files[1];
+        out["thresholds"] = v.json;
+        out["passed"] = v.passed;
+        if (!o.heatmapPath.empty())
+            out["heatmap"] = {{"path", o.heatmapPath},
                               {"error_low", heat.low},
                               {"error_high", heat.high},
                               {"scale", "log10"}};
         std::printf("%s\n", out.dump(2).c_str());
     } else {
-        printTable(files[0], files[1], m);
-        if (!heatmapPath.empty())
+        printTable(o.files[0], o.files[1], m);
+        if (!o.heatmapPath.empty())
             std::printf("\nheatmap        %s (relative error, log10 bar from %s to %s)\n",
-                        heatmapPath.c_str(), formatValue(heat.low).c_str(),
+                        o.heatmapPath.c_str(), formatValue(heat.low).c_str(),
                         formatValue(heat.high).c_str());
-        if (!lines.empty()) std::printf("\n");
-        for (const std::string& l : lines)
+        if (!v.lines.empty()) std::printf("\n");
+        for (const std::string& l : v.lines)
             std::printf("%s\n", l.c_str());
     }
     std::fflush(stdout);
+}
+
+int runCompare(const std::vector<std::string>& args) {
+    const CompareOptions o = parseCompareOptions(args);
+    if (o.help) {
+        std::fputs(compareUsage(), stdout);
+        return 0;
+    }
+    const ImageRGB a = readInput(o.files[0]);
+    const ImageRGB b = readInput(o.files[1]);
+    if (a.width != b.width || a.height != b.height)
+        throw std::runtime_error("image sizes differ: '" + o.files[0] + "' is " +
+                                 std::to_string(a.width) + "x" + std::to_string(a.height) + ", '" +
+                                 o.files[1] + "' is " + std::to_string(b.width) + "x" +
+                                 std::to_string(b.height));
+    const ImageMetrics m = compareImages(a, b);
+    HeatmapInfo heat;
+    if (!o.heatmapPath.empty()) heat = writeHeatmap(o.heatmapPath, a, b);
+    const Verdicts v = judge(m, o.thresholds);
+    printReport(o, m, heat, v);
     if (m.comparedPixels == 0)
         std::fprintf(stderr, "spillway compare: warning: no pixel is finite in both images\n");
-    for (const std::string& f : failures)
+    for (const std::string& f : v.failures)
         std::fprintf(stderr, "spillway compare: %s\n", f.c_str());
-    return passed ? 0 : 1;
+    return v.passed ? 0 : 1;
 }
 
 } // namespace

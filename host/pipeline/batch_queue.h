@@ -1,16 +1,7 @@
-// Ray batches and where they wait: six directional bins, then a FIFO queue of batches that
-// holds at most `memory budget` bytes in RAM and spills the rest to disk.
+// Ray batches and the FIFO queue where they wait once the directional bins (directional_bins.h)
+// made them: it holds at most `memory budget` bytes in RAM and spills the rest to disk.
 //
-// Spilling: all spilled batches share one file in the spill folder, opened with O_TMPFILE (or
-// created and unlinked at once where the file system lacks it), so it has no name from the
-// start: whatever way the process ends, normal exit, exception, SIGINT, SIGTERM or SIGKILL, the
-// kernel frees it and no file is left behind. Each batch is one large pwrite and one pread back.
-// The range of a batch read back is free for the next one (first fit, neighbours merged), so
-// the file stays at the most bytes ever queued on disk at once, and a write lands in pages the
-// kernel already holds for the file rather than new ones it must allocate, account and later
-// drop by punching a hole: pwrite 103 -> 40 us for a 1.1 MB batch, and no fallocate (29 us).
-// The write happens outside the queue's lock (its range is reserved under it), so one worker's
-// write holds up neither the others' pushes nor the consumer's pop.
+// Spilling goes to one nameless file (spill_file.h).
 //
 // Batch buffers are recycled: a batch's bytes, once decoded or written to disk, go back to the
 // queue, which hands them to the bins and to its reads. A batch of 2^15 rays is about 1 MB, above
@@ -20,6 +11,7 @@
 
 #include "host/backend/stats.h"
 #include "host/pipeline/ray_record.h"
+#include "host/pipeline/spill_file.h"
 
 #include <condition_variable>
 #include <cstdint>
@@ -44,31 +36,6 @@ struct RayBatch {
 struct QueueCounters {
     std::uint64_t batchesQueued = 0, batchesSpilled = 0, bytesWritten = 0, bytesRead = 0;
     std::uint64_t peakRamBytes = 0; // queued batches in RAM + rays waiting in bins
-};
-
-class SpillFile {
-  public:
-    // Throws std::runtime_error naming `dir` when no file can be made there.
-    explicit SpillFile(const std::string& dir);
-    ~SpillFile();
-    SpillFile(const SpillFile&) = delete;
-    SpillFile& operator=(const SpillFile&) = delete;
-    // The offset of `size` bytes for write(): free space a read-back batch left, else the
-    // file's end. Thread-safe.
-    std::uint64_t reserve(std::uint64_t size);
-    // Throws naming the folder on any write error (a full disk). Thread-safe.
-    void write(std::uint64_t offset, const std::vector<std::uint8_t>& bytes);
-    void read(std::uint64_t offset, std::vector<std::uint8_t>& bytes);
-    // The range is free for reserve(). Thread-safe.
-    void release(std::uint64_t offset, std::uint64_t size);
-    const std::string& dir() const { return dir_; }
-
-  private:
-    std::string dir_;
-    int fd_ = -1;
-    std::mutex mutex_;
-    std::uint64_t end_ = 0;
-    std::vector<std::pair<std::uint64_t, std::uint64_t>> free_; // (offset, size), by offset
 };
 
 class BatchQueue {
@@ -129,43 +96,6 @@ class BatchQueue {
     QueueCounters counters_;
     std::mutex spareMutex_;
     std::vector<std::vector<std::uint8_t>> spare_; // at most kSpareBuffers
-};
-
-// A thread-local buffer of encoded rays, already split by cardinal bin.
-struct RayBuffer {
-    std::vector<std::uint8_t> perBin[6]; // bytes [0, used[b]) of bin b hold encoded rays
-    size_t used[6] = {};
-    size_t count = 0;
-    void push(vec3 origin, vec3 dir, const PathState& path, RayFormat format, uvec4 rounding);
-};
-
-// Six cardinal-direction bins. Rays arrive in thread-local buffers; a bin holding 2^e rays
-// becomes a batch of exactly 2^e rays in the queue (a buffer larger than a batch simply makes
-// several). When the queue runs dry, the part-full bins are flushed, the fullest first, into one
-// batch of up to 2^e rays.
-class DirectionalBins {
-  public:
-    DirectionalBins(RayFormat format, uint binExponent, BatchQueue& queue);
-    // Thread-safe. Takes the buffer's rays (leaving it empty, capacity kept).
-    void add(RayBuffer& buffer);
-    // Moves the rays of part-full bins into the queue as one batch of up to 2^e rays, the
-    // fullest bins first: the end of an iteration, where bins fill slowly, makes a few mixed
-    // batches rather than many small ones. False when every bin is empty.
-    bool flush();
-    size_t raysWaiting();
-    // Drops every waiting ray (a stopped render).
-    void clear();
-
-  private:
-    struct Bin {
-        std::mutex mutex;
-        std::vector<std::uint8_t> bytes;
-    };
-    RayFormat format_;
-    size_t recordBytes_;
-    size_t batchRays_;
-    BatchQueue& queue_;
-    Bin bins_[6];
 };
 
 } // namespace spw

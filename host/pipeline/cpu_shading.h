@@ -1,6 +1,7 @@
 // The C++ shading engine: the same shadeSurface() the Vulkan kernels run (its Lambert hits in
-// SIMD registers, simd_shading.h), in TBB tasks of `shading size` hits, shaded at submit in one
-// slot (TBB already keeps every core busy, so there is nothing to overlap).
+// SIMD registers, simd_shading.h), on the host's threads: fused with the other per-hit stages
+// chunk by chunk (stages.h: shadeFused), or, with --stages separate, in TBB tasks of `shading
+// size` hits through one slot (TBB already keeps every core busy: nothing to overlap).
 #pragma once
 
 #include "host/backend/backend.h"

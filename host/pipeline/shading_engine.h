@@ -1,15 +1,25 @@
-// The shade stage's interface: what the sorted pipeline hands an engine (contiguous ranges of
-// set-up hits, one surface model each) and what it gets back (ShadeResult per hit). Two engines
-// implement it: C++ in TBB tasks (cpu_shading.h) and Vulkan compute (host/vk/vulkan_shading.h).
+// The shading engine: what the sorted pipeline hands over once a batch is traced and its hits
+// are sorted, in one call (shadeBatch). The engine does the per-hit stages from there, hit setup
+// to bin (stages.h), its own way, and says how it wants the hits ordered. Two engines: C++ on the
+// host's threads (cpu_shading.h), fusing the stages chunk by chunk, and Vulkan compute
+// (host/vk/vulkan_shading.h), overlapping a batch's shading with the next batch's traversal.
+// Both shade contiguous ranges of hits, one surface model each (ShadeRange), through a slot's
+// inputs and results (SlottedEngine, slotted_engine.h).
 #pragma once
 
 #include "host/backend/stats.h"
+#include "host/image/film.h"
+#include "host/pipeline/directional_bins.h"
+#include "host/pipeline/hit_sort.h"
+#include "host/pipeline/ray_record.h"
 #include "shared/shade_io.h"
 
 #include <cstddef>
 #include <vector>
 
 namespace spw {
+
+struct HitRecord; // embree_backend/embree_scene.h
 
 // A contiguous range of a batch's hits that one dispatch shades: all of one shader, so of one
 // surface model, or (hits unsorted) every hit, of any model: kMixedModels.
@@ -19,34 +29,36 @@ struct ShadeRange {
 };
 constexpr uint kMixedModels = 0xFFFFFFFFu;
 
-// Where one batch's hits are shaded. The hit-setup stage writes `inputs` in place (for the Vulkan
-// engine that is the mapped device buffer itself: no copy); `results` hold the shadow rays, their
-// pending contributions and the continuation rays once ShadingEngine::finish() returns.
-struct ShadeSlot {
-    ShadeInput* inputs = nullptr;
-    const ShadeResult* results = nullptr;
+// One traced batch: its rays, their hits, and the hits in shading order (the first `hitCount`
+// of `order`; `order` is empty where the engine takes the hits in traversal order,
+// takesTraversalOrder()).
+struct TracedBatch {
+    const std::vector<RayState>& rays;
+    const std::vector<HitRecord>& hits;
+    const std::vector<SortedHit>& order;
+    size_t hitCount;
 };
 
-// Shades a batch's hits, one pass per range, with shared/path.h's shadeSurface().
 class ShadingEngine {
   public:
     virtual ~ShadingEngine() = default;
+    // Whether the hits are sorted by (shader, object, texture order) before shading: the
+    // engine's rule for --hit-sort auto (render_config.h: HitSortMode).
+    virtual bool sortsHits() const = 0;
+    // Whether, where the scene has no environment for the misses to see, the engine takes the
+    // hits unsorted, in traversal order, misses in place (no hit sort at all).
+    virtual bool takesTraversalOrder() const { return false; }
     virtual void beginIteration(uint iteration) = 0;
-    // Batches that may be in flight at once. With 2 the renderer traverses and sets up batch k+1
-    // while batch k is being shaded (double buffering); with 1 each batch is shaded in turn.
-    virtual int slots() const { return 1; }
-    // True when shading runs on the host's own threads (cpu): the renderer may then call
-    // shadeSurface() itself, chunk by chunk between the other per-hit stages (stages.h:
-    // shadeFused), and the engine's reserve/submit/finish go unused.
-    virtual bool shadesOnHostThreads() const { return false; }
-    // Storage for `count` hits in `slot` (0 <= slot < slots()); the slot's previous batch must be
-    // finished. Valid until the slot's next reserve().
-    virtual ShadeSlot reserve(int slot, size_t count) = 0;
-    // Starts shading the slot's ranges (in order, each over inputs[begin, begin + count)).
-    virtual void submit(int slot, const std::vector<ShadeRange>& ranges) = 0;
-    // Returns once the slot's results are complete.
-    virtual void finish(int slot) = 0;
-    // Adds the engine's own counters to the stats (called at the end of every iteration).
+    // The batch's per-hit stages, hit setup to bin: contributions into `film`, continuation rays
+    // into `bins`. The batch's rays and hits may be reused once this returns; its shading may
+    // still be running (busy()).
+    virtual void shadeBatch(const TracedBatch& batch, Film& film, DirectionalBins& bins) = 0;
+    // Whether a batch is still being shaded; finish() completes it, stages after shading too.
+    virtual bool busy() const { return false; }
+    virtual void finish(Film& /*film*/, DirectionalBins& /*bins*/) {}
+    // A stop: waits for what is in flight and drops it (the iteration is discarded).
+    virtual void abandon() {}
+    // Adds the engine's own counters and decisions to the stats (at the end of every iteration).
     virtual void publishStats(RenderStats& /*stats*/) {}
 };
 

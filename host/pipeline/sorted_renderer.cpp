@@ -13,18 +13,6 @@ struct SortedRenderer::Scratch {
     std::vector<KeyIndex> rayKeys, keyTmp;
     std::vector<HitRecord> hits;
     std::vector<SortedHit> order;
-    std::vector<ShadeRange> ranges;
-    // A batch between its shading submit and its accumulation, one per engine slot.
-    struct InFlight {
-        size_t hitCount = 0;
-        ShadeSlot shading;
-        std::vector<uvec2> paths; // (pathId, bounce) per hit: the film needs them, and the
-                                  // inputs may sit in write-combined device memory
-    };
-    InFlight inFlight[2];
-    std::vector<ShadowRay> shadows;
-    std::vector<std::uint32_t> shadowOwner;
-    std::vector<std::uint8_t> occluded;
 };
 
 namespace {
@@ -38,12 +26,7 @@ SortedRenderer::SortedRenderer(const RenderContext& ctx, const PipelineConfig& c
                                std::unique_ptr<ShadingEngine> shading)
     : ctx_(ctx), config_(config), shading_(std::move(shading)),
       policy_(config.raySort, size_t(1) << uint(ctx.scene.settings.binExponent)),
-      scratch_(std::make_unique<Scratch>()),
-      fused_(config.fuseStages && shading_->shadesOnHostThreads()),
-      simdShading_(fused_ && usesSimdShading(ctx)),
-      sortHits_(config.sortsHits() && (config.hitSort == HitSortMode::On ||
-                                       !shading_->shadesOnHostThreads() || ctx.textures.active())),
-      shaderOrder_(ctx.scene) {
+      scratch_(std::make_unique<Scratch>()), shaderOrder_(ctx.scene) {
     const double budgetMiB = ctx.scene.settings.memoryBudgetMiB;
     const uint exponent = uint(ctx.scene.settings.binExponent);
     // The budget covers every ray waiting in RAM: the six bins fill up to one batch each, and
@@ -67,42 +50,27 @@ bool SortedRenderer::renderIteration(uint iteration, Film& film) {
         StageTimer t(ctx_.stats.stages, "generate");
         cameraRays_.begin(ctx_, iteration, film);
     }
-    // With two engine slots, batch k's shading runs while batch k+1 is loaded, traversed and set
-    // up; batch k is then finished (its continuation rays binned) before k+2 starts. Batches may
-    // be finished in any order: the film and the random numbers do not depend on it.
-    const bool overlap = shading_->slots() > 1;
-    int pending = -1; // the slot whose batch is being shaded
-    int next = 0;
+    Scratch& s = *scratch_;
     for (;;) {
         if (stopRequested(ctx_.config)) {
             // A batch boundary: let the engine finish what it holds, then drop every ray still
             // waiting (the caller discards this iteration's film).
-            if (pending >= 0) shading_->finish(pending);
+            shading_->abandon();
             bins_->clear();
             queue_->clear();
             publishStats();
             return false;
         }
         bool camera = false;
-        // With a batch pending, its continuation rays may yet fill a bin: flush none before.
-        if (!nextBatch(film, pending < 0, camera)) {
-            if (pending < 0) break; // nothing queued, binned, pending or still to make
-            finishBatch(pending, iteration, film); // its continuation rays may refill the queue
-            pending = -1;
+        // With a batch being shaded, its continuation rays may yet fill a bin: flush none before.
+        if (!nextBatch(film, !shading_->busy(), camera)) {
+            if (!shading_->busy()) break;   // nothing queued, binned, pending or still to make
+            shading_->finish(film, *bins_); // its continuation rays may refill the queue
             continue;
         }
-        if (fused_) {
-            runFusedBatch(camera, iteration, film);
-            continue;
-        }
-        startBatch(camera, next, iteration, film);
-        if (pending >= 0) finishBatch(pending, iteration, film);
-        if (overlap) {
-            pending = next;
-            next ^= 1;
-        } else {
-            finishBatch(next, iteration, film);
-        }
+        const size_t hitCount = traceBatch(camera);
+        escapes(iteration, hitCount, film);
+        shading_->shadeBatch({s.rays, s.hits, s.order, hitCount}, film, *bins_);
     }
     publishStats();
     return true;
@@ -152,7 +120,7 @@ size_t SortedRenderer::traceBatch(bool camera) {
         policy_.record(mode != RaySortMode::Off, since(sortStart), n);
         ctx_.stats.bounceRays += n;
     }
-    if (fused_ && !sortHits_ && ctx_.params.environment == kNoEmitter) {
+    if (shading_->takesTraversalOrder()) {
         // Nothing to sort and no miss to shade: the fused loop takes the hits in traversal
         // order and leaves out the misses chunk by chunk (stages.h: shadeFused).
         s.order.clear();
@@ -161,67 +129,8 @@ size_t SortedRenderer::traceBatch(bool camera) {
     StageTimer t(times, "sort hits");
     // Within a shader, texture order only where textures are read: otherwise the traversal
     // order stays, and the radix sort needs one pass instead of three or four.
-    return sortHits(ctx_.scene, shaderOrder_, s.hits, sortHits_, ctx_.textures.active(), s.order,
-                    s.keyTmp);
-}
-
-void SortedRenderer::runFusedBatch(bool camera, uint iteration, Film& film) {
-    Scratch& s = *scratch_;
-    const size_t hitCount = traceBatch(camera);
-    escapes(iteration, hitCount, film);
-    shadeFused(ctx_, iteration, config_.rayFormat, simdShading_, s.rays, s.hits, s.order, hitCount,
-               film, *bins_);
-}
-
-void SortedRenderer::startBatch(bool camera, int slot, uint iteration, Film& film) {
-    Scratch& s = *scratch_;
-    Scratch::InFlight& flight = s.inFlight[slot];
-    StageTimes& times = ctx_.stats.stages;
-    flight.hitCount = traceBatch(camera);
-    escapes(iteration, flight.hitCount, film);
-    {
-        StageTimer t(times, "hit setup");
-        flight.shading = shading_->reserve(slot, flight.hitCount);
-        flight.paths.resize(flight.hitCount);
-        setUpHits(ctx_, s.rays, s.hits, s.order, flight.hitCount, flight.shading.inputs,
-                  flight.paths.data());
-    }
-    {
-        StageTimer t(times, "shade");
-        shadeRanges(ctx_.scene, shaderOrder_, s.order, flight.hitCount, sortHits_, s.ranges);
-        shading_->submit(slot, s.ranges);
-    }
-}
-
-void SortedRenderer::finishBatch(int slot, uint iteration, Film& film) {
-    Scratch& s = *scratch_;
-    StageTimes& times = ctx_.stats.stages;
-    const Scratch::InFlight& flight = s.inFlight[slot];
-    const ShadeResult* results = flight.shading.results;
-    {
-        StageTimer t(times, "shade wait");
-        shading_->finish(slot);
-    }
-    if (config_.fuseStages) {
-        finishFused(ctx_, iteration, config_.rayFormat, results, flight.paths.data(),
-                    flight.hitCount, film, *bins_);
-        return;
-    }
-    {
-        StageTimer t(times, "shadow");
-        gatherShadowRays(results, flight.hitCount, s.shadowOwner, s.shadows);
-        occludedBatch(ctx_.embree, s.shadows, false, s.occluded);
-        ctx_.stats.shadowRays += s.shadows.size();
-    }
-    {
-        StageTimer t(times, "accumulate");
-        accumulate(ctx_, iteration, results, flight.paths.data(), flight.hitCount, s.shadowOwner,
-                   s.occluded, film);
-    }
-    {
-        StageTimer t(times, "bin");
-        binContinuations(ctx_, iteration, config_.rayFormat, results, flight.hitCount, *bins_);
-    }
+    return sortHits(ctx_.scene, shaderOrder_, s.hits, shading_->sortsHits(), ctx_.textures.active(),
+                    s.order, s.keyTmp);
 }
 
 void SortedRenderer::escapes(uint iteration, size_t hitCount, Film& film) {
@@ -232,23 +141,23 @@ void SortedRenderer::escapes(uint iteration, size_t hitCount, Film& film) {
 
 void SortedRenderer::publishStats() {
     const QueueCounters c = queue_->counters();
+    SpillCounters spill;
+    spill.batchesProcessed = batchesProcessed_;
+    spill.batchesQueued = c.batchesQueued;
+    spill.batchesSpilled = c.batchesSpilled;
+    spill.bytesWritten = c.bytesWritten;
+    spill.bytesRead = c.bytesRead;
+    spill.peakRayBytesInRam = c.peakRamBytes;
+    ctx_.stats.spill = spill;
     nlohmann::json& x = ctx_.stats.extra;
-    x["batches_processed"] = batchesProcessed_;
-    x["batches_queued"] = c.batchesQueued;
-    x["batches_spilled"] = c.batchesSpilled;
-    x["bytes_spilled_written"] = c.bytesWritten;
-    x["bytes_spilled_read"] = c.bytesRead;
-    x["peak_ray_bytes_in_ram"] = c.peakRamBytes;
     x["ray_format"] = rayFormatName(config_.rayFormat);
     x["ray_record_bytes"] = rayRecordBytes(config_.rayFormat);
     x["ray_sort"] = raySortName(config_.raySort);
-    x["hit_sort"] = sortHits_;
-    x["shading"] = shadingModeName(sortHits_ ? ShadingMode::Sorted : ShadingMode::Megakernel);
+    x["hit_sort"] = shading_->sortsHits();
+    x["shading"] =
+        shadingModeName(shading_->sortsHits() ? ShadingMode::Sorted : ShadingMode::Megakernel);
     x["batches_ray_sorted"] = policy_.sortedBatches();
     x["batches_ray_unsorted_measured"] = policy_.unsortedBatches();
-    // fused: every per-hit stage chunk by chunk; fused after shading: shadow, accumulate and bin
-    // (an engine that shades elsewhere); separate: each stage over the whole batch.
-    x["stages"] = fused_ ? "fused" : config_.fuseStages ? "fused after shading" : "separate";
     shading_->publishStats(ctx_.stats);
 }
 

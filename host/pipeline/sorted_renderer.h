@@ -1,11 +1,12 @@
-// The sorted deferred pipeline as a backend: it runs the stages of host/pipeline/stages.h over
-// every batch of an iteration, overlapping a batch's shading with the next batch's traversal
-// where the shading engine has two slots, and fusing the per-hit stages chunk by chunk where the
-// engine shades on the host's threads.
+// The sorted deferred pipeline as a backend: for every batch of an iteration it generates or
+// loads the rays, sorts them, traverses them and sorts the hits (stages.h), then hands the batch
+// to the shading engine in one call (shading_engine.h), which runs the per-hit stages its own way
+// (fused on the cpu; overlapped with the next batch's traversal on Vulkan).
 #pragma once
 
 #include "host/backend/backend.h"
 #include "host/pipeline/batch_queue.h"
+#include "host/pipeline/directional_bins.h"
 #include "host/pipeline/ray_sort.h"
 #include "host/pipeline/shading_engine.h"
 #include "host/pipeline/stages.h"
@@ -27,16 +28,8 @@ class SortedRenderer : public Backend {
     // else the next camera rays (generate), else, if `flush`, the part-full bins'
     // (DirectionalBins::flush). False when none.
     bool nextBatch(Film& film, bool flush, bool& camera);
-    // One batch in two halves, so that a batch's shading can overlap the next one's traversal:
-    // sort rays .. hit setup, then submit its shading to `slot`; then wait for it, trace its
-    // shadow rays, accumulate and bin its continuation rays. The misses' environment goes into
-    // the film at once.
-    void startBatch(bool camera, int slot, uint iteration, Film& film);
     // sort rays .. sort hits: the batch's hits in shading order in the scratch; their count.
     size_t traceBatch(bool camera);
-    // The whole batch with the per-hit stages fused (stages.h: shadeFused), for the cpu engine.
-    void runFusedBatch(bool camera, uint iteration, Film& film);
-    void finishBatch(int slot, uint iteration, Film& film);
     // escape: the batch's misses see the environment (stages.h: accumulateEscapes).
     void escapes(uint iteration, size_t hitCount, Film& film);
     void publishStats();
@@ -50,9 +43,6 @@ class SortedRenderer : public Backend {
     size_t batchRays_; // 2^(bin exponent)
     RaySortPolicy policy_;
     std::unique_ptr<Scratch> scratch_;
-    bool fused_;
-    bool simdShading_; // the fused loop's Lambert hits SIMD-wide (cpu_shading.h: usesSimdShading)
-    bool sortHits_;    // the hit sort's auto rule applied (render_config.h: HitSortMode)
     ShaderOrder shaderOrder_; // the shaders' ranks in the hit sort (hit_sort.h)
     std::uint64_t batchesProcessed_ = 0;
 };

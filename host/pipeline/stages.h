@@ -20,6 +20,7 @@
 #include "embree_backend/batch_traversal.h"
 #include "host/backend/backend.h"
 #include "host/pipeline/batch_queue.h"
+#include "host/pipeline/directional_bins.h"
 #include "host/pipeline/hit_sort.h"
 #include "host/pipeline/ray_record.h"
 #include "host/pipeline/shading_engine.h"

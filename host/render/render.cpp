@@ -24,22 +24,18 @@
 namespace spw {
 namespace {
 
-// --stats' `textures`: the texture system's counters, and the traffic per traced ray.
-nlohmann::json textureStatistics(const TextureResolver& textures, const RenderStats& stats) {
+// --stats' `textures`: the texture system's counters.
+TextureCounters textureCounters(const TextureResolver& textures) {
     const TextureStatistics t = textures.statistics();
-    const double rays = double(stats.cameraRays + stats.bounceRays + stats.shadowRays);
-    auto perRay = [&](std::uint64_t n) { return rays > 0 ? double(n) / rays : 0.0; };
-    return {{"lookups", t.lookups},
-            {"tiles_read", t.tilesRead},
-            {"bytes_read", t.bytesRead},
-            {"files_opened", t.filesOpened},
-            {"files_reopened", t.filesReopened},
-            {"cache_misses", t.cacheMisses},
-            {"peak_cache_bytes", t.peakCacheBytes},
-            {"per_ray",
-             {{"lookups", perRay(t.lookups)},
-              {"tiles_read", perRay(t.tilesRead)},
-              {"bytes_read", perRay(t.bytesRead)}}}};
+    TextureCounters c;
+    c.lookups = t.lookups;
+    c.tilesRead = t.tilesRead;
+    c.bytesRead = t.bytesRead;
+    c.filesOpened = t.filesOpened;
+    c.filesReopened = t.filesReopened;
+    c.cacheMisses = t.cacheMisses;
+    c.peakCacheBytes = t.peakCacheBytes;
+    return c;
 }
 
 } // namespace
@@ -295,7 +291,7 @@ void RenderSession::report(const char* stopReason) {
             {"min_samples", scene_.settings.adaptiveMinSamples},
             {"samples_of_full_render",
              std::uint64_t(scene_.image.width) * scene_.image.height * std::uint64_t(stats_.spp)}};
-    if (textures_->active()) stats_.extra["textures"] = textureStatistics(*textures_, stats_);
+    if (textures_->active()) stats_.textures = textureCounters(*textures_);
     sync_.finish(stats_, sinceStart());
     if (sync_.writes() && !checkpoints_.path.empty() && done_ > first_) writeCheckpoint();
     stats_.nonFiniteSamples = film.nonFiniteSamples();

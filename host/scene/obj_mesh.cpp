@@ -233,6 +233,120 @@ std::string readFile(const std::string& path, const std::string& sceneFile, int 
     return text.str();
 }
 
+// tinyobjloader's reading of the checked text; it must agree with the checking pass on every
+// element, or an index could read out of bounds: the file is refused rather than either trusted
+// alone.
+void parseChecked(const ObjText& obj, tinyobj::ObjReader& reader, const std::string& path,
+                  const std::string& sceneFile, int sceneLine) {
+    tinyobj::ObjReaderConfig cfg;
+    cfg.triangulate = true;
+    cfg.vertex_color = false;
+    cfg.mtl_search_path = "";
+    // Materials are ignored (shaders come from the scene): parse the geometry only.
+    if (!reader.ParseFromString(obj.clean, "", cfg)) {
+        std::string why = reader.Error();
+        while (!why.empty() && (why.back() == '\n' || why.back() == '\r'))
+            why.pop_back();
+        throw SceneError(sceneFile, sceneLine, "cannot read OBJ file '" + path + "': " + why);
+    }
+    const tinyobj::attrib_t& a = reader.GetAttrib();
+    if (a.vertices.size() != 3 * obj.positions.size() || a.normals.size() != 3 * obj.normals ||
+        a.texcoords.size() != 2 * obj.uvs)
+        throw SceneError(sceneFile, sceneLine,
+                         "OBJ file '" + path +
+                             "': tinyobjloader read a different number of "
+                             "vertices, normals or texture coordinates than the file holds");
+}
+
+// The mesh, a vertex per distinct (position, normal, uv) triple of the OBJ, placed in the world
+// relative to the camera.
+class MeshBuilder {
+  public:
+    MeshBuilder(const ObjText& obj, const tinyobj::attrib_t& a, const glm::dmat4& objectToWorld,
+                const glm::dvec3& origin, const std::string& path, const std::string& sceneFile,
+                int sceneLine)
+        : obj_(obj), a_(a), objectToWorld_(objectToWorld),
+          normalXf_(glm::transpose(glm::inverse(glm::dmat3(objectToWorld)))), origin_(origin),
+          path_(path), sceneFile_(sceneFile), sceneLine_(sceneLine) {
+        mesh_.name = path;
+    }
+
+    void addFace(const tinyobj::index_t* corners) {
+        uvec3 tri;
+        for (int k = 0; k < 3; ++k)
+            tri[k] = vertex(corners[k]);
+        // Zero area as the renderer sees it: it normalises cross(e1, e2) in float, so |c|^2
+        // must be a normal float (not 0, not a denormal that flush-to-zero turns into 0).
+        vec3 e1 = mesh_.positions[tri.y] - mesh_.positions[tri.x];
+        vec3 e2 = mesh_.positions[tri.z] - mesh_.positions[tri.x];
+        vec3 c = glm::cross(e1, e2);
+        const float c2 = glm::dot(c, c);
+        if (std::isinf(c2) || std::isnan(c2))
+            throw SceneError(sceneFile_, sceneLine_,
+                             "OBJ file '" + path_ +
+                                 "' has a triangle too large for float "
+                                 "(its normal overflows): edges must stay below about 1e9");
+        if (!(c2 >= std::numeric_limits<float>::min())) {
+            ++mesh_.droppedTriangles;
+            return;
+        }
+        mesh_.triangles.push_back(tri);
+    }
+
+    Mesh take() { return std::move(mesh_); }
+
+  private:
+    uint vertex(const tinyobj::index_t& ix) {
+        const long long nv = (long long)obj_.positions.size(), nn = (long long)obj_.normals,
+                        nt = (long long)obj_.uvs;
+        if (ix.vertex_index < 0 || ix.vertex_index >= nv || ix.normal_index >= nn ||
+            ix.texcoord_index >= nt)
+            throw SceneError(sceneFile_, sceneLine_,
+                             "OBJ file '" + path_ + "': a face index is out of range");
+        const bool hasNormals = nn > 0, hasUvs = nt > 0;
+        auto key = std::make_tuple(ix.vertex_index, hasNormals ? ix.normal_index : -1,
+                                   hasUvs ? ix.texcoord_index : -1);
+        auto [it, inserted] = remap_.try_emplace(key, uint(mesh_.positions.size()));
+        if (!inserted) return it->second;
+        // In double until here: the object's transform and the shift to the camera round once,
+        // to float, at the end.
+        const size_t vi = size_t(ix.vertex_index);
+        const glm::dvec3 world =
+            glm::dvec3(objectToWorld_ * glm::dvec4(obj_.positions[vi], 1.0)) - origin_;
+        const std::string far =
+            beyondReach(world, "vertex (after the object's transform, scene " + sceneFile_ + ":" +
+                                   std::to_string(sceneLine_) + ")");
+        if (!far.empty()) throw SceneError(path_, obj_.positionLines[vi], far);
+        mesh_.positions.push_back(vec3(world));
+        if (hasNormals) {
+            glm::dvec3 n(0.0);
+            const size_t ni = size_t(ix.normal_index);
+            if (ix.normal_index >= 0)
+                n = normalXf_ *
+                    glm::dvec3(a_.normals[3 * ni], a_.normals[3 * ni + 1], a_.normals[3 * ni + 2]);
+            const double len = glm::length(n);
+            mesh_.normals.push_back(len > 0.0 && std::isfinite(len) ? vec3(n / len) : vec3(0.0f));
+        }
+        if (hasUvs) {
+            vec2 uv(0.0f);
+            const size_t ti = size_t(ix.texcoord_index);
+            if (ix.texcoord_index >= 0) uv = vec2(a_.texcoords[2 * ti], a_.texcoords[2 * ti + 1]);
+            mesh_.uvs.push_back(uv);
+        }
+        return it->second;
+    }
+
+    const ObjText& obj_;
+    const tinyobj::attrib_t& a_;
+    const glm::dmat4 objectToWorld_;
+    const glm::dmat3 normalXf_;
+    const glm::dvec3 origin_;
+    const std::string &path_, &sceneFile_;
+    const int sceneLine_;
+    Mesh mesh_;
+    std::map<std::tuple<int, int, int>, uint> remap_;
+};
+
 } // namespace
 
 Mesh loadObjMesh(const std::string& path, const glm::dmat4& objectToWorld, const glm::dvec3& origin,
@@ -242,100 +356,15 @@ Mesh loadObjMesh(const std::string& path, const glm::dmat4& objectToWorld, const
     if (obj.faces == 0)
         throw SceneError(sceneFile, sceneLine,
                          "OBJ file '" + path + "' has no face ('f' statement): nothing to render");
-
-    tinyobj::ObjReaderConfig cfg;
-    cfg.triangulate = true;
-    cfg.vertex_color = false;
-    cfg.mtl_search_path = "";
     tinyobj::ObjReader reader;
-    // Materials are ignored (shaders come from the scene): parse the geometry only.
-    if (!reader.ParseFromString(obj.clean, "", cfg)) {
-        std::string why = reader.Error();
-        while (!why.empty() && (why.back() == '\n' || why.back() == '\r'))
-            why.pop_back();
-        throw SceneError(sceneFile, sceneLine, "cannot read OBJ file '" + path + "': " + why);
-    }
-    const tinyobj::attrib_t& a = reader.GetAttrib();
-    // The checking pass and tinyobjloader must agree on every element, or an index could read
-    // out of bounds: refuse the file rather than trust either alone.
-    if (a.vertices.size() != 3 * obj.positions.size() || a.normals.size() != 3 * obj.normals ||
-        a.texcoords.size() != 2 * obj.uvs)
-        throw SceneError(sceneFile, sceneLine,
-                         "OBJ file '" + path +
-                             "': tinyobjloader read a different number of "
-                             "vertices, normals or texture coordinates than the file holds");
-    const long long nv = (long long)obj.positions.size(), nn = (long long)obj.normals,
-                    nt = (long long)obj.uvs;
-
-    Mesh mesh;
-    mesh.name = path;
-    const glm::dmat3 normalXf = glm::transpose(glm::inverse(glm::dmat3(objectToWorld)));
-    const bool hasNormals = nn > 0, hasUvs = nt > 0;
-    // One mesh vertex per distinct (position, normal, uv) triple of the OBJ.
-    std::map<std::tuple<int, int, int>, uint> remap;
+    parseChecked(obj, reader, path, sceneFile, sceneLine);
+    MeshBuilder mesh(obj, reader.GetAttrib(), objectToWorld, origin, path, sceneFile, sceneLine);
     for (const tinyobj::shape_t& shape : reader.GetShapes()) {
         const auto& idx = shape.mesh.indices;
-        for (size_t f = 0; f + 2 < idx.size(); f += 3) {
-            uvec3 tri;
-            for (int k = 0; k < 3; ++k) {
-                const tinyobj::index_t& ix = idx[f + k];
-                if (ix.vertex_index < 0 || ix.vertex_index >= nv || ix.normal_index >= nn ||
-                    ix.texcoord_index >= nt)
-                    throw SceneError(sceneFile, sceneLine,
-                                     "OBJ file '" + path + "': a face index is out of range");
-                auto key = std::make_tuple(ix.vertex_index, hasNormals ? ix.normal_index : -1,
-                                           hasUvs ? ix.texcoord_index : -1);
-                auto [it, inserted] = remap.try_emplace(key, uint(mesh.positions.size()));
-                if (inserted) {
-                    // In double until here: the object's transform and the shift to the camera
-                    // round once, to float, at the end.
-                    const size_t vi = size_t(ix.vertex_index);
-                    const glm::dvec3 world =
-                        glm::dvec3(objectToWorld * glm::dvec4(obj.positions[vi], 1.0)) - origin;
-                    const std::string far =
-                        beyondReach(world, "vertex (after the object's transform, scene " +
-                                               sceneFile + ":" + std::to_string(sceneLine) + ")");
-                    if (!far.empty()) throw SceneError(path, obj.positionLines[vi], far);
-                    mesh.positions.push_back(vec3(world));
-                    if (hasNormals) {
-                        glm::dvec3 n(0.0);
-                        if (ix.normal_index >= 0)
-                            n = normalXf * glm::dvec3(a.normals[3 * size_t(ix.normal_index)],
-                                                      a.normals[3 * size_t(ix.normal_index) + 1],
-                                                      a.normals[3 * size_t(ix.normal_index) + 2]);
-                        const double len = glm::length(n);
-                        mesh.normals.push_back(len > 0.0 && std::isfinite(len) ? vec3(n / len)
-                                                                               : vec3(0.0f));
-                    }
-                    if (hasUvs) {
-                        vec2 uv(0.0f);
-                        if (ix.texcoord_index >= 0)
-                            uv = vec2(a.texcoords[2 * size_t(ix.texcoord_index)],
-                                      a.texcoords[2 * size_t(ix.texcoord_index) + 1]);
-                        mesh.uvs.push_back(uv);
-                    }
-                }
-                tri[k] = it->second;
-            }
-            // Zero area as the renderer sees it: it normalises cross(e1, e2) in float, so |c|^2
-            // must be a normal float (not 0, not a denormal that flush-to-zero turns into 0).
-            vec3 e1 = mesh.positions[tri.y] - mesh.positions[tri.x];
-            vec3 e2 = mesh.positions[tri.z] - mesh.positions[tri.x];
-            vec3 c = glm::cross(e1, e2);
-            const float c2 = glm::dot(c, c);
-            if (std::isinf(c2) || std::isnan(c2))
-                throw SceneError(sceneFile, sceneLine,
-                                 "OBJ file '" + path +
-                                     "' has a triangle too large for float "
-                                     "(its normal overflows): edges must stay below about 1e9");
-            if (!(c2 >= std::numeric_limits<float>::min())) {
-                ++mesh.droppedTriangles;
-                continue;
-            }
-            mesh.triangles.push_back(tri);
-        }
+        for (size_t f = 0; f + 2 < idx.size(); f += 3)
+            mesh.addFace(&idx[f]);
     }
-    return mesh;
+    return mesh.take();
 }
 
 } // namespace spw

@@ -1,10 +1,12 @@
 // The YAML scene loader: docs/scene-format.md made executable. Every value is checked for type and
 // range where it is read, and every error names the file and line of the offending node.
 #include "host/image/image_io.h"
+#include "host/scene/light_loader.h"
 #include "host/scene/obj_mesh.h"
 #include "host/scene/scene.h"
 #include "host/scene/settings_table.h"
 #include "host/scene/surface_models.h"
+#include "host/scene/yaml_reader.h"
 
 #include <OpenImageIO/imageio.h>
 #include <glm/gtc/matrix_transform.hpp>
@@ -28,150 +30,12 @@ namespace fs = std::filesystem;
 namespace spw {
 namespace {
 
+using namespace scene_file;
+
 // Largest image the loader accepts; keeps film and ray ids well inside 32-bit indices.
 constexpr long long kMaxPixels = 1LL << 26;
 constexpr int kMaxDimension = 1 << 15;
 constexpr int kMaxSampleBase = 256;
-
-class Reader {
-  public:
-    explicit Reader(std::string file) : file_(std::move(file)) {}
-
-    [[noreturn]] void fail(const YAML::Node& at, const std::string& message) const {
-        throw SceneError(file_, at.Mark().line + 1, message);
-    }
-    [[noreturn]] void fail(int line, const std::string& message) const {
-        throw SceneError(file_, line, message);
-    }
-
-    // A map node whose keys are all in `allowed`; returns (key, value) pairs in file order.
-    void checkKeys(const YAML::Node& map, const std::string& what,
-                   const std::vector<std::string>& allowed) const {
-        if (!map.IsMap()) fail(map, what + " must be a map of keys to values");
-        for (auto it = map.begin(); it != map.end(); ++it) {
-            std::string key = it->first.as<std::string>();
-            bool known = false;
-            for (const std::string& a : allowed)
-                known = known || key == a;
-            if (!known) fail(it->first, "unknown key '" + key + "' in " + what);
-        }
-    }
-
-    std::string string(const YAML::Node& n, const std::string& what) const {
-        if (!n.IsScalar()) fail(n, what + " must be a string");
-        return n.as<std::string>();
-    }
-
-    double number(const YAML::Node& n, const std::string& what) const {
-        if (!n.IsScalar()) fail(n, what + " must be a number");
-        double v;
-        if (!YAML::convert<double>::decode(n, v))
-            fail(n, what + " must be a number, not '" + n.Scalar() + "'");
-        if (!std::isfinite(v)) fail(n, what + " must be finite");
-        return v;
-    }
-
-    double number(const YAML::Node& n, const std::string& what, double lo, double hi) const {
-        double v = number(n, what);
-        if (v < lo || v > hi)
-            fail(n, what + " must be in [" + fmt(lo) + ", " + fmt(hi) + "], not " + fmt(v));
-        return v;
-    }
-
-    long long integer(const YAML::Node& n, const std::string& what, long long lo,
-                      long long hi) const {
-        if (!n.IsScalar()) fail(n, what + " must be an integer");
-        long long v;
-        if (!YAML::convert<long long>::decode(n, v))
-            fail(n, what + " must be an integer, not '" + n.Scalar() + "'");
-        if (v < lo || v > hi)
-            fail(n, what + " must be in [" + std::to_string(lo) + ", " + std::to_string(hi) +
-                        "], not " + std::to_string(v));
-        return v;
-    }
-
-    bool boolean(const YAML::Node& n, const std::string& what) const {
-        bool v;
-        if (!n.IsScalar() || !YAML::convert<bool>::decode(n, v))
-            fail(n, what + " must be true or false");
-        return v;
-    }
-
-    template <int N>
-    glm::vec<N, float> vec(const YAML::Node& n, const std::string& what, double lo = -HUGE_VAL,
-                           double hi = HUGE_VAL) const {
-        return glm::vec<N, float>(dvec<N>(n, what, lo, hi));
-    }
-
-    template <int N>
-    glm::vec<N, double> dvec(const YAML::Node& n, const std::string& what, double lo = -HUGE_VAL,
-                             double hi = HUGE_VAL) const {
-        if (!n.IsSequence() || n.size() != N)
-            fail(n, what + " must be a list of " + std::to_string(N) + " numbers");
-        glm::vec<N, double> v;
-        for (int i = 0; i < N; ++i)
-            v[i] = number(n[i], what, lo, hi);
-        return v;
-    }
-
-    const std::string& file() const { return file_; }
-
-    static std::string fmt(double v) {
-        if (std::isinf(v)) return v > 0 ? "inf" : "-inf";
-        std::string s = std::to_string(v);
-        if (std::fabs(v) >= 1e7 || (v != 0 && std::fabs(v) < 1e-4)) {
-            // 1e+20 -> 1e20, 1e-05 -> 1e-5: as the format's ranges are written.
-            char buf[32];
-            std::snprintf(buf, sizeof buf, "%g", v);
-            std::string g = buf;
-            const size_t e = g.find('e');
-            if (e == std::string::npos) return g;
-            std::string mant = g.substr(0, e), exp = g.substr(e + 1);
-            const bool neg = exp[0] == '-';
-            exp.erase(0, exp.find_first_not_of("+-0"));
-            return mant + "e" + (neg ? "-" : "") + (exp.empty() ? "0" : exp);
-        }
-        s.erase(s.find_last_not_of('0') + 1);
-        if (!s.empty() && s.back() == '.') s.pop_back();
-        return s;
-    }
-
-  private:
-    std::string file_;
-};
-
-// R = Rz * Ry * Rx, degrees.
-glm::dmat4 rotationXYZ(glm::dvec3 degrees) {
-    glm::dmat4 r(1.0);
-    r = glm::rotate(r, glm::radians(degrees.z), glm::dvec3(0, 0, 1));
-    r = glm::rotate(r, glm::radians(degrees.y), glm::dvec3(0, 1, 0));
-    r = glm::rotate(r, glm::radians(degrees.x), glm::dvec3(1, 0, 0));
-    return r;
-}
-
-// translation * rotation * scale, reading whichever of the three keys are present. In double:
-// the scene is moved to the camera before anything is rounded to float.
-glm::dmat4 readTransform(const Reader& rd, const YAML::Node& n, const std::string& what,
-                         bool scale3) {
-    glm::dmat4 m(1.0);
-    if (n["translation"])
-        m = glm::translate(m, rd.dvec<3>(n["translation"], what + " translation"));
-    if (n["rotation"]) m = m * rotationXYZ(rd.dvec<3>(n["rotation"], what + " rotation"));
-    if (scale3 && n["scale"]) {
-        const YAML::Node& s = n["scale"];
-        glm::dvec3 sc = s.IsScalar() ? glm::dvec3(rd.number(s, what + " scale"))
-                                     : rd.dvec<3>(s, what + " scale");
-        if (sc.x == 0 || sc.y == 0 || sc.z == 0) rd.fail(s, what + " scale must not be zero");
-        m = glm::scale(m, sc);
-    }
-    return m;
-}
-
-void checkDistance(const Reader& rd, const YAML::Node& at, const glm::dvec3& p,
-                   const std::string& what) {
-    const std::string why = beyondReach(p, what);
-    if (!why.empty()) rd.fail(at, why);
-}
 
 void readImage(const Reader& rd, const YAML::Node& n, ImageSettings& img) {
     rd.checkKeys(n, "image", {"width", "height", "sample base", "iterations"});
@@ -480,118 +344,6 @@ void readObject(const Reader& rd, const YAML::Node& n, const fs::path& dir, Scen
     pending.push_back({n, shader, (n["shader"] ? n["shader"] : n).Mark().line + 1});
 }
 
-// A light's `intensity` (1) x `colour` ([1, 1, 1]): the radiance of a quad light or an
-// environment, the intensity of a point light. Each channel must fit the range of any emission.
-glm::dvec3 lightIntensity(const Reader& rd, const YAML::Node& n, bool colourKey) {
-    const double intensity =
-        n["intensity"] ? rd.number(n["intensity"], "light intensity", 0.0, kMaxRadiance) : 1.0;
-    const glm::dvec3 colour = colourKey && n["colour"]
-                                  ? rd.dvec<3>(n["colour"], "light colour", 0.0, kMaxRadiance)
-                                  : glm::dvec3(1.0);
-    for (int i = 0; i < 3; ++i)
-        if (intensity * colour[i] > kMaxRadiance)
-            rd.fail(n["colour"] ? n["colour"] : n["intensity"],
-                    "light intensity x colour = " + Reader::fmt(intensity * colour[i]) +
-                        " exceeds " + Reader::fmt(kMaxRadiance) +
-                        ", the brightest radiance Spillway renders");
-    return intensity * colour;
-}
-
-// A quad light becomes two triangles (appended to lightMeshes) and an emissive Null shader of
-// its own (returned); both go after the scene's objects and shaders once the file is read.
-Shader readQuadLight(const Reader& rd, const YAML::Node& n, const glm::dvec3& origin,
-                     std::vector<Mesh>& lightMeshes) {
-    rd.checkKeys(n, "Quad light",
-                 {"type", "translation", "rotation", "scale", "intensity", "colour"});
-    glm::dvec2 size(1.0);
-    if (n["scale"]) {
-        size = rd.dvec<2>(n["scale"], "light scale", 1e-30, kMaxDistance);
-    }
-    const glm::dvec3 emitted = lightIntensity(rd, n, true);
-    const glm::dmat4 xf = readTransform(rd, n, "light", false);
-
-    Mesh m;
-    m.name = "quad light " + std::to_string(lightMeshes.size());
-    for (glm::dvec2 c : {glm::dvec2(-0.5, -0.5), glm::dvec2(0.5, -0.5), glm::dvec2(0.5, 0.5),
-                         glm::dvec2(-0.5, 0.5)}) {
-        const glm::dvec3 p =
-            glm::dvec3(xf * glm::dvec4(c.x * size.x, c.y * size.y, 0.0, 1.0)) - origin;
-        checkDistance(rd, n, p, "quad light corner");
-        m.positions.push_back(vec3(p));
-    }
-    m.triangles = {uvec3(0, 1, 2), uvec3(0, 2, 3)};
-    // A light too small (or too far out) for float to span: refuse it rather than divide by its
-    // area.
-    for (const uvec3& tri : m.triangles) {
-        vec3 c = glm::cross(m.positions[tri.y] - m.positions[tri.x],
-                            m.positions[tri.z] - m.positions[tri.x]);
-        float a2 = glm::dot(c, c);
-        if (!(a2 >= std::numeric_limits<float>::min()) || !std::isfinite(a2))
-            rd.fail(n, "quad light has no area in float after its scale and transform");
-    }
-    Shader s;
-    s.typeName = "Quad light";
-    s.line = n.Mark().line + 1;
-    s.params.model = kModelNull;
-    s.params.emission = vec3(emitted);
-    lightMeshes.push_back(std::move(m));
-    return s;
-}
-
-// `position` (camera-relative from here on), intensity x colour in W/sr.
-PointLight readPointLight(const Reader& rd, const YAML::Node& n, const glm::dvec3& origin) {
-    rd.checkKeys(n, "Point light", {"type", "position", "intensity", "colour"});
-    if (!n["position"]) rd.fail(n, "Point light needs a position");
-    const glm::dvec3 p = rd.dvec<3>(n["position"], "light position") - origin;
-    checkDistance(rd, n["position"], p, "point light");
-    PointLight light;
-    light.position = vec3(p);
-    light.intensity = vec3(lightIntensity(rd, n, true));
-    light.line = n.Mark().line + 1;
-    return light;
-}
-
-// `colour` (a constant) or `string` / `filename` (a lat-long image, read here, so that a bad
-// file is a scene error), times `intensity`.
-Environment readEnvironment(const Reader& rd, const YAML::Node& n, const fs::path& dir) {
-    rd.checkKeys(n, "Environment light", {"type", "colour", "string", "filename", "intensity"});
-    const YAML::Node file = n["string"] ? n["string"] : n["filename"];
-    if (file && n["colour"])
-        rd.fail(n["colour"], "Environment light takes a colour or an image ('string'), not both");
-    Environment env;
-    env.line = n.Mark().line + 1;
-    env.radiance = vec3(lightIntensity(rd, n, !file));
-    if (!file) return env;
-    const fs::path p = dir / rd.string(file, "environment image");
-    if (!fs::is_regular_file(p))
-        rd.fail(file, "environment image '" + p.string() + "' does not exist");
-    env.path = fs::absolute(p).lexically_normal().string();
-    ImageRGB img;
-    try {
-        img = spw::readImage(env.path);
-    } catch (const std::exception& e) {
-        rd.fail(file, e.what());
-    }
-    if (img.width < 1 || img.height < 1 || size_t(img.width) * size_t(img.height) > (1u << 26))
-        rd.fail(file, "environment image '" + env.path + "' is " + std::to_string(img.width) +
-                          " x " + std::to_string(img.height) +
-                          "; Spillway takes maps of 1 to 2^26 texels");
-    for (size_t i = 0; i < img.rgb.size(); ++i) {
-        const double v = double(img.rgb[i]) * double(env.radiance[int(i % 3)]);
-        if (!(v >= 0.0 && v <= kMaxRadiance)) {
-            const size_t texel = i / 3;
-            rd.fail(file, "environment image '" + env.path + "' has radiance " + Reader::fmt(v) +
-                              " at texel (" + std::to_string(texel % size_t(img.width)) + ", " +
-                              std::to_string(texel / size_t(img.width)) +
-                              "): every value must lie in 0 .. " + Reader::fmt(kMaxRadiance));
-        }
-    }
-    env.width = img.width;
-    env.height = img.height;
-    env.rgb = std::move(img.rgb);
-    return env;
-}
-
 } // namespace
 
 std::string beyondReach(const glm::dvec3& p, const std::string& what) {
@@ -652,16 +404,10 @@ std::string readSceneText(const std::string& path) {
     return text.str();
 }
 
-} // namespace
-
-Scene loadScene(const std::string& path) {
-    Scene scene;
-    scene.file = path;
-    Reader rd(path);
-    YAML::Node root;
-    const std::string text = readSceneText(path);
+// The scene file's YAML, or a SceneError naming where it is malformed.
+YAML::Node parseYaml(const std::string& path, const std::string& text) {
     try {
-        root = YAML::Load(text);
+        return YAML::Load(text);
     } catch (const YAML::DeepRecursion& e) {
         throw SceneError(path, e.mark.line + 1,
                          "YAML nests deeper than yaml-cpp's limit of " +
@@ -671,134 +417,166 @@ Scene loadScene(const std::string& path) {
     } catch (const YAML::Exception& e) {
         throw SceneError(path, e.mark.line + 1, "YAML error: " + e.msg);
     }
-    if (root.IsNull()) return scene; // an empty file is an empty scene: black
-    if (!root.IsMap()) rd.fail(root, "a scene is a map of entries (image, camera, object, ...)");
-    fs::path dir = fs::path(path).parent_path();
+}
 
-    std::vector<PendingObject> pending;
-    std::vector<Mesh> lightMeshes;
-    std::vector<Shader> lightShaders;
-    std::set<std::string> seenOnce;
-    TextureReader textures(rd, dir, scene);
-    // The hit key's limits (kMaxShaders, kMaxObjects), checked before each element that adds
-    // `shaders` shaders and `objects` objects (a light adds one of each): the error names it.
-    auto roomFor = [&](const YAML::Node& e, size_t shaders, size_t objects) {
-        if (scene.shaders.size() + lightShaders.size() + shaders > size_t(kMaxShaders))
-            rd.fail(e,
-                    "more than " + std::to_string(kMaxShaders) + " shaders (a light counts one)");
-        if (scene.meshes.size() + lightMeshes.size() + objects > size_t(kMaxObjects))
-            rd.fail(e,
-                    "more than " + std::to_string(kMaxObjects) + " objects (a light counts one)");
-    };
-    try {
-        // The camera first, wherever it stands in the file: everything else is placed relative to
-        // it.
+// The top level's entries into a scene: the camera first, then the rest in file order, then
+// the quad lights' meshes after the objects'.
+class SceneReader {
+  public:
+    SceneReader(const Reader& rd, const fs::path& dir, Scene& scene)
+        : rd_(rd), dir_(dir), scene_(scene), textures_(rd, dir, scene) {}
+
+    void readEntries(const YAML::Node& root) {
+        // The camera first, wherever it stands in the file: everything else is placed relative
+        // to it.
         for (auto it = root.begin(); it != root.end(); ++it)
             if (it->first.IsScalar() && it->first.Scalar() == "camera") {
-                scene.origin = readCamera(rd, it->second, scene.camera);
+                scene_.origin = readCamera(rd_, it->second, scene_.camera);
                 break;
             }
-        for (auto it = root.begin(); it != root.end(); ++it) {
-            std::string key = it->first.as<std::string>();
-            const YAML::Node v =
-                it->second; // a handle: a reference would dangle (the iterator returns a proxy)
-            bool single = key == "image" || key == "settings" || key == "camera" ||
-                          key == "filter" || key == "sampler";
-            if (single && !seenOnce.insert(key).second)
-                rd.fail(it->first, "'" + key + "' may appear only once");
-            auto each = [&](const std::function<void(const YAML::Node&)>& fn) {
-                if (v.IsSequence()) {
-                    for (const YAML::Node& e : v)
-                        fn(e);
-                } else {
-                    fn(v);
-                }
-            };
-            if (key == "image")
-                readImage(rd, v, scene.image);
-            else if (key == "settings")
-                readSettings(rd, v, scene.settings);
-            else if (key == "camera")
-                continue; // read above
-            else if (key == "filter")
-                readFilter(rd, v, scene.filter);
-            else if (key == "sampler")
-                scene.sampler = readSampler(rd, v);
-            else if (key == "object" || key == "objects") {
-                if (key == "objects" && !v.IsSequence()) rd.fail(v, "'objects' must be a list");
-                each([&](const YAML::Node& e) {
-                    roomFor(e, 0, 1);
-                    readObject(rd, e, dir, scene, pending);
-                });
-            } else if (key == "shader" || key == "shaders") {
-                if (key == "shaders" && !v.IsSequence()) rd.fail(v, "'shaders' must be a list");
-                each([&](const YAML::Node& e) {
-                    roomFor(e, 1, 0);
-                    readShader(rd, e, textures, scene);
-                });
-            } else if (key == "light" || key == "lights") {
-                if (key == "lights" && !v.IsSequence()) rd.fail(v, "'lights' must be a list");
-                each([&](const YAML::Node& e) {
-                    if (!e.IsMap() || !e["type"])
-                        rd.fail(e, "light needs a type (Quad, Point or Environment)");
-                    const std::string t = rd.string(e["type"], "light type");
-                    if (t == "Quad") {
-                        roomFor(e, 1, 1);
-                        lightShaders.push_back(readQuadLight(rd, e, scene.origin, lightMeshes));
-                    } else if (t == "Point") {
-                        scene.pointLights.push_back(readPointLight(rd, e, scene.origin));
-                    } else if (t == "Environment") {
-                        if (scene.environment)
-                            rd.fail(e, "a second Environment light (the first is at line " +
-                                           std::to_string(scene.environment->line) + ")");
-                        scene.environment = readEnvironment(rd, e, dir);
-                    } else {
-                        rd.fail(e["type"],
-                                "unknown light type '" + t + "' (Quad, Point or Environment)");
-                    }
-                });
-            } else {
-                rd.fail(it->first,
-                        "unknown entry '" + key +
-                            "' (image, settings, camera, filter, sampler, object, shader, light)");
-            }
-        }
-    } catch (const YAML::Exception& e) {
-        throw SceneError(path, e.mark.line + 1, e.msg);
+        for (auto it = root.begin(); it != root.end(); ++it)
+            // it->second is a handle: a reference would dangle (the iterator returns a proxy).
+            readEntry(it->first, it->second);
     }
 
-    const int sceneShaders = int(scene.shaders.size());
-    for (const PendingObject& o : pending)
-        if (o.shader >= sceneShaders)
-            rd.fail(o.line, "object uses shader " + std::to_string(o.shader) +
-                                " but the scene has " + std::to_string(sceneShaders) + " shader" +
-                                (sceneShaders == 1 ? "" : "s"));
-    scene.objectCount = int(scene.meshes.size());
-    scene.quadLightCount = int(lightMeshes.size());
-    for (size_t i = 0; i < lightMeshes.size(); ++i) {
-        lightMeshes[i].shader = int(scene.shaders.size());
-        scene.shaders.push_back(lightShaders[i]);
-        scene.meshes.push_back(std::move(lightMeshes[i]));
+    void finish(const YAML::Node& root);
+
+  private:
+    void readEntry(const YAML::Node& keyNode, const YAML::Node& v) {
+        const std::string key = keyNode.as<std::string>();
+        const bool single = key == "image" || key == "settings" || key == "camera" ||
+                            key == "filter" || key == "sampler";
+        if (single && !seenOnce_.insert(key).second)
+            rd_.fail(keyNode, "'" + key + "' may appear only once");
+        auto each = [&](const char* plural, const std::function<void(const YAML::Node&)>& fn) {
+            if (key == plural && !v.IsSequence())
+                rd_.fail(v, "'" + std::string(plural) + "' must be a list");
+            if (v.IsSequence()) {
+                for (const YAML::Node& e : v)
+                    fn(e);
+            } else {
+                fn(v);
+            }
+        };
+        if (key == "image")
+            readImage(rd_, v, scene_.image);
+        else if (key == "settings")
+            readSettings(rd_, v, scene_.settings);
+        else if (key == "camera")
+            return; // read first
+        else if (key == "filter")
+            readFilter(rd_, v, scene_.filter);
+        else if (key == "sampler")
+            scene_.sampler = readSampler(rd_, v);
+        else if (key == "object" || key == "objects")
+            each("objects", [&](const YAML::Node& e) {
+                roomFor(e, 0, 1);
+                readObject(rd_, e, dir_, scene_, pending_);
+            });
+        else if (key == "shader" || key == "shaders")
+            each("shaders", [&](const YAML::Node& e) {
+                roomFor(e, 1, 0);
+                readShader(rd_, e, textures_, scene_);
+            });
+        else if (key == "light" || key == "lights")
+            each("lights", [&](const YAML::Node& e) { readLight(e); });
+        else
+            rd_.fail(keyNode,
+                     "unknown entry '" + key +
+                         "' (image, settings, camera, filter, sampler, object, shader, light)");
     }
-    const ImageSettings& img = scene.image;
+
+    void readLight(const YAML::Node& e) {
+        if (!e.IsMap() || !e["type"])
+            rd_.fail(e, "light needs a type (Quad, Point or Environment)");
+        const std::string t = rd_.string(e["type"], "light type");
+        if (t == "Quad") {
+            roomFor(e, 1, 1);
+            lightShaders_.push_back(readQuadLight(rd_, e, scene_.origin, lightMeshes_));
+        } else if (t == "Point") {
+            scene_.pointLights.push_back(readPointLight(rd_, e, scene_.origin));
+        } else if (t == "Environment") {
+            if (scene_.environment)
+                rd_.fail(e, "a second Environment light (the first is at line " +
+                                std::to_string(scene_.environment->line) + ")");
+            scene_.environment = readEnvironment(rd_, e, dir_);
+        } else {
+            rd_.fail(e["type"], "unknown light type '" + t + "' (Quad, Point or Environment)");
+        }
+    }
+
+    // The hit key's limits (kMaxShaders, kMaxObjects), checked before each element that adds
+    // `shaders` shaders and `objects` objects (a light adds one of each): the error names it.
+    void roomFor(const YAML::Node& e, size_t shaders, size_t objects) const {
+        if (scene_.shaders.size() + lightShaders_.size() + shaders > size_t(kMaxShaders))
+            rd_.fail(e,
+                     "more than " + std::to_string(kMaxShaders) + " shaders (a light counts one)");
+        if (scene_.meshes.size() + lightMeshes_.size() + objects > size_t(kMaxObjects))
+            rd_.fail(e,
+                     "more than " + std::to_string(kMaxObjects) + " objects (a light counts one)");
+    }
+
+    const Reader& rd_;
+    const fs::path& dir_;
+    Scene& scene_;
+    TextureReader textures_;
+    std::vector<PendingObject> pending_;
+    std::vector<Mesh> lightMeshes_;
+    std::vector<Shader> lightShaders_;
+    std::set<std::string> seenOnce_;
+};
+
+// What can be checked only once everything is read: the objects' shaders exist, the quad
+// lights' meshes follow the objects', and the camera and sample counts stay in range.
+void SceneReader::finish(const YAML::Node& root) {
+    const int sceneShaders = int(scene_.shaders.size());
+    for (const PendingObject& o : pending_)
+        if (o.shader >= sceneShaders)
+            rd_.fail(o.line, "object uses shader " + std::to_string(o.shader) +
+                                 " but the scene has " + std::to_string(sceneShaders) + " shader" +
+                                 (sceneShaders == 1 ? "" : "s"));
+    scene_.objectCount = int(scene_.meshes.size());
+    scene_.quadLightCount = int(lightMeshes_.size());
+    for (size_t i = 0; i < lightMeshes_.size(); ++i) {
+        lightMeshes_[i].shader = int(scene_.shaders.size());
+        scene_.shaders.push_back(lightShaders_[i]);
+        scene_.meshes.push_back(std::move(lightMeshes_[i]));
+    }
+    const ImageSettings& img = scene_.image;
     // A ThinLens ray aims at the focal plane: its farthest corner lies within kMaxDistance too.
-    if (scene.camera.type == CameraType::ThinLens) {
-        const double tx = scene.camera.tanHalfFovX(), ty = tx * img.height / img.width;
-        const double corner = scene.camera.focalDistance * std::sqrt(1.0 + tx * tx + ty * ty);
+    if (scene_.camera.type == CameraType::ThinLens) {
+        const double tx = scene_.camera.tanHalfFovX(), ty = tx * img.height / img.width;
+        const double corner = scene_.camera.focalDistance * std::sqrt(1.0 + tx * tx + ty * ty);
         if (!(corner <= kMaxDistance)) {
-            const YAML::Node cam = static_cast<const YAML::Node&>(root)["camera"];
-            rd.fail(cam["focal distance"] ? cam["focal distance"] : cam,
-                    "the focal plane's corners lie " + Reader::fmt(corner) +
-                        " units from the camera; Spillway renders "
-                        "within " +
-                        Reader::fmt(kMaxDistance) + " units of it");
+            const YAML::Node cam = root["camera"];
+            rd_.fail(cam["focal distance"] ? cam["focal distance"] : cam,
+                     "the focal plane's corners lie " + Reader::fmt(corner) +
+                         " units from the camera; Spillway renders within " +
+                         Reader::fmt(kMaxDistance) + " units of it");
         }
     }
     if ((unsigned long long)img.width * img.height * img.samplesPerIteration() > 0xFFFFFFFFull)
-        rd.fail(
-            1,
-            "width x height x sample base^2 exceeds 2^32 samples per iteration; lower the sample "
-            "base and raise iterations");
+        rd_.fail(1, "width x height x sample base^2 exceeds 2^32 samples per iteration; lower the "
+                    "sample base and raise iterations");
+}
+
+} // namespace
+
+Scene loadScene(const std::string& path) {
+    Scene scene;
+    scene.file = path;
+    const Reader rd(path);
+    const YAML::Node root = parseYaml(path, readSceneText(path));
+    if (root.IsNull()) return scene; // an empty file is an empty scene: black
+    if (!root.IsMap()) rd.fail(root, "a scene is a map of entries (image, camera, object, ...)");
+    const fs::path dir = fs::path(path).parent_path();
+    SceneReader reader(rd, dir, scene);
+    try {
+        reader.readEntries(root);
+    } catch (const YAML::Exception& e) {
+        throw SceneError(path, e.mark.line + 1, e.msg);
+    }
+    reader.finish(root);
     return scene;
 }
 

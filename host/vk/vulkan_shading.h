@@ -3,7 +3,7 @@
 // Per batch slot (two: double buffering) it keeps an input and a result buffer sized to the
 // largest batch so far, a command buffer, a fence and a timestamp query pool. submit() records
 // one dispatch per non-empty shader range, with {offset, count} in push constants, and returns
-// at once; finish() waits on the fence. Meanwhile the renderer loads, traverses and sets up the
+// at once; wait() waits on the fence. Meanwhile the renderer loads, traverses and sets up the
 // next batch into the other slot. Inputs are written by the hit-setup stage straight into the
 // mapped buffer where memory is device-local and host-visible (lavapipe, integrated GPUs,
 // resizable BAR); elsewhere the engine records staging copies (host/vk/buffer.h).

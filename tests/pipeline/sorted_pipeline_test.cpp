@@ -156,7 +156,7 @@ TEST(SortedPipeline, ImageIsIndependentOfBatchingSortingBudgetAndThreads) {
             change(changed.settings, cfg);
         auto result = render(changed, cfg);
         EXPECT_TRUE(sameBits(expected, result->film->image())) << what;
-        return result->stats.extra["batches_spilled"].get<long>();
+        return long(result->stats.spill->batchesSpilled);
     };
     EXPECT_EQ(variant("the same again", [](RenderConfig&) {}), 0);
     EXPECT_NE(render(scene, base)->stats.extra["simd_shading"], "off");
@@ -227,7 +227,7 @@ TEST(SortedPipeline, ThreadBufferLargerThanABatch) {
     Scene large = scene;
     large.settings.binExponent = 16;
     EXPECT_TRUE(sameBits(result->film->image(), renderImage(large, RenderConfig{})));
-    EXPECT_GE(result->stats.extra["batches_processed"].get<int>(), 64 * 64 * 64 / 256);
+    EXPECT_GE(result->stats.spill->batchesProcessed, 64u * 64u * 64u / 256u);
 }
 
 // A scene whose single iteration holds 256 x 256 x 64 = 4M camera rays, 128 MiB as compact

@@ -29,7 +29,7 @@ class ProductionScene : public ::testing::Test {
     // order of the lookups alone, so the counts are exact).
     static nlohmann::json textureStats(RenderConfig cfg) {
         cfg.threads = 1;
-        return render(*scene_, cfg)->stats.extra["textures"];
+        return render(*scene_, cfg)->stats.toJson()["textures"];
     }
     static TempDir* dir_;
     static Scene* scene_;

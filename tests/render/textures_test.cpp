@@ -81,7 +81,7 @@ TEST(Textures, LayeredImageOverConstantByImageMaskOnEveryBackend) {
         const std::vector<float> img = result->film->image();
         // --stats' texture counters: 256 camera hits on the plane, two image nodes each (the
         // bounces find the untextured enclosure); each 8 x 8 float image is one tile, read once.
-        const nlohmann::json& t = result->stats.extra["textures"];
+        const nlohmann::json t = result->stats.toJson()["textures"];
         EXPECT_EQ(t["lookups"], 256 * 2) << backend;
         EXPECT_EQ(t["files_opened"], 2) << backend;
         EXPECT_EQ(t["files_reopened"], 0) << backend;
@@ -134,7 +134,7 @@ TEST(Textures, NoTextureStatisticsWithoutImageTextures) {
     const Scene box = loadScene(sourceDir() + "/scenes/cornell-box.yaml");
     RenderConfig cfg;
     cfg.spp = 1;
-    EXPECT_FALSE(render(box, cfg)->stats.extra.contains("textures"));
+    EXPECT_FALSE(render(box, cfg)->stats.toJson().contains("textures"));
 }
 
 } // namespace

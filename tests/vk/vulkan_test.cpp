@@ -5,6 +5,7 @@
 #include "embree_backend/embree_scene.h"
 #include "host/image/image_io.h"
 #include "host/pipeline/cpu_shading.h"
+#include "host/pipeline/slotted_engine.h"
 #include "host/scene/camera.h"
 #include "host/scene/surface_models.h"
 #include "host/scene/textures.h"
@@ -419,13 +420,16 @@ PerHit shadeSameHits(ShadingMode mode) {
         }
         if (mode == ShadingMode::Megakernel) ranges = {{kMixedModels, 0, n}};
 
-        ShadeSlot g = gpu->reserve(0, n), c = cpu->reserve(0, n);
+        // The engines' slots, fed the same inputs directly.
+        auto& gpuSlots = dynamic_cast<SlottedEngine&>(*gpu);
+        auto& cpuSlots = dynamic_cast<SlottedEngine&>(*cpu);
+        ShadeSlot g = gpuSlots.reserve(0, n), c = cpuSlots.reserve(0, n);
         std::copy(inputs.begin(), inputs.end(), g.inputs);
         std::copy(inputs.begin(), inputs.end(), c.inputs);
-        gpu->submit(0, ranges);
-        cpu->submit(0, ranges);
-        gpu->finish(0);
-        cpu->finish(0);
+        gpuSlots.submit(0, ranges);
+        cpuSlots.submit(0, ranges);
+        gpuSlots.wait(0);
+        cpuSlots.wait(0);
 
         out.hits = n;
         for (size_t i = 0; i < n; ++i) {

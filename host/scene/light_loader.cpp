@@ -1,0 +1,129 @@
+#include "host/scene/light_loader.h"
+
+#include "host/image/image_io.h"
+#include "host/scene/surface_models.h"
+
+#include <cmath>
+#include <limits>
+
+namespace spw::scene_file {
+
+namespace fs = std::filesystem;
+
+// A light's `intensity` (1) x `colour` ([1, 1, 1]): the radiance of a quad light or an
+// environment, the intensity of a point light. Each channel must fit the range of any emission.
+namespace {
+
+glm::dvec3 lightIntensity(const Reader& rd, const YAML::Node& n, bool colourKey) {
+    const double intensity =
+        n["intensity"] ? rd.number(n["intensity"], "light intensity", 0.0, kMaxRadiance) : 1.0;
+    const glm::dvec3 colour = colourKey && n["colour"]
+                                  ? rd.dvec<3>(n["colour"], "light colour", 0.0, kMaxRadiance)
+                                  : glm::dvec3(1.0);
+    for (int i = 0; i < 3; ++i)
+        if (intensity * colour[i] > kMaxRadiance)
+            rd.fail(n["colour"] ? n["colour"] : n["intensity"],
+                    "light intensity x colour = " + Reader::fmt(intensity * colour[i]) +
+                        " exceeds " + Reader::fmt(kMaxRadiance) +
+                        ", the brightest radiance Spillway renders");
+    return intensity * colour;
+}
+
+} // namespace
+
+// A quad light becomes two triangles (appended to lightMeshes) and an emissive Null shader of
+// its own (returned); both go after the scene's objects and shaders once the file is read.
+Shader readQuadLight(const Reader& rd, const YAML::Node& n, const glm::dvec3& origin,
+                     std::vector<Mesh>& lightMeshes) {
+    rd.checkKeys(n, "Quad light",
+                 {"type", "translation", "rotation", "scale", "intensity", "colour"});
+    glm::dvec2 size(1.0);
+    if (n["scale"]) {
+        size = rd.dvec<2>(n["scale"], "light scale", 1e-30, kMaxDistance);
+    }
+    const glm::dvec3 emitted = lightIntensity(rd, n, true);
+    const glm::dmat4 xf = readTransform(rd, n, "light", false);
+
+    Mesh m;
+    m.name = "quad light " + std::to_string(lightMeshes.size());
+    for (glm::dvec2 c : {glm::dvec2(-0.5, -0.5), glm::dvec2(0.5, -0.5), glm::dvec2(0.5, 0.5),
+                         glm::dvec2(-0.5, 0.5)}) {
+        const glm::dvec3 p =
+            glm::dvec3(xf * glm::dvec4(c.x * size.x, c.y * size.y, 0.0, 1.0)) - origin;
+        checkDistance(rd, n, p, "quad light corner");
+        m.positions.push_back(vec3(p));
+    }
+    m.triangles = {uvec3(0, 1, 2), uvec3(0, 2, 3)};
+    // A light too small (or too far out) for float to span: refuse it rather than divide by its
+    // area.
+    for (const uvec3& tri : m.triangles) {
+        vec3 c = glm::cross(m.positions[tri.y] - m.positions[tri.x],
+                            m.positions[tri.z] - m.positions[tri.x]);
+        float a2 = glm::dot(c, c);
+        if (!(a2 >= std::numeric_limits<float>::min()) || !std::isfinite(a2))
+            rd.fail(n, "quad light has no area in float after its scale and transform");
+    }
+    Shader s;
+    s.typeName = "Quad light";
+    s.line = n.Mark().line + 1;
+    s.params.model = kModelNull;
+    s.params.emission = vec3(emitted);
+    lightMeshes.push_back(std::move(m));
+    return s;
+}
+
+// `position` (camera-relative from here on), intensity x colour in W/sr.
+PointLight readPointLight(const Reader& rd, const YAML::Node& n, const glm::dvec3& origin) {
+    rd.checkKeys(n, "Point light", {"type", "position", "intensity", "colour"});
+    if (!n["position"]) rd.fail(n, "Point light needs a position");
+    const glm::dvec3 p = rd.dvec<3>(n["position"], "light position") - origin;
+    checkDistance(rd, n["position"], p, "point light");
+    PointLight light;
+    light.position = vec3(p);
+    light.intensity = vec3(lightIntensity(rd, n, true));
+    light.line = n.Mark().line + 1;
+    return light;
+}
+
+// `colour` (a constant) or `string` / `filename` (a lat-long image, read here, so that a bad
+// file is a scene error), times `intensity`.
+Environment readEnvironment(const Reader& rd, const YAML::Node& n, const fs::path& dir) {
+    rd.checkKeys(n, "Environment light", {"type", "colour", "string", "filename", "intensity"});
+    const YAML::Node file = n["string"] ? n["string"] : n["filename"];
+    if (file && n["colour"])
+        rd.fail(n["colour"], "Environment light takes a colour or an image ('string'), not both");
+    Environment env;
+    env.line = n.Mark().line + 1;
+    env.radiance = vec3(lightIntensity(rd, n, !file));
+    if (!file) return env;
+    const fs::path p = dir / rd.string(file, "environment image");
+    if (!fs::is_regular_file(p))
+        rd.fail(file, "environment image '" + p.string() + "' does not exist");
+    env.path = fs::absolute(p).lexically_normal().string();
+    ImageRGB img;
+    try {
+        img = spw::readImage(env.path);
+    } catch (const std::exception& e) {
+        rd.fail(file, e.what());
+    }
+    if (img.width < 1 || img.height < 1 || size_t(img.width) * size_t(img.height) > (1u << 26))
+        rd.fail(file, "environment image '" + env.path + "' is " + std::to_string(img.width) +
+                          " x " + std::to_string(img.height) +
+                          "; Spillway takes maps of 1 to 2^26 texels");
+    for (size_t i = 0; i < img.rgb.size(); ++i) {
+        const double v = double(img.rgb[i]) * double(env.radiance[int(i % 3)]);
+        if (!(v >= 0.0 && v <= kMaxRadiance)) {
+            const size_t texel = i / 3;
+            rd.fail(file, "environment image '" + env.path + "' has radiance " + Reader::fmt(v) +
+                              " at texel (" + std::to_string(texel % size_t(img.width)) + ", " +
+                              std::to_string(texel / size_t(img.width)) +
+                              "): every value must lie in 0 .. " + Reader::fmt(kMaxRadiance));
+        }
+    }
+    env.width = img.width;
+    env.height = img.height;
+    env.rgb = std::move(img.rgb);
+    return env;
+}
+
+} // namespace spw::scene_file

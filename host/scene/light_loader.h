@@ -1,0 +1,24 @@
+// The scene file's lights: Quad (two triangles and an emissive shader of their own), Point and
+// Environment (a constant or a lat-long image, read and range-checked here so that a bad file is
+// a scene error).
+#pragma once
+
+#include "host/scene/scene.h"
+#include "host/scene/yaml_reader.h"
+
+#include <filesystem>
+#include <vector>
+
+namespace spw::scene_file {
+
+// A quad light becomes two triangles (appended to lightMeshes) and an emissive Null shader of
+// its own (returned); both go after the scene's objects and shaders once the file is read.
+Shader readQuadLight(const Reader& rd, const YAML::Node& n, const glm::dvec3& origin,
+                     std::vector<Mesh>& lightMeshes);
+// `position` (camera-relative from here on), intensity x colour in W/sr.
+PointLight readPointLight(const Reader& rd, const YAML::Node& n, const glm::dvec3& origin);
+// `colour` (a constant) or `string` / `filename` (a lat-long image), times `intensity`.
+Environment readEnvironment(const Reader& rd, const YAML::Node& n,
+                            const std::filesystem::path& dir);
+
+} // namespace spw::scene_file
