@@ -29,6 +29,10 @@ int mergeCommand(const std::vector<std::string>& args) {
     if (output.empty()) throw UsageError("merge needs -o IMAGE");
     if (!isSupportedOutput(output))
         throw UsageError("output '" + output + "' must end in .exr or .png");
+    for (const std::string& p : parts)
+        if (sameFile(output, p))
+            throw UsageError("-o and the partial render '" + p +
+                             "' name the same file: the image would destroy the part");
     checkWritable(output);
     std::vector<std::pair<std::string, Checkpoint>> partials;
     for (const std::string& p : parts) {

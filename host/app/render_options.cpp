@@ -2,10 +2,12 @@
 
 #include "host/app/usage_error.h"
 #include "host/image/image_io.h"
+#include "host/image/output_file.h"
 
 #include <cctype>
 #include <cmath>
 #include <filesystem>
+#include <iterator>
 #include <sstream>
 
 namespace spw {
@@ -245,6 +247,8 @@ const CliOption* findOption(const std::string& arg) {
     return nullptr;
 }
 
+void checkAliases(const RenderOptions& r);
+
 // How the options go together, checked before any work so that a mistake costs no render.
 void checkRelations(RenderOptions& r) {
     if (r.scenePath.empty()) throw UsageError("render needs a scene file");
@@ -272,6 +276,42 @@ void checkRelations(RenderOptions& r) {
             c = char(std::tolower(static_cast<unsigned char>(c)));
         if (ext != ".exr")
             throw UsageError("checkpoint '" + r.checkpointPath + "' must end in .exr");
+    }
+    checkAliases(r);
+}
+
+// Outputs that name one file, or an output that names an input, would destroy one with the
+// other: refused before any work, naming both. (--resume's file is the checkpoint's by design.)
+void checkAliases(const RenderOptions& r) {
+    struct Named {
+        std::string what;
+        const std::string* path;
+    };
+    const std::string checkpoint = !r.partialPath.empty() ? "--partial"
+                                   : !r.resumePath.empty() && r.checkpointPath == r.resumePath
+                                       ? "--resume"
+                                       : "--checkpoint";
+    const Named outputs[] = {{"-o", &r.output},
+                             {"--stats", &r.statsPath},
+                             {"--error-csv", &r.errorCsvPath},
+                             {checkpoint, &r.checkpointPath}};
+    const Named inputs[] = {{"the scene", &r.scenePath},
+                            {"--reference", &r.referencePath},
+                            {"--resume", &r.resumePath}};
+    auto refuse = [](const Named& a, const Named& b) {
+        throw UsageError(a.what + " and " + b.what + " name the same file '" + *a.path +
+                         "': one would destroy the other");
+    };
+    for (size_t i = 0; i < std::size(outputs); ++i) {
+        if (outputs[i].path->empty()) continue;
+        for (size_t j = i + 1; j < std::size(outputs); ++j)
+            if (!outputs[j].path->empty() && sameFile(*outputs[i].path, *outputs[j].path))
+                refuse(outputs[i], outputs[j]);
+        for (const Named& in : inputs) {
+            const bool resumed = in.path == &r.resumePath && outputs[i].path == &r.checkpointPath;
+            if (!in.path->empty() && !resumed && sameFile(*outputs[i].path, *in.path))
+                refuse(outputs[i], in);
+        }
     }
 }
 

@@ -159,4 +159,14 @@ void checkWritable(const std::string& path) {
         fail("folder '" + dir + "': " + std::strerror(errno));
 }
 
+bool sameFile(const std::string& a, const std::string& b) {
+    namespace fs = std::filesystem;
+    std::error_code ea, eb;
+    const bool hasA = fs::exists(a, ea), hasB = fs::exists(b, eb);
+    if (hasA && hasB) return fs::equivalent(a, b, ea) && !ea;
+    const fs::path ca = fs::weakly_canonical(fs::absolute(a, ea), ea);
+    const fs::path cb = fs::weakly_canonical(fs::absolute(b, eb), eb);
+    return !ea && !eb && ca == cb;
+}
+
 } // namespace spw

@@ -53,4 +53,8 @@ inline void writeFileAtomically(const std::string& path, const std::string& text
 // Called for every output before a render starts, so that no work is lost to a typo.
 void checkWritable(const std::string& path);
 
+// Whether two paths name one file: both exist and are the same file (a hard link, a symbolic
+// link, another spelling), or, where one does not exist yet, they resolve to the same path.
+bool sameFile(const std::string& a, const std::string& b);
+
 } // namespace spw

@@ -67,9 +67,10 @@ class CliBadUsage : public ::testing::TestWithParam<BadUsage> {};
 TEST_P(CliBadUsage, ExitsTwoAndWritesNothing) {
     const BadUsage& c = GetParam();
     TempDir dir;
-    std::string args = replaceAll(
-        replaceAll(replaceAll(c.args, "{scene}", cornellBox()), "{out}", dir.file("out.exr")),
-        "{dir}", dir.path());
+    std::string args = replaceAll(replaceAll(replaceAll(replaceAll(c.args, "{scene}", cornellBox()),
+                                                        "{out}", dir.file("out.exr")),
+                                             "{dir}", dir.path()),
+                                  "{dirname}", fs::path(dir.path()).filename().string());
     CommandResult r = runSpillway("render " + args);
     EXPECT_EQ(r.status, 2) << args << "\n" << r.output;
     EXPECT_TRUE(contains(r.output, c.mention)) << args << "\n" << r.output;
@@ -93,12 +94,33 @@ const BadUsage kBadUsages[] = {
     {"TwoScenes", "{scene} {scene} -o {out} --quiet", "more than one"},
     {"JpgOutput", "{scene} -o {dir}/out.jpg --quiet --spp 1", "out.jpg"},
     {"OutputWithoutExtension", "{scene} -o {dir}/out --quiet --spp 1", ".exr"},
+    // Outputs that would destroy one another, or an input, however they are spelt.
+    {"OutputIsTheCheckpoint", "{scene} -o {dir}/x.exr --checkpoint {dir}/./x.exr --quiet",
+     "-o and --checkpoint name the same file"},
+    {"OutputIsThePartial", "{scene} --spp 2 --samples 0:1 --partial {dir}/x.exr -o {dir}/x.exr",
+     "-o and --partial name the same file"},
+    {"StatsIsTheOutput", "{scene} -o {dir}/x.exr --stats {dir}/../{dirname}/x.exr --quiet",
+     "-o and --stats name the same file"},
+    {"ErrorCsvIsTheStats", "{scene} -o {out} --stats {dir}/s.csv --error-csv {dir}/s.csv",
+     "--stats and --error-csv name the same file"},
+    {"StatsIsTheScene", "{scene} -o {out} --stats {scene} --quiet",
+     "--stats and the scene name the same file"},
 };
 
 INSTANTIATE_TEST_SUITE_P(Cli, CliBadUsage, ::testing::ValuesIn(kBadUsages),
                          [](const ::testing::TestParamInfo<BadUsage>& info) {
                              return std::string(info.param.name);
                          });
+
+// merge A B -o A would overwrite a part with the image: refused before anything is read.
+TEST(Cli, MergeRefusesAnOutputThatIsOneOfItsParts) {
+    TempDir dir;
+    const std::string a = dir.file("a.exr"), b = dir.file("b.exr");
+    CommandResult r = runSpillway("merge " + a + " " + b + " -o " + dir.path() + "/./a.exr");
+    EXPECT_EQ(r.status, 2) << r.output;
+    EXPECT_TRUE(contains(r.output, "name the same file")) << r.output;
+    EXPECT_TRUE(fs::is_empty(dir.path()));
+}
 
 TEST(Cli, MissingSceneFileExitsTwo) {
     TempDir dir;
