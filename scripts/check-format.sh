@@ -8,7 +8,7 @@ root="$(cd "$(dirname "$0")/.." && pwd)"
 clang_format="${1:-clang-format}"
 cd "$root"
 mapfile -t files < <(git ls-files -co --exclude-standard '*.cpp' '*.h' 2>/dev/null ||
-                     find host embree_backend tests shaders -name '*.cpp' -o -name '*.h')
+                     find host tests shaders -name '*.cpp' -o -name '*.h')
 bad=()
 for f in "${files[@]}"; do
     [ -f "$f" ] || continue

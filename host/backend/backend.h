@@ -6,6 +6,7 @@
 #include "host/backend/stats.h"
 #include "host/image/film.h"
 #include "host/scene/camera.h"
+#include "host/scene/hit_setup.h"
 #include "host/scene/lights.h"
 #include "host/scene/scene.h"
 #include "host/scene/textures.h"
@@ -18,7 +19,8 @@ struct RenderContext {
     const Scene& scene;
     const RenderConfig& config;
     const SceneLights& lights; // shaders and emitters, as shading reads them
-    const EmbreeScene& embree;
+    const EmbreeScene& embree; // the BVH (host/accel/)
+    const HitSetup& hitSetup;  // what a hit means
     const TextureResolver& textures;
     const CameraModel& camera;
     RenderParams params; // the render-wide values; each backend sets `iteration` in its own copy

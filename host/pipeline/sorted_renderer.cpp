@@ -1,6 +1,5 @@
 #include "host/pipeline/sorted_renderer.h"
 
-#include "host/pipeline/cpu_shading.h"
 #include "host/pipeline/stages.h"
 
 #include <algorithm>

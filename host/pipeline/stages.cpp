@@ -2,7 +2,7 @@
 
 #include "host/pipeline/parallel.h"
 #include "host/pipeline/radix_sort.h"
-#include "host/pipeline/simd_shading.h"
+#include "host/simd/simd_random.h"
 #include "shared/path.h"
 
 #include <tbb/blocked_range.h>
@@ -210,14 +210,14 @@ void setUpChunk(const RenderContext& ctx, const std::vector<RayState>& rays,
     vec3 albedo[kChunk];
     size_t m = 0;
     for (size_t i = 0; i < n; ++i)
-        ctx.embree.prefetchTriangle(hits[order[i].index]);
+        ctx.hitSetup.prefetchTriangle(hits[order[i].index]);
     for (size_t i = 0; i < n; ++i)
-        ctx.embree.prefetchVertices(hits[order[i].index]);
+        ctx.hitSetup.prefetchVertices(hits[order[i].index]);
     for (size_t i = 0; i < n; ++i) {
         const std::uint32_t k = order[i].index;
         const RayState& ray = rays[k];
         ShadeInput& x = in[i];
-        ctx.embree.setUpGeometry(hits[k], x.hit);
+        ctx.hitSetup.setUpGeometry(hits[k], x.hit);
         x.path = ray.path;
         x.rayDir = ray.dir;
         x.pad0 = 0.0f;
@@ -227,7 +227,7 @@ void setUpChunk(const RenderContext& ctx, const std::vector<RayState>& rays,
             x.hit.albedo = ctx.textures.albedo(shader, vec2(0.0f), 0.0f);
             continue;
         }
-        ctx.embree.textureQuery(hits[k], ray.dir, ray.path.cone, x.hit, uv[m], footprint[m]);
+        ctx.hitSetup.textureQuery(hits[k], ray.dir, ray.path.cone, x.hit, uv[m], footprint[m]);
         slot[m++] = std::uint8_t(i);
     }
     for (size_t a = 0; a < m;) {
@@ -501,12 +501,11 @@ class FusedTimes {
 };
 } // namespace
 
-void shadeFused(const RenderContext& ctx, uint iteration, RayFormat format, bool simd,
+void shadeFused(const RenderContext& ctx, uint iteration, RayFormat format, const ShadeChunk& shade,
                 const std::vector<RayState>& rays, const std::vector<HitRecord>& hits,
                 const std::vector<SortedHit>& order, size_t hitCount, Film& film,
                 DirectionalBins& bins) {
     const RenderParams rp = paramsAt(ctx, iteration);
-    const SceneView view = ctx.lights.view();
     FusedTimes times;
     const bool inTraversalOrder = order.empty();
     // Tasks of up to `shading size` hits, each handing its continuation rays to the bins once.
@@ -527,7 +526,7 @@ void shadeFused(const RenderContext& ctx, uint iteration, RayFormat format, bool
                               }
                               setUpChunk(ctx, rays, hits, chunk, n, c.in);
                               task.lap(kSetUp);
-                              shadeHits(view, rp, simd, c.in, n, c.out);
+                              shade(rp, c.in, n, c.out);
                               task.lap(kShade);
                               task.finishChunk(ctx, rp, format, c.out, n, [&](size_t i) {
                                   return uvec2(c.in[i].path.pathId, c.in[i].path.bounce);

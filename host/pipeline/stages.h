@@ -6,7 +6,7 @@
 //   load          the next batch from RAM or the spill file      BatchQueue::pop (batch_queue.h)
 //   decompress    34- or 50-byte records -> RayState
 //   sort rays     Morton radix sort, median split, or none        ray_sort.h; RaySortPolicy decides
-//   traverse      closest hits of the whole batch                 intersectBatch (embree_backend/)
+//   traverse      closest hits of the whole batch                 intersectBatch (host/accel/)
 //   sort hits     by (shader, object, texture order), misses last
 //   escape        misses see the environment (scenes with one)
 //   hit setup     world-space hit and texture albedo, in sorted order, into the engine's inputs
@@ -17,7 +17,7 @@
 //   bin           continuation rays -> thread-local ray buffers -> bins
 #pragma once
 
-#include "embree_backend/batch_traversal.h"
+#include "host/accel/batch_traversal.h"
 #include "host/backend/backend.h"
 #include "host/pipeline/batch_queue.h"
 #include "host/pipeline/directional_bins.h"
@@ -26,6 +26,7 @@
 #include "host/pipeline/shading_engine.h"
 
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 namespace spw {
@@ -103,10 +104,11 @@ void binContinuations(const RenderContext& ctx, uint iteration, RayFormat format
 // proportion to the thread time the stage took.
 // With an empty `order` (the hit sort skipped: no shader sort and no environment for the misses
 // to see), the hits are taken in traversal order from all `hitCount` = rays.size() rays, each
-// chunk leaving out its misses itself. `simd`: Lambert hits through the SIMD kernel
-// (simd_shading.h: shadeHits; the caller decides once per render, cpu_shading.h:
-// usesSimdShading).
-void shadeFused(const RenderContext& ctx, uint iteration, RayFormat format, bool simd,
+// chunk leaving out its misses itself. `shade` shades a chunk: out[i] for in[i], i < n (the cpu
+// engine's shadeHits, host/cpu/simd_shading.h).
+using ShadeChunk =
+    std::function<void(const RenderParams& rp, const ShadeInput* in, size_t n, ShadeResult* out)>;
+void shadeFused(const RenderContext& ctx, uint iteration, RayFormat format, const ShadeChunk& shade,
                 const std::vector<RayState>& rays, const std::vector<HitRecord>& hits,
                 const std::vector<SortedHit>& order, size_t hitCount, Film& film,
                 DirectionalBins& bins);

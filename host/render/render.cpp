@@ -1,10 +1,10 @@
 #include "host/render/render.h"
 
-#include "embree_backend/embree_scene.h"
-#include "embree_backend/reference_renderer.h"
+#include "host/accel/embree_scene.h"
 #include "host/backend/backend.h"
-#include "host/pipeline/cpu_shading.h"
+#include "host/cpu/cpu_shading.h"
 #include "host/pipeline/sorted_renderer.h"
+#include "host/reference/reference_renderer.h"
 #include "host/render/backend_choice.h"
 #include "host/render/rank_policy.h"
 #include "host/render/stop_rule.h"
@@ -109,6 +109,7 @@ class RenderSession {
     int threads_ = 0;
     std::optional<SceneLights> lights_;
     std::unique_ptr<EmbreeScene> embree_;
+    std::optional<HitSetup> hitSetup_;
     std::optional<TextureResolver> textures_;
     std::optional<CameraModel> camera_;
     std::optional<RenderContext> ctx_;
@@ -163,8 +164,9 @@ void RenderSession::build() {
     lights_.emplace(scene_);
     {
         StageTimer t(stats_.stages, "build bvh");
-        embree_ = std::make_unique<EmbreeScene>(scene_, *lights_);
+        embree_ = std::make_unique<EmbreeScene>(scene_);
     }
+    hitSetup_.emplace(scene_, *lights_);
     textures_.emplace(scene_, scene_.settings.textureCacheMiB,
                       config_.textureFilter == TextureFilter::Cone);
     camera_.emplace(scene_, plan_.sampleBase);
@@ -183,8 +185,8 @@ void RenderSession::build() {
     params.sampling = dimensionSampler(scene_.sampler);
     stats_.extra["sampler"] = samplerName(scene_.sampler);
 
-    ctx_.emplace(RenderContext{scene_, config_, *lights_, *embree_, *textures_, *camera_, params,
-                               threads_, stats_});
+    ctx_.emplace(RenderContext{scene_, config_, *lights_, *embree_, *hitSetup_, *textures_,
+                               *camera_, params, threads_, stats_});
     result_->film =
         std::make_unique<Film>(scene_.image.width, scene_.image.height, scene_.filter,
                                lights_->brightestEmission(), int(params.samplesPerIteration));

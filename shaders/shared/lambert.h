@@ -9,6 +9,7 @@
 
 SHARED_BEGIN
 
+// SIMD twin: host/simd/simd_math-inl.h
 SHARED_FN vec3 lambertEval(vec3 albedo, vec3 ng, vec3 ns, vec3 wo, vec3 wi, OUT(float) pdf) {
     pdf = 0.0f;
     if (dot(ng, wo) * dot(ng, wi) <= 0.0f) return vec3(0.0f);

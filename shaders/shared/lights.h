@@ -25,6 +25,7 @@ SHARED_FN uint pickEmitter(SCENE_PARAM uint count, float u) {
 
 // Cosine at the emitter between its normal and the direction back to the receiver, 0 if the
 // receiver sees the emitter's back (one-sided emitters).
+// SIMD twin: host/simd/simd_math-inl.h
 SHARED_FN float emitterCosine(Emitter e, vec3 towardReceiver) {
     float c = dot(e.normal, towardReceiver);
     if (e.twoSided != 0u) c = abs(c);
@@ -33,11 +34,13 @@ SHARED_FN float emitterCosine(Emitter e, vec3 towardReceiver) {
 
 // Solid-angle pdf of reaching a point of emitter e at distance `dist` with cosine `cosLight`
 // through light sampling.
+// SIMD twin: host/simd/simd_math-inl.h
 SHARED_FN float emitterSolidAnglePdf(Emitter e, float dist, float cosLight) {
     if (cosLight <= 0.0f) return 0.0f;
     return e.pickPdf * (dist * dist) / (cosLight * e.area);
 }
 
+// SIMD twin: host/simd/simd_math-inl.h
 SHARED_FN vec3 emitterPoint(Emitter e, vec2 u) {
     vec2 b = sampleTriangle(u);
     return e.p0 + b.x * e.e1 + b.y * e.e2;

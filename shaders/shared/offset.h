@@ -38,12 +38,14 @@ const float kOffsetAbsolute = 1e-30f;
 const float kInfiniteDistance = 1e30f;
 
 // How far rays leave point p of triangle (v0, v1, v2), whose unit geometric normal is n.
+// SIMD twin: host/simd/simd_math-inl.h
 SHARED_FN float surfaceOffset(vec3 p, vec3 v0, vec3 v1, vec3 v2, vec3 n) {
     vec3 m = max(max(abs(v0), abs(v1)), max(abs(v2), abs(p)));
     return dot(m, abs(n)) * kOffsetRelative + kOffsetAbsolute;
 }
 
 // p moved by `offset` off its surface, to the side of ng that `dir` leaves towards.
+// SIMD twin: host/simd/simd_math-inl.h
 SHARED_FN vec3 offsetOrigin(vec3 p, vec3 ng, float offset, vec3 dir) {
     float side = dot(ng, dir) >= 0.0f ? 1.0f : -1.0f;
     return p + ng * (side * offset);
@@ -54,6 +56,7 @@ SHARED_FN vec3 offsetOrigin(vec3 p, vec3 ng, float offset, vec3 dir) {
 // the origin moved offsetP, and the ray meets that surface at cosine cosQ, so the ray must stop
 // (offsetP + offsetQ) / cosQ short of q; the relative 2^-20 covers the rounding of the
 // traversal's distance itself. Non-positive when no such ray exists (cosQ ~ 0).
+// SIMD twin: host/simd/simd_math-inl.h
 SHARED_FN float shadowRayTmax(float dist, float offsetP, float offsetQ, float cosQ) {
     if (!(cosQ > 0.0f)) return 0.0f;
     return dist * (1.0f - kOffsetRelative) - (offsetP + offsetQ) / cosQ;

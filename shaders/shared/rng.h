@@ -33,6 +33,7 @@ const uint kBounceCamera = 255u;
 const uint kSamplerIndependent = 0u;
 const uint kSamplerSobol = 1u;
 
+// SIMD twin: host/simd/simd_math-inl.h
 SHARED_FN uvec4 pcg4d(uvec4 v) {
     v = v * 1664525u + 1013904223u;
     v.x += v.y * v.w;
@@ -48,6 +49,7 @@ SHARED_FN uvec4 pcg4d(uvec4 v) {
 }
 
 // A 32-bit word to a float in [0, 1): the top 24 bits, so every value is exact.
+// SIMD twin: host/simd/simd_math-inl.h
 SHARED_FN float uintToUnit(uint x) {
     return float(x >> 8u) * (1.0f / 16777216.0f);
 }
@@ -55,7 +57,7 @@ SHARED_FN float uintToUnit(uint x) {
 // Sobol's generator matrices for dimensions 1, 2, 3 (Joe & Kuo's primitive polynomials x + 1,
 // x^2 + x + 1, x^3 + x + 1 with initial numbers {1}, {1, 3}, {1, 3, 1}; dimension 0 is the
 // index's bits reversed), stored the way the scrambler consumes them: entry p of a dimension is
-// the column for index bit 31 - p, bit-reversed. tests/render/sampler_test.cpp recomputes them.
+// the column for index bit 31 - p, bit-reversed. tests/shared/sampler_test.cpp recomputes them.
 // clang-format off
 SHARED_ARRAY_BEGIN(uint, kSobolReversed, 96)
     // dimension 1
@@ -138,6 +140,7 @@ uvec3 sobolReversedColumns(uint r) {
 
 // Burley 2020's hash, a Laine-Karras-style permutation: output bit i depends on input bits <= i
 // only, so on bit-reversed values it is a random nested uniform (Owen) scramble.
+// SIMD twin: host/simd/simd_math-inl.h
 SHARED_FN uint laineKarrasPermutation(uint x, uint seed) {
     x += seed;
     x ^= x * 0x6c50b47cu;
@@ -159,6 +162,7 @@ SHARED_FN uint nestedUniformScramble(uint x, uint seed) {
 // is index' itself. Six bit reversals instead of ten.
 // The index's shuffle takes the XOR of the four scrambles' seeds as its own: a fifth seed without a
 // second hash (which cost 8 ns a call).
+// SIMD twin: host/simd/simd_math-inl.h
 SHARED_FN uvec4 scrambledSobol4(uint sampleIndex, uvec4 key) {
     uvec4 seeds = pcg4d(key);
     uint shuffleSeed = seeds.x ^ seeds.y ^ seeds.z ^ seeds.w;
@@ -173,6 +177,7 @@ SHARED_FN uvec4 scrambledSobol4(uint sampleIndex, uvec4 key) {
 // Four uniform numbers for (seed, pixel, sample, bounce, group) from `sampling` (kSampler*).
 // `sampleIndex` counts samples of the whole render (iteration * samples per iteration +
 // sample), so iterations differ.
+// SIMD twin: host/simd/simd_math-inl.h
 SHARED_FN vec4 rand4(uint sampling, uint seed, uint pixel, uint sampleIndex, uint bounce,
                      uint group) {
     uvec4 h;

@@ -16,6 +16,7 @@ SHARED_FN void makeFrame(vec3 n, OUT(vec3) t, OUT(vec3) b) {
     b = vec3(c, s + n.y * n.y * a, -n.y);
 }
 
+// SIMD twin: host/simd/simd_math-inl.h
 SHARED_FN vec3 toWorld(vec3 local, vec3 n) {
     vec3 t;
     vec3 b;
@@ -35,16 +36,19 @@ const float kSinS7 = -1.9515295891e-4f;
 const float kCosC4 = 4.166664568298827e-2f;
 const float kCosC6 = -1.388731625493765e-3f;
 const float kCosC8 = 2.443315711809948e-5f;
+// SIMD twin: host/simd/simd_math-inl.h
 SHARED_FN float sinQuarterPi(float x) {
     float z = x * x;
     return ((kSinS7 * z + kSinS5) * z + kSinS3) * z * x + x;
 }
+// SIMD twin: host/simd/simd_math-inl.h
 SHARED_FN float cosQuarterPi(float x) {
     float z = x * x;
     return ((kCosC8 * z + kCosC6) * z + kCosC4) * z * z - 0.5f * z + 1.0f;
 }
 
 // Cosine-weighted hemisphere around +Z through the concentric disk map (Shirley & Chiu 1997).
+// SIMD twin: host/simd/simd_math-inl.h
 SHARED_FN vec3 sampleCosineHemisphere(vec2 u) {
     vec2 d = 2.0f * u - vec2(1.0f, 1.0f);
     if (d.x == 0.0f && d.y == 0.0f) {
@@ -77,6 +81,7 @@ SHARED_FN vec2 sampleTriangle(vec2 u) {
 
 // Power heuristic with beta = 2 (Veach 1997, ch. 9), written to stay finite for any pair of
 // non-negative pdfs, including infinite ones.
+// SIMD twin: host/simd/simd_math-inl.h
 SHARED_FN float powerHeuristic(float pdfThis, float pdfOther) {
     if (pdfThis <= 0.0f) return 0.0f;
     float r = pdfOther / pdfThis;
@@ -87,11 +92,13 @@ SHARED_FN float powerHeuristic(float pdfThis, float pdfOther) {
 // bfloat16 (the top 16 bits of the float). Quantising it the same way on *both* sides of the
 // MIS pair (light sampling and BSDF sampling) keeps the weights an exact partition of unity, so
 // the quantisation changes which strategy gets credit, never the expected value.
+// SIMD twin: host/simd/simd_math-inl.h
 SHARED_FN float quantizePdf(float pdf) {
     return uintBitsToFloat(floatBitsToUint(pdf) & 0xFFFF0000u);
 }
 
 // The shading normal turned to the side of the geometric normal that wo is on.
+// SIMD twin: host/simd/simd_math-inl.h
 SHARED_FN vec3 facingShadingNormal(vec3 ns, vec3 ng, vec3 wo) {
     float side = dot(ng, wo) >= 0.0f ? 1.0f : -1.0f;
     vec3 n = ns * side;
@@ -100,6 +107,7 @@ SHARED_FN vec3 facingShadingNormal(vec3 ns, vec3 ng, vec3 wo) {
     return dot(n, ng * side) > 0.0f ? n : ng * side;
 }
 
+// SIMD twin: host/simd/simd_math-inl.h
 SHARED_FN float maxComponent(vec3 v) {
     return max(v.x, max(v.y, v.z));
 }

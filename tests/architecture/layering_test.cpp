@@ -1,8 +1,9 @@
 // The architecture as docs/design.md draws it, checked on the sources: every #include goes down
-// the layers, never up or sideways, and Embree stays inside embree_backend/.
+// the layers, never up or sideways, and Embree stays inside host/accel/.
 //
-//   app -> render -> {pipeline -> embree_backend, vk -> pipeline's shading-engine interface}
-//       -> backend (what every backend is handed) -> scene -> image -> shaders/shared
+//   app -> render -> {reference, cpu and vk (the shading engines) -> pipeline}
+//       -> {pipeline -> accel (Embree), simd (Highway)} -> backend (what every backend is
+//       handed) -> scene -> image -> shaders/shared
 #include "test_util.h"
 
 #include <gtest/gtest.h>
@@ -19,12 +20,11 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// The folder a source or an include path belongs to: host/<folder>/..., embree_backend, shared.
+// The folder a source or an include path belongs to: host/<folder>/..., or shared.
 std::string layerOf(const std::string& path) {
     static const std::regex host("^host/([a-z_]+)/");
     std::smatch m;
     if (std::regex_search(path, m, host)) return m[1];
-    if (path.rfind("embree_backend/", 0) == 0) return "embree_backend";
     if (path.rfind("shared/", 0) == 0 || path.rfind("shaders/shared/", 0) == 0) return "shared";
     return "";
 }
@@ -35,16 +35,22 @@ const std::map<std::string, std::set<std::string>> kMayInclude = {
     {"image", {"shared"}},
     {"scene", {"image", "shared"}},
     {"backend", {"scene", "image", "shared"}},
-    {"embree_backend", {"backend", "scene", "image", "shared"}},
-    {"pipeline", {"embree_backend", "backend", "scene", "image", "shared"}},
+    {"simd", {"shared"}},
+    {"accel", {"backend", "scene", "image", "shared"}},
+    {"pipeline", {"accel", "simd", "backend", "scene", "image", "shared"}},
+    {"cpu", {"pipeline", "accel", "simd", "backend", "scene", "image", "shared"}},
     {"vk", {"pipeline", "backend", "scene", "image", "shared"}},
-    {"render", {"pipeline", "vk", "embree_backend", "backend", "scene", "image", "shared"}},
-    {"app", {"render", "pipeline", "vk", "embree_backend", "backend", "scene", "image", "shared"}},
+    {"reference", {"accel", "backend", "scene", "image", "shared"}},
+    {"render",
+     {"reference", "cpu", "vk", "pipeline", "accel", "backend", "scene", "image", "shared"}},
+    {"app",
+     {"render", "reference", "cpu", "vk", "pipeline", "accel", "backend", "scene", "image",
+      "shared"}},
 };
 
 std::vector<std::string> sources() {
     std::vector<std::string> out;
-    for (const char* dir : {"host", "embree_backend", "shaders/shared"})
+    for (const char* dir : {"host", "shaders/shared"})
         for (const auto& e : fs::recursive_directory_iterator(sourceDir() + "/" + dir)) {
             const std::string ext = e.path().extension().string();
             if (e.is_regular_file() && (ext == ".h" || ext == ".cpp"))
@@ -76,10 +82,10 @@ TEST(Architecture, EveryIncludeGoesDownTheLayers) {
     EXPECT_GT(checked, 50u);
 }
 
-TEST(Architecture, NoEmbreeTypeOutsideEmbreeBackend) {
+TEST(Architecture, NoEmbreeTypeOutsideAccel) {
     static const std::regex embree("embree3/|\\bRTC[A-Z][A-Za-z]*\\b|\\brtc[A-Z][A-Za-z0-9]*\\(");
     for (const std::string& file : sources()) {
-        if (layerOf(file) == "embree_backend") continue;
+        if (layerOf(file) == "accel") continue;
         std::ifstream in(sourceDir() + "/" + file);
         std::string line;
         for (int n = 1; std::getline(in, line); ++n)

@@ -2,9 +2,9 @@
 // silent skip), pass the Khronos validation layer without a single message, render the cpu
 // backend's image up to float rounding (the shading math is the same source), build only the
 // pipelines a scene needs, and fail or fall back cleanly when no driver is visible.
-#include "embree_backend/embree_scene.h"
+#include "host/accel/embree_scene.h"
+#include "host/cpu/cpu_shading.h"
 #include "host/image/image_io.h"
-#include "host/pipeline/cpu_shading.h"
 #include "host/pipeline/slotted_engine.h"
 #include "host/scene/camera.h"
 #include "host/scene/surface_models.h"
@@ -355,7 +355,8 @@ PerHit shadeSameHits(ShadingMode mode) {
     TempDir dir;
     Scene scene = everyModelScene(dir);
     SceneLights lights(scene);
-    EmbreeScene embree(scene, lights);
+    EmbreeScene embree(scene);
+    HitSetup hitSetup(scene, lights);
     TextureResolver textures(scene, scene.settings.textureCacheMiB);
     CameraModel camera(scene, 1);
     RenderStats stats;
@@ -371,7 +372,7 @@ PerHit shadeSameHits(ShadingMode mode) {
     params.threshold = scene.settings.threshold;
     params.strategy = kStrategyMis;
     params.emitterCount = uint(lights.emitters().size());
-    RenderContext ctx{scene, cfg, lights, embree, textures, camera, params, 2, stats};
+    RenderContext ctx{scene, cfg, lights, embree, hitSetup, textures, camera, params, 2, stats};
 
     const std::uint64_t before = vk::validationMessageCount();
     PerHit out;
@@ -392,8 +393,8 @@ PerHit shadeSameHits(ShadingMode mode) {
             float u = unit(rng), v = unit(rng);
             if (u + v > 1.0f) u = 1.0f - u, v = 1.0f - v;
             ShadeInput& in = inputs[i];
-            embree.setUpHit(HitRecord{mesh, prim, u, v, 10.0f + 1000.0f * unit(rng)},
-                            vec3(0.0f, 0.0f, 1.0f), 0u, textures, true, in.hit);
+            hitSetup.setUpHit(HitRecord{mesh, prim, u, v, 10.0f + 1000.0f * unit(rng)},
+                              vec3(0.0f, 0.0f, 1.0f), 0u, textures, true, in.hit);
             vec3 d = glm::normalize(vec3(unit(rng) - 0.5f, unit(rng) - 0.5f, unit(rng) - 0.5f));
             if (rng() % 8 != 0 && glm::dot(d, in.hit.ng) > 0.0f)
                 d = -d; // mostly the front, some backs

@@ -1,9 +1,10 @@
-// The SIMD Lambert kernel (host/pipeline/simd_shading.h) against shadeSurface(), hit by hit and
+// The SIMD Lambert kernel (host/cpu/simd_shading.h) against shadeSurface(), hit by hit and
 // bit by bit, on random hits that reach every branch: both sides of the surface, shading normals
 // on the wrong side, emitters seen from behind and one- and two-sided, every strategy and
 // sampler, paths before min depth, past it and at max depth, and Lambert hits mixed with other
 // models in runs that are not a multiple of the vector width.
-#include "host/pipeline/simd_shading.h"
+#include "host/cpu/simd_shading.h"
+#include "host/simd/simd_random.h"
 
 #include "shared/path.h"
 
@@ -156,8 +157,8 @@ TEST(SimdShading, LambertHitsAreShadeSurfaceToTheBit) {
     std::set<std::string> ran;
     for (int64_t target : targets) {
         hwy::SetSupportedTargetsForTest(target);
-        ran.insert(simdShadingTarget());
-        SCOPED_TRACE(simdShadingTarget());
+        ran.insert(simdTarget());
+        SCOPED_TRACE(simdTarget());
         expectLambertHitsAreShadeSurface();
     }
     hwy::SetSupportedTargetsForTest(0);
@@ -201,7 +202,7 @@ TEST(SimdShading, Rand4ManyIsRand4ToTheBit) {
     }
     for (int64_t target : hwy::SupportedAndGeneratedTargets()) {
         hwy::SetSupportedTargetsForTest(target);
-        SCOPED_TRACE(simdShadingTarget());
+        SCOPED_TRACE(simdTarget());
         for (uint sampling : {kSamplerIndependent, kSamplerSobol})
             for (size_t n : {size_t(1), size_t(64), size_t(203)}) {
                 std::vector<vec4> many(n);
@@ -219,7 +220,7 @@ TEST(SimdShading, Rand4ManyIsRand4ToTheBit) {
 }
 
 TEST(SimdShading, RunsInTheWidestInstructionSetAndOnlyWhereEveryLightIsATriangle) {
-    EXPECT_STRNE(simdShadingTarget(), "");
+    EXPECT_STRNE(simdTarget(), "");
     std::mt19937 rng(5);
     Fixture f = makeFixture(rng, 2);
     EXPECT_TRUE(simdShadingApplies(f.view()));

@@ -1,8 +1,9 @@
-#include "host/pipeline/cpu_shading.h"
+#include "host/cpu/cpu_shading.h"
 
-#include "host/pipeline/simd_shading.h"
+#include "host/cpu/simd_shading.h"
 #include "host/pipeline/slotted_engine.h"
 #include "host/pipeline/stages.h"
+#include "host/simd/simd_random.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -36,13 +37,15 @@ class CpuShading : public SlottedEngine {
     }
     void shadeBatch(const TracedBatch& b, Film& film, DirectionalBins& bins) override {
         if (!fused_) return SlottedEngine::shadeBatch(b, film, bins);
-        shadeFused(ctx_, iteration_, ctx_.config.pipeline.rayFormat, simd_, b.rays, b.hits, b.order,
+        const ShadeChunk shade = [&](const RenderParams& rp, const ShadeInput* in, size_t n,
+                                     ShadeResult* out) { shadeHits(view_, rp, simd_, in, n, out); };
+        shadeFused(ctx_, iteration_, ctx_.config.pipeline.rayFormat, shade, b.rays, b.hits, b.order,
                    b.hitCount, film, bins);
     }
     void publishStats(RenderStats& stats) override {
         SlottedEngine::publishStats(stats);
         if (fused_) stats.extra["stages"] = "fused"; // every per-hit stage chunk by chunk
-        stats.extra["simd_shading"] = simd_ ? simdShadingTarget() : "off";
+        stats.extra["simd_shading"] = simd_ ? simdTarget() : "off";
     }
 
     int slots() const override { return 1; }

@@ -29,12 +29,4 @@ bool simdShadingApplies(const SceneView& view);
 void shadeHits(const SceneView& view, const RenderParams& rp, bool simd, const ShadeInput* in,
                size_t n, ShadeResult* out);
 
-// out[i] = rand4(sampling, seed, pixel[i], sampleIndex[i], bounce, group) for i in [0, n), in
-// the kernel's instruction set (the camera's random numbers, a batch at a time).
-void rand4Many(uint sampling, uint seed, uint bounce, uint group, const uint* pixel,
-               const uint* sampleIndex, size_t n, vec4* out);
-
-// The instruction set the kernel runs in on this machine ("AVX3", "AVX2", "SSE4", ...).
-const char* simdShadingTarget();
-
 } // namespace spw

@@ -1,6 +1,6 @@
-#include "embree_backend/reference_renderer.h"
+#include "host/reference/reference_renderer.h"
 
-#include "embree_backend/batch_traversal.h"
+#include "host/accel/batch_traversal.h"
 #include "shared/path.h"
 
 #include <tbb/blocked_range2d.h>
@@ -45,8 +45,8 @@ bool ReferenceRenderer::renderIteration(uint iteration, Film& film) {
                                 break;
                             }
                             SurfaceHit hit;
-                            embree.setUpHit(h, dir, st.cone, ctx_.textures, st.bounce < rp.maxDepth,
-                                            hit);
+                            ctx_.hitSetup.setUpHit(h, dir, st.cone, ctx_.textures,
+                                                   st.bounce < rp.maxDepth, hit);
                             ShadeResult res;
                             shadeSurface(view, rp, hit, dir, st, res);
                             if (res.flags & kShadeEmitted)

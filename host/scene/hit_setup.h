@@ -1,19 +1,12 @@
-// The scene as Embree sees it: one triangle geometry per mesh (geometry id = mesh index), built
-// with the robust flag, and hit setup on it. The shader table and the emitters are the scene
-// side's (host/scene/lights.h).
+// Hit setup, the same on every backend: from a closest hit (mesh, triangle, barycentrics,
+// distance) to the world-space SurfaceHit shading reads — position, normals, self-intersection
+// offset, shader, emitter — and the albedo the shader's texture gives there. It reads the scene
+// and the emitter table only; the BVH that found the hit is host/accel/'s.
 #pragma once
 
 #include "host/scene/lights.h"
 #include "host/scene/scene.h"
 #include "host/scene/textures.h"
-
-#include <string>
-#include <vector>
-
-// Embree's handles, declared as Embree declares them, so that <embree3/rtcore.h> stays inside
-// embree_backend/.
-struct RTCDeviceTy;
-struct RTCSceneTy;
 
 namespace spw {
 
@@ -26,24 +19,16 @@ struct HitRecord {
     float u, v, t;
 };
 
-class EmbreeScene {
+class HitSetup {
   public:
-    // Builds the BVH on Embree's default device. Throws std::runtime_error on a device error.
     // `lights` gives each hit its emitter index; both must outlive this.
-    EmbreeScene(const Scene& scene, const SceneLights& lights);
-    ~EmbreeScene();
-    EmbreeScene(const EmbreeScene&) = delete;
-    EmbreeScene& operator=(const EmbreeScene&) = delete;
+    HitSetup(const Scene& scene, const SceneLights& lights) : src_(scene), lights_(lights) {}
 
-    RTCSceneTy* handle() const { return scene_; }
-    const Scene& scene() const { return src_; }
-
-    // Hit setup, the same on every backend: the world-space hit (position, normals, self-
-    // intersection offset, shader, emitter) and the albedo the shader's texture gives there.
-    // `dir` and `cone`: the ray's unit direction and packed cone (shared/cone.h), for the
-    // texture filter width. `albedo` false: the hit ends its path (max depth), so shading never
-    // reads the albedo, and no texture is looked up for it (albedo left 0). Written into `hit`
-    // in place: a returned 72-byte struct is copied through the stack, which stalls.
+    // The whole hit. `dir` and `cone`: the ray's unit direction and packed cone
+    // (shared/cone.h), for the texture filter width. `albedo` false: the hit ends its path (max
+    // depth), so shading never reads the albedo, and no texture is looked up for it (albedo
+    // left 0). Written into `hit` in place: a returned 72-byte struct is copied through the
+    // stack, which stalls.
     void setUpHit(const HitRecord& h, vec3 dir, uint cone, const TextureResolver& textures,
                   bool albedo, SurfaceHit& hit) const;
     // setUpHit in two halves, for a caller that looks textures up for many hits at once
@@ -69,20 +54,15 @@ class EmbreeScene {
             if (!mesh.normals.empty()) __builtin_prefetch(&mesh.normals[i]);
         }
     }
-    // Throws if Embree reported an error since the last check.
-    void checkError(const char* what) const;
 
   private:
-    const Scene& src_;
     // World-space hit for (mesh, triangle, Embree's u, v) at distance t; albedo left at 0.
-    void surfaceHit(uint geomID, uint primID, float u, float v, float t, SurfaceHit& hit) const;
+    void surfaceHit(uint meshIndex, uint prim, float u, float v, float t, SurfaceHit& hit) const;
     // Interpolated texture coordinates (0, 0 when the mesh has none).
-    vec2 uvAt(uint geomID, uint primID, float u, float v) const;
+    vec2 uvAt(uint meshIndex, uint prim, float u, float v) const;
 
-    RTCDeviceTy* device_ = nullptr;
-    RTCSceneTy* scene_ = nullptr;
+    const Scene& src_;
     const SceneLights& lights_;
-    mutable std::string error_;
 };
 
 } // namespace spw

@@ -1,0 +1,344 @@
+// The SIMD Lambert kernel (simd_shading.h). Highway compiles the part between
+// HWY_BEFORE_NAMESPACE and HWY_AFTER_NAMESPACE once per instruction set (this file includes
+// itself through foreach_target.h) and picks the best the processor has at the first call.
+//
+// The kernel is shadeSurface() (shared/path.h) for the Lambert model (shared/lambert.h) and
+// triangle emitters, written with the SIMD twins of the shared functions
+// (host/simd/simd_math-inl.h, each checked against its scalar function lane by lane); what the
+// kernel itself adds is the control flow, and normalize written as glm does it,
+// v * (1 / sqrt(dot(v, v))).
+#include "host/cpu/simd_shading.h"
+
+#include "host/simd/lanes.h"
+#include "shared/path.h"
+
+#include <algorithm>
+#include <cstdint>
+#include <cstring>
+
+#ifndef SPILLWAY_SIMD_SHADING_LANES
+#define SPILLWAY_SIMD_SHADING_LANES
+namespace spw::simd_shading {
+
+using simd::Floats;
+using simd::kBlock;
+using simd::Uints;
+using simd::Vec3s;
+
+// Every struct of lanes below is rows of kBlock 4-byte values and nothing else, so padding a
+// block copies rows (padLanes).
+
+// The random numbers of up to kBlock hits: what they are a function of, and what
+// MakeRandomNumbers makes of it.
+struct RandomLanes {
+    Uints pixel, sampleIndex, bounce;
+    Floats uLightX, uLightY, uLightZ, uLightW; // rand4(kDimLight)
+    Floats uBsdfX, uBsdfY, uBsdfZ;             // rand4(kDimBsdf).xyz
+};
+
+// The kernel's inputs for up to kBlock Lambert hits.
+struct LambertLanes {
+    Vec3s p, ng, ns, albedo, wo, beta; // the hit, -rayDir, the path's throughput
+    Floats offset;
+    Uints live;     // bounce < max depth: the path goes on from here
+    Uints roulette; // bounce >= min depth
+    RandomLanes random;
+    Vec3s e0, e1, e2, eNormal, eRadiance; // the picked emitter (a triangle)
+    Floats ePickPdf, eArea;
+    Uints eTwoSided;
+};
+static_assert(sizeof(LambertLanes) % sizeof(Floats) == 0, "rows only");
+static_assert(sizeof(RandomLanes) % sizeof(Floats) == 0, "rows only");
+
+// What the kernel writes; shadeHits() puts it into the ShadeResults.
+struct LambertResults {
+    Uints shadow, next; // kShadeShadow, kShadeContinue
+    Vec3s shadowOrigin, shadowDir, shadowContribution, nextOrigin, nextDir, nextBeta;
+    Floats shadowTmax, nextPdf;
+};
+
+} // namespace spw::simd_shading
+#endif
+
+#undef HWY_TARGET_INCLUDE
+#define HWY_TARGET_INCLUDE "host/cpu/simd_shading.cpp"
+#include <hwy/foreach_target.h> // must come before highway.h
+#include <hwy/highway.h>
+
+#include "host/simd/simd_math-inl.h"
+
+HWY_BEFORE_NAMESPACE();
+namespace spw::HWY_NAMESPACE {
+
+// The lanes' rand4(kDimLight) and rand4(kDimBsdf).xyz, for lanes [0, count).
+void MakeRandomNumbers(simd_shading::RandomLanes& lanes, size_t count, uint sampling, uint seed) {
+    for (size_t i = 0; i < count; i += hn::Lanes(D())) {
+        const VU pixel = loadU(lanes.pixel, i), sampleIndex = loadU(lanes.sampleIndex, i);
+        const VU bounce = loadU(lanes.bounce, i);
+        const U4 light = rand4(sampling, seed, pixel, sampleIndex, bounce, kDimLight);
+        store(uintToUnit(light.x), lanes.uLightX, i);
+        store(uintToUnit(light.y), lanes.uLightY, i);
+        store(uintToUnit(light.z), lanes.uLightZ, i);
+        store(uintToUnit(light.w), lanes.uLightW, i);
+        const U4 bsdf = rand4(sampling, seed, pixel, sampleIndex, bounce, kDimBsdf);
+        store(uintToUnit(bsdf.x), lanes.uBsdfX, i);
+        store(uintToUnit(bsdf.y), lanes.uBsdfY, i);
+        store(uintToUnit(bsdf.z), lanes.uBsdfZ, i);
+    }
+}
+
+// Steps 2 and 3 of shadeSurface for lanes [0, count), count a multiple of the vector width.
+void ShadeLambertLanes(const simd_shading::LambertLanes& in, size_t count, bool nee, bool mis,
+                       float threshold, simd_shading::LambertResults& out) {
+    const D d;
+    const V zero = hn::Zero(d);
+    const V one = hn::Set(d, 1.0f);
+    const V invPi = hn::Set(d, kInvPi);
+    for (size_t i = 0; i < count; i += hn::Lanes(d)) {
+        const V3 p = load(in.p, i), ng = load(in.ng, i), ns = load(in.ns, i);
+        const V3 albedo = load(in.albedo, i), wo = load(in.wo, i), beta = load(in.beta, i);
+        const V offset = load(in.offset, i);
+        const M live = loadMask(in.live, i);
+        const V ngDotWo = dot(ng, wo);
+        const V3 n = facingShadingNormal(ns, ng, ngDotWo);
+
+        // 2. Next-event estimation toward a point of the picked triangle (sampleEmitter).
+        M shadowing = hn::And(live, hn::MaskFromVec(nee ? hn::Not(zero) : zero));
+        if (!hn::AllFalse(d, shadowing)) {
+            const V3 e0 = load(in.e0, i), e1 = load(in.e1, i), e2 = load(in.e2, i);
+            const V3 eNormal = load(in.eNormal, i);
+            const V3 q =
+                emitterPoint(e0, e1, e2, load(in.random.uLightY, i), load(in.random.uLightZ, i));
+            const V3 dq = sub(q, p);
+            const V dist = hn::Sqrt(dot(dq, dq));
+            const V3 wi = div(dq, dist);
+            const V cosLight = emitterCosine(eNormal, loadMask(in.eTwoSided, i), neg(wi));
+            const V pdf =
+                emitterSolidAnglePdf(load(in.ePickPdf, i), load(in.eArea, i), dist, cosLight);
+            const V offsetQ = surfaceOffset(q, e0, add(e0, e1), add(e0, e2), eNormal);
+            const V tmax = shadowRayTmax(dist, offset, offsetQ, cosLight);
+            shadowing = hn::And(shadowing, hn::And(hn::Gt(dist, zero), hn::Gt(pdf, zero)));
+
+            V bsdfPdf;
+            const V3 fcos = lambertEval(albedo, ng, ngDotWo, n, wi, bsdfPdf);
+            shadowing = hn::And(shadowing, hn::Gt(maxComponent(fcos), zero));
+
+            const V w = mis ? powerHeuristic(pdf, quantizePdf(bsdfPdf)) : one;
+            const V3 radiance = load(in.eRadiance, i);
+            store(shadowing, offsetOrigin(p, ng, offset, wi), out.shadowOrigin, i);
+            store(shadowing, wi, out.shadowDir, i);
+            store(hn::IfThenElseZero(shadowing, tmax), out.shadowTmax, i);
+            store(shadowing, mul(mul(mul(beta, fcos), radiance), hn::Div(w, pdf)),
+                  out.shadowContribution, i);
+            shadowing = hn::And(shadowing, hn::Gt(tmax, zero));
+        } else {
+            const V3 none = {zero, zero, zero};
+            store(shadowing, none, out.shadowOrigin, i);
+            store(shadowing, none, out.shadowDir, i);
+            store(zero, out.shadowTmax, i);
+            store(shadowing, none, out.shadowContribution, i);
+        }
+        store(shadowing, out.shadow, i);
+
+        // 3. Continuation: lambertSample, then Russian roulette.
+        const V3 local =
+            sampleCosineHemisphere(load(in.random.uBsdfX, i), load(in.random.uBsdfY, i));
+        const V3 world = toWorld(local, n);
+        const V3 wi = mul(world, hn::Div(one, hn::Sqrt(dot(world, world))));
+        M next = hn::And(live, hn::Not(hn::Or(hn::Le(hn::Mul(ngDotWo, dot(ng, wi)), zero),
+                                              hn::Le(local.z, zero))));
+        V3 nextBeta = mul(beta, albedo);
+        const V q = gmin(one, hn::Div(maxComponent(nextBeta), hn::Set(d, threshold)));
+        const M roulette = loadMask(in.roulette, i);
+        next = hn::And(next, hn::Or(hn::Not(roulette), hn::Lt(load(in.random.uLightW, i), q)));
+        nextBeta = select(roulette, div(nextBeta, q), nextBeta);
+        next = hn::And(next, hn::Gt(maxComponent(nextBeta), zero));
+        store(next, out.next, i);
+        store(next, offsetOrigin(p, ng, offset, wi), out.nextOrigin, i);
+        store(next, wi, out.nextDir, i);
+        store(next, nextBeta, out.nextBeta, i);
+        store(hn::IfThenElseZero(next, quantizePdf(hn::Mul(local.z, invPi))), out.nextPdf, i);
+    }
+}
+
+} // namespace spw::HWY_NAMESPACE
+HWY_AFTER_NAMESPACE();
+
+#if HWY_ONCE
+namespace spw {
+HWY_EXPORT(ShadeLambertLanes);
+HWY_EXPORT(MakeRandomNumbers);
+
+using simd::kBlock;
+using simd::wholeVectors;
+using simd_shading::LambertLanes;
+using simd_shading::LambertResults;
+
+namespace {
+
+void set(simd::Vec3s& a, size_t k, vec3 v) {
+    a.x.v[k] = v.x;
+    a.y.v[k] = v.y;
+    a.z.v[k] = v.z;
+}
+vec3 get(const simd::Vec3s& a, size_t k) {
+    return vec3(a.x.v[k], a.y.v[k], a.z.v[k]);
+}
+std::uint32_t mask(bool b) {
+    return b ? ~0u : 0u;
+}
+
+// Lane k of `lanes`: what path st's random numbers at this bounce are a function of.
+void setRandomLane(const RenderParams& rp, const PathState& st, simd_shading::RandomLanes& lanes,
+                   size_t k) {
+    lanes.pixel.v[k] = pathPixel(rp, st.pathId);
+    lanes.sampleIndex.v[k] = pathSample(rp, st.pathId);
+    lanes.bounce.v[k] = st.bounce;
+}
+
+// Lane k from hit `in`: what the kernel reads, and (scalar) the emission into `out`.
+void fillLane(const SceneView& scene, const RenderParams& rp, const ShadeInput& in,
+              LambertLanes& lanes, size_t k, ShadeResult& out) {
+    const SurfaceHit& hit = in.hit;
+    const PathState& st = in.path;
+    const vec3 wo = -in.rayDir;
+    out.flags = 0u;
+    out.emitted = vec3(0.0f);
+    addEmission(scene, rp, hit, wo, st, out);
+    set(lanes.p, k, hit.p);
+    set(lanes.ng, k, hit.ng);
+    set(lanes.ns, k, hit.ns);
+    set(lanes.albedo, k, hit.albedo);
+    set(lanes.wo, k, wo);
+    set(lanes.beta, k, st.beta);
+    lanes.offset.v[k] = hit.offset;
+    const bool live = st.bounce < rp.maxDepth;
+    lanes.live.v[k] = mask(live);
+    lanes.roulette.v[k] = mask(st.bounce >= rp.minDepth);
+    setRandomLane(rp, st, lanes.random, k);
+}
+
+// Lane k's emitter, picked with the random number MakeRandomNumbers made (zeros where the path ends
+// here or nothing is sampled, so that the kernel reads defined values).
+void pickLaneEmitter(const SceneView& scene, const RenderParams& rp, bool nee, LambertLanes& lanes,
+                     size_t k) {
+    static const Emitter kNone{};
+    const Emitter& e =
+        nee && lanes.live.v[k] != 0u
+            ? scene.emitters[pickEmitter(scene, rp.emitterCount, lanes.random.uLightX.v[k])]
+            : kNone;
+    set(lanes.e0, k, e.p0);
+    set(lanes.e1, k, e.e1);
+    set(lanes.e2, k, e.e2);
+    set(lanes.eNormal, k, e.normal);
+    set(lanes.eRadiance, k, e.radiance);
+    lanes.ePickPdf.v[k] = e.pickPdf;
+    lanes.eArea.v[k] = e.area;
+    lanes.eTwoSided.v[k] = mask(e.twoSided != 0u);
+}
+
+// Lanes [count, end) copies of lane 0, so that whole vectors read defined values.
+template <class Lanes> void padLanes(Lanes& lanes, size_t count, size_t end) {
+    auto* rows = reinterpret_cast<unsigned char*>(&lanes);
+    for (size_t row = 0; row < sizeof(Lanes); row += sizeof(simd::Floats))
+        for (size_t k = count; k < end; ++k)
+            std::memcpy(rows + row + 4 * k, rows + row, 4);
+}
+
+// The kernel's results for lane k into `out` (whose emission fillLane wrote).
+void takeLane(const ShaderParams& sh, const LambertResults& res, size_t k, const ShadeInput& in,
+              ShadeResult& out) {
+    const PathState& st = in.path;
+    out.shadowOrigin = get(res.shadowOrigin, k);
+    out.shadowDir = get(res.shadowDir, k);
+    out.shadowTmax = res.shadowTmax.v[k];
+    out.shadowContribution = get(res.shadowContribution, k);
+    out.nextOrigin = get(res.nextOrigin, k);
+    out.nextDir = get(res.nextDir, k);
+    out.next = st;
+    if (res.shadow.v[k]) out.flags |= kShadeShadow;
+    if (!res.next.v[k]) return;
+    out.next.beta = get(res.nextBeta, k);
+    out.next.prevPdf = res.nextPdf.v[k];
+    out.next.bounce = st.bounce + 1u;
+    out.next.flags = 0u;
+    out.next.cone =
+        packCone(coneWidthAt(st.cone, in.hit.t), coneSpread(st.cone) + bsdfConeSpread(sh, false));
+    out.flags |= kShadeContinue;
+}
+
+} // namespace
+
+bool simdShadingApplies(const SceneView& view) {
+    for (uint i = 0; i < view.emitterCount; ++i)
+        if (view.emitters[i].type != kEmitterTriangle) return false;
+    return true;
+}
+
+void shadeHits(const SceneView& view, const RenderParams& rp, bool simd, const ShadeInput* in,
+               size_t n, ShadeResult* out) {
+    if (!simd) {
+        for (size_t i = 0; i < n; ++i)
+            shadeSurface(view, rp, in[i].hit, in[i].rayDir, in[i].path, out[i]);
+        return;
+    }
+    const bool nee = rp.emitterCount > 0u && rp.strategy != kStrategyBsdf;
+    const bool mis = rp.strategy == kStrategyMis;
+    // The other models' hits that go on: shadeSurface with their random numbers made here.
+    simd_shading::RandomLanes others;
+    std::uint32_t otherOf[kBlock];
+    size_t otherCount = 0;
+    auto runOthers = [&] {
+        const size_t end = wholeVectors(otherCount);
+        padLanes(others, otherCount, end);
+        HWY_DYNAMIC_DISPATCH(MakeRandomNumbers)(others, end, rp.sampling, rp.seed);
+        for (size_t k = 0; k < otherCount; ++k) {
+            const ShadeInput& hit = in[otherOf[k]];
+            const vec4 uLight(others.uLightX.v[k], others.uLightY.v[k], others.uLightZ.v[k],
+                              others.uLightW.v[k]);
+            const vec4 uBsdf(others.uBsdfX.v[k], others.uBsdfY.v[k], others.uBsdfZ.v[k], 0.0f);
+            shadeSurfaceWith(view, rp, hit.hit, hit.rayDir, hit.path, uLight, uBsdf,
+                             out[otherOf[k]]);
+        }
+        otherCount = 0;
+    };
+    LambertLanes lanes;
+    LambertResults results;
+    std::uint32_t hitOf[kBlock];
+    size_t count = 0;
+    auto run = [&] {
+        const size_t end = wholeVectors(count);
+        padLanes(lanes, count, end);
+        HWY_DYNAMIC_DISPATCH(MakeRandomNumbers)(lanes.random, end, rp.sampling, rp.seed);
+        for (size_t k = 0; k < end; ++k)
+            pickLaneEmitter(view, rp, nee, lanes, k);
+        HWY_DYNAMIC_DISPATCH(ShadeLambertLanes)(lanes, end, nee, mis, rp.threshold, results);
+        for (size_t k = 0; k < count; ++k) {
+            const ShadeInput& hit = in[hitOf[k]];
+            takeLane(view.shaders[hit.hit.shader], results, k, hit, out[hitOf[k]]);
+        }
+        count = 0;
+    };
+    for (size_t i = 0; i < n; ++i) {
+        const ShaderParams& sh = view.shaders[in[i].hit.shader];
+        if (sh.model != kModelLambert) {
+            if (!shadeGoesOn(rp, sh, in[i].path)) {
+                shadeSurfaceWith(view, rp, in[i].hit, in[i].rayDir, in[i].path, vec4(0.0f),
+                                 vec4(0.0f), out[i]);
+                continue;
+            }
+            setRandomLane(rp, in[i].path, others, otherCount);
+            otherOf[otherCount++] = std::uint32_t(i);
+            if (otherCount == kBlock) runOthers();
+            continue;
+        }
+        fillLane(view, rp, in[i], lanes, count, out[i]);
+        hitOf[count++] = std::uint32_t(i);
+        if (count == kBlock) run();
+    }
+    if (count > 0) run();
+    if (otherCount > 0) runOthers();
+}
+
+} // namespace spw
+#endif

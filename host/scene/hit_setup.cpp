@@ -1,0 +1,79 @@
+#include "host/scene/hit_setup.h"
+
+#include "shared/cone.h"
+#include "shared/offset.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace spw {
+
+void HitSetup::surfaceHit(uint meshIndex, uint prim, float u, float v, float t,
+                          SurfaceHit& hit) const {
+    const Mesh& mesh = src_.meshes[meshIndex];
+    const uvec3 tri = mesh.triangles[prim];
+    // References, not copies: GCC copies a 12-byte vec3 through the stack in two stores that one
+    // 8-byte load then straddles, a store-forwarding stall that was a quarter of this function.
+    const vec3 &p0 = mesh.positions[tri.x], &p1 = mesh.positions[tri.y],
+               &p2 = mesh.positions[tri.z];
+    const float w = 1.0f - u - v;
+    hit.p = w * p0 + u * p1 + v * p2;
+    hit.t = t;
+    hit.ng = glm::normalize(glm::cross(p1 - p0, p2 - p0));
+    hit.ns = hit.ng;
+    if (!mesh.normals.empty()) {
+        vec3 n = w * mesh.normals[tri.x] + u * mesh.normals[tri.y] + v * mesh.normals[tri.z];
+        float len = glm::length(n);
+        if (len > 0.0f) hit.ns = n / len;
+    }
+    hit.shader = uint(mesh.shader);
+    hit.emitter = lights_.emitterOf(meshIndex, prim);
+    hit.albedo = vec3(0.0f);
+    hit.offset = surfaceOffset(hit.p, p0, p1, p2, hit.ng);
+}
+
+void HitSetup::setUpHit(const HitRecord& h, vec3 dir, uint cone, const TextureResolver& textures,
+                        bool albedo, SurfaceHit& hit) const {
+    surfaceHit(h.mesh, h.prim, h.u, h.v, h.t, hit);
+    if (!albedo) return;
+    const Shader& shader = src_.shaders[hit.shader];
+    if (shader.texture < 0) {
+        hit.albedo = textures.albedo(shader, vec2(0.0f), 0.0f);
+        return;
+    }
+    vec2 uv;
+    float footprint;
+    textureQuery(h, dir, cone, hit, uv, footprint);
+    hit.albedo = textures.albedo(shader, uv, footprint);
+}
+
+void HitSetup::textureQuery(const HitRecord& h, vec3 dir, uint cone, const SurfaceHit& hit,
+                            vec2& uv, float& footprint) const {
+    // The filter width in texture space: the cone's width at the hit, stretched by the
+    // incidence (1/|cos|, at most 1000x at grazing angles) and scaled by the triangle's texture
+    // area over its world area (the Delta_0 term of Akenine-Moller et al. 2019's ray-cone LOD).
+    const Mesh& mesh = src_.meshes[h.mesh];
+    footprint = 0.0f;
+    if (!mesh.uvs.empty()) {
+        const uvec3 tri = mesh.triangles[h.prim];
+        const vec3 p0 = mesh.positions[tri.x];
+        const vec2 t0 = mesh.uvs[tri.x];
+        const float worldArea =
+            glm::length(glm::cross(mesh.positions[tri.y] - p0, mesh.positions[tri.z] - p0));
+        const vec2 a = mesh.uvs[tri.y] - t0, b = mesh.uvs[tri.z] - t0;
+        const float uvArea = std::fabs(a.x * b.y - a.y * b.x);
+        const float cosine = std::max(std::fabs(glm::dot(dir, hit.ng)), 1e-3f);
+        if (worldArea > 0.0f)
+            footprint = coneWidthAt(cone, h.t) / cosine * std::sqrt(uvArea / worldArea);
+    }
+    uv = uvAt(h.mesh, h.prim, h.u, h.v);
+}
+
+vec2 HitSetup::uvAt(uint meshIndex, uint prim, float u, float v) const {
+    const Mesh& mesh = src_.meshes[meshIndex];
+    if (mesh.uvs.empty()) return vec2(0.0f);
+    const uvec3 tri = mesh.triangles[prim];
+    return (1.0f - u - v) * mesh.uvs[tri.x] + u * mesh.uvs[tri.y] + v * mesh.uvs[tri.z];
+}
+
+} // namespace spw

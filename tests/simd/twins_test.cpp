@@ -1,0 +1,304 @@
+// Every SIMD twin (host/simd/twins.h) against its scalar function in shaders/shared/, lane by
+// lane and bit for bit, on random inputs that reach each branch (both signs, zeros, grazing
+// angles, every sampler), in every instruction set this machine has: a change to either side of
+// a twin fails here, at the function that drifted. And the tags: the scalar functions marked
+// "SIMD twin" in shaders/shared/ are exactly the registry's.
+#include "host/simd/simd_random.h"
+#include "host/simd/twins.h"
+#include "test_util.h"
+
+#include "shared/lambert.h"
+#include "shared/path.h"
+
+#include <gtest/gtest.h>
+#include <hwy/targets.h>
+
+#include <cstring>
+#include <fstream>
+#include <functional>
+#include <map>
+#include <random>
+#include <regex>
+#include <set>
+#include <string>
+
+namespace spw::simd {
+namespace {
+
+constexpr size_t kLanes = kBlock; // a multiple of every vector width
+
+// Random arguments: each float row a mix of ordinary values, zeros, negatives and near-zeros;
+// unit vectors and [0, 1) numbers where the scalar function asks for them.
+struct Inputs {
+    TwinLanes lanes{};
+    std::mt19937 rng;
+    explicit Inputs(unsigned seed) : rng(seed) {}
+
+    float any() {
+        std::uniform_real_distribution<float> u(-4.0f, 4.0f);
+        switch (rng() % 8) {
+        case 0:
+            return 0.0f;
+        case 1:
+            return std::ldexp(u(rng), -20);
+        case 2:
+            return std::ldexp(u(rng), 12);
+        default:
+            return u(rng);
+        }
+    }
+    float unit() { return std::uniform_real_distribution<float>(0.0f, 1.0f)(rng); }
+    vec3 direction() {
+        std::normal_distribution<float> g;
+        return normalize(vec3(g(rng), g(rng), g(rng)));
+    }
+    void fillAny() {
+        for (Floats& row : lanes.f)
+            for (float& x : row.v)
+                x = any();
+        for (Uints& row : lanes.u)
+            for (std::uint32_t& x : row.v)
+                x = std::uint32_t(rng());
+    }
+    void setUnit(int row) {
+        for (float& x : lanes.f[row].v)
+            x = unit();
+    }
+    void setDirection(int row) {
+        for (size_t k = 0; k < kLanes; ++k)
+            set3(row, k, direction());
+    }
+    void set3(int row, size_t k, vec3 v) {
+        lanes.f[row].v[k] = v.x;
+        lanes.f[row + 1].v[k] = v.y;
+        lanes.f[row + 2].v[k] = v.z;
+    }
+    vec3 get3(int row, size_t k) const {
+        return vec3(lanes.f[row].v[k], lanes.f[row + 1].v[k], lanes.f[row + 2].v[k]);
+    }
+    float f(int row, size_t k) const { return lanes.f[row].v[k]; }
+    std::uint32_t u(int row, size_t k) const { return lanes.u[row].v[k]; }
+};
+
+// The scalar side's results for lane k, as the twin writes them.
+struct Expected {
+    float f[4] = {};
+    std::uint32_t u[4] = {};
+    int floats = 0, uints = 0;
+    void put(float x) { f[floats++] = x; }
+    void put(vec3 v) { put(v.x), put(v.y), put(v.z); }
+    void put(vec4 v) { put(v.x), put(v.y), put(v.z), put(v.w); }
+    void putU(std::uint32_t x) { u[uints++] = x; }
+    void putU(uvec4 v) { putU(v.x), putU(v.y), putU(v.z), putU(v.w); }
+};
+
+// Each twin: how its arguments are drawn, and its scalar function on lane k.
+struct ScalarSide {
+    std::function<void(Inputs&)> draw;
+    std::function<void(const Inputs&, size_t, Expected&)> eval;
+};
+
+const std::map<Twin, ScalarSide>& scalarSides() {
+    static const std::map<Twin, ScalarSide> sides = {
+        {Twin::maxComponent,
+         {[](Inputs&) {},
+          [](const Inputs& in, size_t k, Expected& e) { e.put(maxComponent(in.get3(0, k))); }}},
+        {Twin::quantizePdf,
+         {[](Inputs&) {},
+          [](const Inputs& in, size_t k, Expected& e) { e.put(quantizePdf(in.f(0, k))); }}},
+        {Twin::powerHeuristic,
+         {[](Inputs&) {}, [](const Inputs& in, size_t k,
+                             Expected& e) { e.put(powerHeuristic(in.f(0, k), in.f(1, k))); }}},
+        {Twin::facingShadingNormal,
+         {[](Inputs& in) { in.setDirection(0), in.setDirection(3), in.setDirection(6); },
+          [](const Inputs& in, size_t k, Expected& e) {
+              e.put(facingShadingNormal(in.get3(0, k), in.get3(3, k), in.get3(6, k)));
+          }}},
+        {Twin::sinQuarterPi,
+         {[](Inputs& in) { in.setUnit(0); },
+          [](const Inputs& in, size_t k, Expected& e) { e.put(sinQuarterPi(in.f(0, k))); }}},
+        {Twin::cosQuarterPi,
+         {[](Inputs& in) { in.setUnit(0); },
+          [](const Inputs& in, size_t k, Expected& e) { e.put(cosQuarterPi(in.f(0, k))); }}},
+        {Twin::sampleCosineHemisphere,
+         {[](Inputs& in) {
+              in.setUnit(0), in.setUnit(1);
+              in.lanes.f[0].v[3] = in.lanes.f[1].v[3] = 0.5f; // the disk's centre
+          },
+          [](const Inputs& in, size_t k, Expected& e) {
+              e.put(sampleCosineHemisphere(vec2(in.f(0, k), in.f(1, k))));
+          }}},
+        {Twin::toWorld,
+         {[](Inputs& in) {
+              in.setDirection(3);
+              in.set3(3, 1, vec3(0.0f, 0.0f, -1.0f)); // makeFrame's singular pole
+          },
+          [](const Inputs& in, size_t k, Expected& e) {
+              e.put(toWorld(in.get3(0, k), in.get3(3, k)));
+          }}},
+        {Twin::surfaceOffset,
+         {[](Inputs& in) { in.setDirection(12); },
+          [](const Inputs& in, size_t k, Expected& e) {
+              e.put(surfaceOffset(in.get3(0, k), in.get3(3, k), in.get3(6, k), in.get3(9, k),
+                                  in.get3(12, k)));
+          }}},
+        {Twin::offsetOrigin,
+         {[](Inputs& in) { in.setDirection(3), in.setDirection(7); },
+          [](const Inputs& in, size_t k, Expected& e) {
+              e.put(offsetOrigin(in.get3(0, k), in.get3(3, k), in.f(6, k), in.get3(7, k)));
+          }}},
+        {Twin::shadowRayTmax,
+         {[](Inputs&) {},
+          [](const Inputs& in, size_t k, Expected& e) {
+              e.put(shadowRayTmax(in.f(0, k), in.f(1, k), in.f(2, k), in.f(3, k)));
+          }}},
+        {Twin::emitterPoint,
+         {[](Inputs& in) { in.setUnit(9), in.setUnit(10); },
+          [](const Inputs& in, size_t k, Expected& e) {
+              Emitter em{};
+              em.p0 = in.get3(0, k), em.e1 = in.get3(3, k), em.e2 = in.get3(6, k);
+              e.put(emitterPoint(em, vec2(in.f(9, k), in.f(10, k))));
+          }}},
+        {Twin::emitterCosine,
+         {[](Inputs& in) {
+              in.setDirection(0), in.setDirection(3);
+              for (std::uint32_t& m : in.lanes.u[0].v)
+                  m = (m & 1u) ? ~0u : 0u;
+          },
+          [](const Inputs& in, size_t k, Expected& e) {
+              Emitter em{};
+              em.normal = in.get3(0, k);
+              em.twoSided = in.u(0, k) != 0u ? 1u : 0u;
+              e.put(emitterCosine(em, in.get3(3, k)));
+          }}},
+        {Twin::emitterSolidAnglePdf,
+         {[](Inputs&) {},
+          [](const Inputs& in, size_t k, Expected& e) {
+              Emitter em{};
+              em.pickPdf = in.f(0, k), em.area = in.f(1, k);
+              e.put(emitterSolidAnglePdf(em, in.f(2, k), in.f(3, k)));
+          }}},
+        {Twin::lambertEval,
+         {[](Inputs& in) {
+              in.setUnit(0), in.setUnit(1), in.setUnit(2);
+              in.setDirection(3), in.setDirection(6), in.setDirection(9), in.setDirection(12);
+          },
+          [](const Inputs& in, size_t k, Expected& e) {
+              float pdf;
+              e.put(lambertEval(in.get3(0, k), in.get3(3, k), in.get3(6, k), in.get3(9, k),
+                                in.get3(12, k), pdf));
+              e.put(pdf);
+          }}},
+        {Twin::pcg4d,
+         {[](Inputs&) {},
+          [](const Inputs& in, size_t k, Expected& e) {
+              e.putU(pcg4d(uvec4(in.u(0, k), in.u(1, k), in.u(2, k), in.u(3, k))));
+          }}},
+        {Twin::laineKarrasPermutation,
+         {[](Inputs&) {},
+          [](const Inputs& in, size_t k, Expected& e) {
+              e.putU(laineKarrasPermutation(in.u(0, k), in.u(1, k)));
+          }}},
+        {Twin::scrambledSobol4,
+         {[](Inputs& in) { in.lanes.u[0].v[0] = 0u; },
+          [](const Inputs& in, size_t k, Expected& e) {
+              e.putU(scrambledSobol4(in.u(0, k),
+                                     uvec4(in.u(1, k), in.u(2, k), in.u(3, k), in.u(4, k))));
+          }}},
+        {Twin::uintToUnit,
+         {[](Inputs& in) { in.lanes.u[0].v[0] = ~0u, in.lanes.u[0].v[1] = 0u; },
+          [](const Inputs& in, size_t k, Expected& e) { e.put(uintToUnit(in.u(0, k))); }}},
+        {Twin::rand4,
+         {[](Inputs& in) {
+              for (std::uint32_t& b : in.lanes.u[2].v)
+                  b %= 64u;
+              in.lanes.uniform[0] = in.rng() % 2 ? kSamplerSobol : kSamplerIndependent;
+              in.lanes.uniform[1] = std::uint32_t(in.rng());
+              in.lanes.uniform[2] = kDimBsdf;
+          },
+          [](const Inputs& in, size_t k, Expected& e) {
+              e.put(rand4(in.lanes.uniform[0], in.lanes.uniform[1], in.u(0, k), in.u(1, k),
+                          in.u(2, k), in.lanes.uniform[2]));
+          }}},
+    };
+    return sides;
+}
+
+bool sameBits(float a, float b) {
+    return std::memcmp(&a, &b, sizeof a) == 0 || (std::isnan(a) && std::isnan(b));
+}
+
+// One twin on `rounds` blocks of random lanes; the first lane that differs is reported.
+void expectTwinIsScalar(const TwinInfo& info, const ScalarSide& side, int rounds) {
+    for (int round = 0; round < rounds; ++round) {
+        Inputs in(1000u * unsigned(info.twin) + unsigned(round));
+        in.fillAny();
+        side.draw(in);
+        TwinResults out{};
+        runTwin(info.twin, in.lanes, kLanes, out);
+        for (size_t k = 0; k < kLanes; ++k) {
+            Expected e;
+            side.eval(in, k, e);
+            ASSERT_GT(e.floats + e.uints, 0);
+            for (int r = 0; r < e.floats; ++r)
+                ASSERT_TRUE(sameBits(out.f[r].v[k], e.f[r]))
+                    << info.name << " (shared/" << info.header << "), round " << round << ", lane "
+                    << k << ", result " << r << ": SIMD " << out.f[r].v[k] << ", scalar " << e.f[r];
+            for (int r = 0; r < e.uints; ++r)
+                ASSERT_EQ(out.u[r].v[k], e.u[r])
+                    << info.name << " (shared/" << info.header << "), round " << round << ", lane "
+                    << k << ", result " << r;
+        }
+    }
+}
+
+TEST(SimdTwins, EachTwinIsItsScalarFunctionLaneByLaneInEveryInstructionSet) {
+    const std::vector<int64_t> targets = hwy::SupportedAndGeneratedTargets();
+    ASSERT_FALSE(targets.empty());
+    for (int64_t target : targets) {
+        hwy::SetSupportedTargetsForTest(target);
+        SCOPED_TRACE(simdTarget());
+        for (const TwinInfo& info : kTwins) {
+            const auto side = scalarSides().find(info.twin);
+            ASSERT_NE(side, scalarSides().end()) << info.name << ": no scalar side in this test";
+            expectTwinIsScalar(info, side->second, 40);
+        }
+    }
+    hwy::SetSupportedTargetsForTest(0);
+}
+
+// The tags "// SIMD twin: host/simd/simd_math-inl.h" above SHARED_FN definitions in
+// shaders/shared/, as (header, function) pairs.
+std::set<std::string> taggedFunctions() {
+    std::set<std::string> out;
+    static const std::regex fn("^SHARED_FN \\w+ (\\w+)\\(");
+    for (const char* header :
+         {"sampling.h", "offset.h", "lights.h", "lambert.h", "rng.h", "path.h", "bsdf.h", "ggx.h",
+          "conductor.h", "dielectric.h", "cone.h", "types.h", "compat.h"}) {
+        std::ifstream in(test::sourceDir() + "/shaders/shared/" + header);
+        EXPECT_TRUE(in) << header;
+        std::string line;
+        bool tagged = false;
+        while (std::getline(in, line)) {
+            std::smatch m;
+            if (tagged && std::regex_search(line, m, fn))
+                out.insert(std::string(header) + " " + m[1].str());
+            else if (tagged)
+                ADD_FAILURE() << header
+                              << ": a SIMD twin tag not followed by a SHARED_FN: " << line;
+            tagged = line == "// SIMD twin: host/simd/simd_math-inl.h";
+        }
+    }
+    return out;
+}
+
+TEST(SimdTwins, TheTaggedScalarFunctionsAreTheRegistry) {
+    std::set<std::string> registry;
+    for (const TwinInfo& info : kTwins)
+        registry.insert(std::string(info.header) + " " + info.name);
+    EXPECT_EQ(taggedFunctions(), registry);
+    EXPECT_EQ(scalarSides().size(), registry.size());
+}
+
+} // namespace
+} // namespace spw::simd
