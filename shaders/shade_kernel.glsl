@@ -23,9 +23,9 @@
 //                   and the host-resolved per-hit albedo is not read;
 //   2 kSampling, 3 kStrategy  RenderParams' sampler and MIS strategy, fixed for the render: the
 //                   other samplers' and strategies' code is dropped;
-//   4 kEmitterKinds bit 1 << kEmitter* for each kind of emitter in the scene: with one kind, the
-//                   others' light sampling (the environment's CDF searches, point lights) is
-//                   dropped.
+//   4 kEmitterKinds bit 1 << kEmitter* for each kind of emitter in the scene (every kind of the
+//                   registry, shared/emitter_kinds.h): with one kind, the others' light
+//                   sampling (the environment's CDF searches, point lights) is dropped.
 // Why it matters on lavapipe: it runs 8 invocations as the lanes of one vector and executes both
 // sides of every if, masked, whatever the lanes decide; code a uniform condition switches off
 // still costs its full time there. Constants make the condition known to the compiler instead.
@@ -54,7 +54,7 @@ layout(constant_id = 0) const bool kHasEmitters = true;
 layout(constant_id = 1) const bool kTextured = true;
 layout(constant_id = 2) const uint kSampling = kSamplerIndependent;
 layout(constant_id = 3) const uint kStrategy = kStrategyMis;
-layout(constant_id = 4) const uint kEmitterKinds = 7u;
+layout(constant_id = 4) const uint kEmitterKinds = 0xFFFFFFFFu; // every kind
 
 layout(set = 0, binding = 0) uniform usamplerBuffer shaderTable; // 3 texels per ShaderParams
 layout(set = 0, binding = 1) uniform usamplerBuffer emitterTable; // 5 texels per Emitter
@@ -99,9 +99,10 @@ Emitter kernelEmitter(uint i) {
     e.type = w3.w;
     e.radiance = uintBitsToFloat(w4.xyz);
     e.pad1 = uintBitsToFloat(w4.w);
-    if (kEmitterKinds == (1u << kEmitterTriangle)) e.type = kEmitterTriangle;
-    if (kEmitterKinds == (1u << kEmitterPoint)) e.type = kEmitterPoint;
-    if (kEmitterKinds == (1u << kEmitterEnvironment)) e.type = kEmitterEnvironment;
+#define SPW_ONLY_KIND(Name, id, stem, Scene, flags)                                                \
+    if (kEmitterKinds == (1u << kEmitter##Name)) e.type = kEmitter##Name;
+    SPW_EMITTER_KINDS(SPW_ONLY_KIND)
+#undef SPW_ONLY_KIND
     return e;
 }
 

@@ -72,14 +72,32 @@ Shader readQuadLight(const Reader& rd, const YAML::Node& n, const glm::dvec3& or
     return s;
 }
 
-// `position` (camera-relative from here on), intensity x colour in W/sr.
-PointLight readPointLight(const Reader& rd, const YAML::Node& n, const glm::dvec3& origin) {
-    rd.checkKeys(n, "Point light", {"type", "position", "intensity", "colour"});
-    if (!n["position"]) rd.fail(n, "Point light needs a position");
-    const glm::dvec3 p = rd.dvec<3>(n["position"], "light position") - origin;
-    checkDistance(rd, n["position"], p, "point light");
-    PointLight light;
-    light.position = vec3(p);
+// A punctual light: the keys its kind's flags name, and intensity x colour.
+PunctualLight readPunctualLight(const Reader& rd, const YAML::Node& n, const glm::dvec3& origin,
+                                const EmitterKindInfo& kind) {
+    const std::string what = std::string(kind.scene) + " light";
+    std::vector<std::string> keys = {"type", "intensity", "colour"};
+    const bool positioned = (kind.flags & kLightTakesPosition) != 0u;
+    const bool directed = (kind.flags & kLightTakesDirection) != 0u;
+    if (positioned) keys.push_back("position");
+    if (directed) keys.push_back("direction");
+    rd.checkKeys(n, what, keys);
+    PunctualLight light;
+    light.kind = kind.kind;
+    if (positioned) {
+        if (!n["position"]) rd.fail(n, what + " needs a position");
+        const glm::dvec3 p = rd.dvec<3>(n["position"], "light position") - origin;
+        checkDistance(rd, n["position"], p, "point light");
+        light.position = vec3(p);
+    }
+    if (directed) {
+        if (!n["direction"]) rd.fail(n, what + " needs a direction");
+        const glm::dvec3 d = rd.dvec<3>(n["direction"], "light direction");
+        const double length = glm::length(d);
+        if (!(length > 1e-30) || !std::isfinite(length))
+            rd.fail(n["direction"], what + " direction must be a non-zero vector");
+        light.direction = vec3(d / length);
+    }
     light.intensity = vec3(lightIntensity(rd, n, true));
     light.line = n.Mark().line + 1;
     return light;

@@ -1,5 +1,7 @@
 #include "host/scene/lights.h"
 
+#include "host/scene/emitter_kinds.h"
+
 #include "shared/sampling.h"
 
 #include <algorithm>
@@ -56,19 +58,8 @@ SceneLights::SceneLights(const Scene& scene) {
     }
 
     const double radius = sceneRadius(scene);
-    for (const PointLight& p : scene.pointLights) {
-        if (maxComponent(p.intensity) <= 0.0f) continue;
-        Emitter e{};
-        e.type = kEmitterPoint;
-        e.p0 = p.position;
-        e.radiance = p.intensity;
-        // Power = 4 pi I. For the film's scale: the irradiance at the scene's own size.
-        powers.push_back(4.0 * kPi * double(luminance(p.intensity)));
-        const double r = std::max(radius, 1e-30);
-        brightest_ = std::max(brightest_,
-                              float(std::min(double(maxComponent(p.intensity)) / (r * r), 1e30)));
-        emitters_.push_back(e);
-    }
+    for (const PunctualLight& p : scene.punctualLights)
+        addPunctual(p, radius, powers);
 
     if (scene.environment) buildEnvironment(*scene.environment, radius, powers);
 
@@ -99,6 +90,30 @@ SceneLights::SceneLights(const Scene& scene) {
         environment_ = uint(emitters_.size());
         emitters_.push_back(e); // pickPdf 0, after the CDF: never picked
     }
+}
+
+// A punctual light's emitter and its power, by what its kind takes (emitter_kinds.h):
+// - a position: power 4 pi I; for the film's scale, the irradiance at the scene's own size;
+// - a direction from infinity: what a disc of the scene's radius facing it intercepts, pi r^2 E
+//   (pbrt-v4's estimate for distant lights); for the film's scale, E itself.
+void SceneLights::addPunctual(const PunctualLight& p, double radius, std::vector<double>& powers) {
+    if (maxComponent(p.intensity) <= 0.0f) return;
+    const EmitterKindInfo& kind = *emitterKind(p.kind);
+    Emitter e{};
+    e.type = p.kind;
+    if (kind.flags & kLightTakesPosition) e.p0 = p.position;
+    if (kind.flags & kLightTakesDirection) e.normal = p.direction;
+    e.radiance = p.intensity;
+    const double r = std::max(radius, 1e-30);
+    if (kind.flags & kLightTakesPosition) {
+        powers.push_back(4.0 * kPi * double(luminance(p.intensity)));
+        brightest_ = std::max(brightest_,
+                              float(std::min(double(maxComponent(p.intensity)) / (r * r), 1e30)));
+    } else {
+        powers.push_back(kPi * r * r * double(luminance(p.intensity)));
+        brightest_ = std::max(brightest_, maxComponent(p.intensity));
+    }
+    emitters_.push_back(e);
 }
 
 // The environment's emitter, its power, and for a map the texels and CDFs of shared/lights.h.

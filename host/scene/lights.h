@@ -1,5 +1,5 @@
 // What shading reads of the scene besides the hit: the shader table, and the lights. Every
-// triangle of a mesh whose shader emits is an emitter, and so is every point light and the
+// triangle of a mesh whose shader emits is an emitter, and so is every punctual light and the
 // environment; next-event estimation picks one with probability proportional to its power (the
 // CDF), and the film's fixed-point scale reads the brightest emission. Built from the Scene alone,
 // apart from the BVH (host/accel/), as pbrt-v4 builds its lights and light sampler apart from
@@ -36,6 +36,7 @@ class SceneLights {
     }
 
   private:
+    void addPunctual(const PunctualLight& p, double radius, std::vector<double>& powers);
     void buildEnvironment(const Environment& env, double radius, std::vector<double>& powers);
 
     std::vector<ShaderParams> shaders_;

@@ -130,10 +130,15 @@ struct Mesh {
     int droppedTriangles = 0; // zero-area triangles left out when loading
 };
 
-// A point light: `intensity` W/sr in every direction (intensity x colour), at `position`.
-struct PointLight {
-    vec3 position;
-    vec3 intensity;
+// A punctual light of an emitter kind that takes a position or a direction
+// (host/scene/emitter_kinds.h): a point light's `intensity` W/sr in every direction at
+// `position`; a directional light's irradiance `intensity` W/m^2 arriving along the unit
+// `direction` (intensity x colour, both).
+struct PunctualLight {
+    uint kind = 0; // kEmitter*
+    vec3 position{0.0f};
+    vec3 direction{0.0f, -1.0f, 0.0f};
+    vec3 intensity{1.0f};
     int line = 0;
 };
 
@@ -163,7 +168,7 @@ struct Scene {
     std::vector<Mesh> meshes; // objects first, then the quad lights' geometry
     int objectCount = 0;
     int quadLightCount = 0;
-    std::vector<PointLight> pointLights;
+    std::vector<PunctualLight> punctualLights;
     std::optional<Environment> environment;
 
     bool usesTextures() const;

@@ -487,21 +487,20 @@ class SceneReader {
     }
 
     void readLight(const YAML::Node& e) {
-        if (!e.IsMap() || !e["type"])
-            rd_.fail(e, "light needs a type (Quad, Point or Environment)");
+        if (!e.IsMap() || !e["type"]) rd_.fail(e, "light needs a type (" + lightTypeList() + ")");
         const std::string t = rd_.string(e["type"], "light type");
-        if (t == "Quad") {
+        const EmitterKindInfo* kind = emitterKindNamed(t);
+        if (!kind) rd_.fail(e["type"], "unknown light type '" + t + "' (" + lightTypeList() + ")");
+        if (kind->kind == kEmitterTriangle) {
             roomFor(e, 1, 1);
             lightShaders_.push_back(readQuadLight(rd_, e, scene_.origin, lightMeshes_));
-        } else if (t == "Point") {
-            scene_.pointLights.push_back(readPointLight(rd_, e, scene_.origin));
-        } else if (t == "Environment") {
+        } else if (kind->kind == kEmitterEnvironment) {
             if (scene_.environment)
                 rd_.fail(e, "a second Environment light (the first is at line " +
                                 std::to_string(scene_.environment->line) + ")");
             scene_.environment = readEnvironment(rd_, e, dir_);
         } else {
-            rd_.fail(e["type"], "unknown light type '" + t + "' (Quad, Point or Environment)");
+            scene_.punctualLights.push_back(readPunctualLight(rd_, e, scene_.origin, *kind));
         }
     }
 

@@ -178,21 +178,22 @@ HWY_INLINE V3 toWorld(V3 local, V3 n) {
     return add(add(mul(t, local.x), mul(b, local.y)), mul(n, local.z));
 }
 
-// --- triangle emitters (shared/lights.h, shared/offset.h) and Lambert (shared/lambert.h) -------
+// --- triangle emitters (shared/light_sample.h, shared/offset.h) and Lambert (shared/lambert.h)
+// -------
 
-// Twin of emitterPoint (shared/lights.h) with sampleTriangle (shared/sampling.h) inlined.
+// Twin of emitterPoint (shared/light_sample.h) with sampleTriangle (shared/sampling.h) inlined.
 HWY_INLINE V3 emitterPoint(V3 p0, V3 e1, V3 e2, V ux, V uy) {
     const V su = hn::Sqrt(ux);
     const V bx = hn::Sub(hn::Set(D(), 1.0f), su);
     const V by = hn::Mul(uy, su);
     return add(add(p0, mul(e1, bx)), mul(e2, by));
 }
-// Twin of emitterCosine (shared/lights.h).
+// Twin of emitterCosine (shared/light_sample.h).
 HWY_INLINE V emitterCosine(V3 normal, M twoSided, V3 towardReceiver) {
     const V c = dot(normal, towardReceiver);
     return gmax(hn::IfThenElse(twoSided, hn::Abs(c), c), hn::Zero(D()));
 }
-// Twin of emitterSolidAnglePdf (shared/lights.h).
+// Twin of emitterSolidAnglePdf (shared/light_sample.h).
 HWY_INLINE V emitterSolidAnglePdf(V pickPdf, V area, V dist, V cosLight) {
     return hn::IfThenZeroElse(
         hn::Le(cosLight, hn::Zero(D())),

@@ -24,9 +24,9 @@
     X(surfaceOffset, "offset.h")                                                                   \
     X(offsetOrigin, "offset.h")                                                                    \
     X(shadowRayTmax, "offset.h")                                                                   \
-    X(emitterPoint, "lights.h")                                                                    \
-    X(emitterCosine, "lights.h")                                                                   \
-    X(emitterSolidAnglePdf, "lights.h")                                                            \
+    X(emitterPoint, "light_sample.h")                                                              \
+    X(emitterCosine, "light_sample.h")                                                             \
+    X(emitterSolidAnglePdf, "light_sample.h")                                                      \
     X(lambertEval, "lambert.h")                                                                    \
     X(pcg4d, "rng.h")                                                                              \
     X(laineKarrasPermutation, "rng.h")                                                             \

@@ -18,11 +18,11 @@ namespace spw::vk {
 // What a render fixes for all its hits, given to the kernels as specialisation constants so that
 // the driver drops the code a scene does not use (shaders/shade_kernel.glsl).
 struct KernelSpecialization {
-    bool hasEmitters = true;   // constant_id 0: emission and next-event estimation
-    bool textured = true;      // constant_id 1: per-hit albedo resolved by the host
-    uint32_t sampling = 0;     // constant_id 2: RenderParams::sampling
-    uint32_t strategy = 0;     // constant_id 3: RenderParams::strategy
-    uint32_t emitterKinds = 7; // constant_id 4: bit 1 << kEmitter* for each kind in the scene
+    bool hasEmitters = true;     // constant_id 0: emission and next-event estimation
+    bool textured = true;        // constant_id 1: per-hit albedo resolved by the host
+    uint32_t sampling = 0;       // constant_id 2: RenderParams::sampling
+    uint32_t strategy = 0;       // constant_id 3: RenderParams::strategy
+    uint32_t emitterKinds = ~0u; // constant_id 4: bit 1 << kEmitter* for each kind in the scene
 };
 
 class ShadingPipelines {

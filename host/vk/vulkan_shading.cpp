@@ -1,5 +1,9 @@
 #include "host/vk/vulkan_engine.h"
 
+#include "host/scene/emitter_kinds.h"
+
+#include <cctype>
+
 namespace spw::vk_engine {
 
 ShadeSlot VulkanShading::reserve(int slot, size_t count) {
@@ -184,9 +188,12 @@ void VulkanShading::publishStats(RenderStats& stats) {
     v["api"] = d.api;
     v["pipelines"] = pipelines_->names();
     nlohmann::json kinds = nlohmann::json::array();
-    const char* kindNames[] = {"triangle", "point", "environment"};
-    for (uint k = 0; k < 3; ++k)
-        if (spec_.emitterKinds & (1u << k)) kinds.push_back(kindNames[k]);
+    for (const EmitterKindInfo& k : kEmitterKindTable)
+        if (spec_.emitterKinds & (1u << k.kind)) {
+            std::string name = k.name;
+            name[0] = char(std::tolower(name[0]));
+            kinds.push_back(name);
+        }
     v["specialization"] = {{"emitters", spec_.hasEmitters},
                            {"textures", spec_.textured},
                            {"sampler", spec_.sampling == kSamplerSobol ? "sobol" : "pcg"},

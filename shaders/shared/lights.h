@@ -1,167 +1,34 @@
 // Emitters: every emitting surface is a list of triangles (a Quad light is two), each sampled
-// uniformly by area; point lights; and the environment. Next-event estimation picks one in
+// uniformly by area; punctual lights; and the environment. Next-event estimation picks one in
 // proportion to its power. pdfs are converted to solid angle at the shading point so that MIS
-// compares like with like.
+// compares like with like. Each kind of emitter is a line of the registry
+// (shared/emitter_kinds.h) and a header of its own, <stem>.h, which defines
+//   LightSample <stem>Sample(SCENE_PARAM RenderParams rp, Emitter e, SurfaceHit hit, vec2 u)
+// (one light sample toward emitter e from the hit, with u uniform in [0, 1)^2); this file
+// dispatches on the kind.
 #ifndef SPILLWAY_SHARED_LIGHTS_H
 #define SPILLWAY_SHARED_LIGHTS_H
-#include "sampling.h"
-#include "scene_access.h"
+#include "emitter_kind_headers.h"
+#include "light_sample.h"
 
 SHARED_BEGIN
 
-// Index of the emitter whose CDF interval holds u: the first cdf > u (the last entry is 1 > u).
-// A binary search whose steps depend on the count alone and whose halving is a select, not a
-// branch: which half u falls in is a coin flip the CPU would mispredict half the time.
-SHARED_FN uint pickEmitter(SCENE_PARAM uint count, float u) {
-    uint base = 0u;
-    uint len = count;
-    while (len > 1u) {
-        uint step = len >> 1u;
-        base = EMITTER_CDF(base + step) <= u ? base + step : base;
-        len -= step;
-    }
-    return base + uint(EMITTER_CDF(base) <= u);
+SHARED_FN LightSample sampleEmitter(SCENE_PARAM RenderParams rp, Emitter e, SurfaceHit hit,
+                                    vec2 u) {
+#define SPW_SAMPLE_EMITTER(Name, id, stem, Scene, flags)                                           \
+    if (e.type == kEmitter##Name) return stem##Sample(SCENE_ARG rp, e, hit, u);
+    SPW_EMITTER_KINDS(SPW_SAMPLE_EMITTER)
+#undef SPW_SAMPLE_EMITTER
+    return noLightSample();
 }
 
-// Cosine at the emitter between its normal and the direction back to the receiver, 0 if the
-// receiver sees the emitter's back (one-sided emitters).
-// SIMD twin: host/simd/simd_math-inl.h
-SHARED_FN float emitterCosine(Emitter e, vec3 towardReceiver) {
-    float c = dot(e.normal, towardReceiver);
-    if (e.twoSided != 0u) c = abs(c);
-    return max(c, 0.0f);
-}
-
-// Solid-angle pdf of reaching a point of emitter e at distance `dist` with cosine `cosLight`
-// through light sampling.
-// SIMD twin: host/simd/simd_math-inl.h
-SHARED_FN float emitterSolidAnglePdf(Emitter e, float dist, float cosLight) {
-    if (cosLight <= 0.0f) return 0.0f;
-    return e.pickPdf * (dist * dist) / (cosLight * e.area);
-}
-
-// SIMD twin: host/simd/simd_math-inl.h
-SHARED_FN vec3 emitterPoint(Emitter e, vec2 u) {
-    vec2 b = sampleTriangle(u);
-    return e.p0 + b.x * e.e1 + b.y * e.e2;
-}
-
-// --- the environment: radiance at infinity --------------------------------------------------
-// A lat-long map of W x H texels covers the sphere of directions: texel column u = phi / 2pi + 1/2
-// with phi = atan2(d.x, -d.z) (the map's centre looks along -Z), row v = theta / pi with
-// theta = acos(d.y) (row 0 is straight up, +Y). Its radiance is constant over each texel, and so
-// is the sampling density in (u, v): texels are picked in proportion to luminance x sin(theta)
-// (the solid angle a texel spans), a row from the marginal CDF, then a column from that row's
-// conditional CDF (Pharr et al., pbrt 3rd ed., 14.2.4). ENVIRONMENT_DATA holds, as floats:
-//   3WH   the texels' RGB radiance, row by row
-//   H     the rows' CDF (inclusive prefix sums, the last exactly 1)
-//   WH    each row's CDF over its columns
-//   H-1   cos(theta) of the boundaries between rows, k pi / H for k = 1 .. H-1
-//   W-1   cos(phi) of the boundaries between columns, phi = -pi + 2 pi k / W for k = 1 .. W-1
-// A direction's texel is found by comparing it with the boundaries, never through acos and
-// atan: GLSL lets those be far less exact than C++'s (lavapipe's differ by 1e-6), and a
-// direction near a boundary would then read one texel on one backend and its neighbour on
-// another. A constant environment has no map: it is sampled uniformly over the sphere.
-
-SHARED_FN vec3 environmentDirection(vec2 uv) {
-    float phi = (uv.x - 0.5f) * (2.0f * kPi);
-    float theta = uv.y * kPi;
-    float s = sin(theta);
-    return vec3(s * sin(phi), cos(theta), -s * cos(phi));
-}
-
-// Whether direction d's phi = atan2(d.x, -d.z) is at least the k-th column boundary (k >= 1),
-// from cos(phi) = -d.z / rho on either half of the circle, without dividing.
-SHARED_FN bool environmentPastColumn(SCENE_PARAM RenderParams rp, vec3 d, float rho, uint k) {
-    uint w = rp.envWidth;
-    float c = ENVIRONMENT_DATA(4u * w * rp.envHeight + 2u * rp.envHeight - 1u + k - 1u);
-    if (2u * k <= w) return d.x < 0.0f ? -d.z >= c * rho : true; // boundary phi <= 0
-    return d.x >= 0.0f && -d.z <= c * rho;                       // boundary phi > 0
-}
-
-// The map texel a unit direction falls in (binary searches over the boundaries).
-SHARED_FN uvec2 environmentTexel(SCENE_PARAM RenderParams rp, vec3 d) {
-    uint rowCos = 4u * rp.envWidth * rp.envHeight + rp.envHeight;
-    uint lo = 0u;
-    uint hi = rp.envHeight - 1u;
-    while (lo < hi) { // the first boundary below d: cos falls as theta grows
-        uint mid = (lo + hi) >> 1u;
-        if (d.y > ENVIRONMENT_DATA(rowCos + mid))
-            hi = mid;
-        else
-            lo = mid + 1u;
-    }
-    uint row = lo;
-    float rho = sqrt(d.x * d.x + d.z * d.z);
-    lo = 0u;
-    hi = rp.envWidth - 1u;
-    while (lo < hi) { // how many column boundaries phi has passed
-        uint mid = (lo + hi + 1u) >> 1u;
-        if (environmentPastColumn(SCENE_ARG rp, d, rho, mid))
-            lo = mid;
-        else
-            hi = mid - 1u;
-    }
-    return uvec2(lo, row);
-}
-
-SHARED_FN float environmentCdfInterval(SCENE_PARAM uint base, uint i) {
-    return ENVIRONMENT_DATA(base + i) - (i > 0u ? ENVIRONMENT_DATA(base + i - 1u) : 0.0f);
-}
-
-// Radiance arriving from direction d (unit) out of environment e.
-SHARED_FN vec3 environmentRadiance(SCENE_PARAM RenderParams rp, Emitter e, vec3 d) {
-    if (rp.envWidth == 0u) return e.radiance;
-    uvec2 t = environmentTexel(SCENE_ARG rp, d);
-    uint i = 3u * (t.y * rp.envWidth + t.x);
-    return vec3(ENVIRONMENT_DATA(i), ENVIRONMENT_DATA(i + 1u), ENVIRONMENT_DATA(i + 2u));
-}
-
-// Solid-angle density of environmentSample() choosing d, before the pick probability.
-SHARED_FN float environmentPdf(SCENE_PARAM RenderParams rp, vec3 d) {
-    if (rp.envWidth == 0u) return 0.25f * kInvPi;
-    float sinTheta = sqrt(max(0.0f, 1.0f - d.y * d.y));
-    if (!(sinTheta > 0.0f)) return 0.0f;
-    uvec2 t = environmentTexel(SCENE_ARG rp, d);
-    uint marginal = 3u * rp.envWidth * rp.envHeight;
-    uint conditional = marginal + rp.envHeight + t.y * rp.envWidth;
-    float p = environmentCdfInterval(SCENE_ARG marginal, t.y) *
-              environmentCdfInterval(SCENE_ARG conditional, t.x);
-    return p * float(rp.envWidth) * float(rp.envHeight) / (2.0f * kPi * kPi * sinTheta);
-}
-
-// Index of the first entry of cdf[base .. base + n) above u (binary search), and u rescaled to
-// [0, 1) within that entry's interval.
-SHARED_FN uint environmentSearch(SCENE_PARAM uint base, uint n, INOUT(float) u) {
-    uint lo = 0u;
-    uint hi = n - 1u;
-    while (lo < hi) {
-        uint mid = (lo + hi) >> 1u;
-        if (ENVIRONMENT_DATA(base + mid) > u)
-            hi = mid;
-        else
-            lo = mid + 1u;
-    }
-    float below = lo > 0u ? ENVIRONMENT_DATA(base + lo - 1u) : 0.0f;
-    float width = ENVIRONMENT_DATA(base + lo) - below;
-    u = width > 0.0f ? min((u - below) / width, kOneMinusEpsilon) : 0.5f;
-    return lo;
-}
-
-// A direction toward the environment, with importance over its map (or uniform without one).
-SHARED_FN vec3 environmentSample(SCENE_PARAM RenderParams rp, vec2 u) {
-    if (rp.envWidth == 0u) {
-        float z = 1.0f - 2.0f * u.x;
-        float r = sqrt(max(0.0f, 1.0f - z * z));
-        float phi = 2.0f * kPi * u.y;
-        return vec3(r * cos(phi), z, r * sin(phi));
-    }
-    uint marginal = 3u * rp.envWidth * rp.envHeight;
-    uint row = environmentSearch(SCENE_ARG marginal, rp.envHeight, u.y);
-    uint column =
-        environmentSearch(SCENE_ARG marginal + rp.envHeight + row * rp.envWidth, rp.envWidth, u.x);
-    return environmentDirection(
-        vec2((float(column) + u.x) / float(rp.envWidth), (float(row) + u.y) / float(rp.envHeight)));
+// Whether an emitter of this kind is a delta light (its FLAGS in the registry).
+SHARED_FN bool emitterIsDelta(uint type) {
+#define SPW_EMITTER_IS_DELTA(Name, id, stem, Scene, flags)                                         \
+    if (type == kEmitter##Name) return ((flags)&kLightDelta) != 0u;
+    SPW_EMITTER_KINDS(SPW_EMITTER_IS_DELTA)
+#undef SPW_EMITTER_IS_DELTA
+    return false;
 }
 
 SHARED_END

@@ -35,51 +35,6 @@ SHARED_FN PathState cameraPath(RenderParams rp, uint pixel, uint s, float pixelS
     return st;
 }
 
-// One light sample from a shading point: the direction, how far the shadow ray may go, the
-// radiance (or a point light's intensity / r^2) arriving along it, and its solid-angle pdf
-// including the emitter's pick probability (for a point light, the pick probability alone).
-struct LightSample {
-    vec3 wi;
-    float tmax;
-    vec3 radiance;
-    float pdf;
-};
-
-SHARED_FN LightSample sampleEmitter(SCENE_PARAM RenderParams rp, Emitter e, SurfaceHit hit,
-                                    vec2 u) {
-    LightSample ls;
-    ls.wi = vec3(0.0f, 0.0f, 1.0f);
-    ls.tmax = 0.0f;
-    ls.radiance = vec3(0.0f);
-    ls.pdf = 0.0f;
-    if (e.type == kEmitterEnvironment) {
-        ls.wi = environmentSample(SCENE_ARG rp, u);
-        ls.pdf = e.pickPdf * environmentPdf(SCENE_ARG rp, ls.wi);
-        ls.radiance = environmentRadiance(SCENE_ARG rp, e, ls.wi);
-        ls.tmax = kInfiniteDistance;
-        return ls;
-    }
-    vec3 q = e.type == kEmitterPoint ? e.p0 : emitterPoint(e, u);
-    vec3 d = q - hit.p;
-    float dist = length(d);
-    if (!(dist > 0.0f)) return ls;
-    ls.wi = d / dist;
-    if (e.type == kEmitterPoint) {
-        ls.radiance = e.radiance / (dist * dist);
-        ls.pdf = e.pickPdf;
-        // Stop short of the point by the origin's own offset: there is no surface at q.
-        ls.tmax = shadowRayTmax(dist, hit.offset, 0.0f, 1.0f);
-        return ls;
-    }
-    float cosLight = emitterCosine(e, -ls.wi);
-    ls.pdf = emitterSolidAnglePdf(e, dist, cosLight);
-    ls.radiance = e.radiance;
-    // Stop short of the emitter's own surface, whatever the scene's scale.
-    float offsetQ = surfaceOffset(q, e.p0, e.p0 + e.e1, e.p0 + e.e2, e.normal);
-    ls.tmax = shadowRayTmax(dist, hit.offset, offsetQ, cosLight);
-    return ls;
-}
-
 // What a ray that leaves the scene brings back: the environment's radiance along it, weighted
 // against having sampled that direction from the previous vertex (zero without an environment).
 SHARED_FN vec3 escapedRadiance(SCENE_PARAM RenderParams rp, vec3 rayDir, PathState st) {
@@ -151,8 +106,8 @@ SHARED_FN void shadeSurfaceWith(SCENE_PARAM RenderParams rp, SurfaceHit hit, vec
             float bsdfPdf;
             vec3 fcos = bsdfEval(sh, hit.albedo, hit.ng, hit.ns, wo, ls.wi, bsdfPdf);
             if (maxComponent(fcos) > 0.0f) {
-                // A point light is a delta: BSDF sampling cannot find it, no MIS.
-                float w = rp.strategy == kStrategyMis && e.type != kEmitterPoint
+                // A delta light (a point, a direction): BSDF sampling cannot find it, no MIS.
+                float w = rp.strategy == kStrategyMis && !emitterIsDelta(e.type)
                               ? powerHeuristic(ls.pdf, quantizePdf(bsdfPdf))
                               : 1.0f;
                 r.shadowOrigin = offsetOrigin(hit.p, hit.ng, hit.offset, ls.wi);

@@ -4,6 +4,7 @@
 #ifndef SPILLWAY_SHARED_TYPES_H
 #define SPILLWAY_SHARED_TYPES_H
 #include "compat.h"
+#include "emitter_kinds.h"
 #include "surface_models.h"
 
 SHARED_BEGIN
@@ -32,11 +33,19 @@ struct ShaderParams {
 };
 
 // What next-event estimation picks, with probability pickPdf, proportional to its power
-// (host/scene/lights.cpp says how each kind's power is estimated).
-const uint kEmitterTriangle = 0u;    // one triangle of an emitting mesh (a quad light is two),
-                                     // sampled uniformly by area
-const uint kEmitterPoint = 1u;       // a point light at p0: a delta light, never hit
-const uint kEmitterEnvironment = 2u; // radiance at infinity, seen by rays that escape
+// (host/scene/lights.cpp says how each kind's power is estimated): kEmitter<Name> for every line
+// of the registry (shared/emitter_kinds.h), and their count.
+const uint kLightSurface = 1u;
+const uint kLightAtInfinity = 2u;
+const uint kLightDelta = 4u;
+const uint kLightTakesPosition = 8u;
+const uint kLightTakesDirection = 16u;
+#define SPW_EMITTER_CONSTANT(Name, id, stem, Scene, flags) const uint kEmitter##Name = id;
+SPW_EMITTER_KINDS(SPW_EMITTER_CONSTANT)
+#undef SPW_EMITTER_CONSTANT
+#define SPW_EMITTER_ONE(Name, id, stem, Scene, flags) +1u
+const uint kEmitterKindCount = 0u SPW_EMITTER_KINDS(SPW_EMITTER_ONE);
+#undef SPW_EMITTER_ONE
 
 struct Emitter {
     vec3 p0; // triangle: vertex 0; point: the position
@@ -45,10 +54,11 @@ struct Emitter {
     float pickPdf;
     vec3 e2; // triangle: v2 - v0
     uint twoSided;
-    vec3 normal;   // triangle: unit, cross(e1, e2) direction: the front face
+    vec3 normal;   // triangle: unit, cross(e1, e2) direction: the front face; directional: the
+                   // unit direction its light travels
     uint type;     // kEmitter*
     vec3 radiance; // triangle: radiance; point: intensity (W/sr); environment: radiance (times
-                   // the map's texel where it has one)
+                   // the map's texel where it has one); directional: irradiance (W/m^2)
     float pad1;
 };
 

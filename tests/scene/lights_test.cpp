@@ -1,6 +1,7 @@
-// Point lights and the environment against closed forms, on the reference and cpu backends (the
-// vulkan backend is compared with cpu in tests/vk/vulkan_test.cpp): the white furnace, the
-// inverse-square law, the environment map's sampling density, and MIS with an environment.
+// Point and directional lights and the environment against closed forms, on the reference and cpu
+// backends (the vulkan backend is compared with cpu in tests/vk/vulkan_test.cpp): the white
+// furnace, the inverse-square law, the environment map's sampling density, and MIS with an
+// environment.
 #include "host/image/image_io.h"
 #include "host/scene/camera.h"
 #include "host/scene/lights.h"
@@ -60,7 +61,7 @@ std::vector<BackendKind> hostBackends() {
 // A convex Lambert object of albedo a under a uniform environment of radiance L reflects a L
 // everywhere (every reflected ray escapes), and the background is L. A constant environment
 // and a map of one value alike (the map is sampled by its CDFs, the constant uniformly).
-TEST(Environment, WhiteFurnaceConvexLambertIsAlbedoTimesRadiance) {
+TEST(EnvironmentLight, WhiteFurnaceConvexLambertIsAlbedoTimesRadiance) {
     TempDir dir;
     dir.write("cube.obj", outsideCubeObj());
     ImageRGB flat{8, 4, std::vector<float>(8 * 4 * 3, 0.5f)};
@@ -142,6 +143,66 @@ TEST(PointLight, RadianceIsAlbedoOverPiTimesIntensityCosOverRSquared) {
     }
 }
 
+// A directional light of irradiance E arriving along unit d lights the floor (albedo 0.5) with
+// 0.5/pi E cos(theta) everywhere, cos(theta) = -d.y: one value for every pixel, on every
+// backend (vulkan: tests/vk/vulkan_test.cpp's every-kind scene).
+TEST(DirectionalLight, RadianceIsAlbedoOverPiTimesIrradianceCos) {
+    TempDir dir;
+    const Scene scene = floorUnderLight(
+        dir, 4, "max depth: 1",
+        "{type: Directional, direction: [0.3, -2, 0.6], intensity: 3, colour: [1, 0.5, 0.25]}");
+    const double cosTheta = 2.0 / std::sqrt(0.09 + 4.0 + 0.36);
+    for (BackendKind b : hostBackends()) {
+        RenderConfig cfg;
+        cfg.backend = b;
+        const std::vector<float> img = render(scene, cfg)->film->image();
+        double worst = 0;
+        for (int y = 0; y < 16; ++y)
+            for (int x = 0; x < 16; ++x)
+                for (int c = 0; c < 3; ++c) {
+                    const double expected = 0.5 / kPi * 3.0 * cosTheta *
+                                            (c == 0   ? 1.0
+                                             : c == 1 ? 0.5
+                                                      : 0.25);
+                    const double got = img[size_t(y * 16 + x) * 3 + size_t(c)];
+                    worst = std::max(worst, std::fabs(got - expected) / expected);
+                }
+        std::printf("%s: worst relative difference %.2e\n", backendName(b), worst);
+        EXPECT_LT(worst, 1e-5) << backendName(b);
+    }
+}
+
+// A directional light shares next-event estimation with a quad light by power (pi r^2 E
+// against pi L A), and neither biases the other: outside the quad's shadow (the sun shines
+// straight down, so the shadow is the quad's own footprint), the floor under both is the floor
+// under the quad plus the sun's closed form, within the noise of the quad light's sampling.
+TEST(DirectionalLight, AddsToAQuadLightWithoutBias) {
+    TempDir dir;
+    const std::string sun = "{type: Directional, direction: [0, -1, 0], intensity: 0.5}";
+    auto litMean = [&](const std::string& lights) {
+        const Scene scene = floorUnderLight(dir, 64, "max depth: 1", lights);
+        RenderConfig cfg;
+        cfg.backend = BackendKind::Cpu;
+        const std::vector<float> img = render(scene, cfg)->film->image();
+        double sum = 0;
+        int n = 0;
+        for (int y = 0; y < 16; ++y)
+            for (int x = 0; x < 16; ++x) {
+                const vec3 p = floorPointAtPixelCentre(scene, x, y);
+                if (std::fabs(p.x) < 0.7f && std::fabs(p.z) < 0.45f) continue; // the shadow
+                for (int c = 0; c < 3; ++c, ++n)
+                    sum += double(img[size_t(y * 16 + x) * 3 + size_t(c)]);
+            }
+        EXPECT_GT(n, 100);
+        return sum / double(n);
+    };
+    const double quad = litMean(kQuadOverFloor);
+    const double both = litMean("[" + std::string(kQuadOverFloor) + ", " + sun + "]");
+    const double sunAlone = 0.5 / kPi * 0.5;
+    std::printf("quad %.5f, both %.5f, sun alone %.5f\n", quad, both, sunAlone);
+    EXPECT_NEAR(both, quad + sunAlone, 0.01 * (quad + sunAlone));
+}
+
 // A map with a bright texel, a black band and a gradient.
 Scene mapScene(int w, int h) {
     Scene scene;
@@ -162,7 +223,7 @@ Scene mapScene(int w, int h) {
 // Directions drawn by environmentSample() land in texels as often as their share of
 // luminance x sin(theta) says (chi-square over the texels; none in black ones), and
 // environmentPdf() is that density in solid angle: it integrates to 1 over the sphere.
-TEST(Environment, MapSamplingPassesChiSquareAgainstItsPdf) {
+TEST(EnvironmentLight, MapSamplingPassesChiSquareAgainstItsPdf) {
     const int w = 16, h = 8;
     const Scene scene = mapScene(w, h);
     const SceneLights lights(scene);
@@ -245,7 +306,7 @@ TEST(Environment, MapSamplingPassesChiSquareAgainstItsPdf) {
 // A glossy metal floor under a sky with a small, bright sun: light sampling wastes samples on
 // sky the narrow lobe does not reflect, BSDF sampling rarely finds the sun, and MIS is better
 // than either. All three agree on the image (within their standard errors).
-TEST(Environment, MisHasLowerVarianceThanEitherStrategyOnAGlossyObject) {
+TEST(EnvironmentLight, MisHasLowerVarianceThanEitherStrategyOnAGlossyObject) {
     TempDir dir;
     dir.write("floor.obj", floorObj(2.0f));
     ImageRGB sky{32, 16, std::vector<float>(32 * 16 * 3, 1.0f)};

@@ -434,10 +434,10 @@ TEST(Loader, PointAndEnvironmentLightsAddNoShaderOrObject) {
                   "  - {type: Environment, string: sky.exr, intensity: 4}\n"));
     EXPECT_TRUE(scene.shaders.empty());
     EXPECT_TRUE(scene.meshes.empty());
-    ASSERT_EQ(scene.pointLights.size(), 1u);
+    ASSERT_EQ(scene.punctualLights.size(), 1u);
     // Camera-relative, as all geometry.
-    expectNear(scene.pointLights[0].position, vec3(0, 5, -3), 1e-6f, "position");
-    expectNear(scene.pointLights[0].intensity, vec3(2, 1, 0), 0.0f, "intensity");
+    expectNear(scene.punctualLights[0].position, vec3(0, 5, -3), 1e-6f, "position");
+    expectNear(scene.punctualLights[0].intensity, vec3(2, 1, 0), 0.0f, "intensity");
     ASSERT_TRUE(scene.environment);
     EXPECT_EQ(scene.environment->width, 4);
     EXPECT_EQ(scene.environment->height, 2);
@@ -581,7 +581,7 @@ const ErrorCase kErrorCases[] = {
      "radiance -1 at texel (1, 0)"},
     {"SecondEnvironment", "lights:\n  - {type: Environment}\n  - {type: Environment}\n", 3,
      "second Environment"},
-    {"UnknownLightType", "light: {type: Spot}\n", 1, "Quad, Point or Environment"},
+    {"UnknownLightType", "light: {type: Spot}\n", 1, "Quad, Point, Environment or Directional"},
     {"UnknownShaderType", "shader:\n  type: Phong\n", 2, "Phong"},
     {"YamlSyntaxError", "image:\n  width: 8\n  height: 8: 9\n", 3, "YAML"},
     {"ImageTwice", "image: {width: 8}\ncamera: {fov: 40}\nimage: {height: 8}\n", 3, "image"},

@@ -273,8 +273,8 @@ std::set<std::string> taggedFunctions() {
     std::set<std::string> out;
     static const std::regex fn("^SHARED_FN \\w+ (\\w+)\\(");
     for (const char* header :
-         {"sampling.h", "offset.h", "lights.h", "lambert.h", "rng.h", "path.h", "bsdf.h", "ggx.h",
-          "conductor.h", "dielectric.h", "cone.h", "types.h", "compat.h"}) {
+         {"sampling.h", "offset.h", "light_sample.h", "lights.h", "lambert.h", "rng.h", "path.h",
+          "bsdf.h", "ggx.h", "conductor.h", "dielectric.h", "cone.h", "types.h", "compat.h"}) {
         std::ifstream in(test::sourceDir() + "/shaders/shared/" + header);
         EXPECT_TRUE(in) << header;
         std::string line;

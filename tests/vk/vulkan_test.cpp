@@ -256,7 +256,7 @@ TEST(VulkanVsCpu, EachSamplingStrategyAgreesUpToFloatRounding) {
 
 // Scenes lit only by point lights, only by an environment map, and by both: the kernels' branches
 // (shared/path.h's sampleEmitter) against cpu, and the environment map's buffer bound and read.
-TEST(VulkanVsCpu, PointLightsAndEnvironmentMapAgreeUpToFloatRounding) {
+TEST(VulkanVsCpu, EveryEmitterKindAgreesUpToFloatRounding) {
     TempDir dir;
     dir.write("floor.obj", floorObj(2.0f));
     dir.write("cube.obj", insideCubeObj());
@@ -277,10 +277,13 @@ TEST(VulkanVsCpu, PointLightsAndEnvironmentMapAgreeUpToFloatRounding) {
                               "  - {type: Point, position: [-1, 0.5, 1], intensity: 1, "
                               "colour: [0.2, 0.4, 1]}\n";
     const std::string environment = "  - {type: Environment, string: sky.exr}\n";
+    const std::string sun = "  - {type: Directional, direction: [0.4, -1, -0.3], intensity: 1.5}\n";
     for (const auto& [lights, kinds] :
          {std::pair{point, nlohmann::json({"point"})},
           std::pair{environment, nlohmann::json({"environment"})},
-          std::pair{point + environment, nlohmann::json({"point", "environment"})}}) {
+          std::pair{sun, nlohmann::json({"directional"})},
+          std::pair{point + environment + sun,
+                    nlohmann::json({"point", "environment", "directional"})}}) {
         const Scene scene = loadScene(dir.write("lights.yaml", common + "lights:\n" + lights));
         auto result = expectVulkanMatchesCpu(scene, 16, lights.c_str(), 1e-4);
         EXPECT_GT(mean(result->film->image()), 0.01) << lights;
