@@ -66,6 +66,7 @@ layout(scalar, push_constant) uniform Push { ShadePush pc; };
 
 uvec4 fetch(usamplerBuffer table, uint texel) { return texelFetch(table, int(texel)); }
 
+// Layout twin of the C++ ShaderParams (shared/types.h): tests/vk/kernel_layout_test.cpp checks it field by field.
 ShaderParams kernelShader(uint i) {
     uvec4 w0 = fetch(shaderTable, 3u * i), w1 = fetch(shaderTable, 3u * i + 1u),
           w2 = fetch(shaderTable, 3u * i + 2u);
@@ -84,6 +85,7 @@ ShaderParams kernelShader(uint i) {
     return s;
 }
 
+// Layout twin of the C++ Emitter (shared/types.h): tests/vk/kernel_layout_test.cpp checks it field by field.
 Emitter kernelEmitter(uint i) {
     uvec4 w0 = fetch(emitterTable, 5u * i), w1 = fetch(emitterTable, 5u * i + 1u),
           w2 = fetch(emitterTable, 5u * i + 2u), w3 = fetch(emitterTable, 5u * i + 3u),
@@ -106,6 +108,7 @@ Emitter kernelEmitter(uint i) {
     return e;
 }
 
+// Layout twin of the C++ ShadeInput (shared/shade_io.h): tests/vk/kernel_layout_test.cpp checks it field by field.
 ShadeInput loadInput(uint i) {
     uint t = 7u * i;
     uvec4 w[7] = uvec4[7](fetch(inputs, t), fetch(inputs, t + 1u), fetch(inputs, t + 2u),
@@ -131,6 +134,7 @@ ShadeInput loadInput(uint i) {
     return r;
 }
 
+// Layout twin of the C++ ShadeResult (shared/types.h): tests/vk/kernel_layout_test.cpp checks it field by field.
 void storeResult(uint i, ShadeResult r) {
     uint o = 7u * i;
     results[o] = uvec4(r.flags, floatBitsToUint(r.emitted));
