@@ -7,6 +7,7 @@
 #include "host/app/render_command.h"
 #include "host/app/usage.h"
 #include "host/app/usage_error.h"
+#include "host/backend/render_config.h"
 #include "host/render/ranks.h"
 #include "host/scene/scene.h"
 
@@ -73,6 +74,9 @@ int main(int argc, char** argv) {
         return 2;
     } catch (const spw::SceneError& e) {
         std::fprintf(stderr, "%s%s\n", gRankLabel.c_str(), e.what());
+        return 2;
+    } catch (const spw::RenderRefused& e) {
+        std::fprintf(stderr, "spillway: %s%s\n", gRankLabel.c_str(), e.what());
         return 2;
     } catch (const std::exception& e) {
         std::fprintf(stderr, "spillway: %serror: %s\n", gRankLabel.c_str(), e.what());

@@ -8,10 +8,19 @@
 
 #include <atomic>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <utility>
 
 namespace spw {
+
+// A render refused before any work because its inputs do not fit together (a checkpoint or a
+// partial range of another render, MPI ranks that would render different things): bad input,
+// exit 2, as a usage or scene error is.
+class RenderRefused : public std::invalid_argument {
+  public:
+    using std::invalid_argument::invalid_argument;
+};
 
 // Which renderer: the sorted pipeline shading with Vulkan or C++, or the depth-first reference.
 // Auto: a real GPU where one is usable, else cpu (vk::chooseAutoDevice).

@@ -26,31 +26,6 @@ std::string sumChannel(int k, int w) {
     return "state." + std::to_string(k) + "." + std::to_string(w);
 }
 
-struct Fnv {
-    std::uint64_t h = 0xcbf29ce484222325ull;
-    void bytes(const void* data, size_t n) {
-        const auto* p = static_cast<const unsigned char*>(data);
-        size_t i = 0;
-        for (; i + 8 <= n; i += 8) { // a word at a time: meshes are large
-            std::uint64_t w;
-            std::memcpy(&w, p + i, 8);
-            h = (h ^ w) * 0x100000001b3ull;
-        }
-        for (; i < n; ++i)
-            h = (h ^ p[i]) * 0x100000001b3ull;
-    }
-    void text(const std::string& s) {
-        const std::uint64_t n = s.size();
-        bytes(&n, sizeof n);
-        bytes(s.data(), s.size());
-    }
-    template <class T> void array(const std::vector<T>& v) {
-        const std::uint64_t n = v.size();
-        bytes(&n, sizeof n);
-        bytes(v.data(), v.size() * sizeof(T));
-    }
-};
-
 std::string fileText(const std::string& path) {
     std::ifstream in(path, std::ios::binary);
     return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
@@ -65,6 +40,27 @@ const char* filterName(TextureFilter f) {
 }
 
 } // namespace
+
+void Fnv::bytes(const void* data, size_t n) {
+    const auto* p = static_cast<const unsigned char*>(data);
+    size_t i = 0;
+    for (; i + 8 <= n; i += 8) { // a word at a time: meshes are large
+        std::uint64_t w;
+        std::memcpy(&w, p + i, 8);
+        h = (h ^ w) * 0x100000001b3ull;
+    }
+    for (; i < n; ++i)
+        h = (h ^ p[i]) * 0x100000001b3ull;
+}
+
+std::uint64_t environmentHash(const Scene& scene) {
+    if (!scene.environment) return 0;
+    const Environment& env = *scene.environment;
+    Fnv f;
+    f.value(env.radiance).value(env.width).value(env.height);
+    f.array(env.rgb);
+    return f.h;
+}
 
 std::uint64_t sceneHash(const Scene& scene) {
     Fnv f;
@@ -91,6 +87,7 @@ CheckpointKey checkpointKey(const Scene& scene, const RenderConfig& config, int 
     CheckpointKey k;
     k.version = SPILLWAY_VERSION;
     k.sceneHash = sceneHash(scene);
+    k.environmentHash = environmentHash(scene);
     k.seed = scene.settings.seed;
     k.width = scene.image.width;
     k.height = scene.image.height;
@@ -118,6 +115,9 @@ std::string checkpointMismatch(const CheckpointKey& e, const CheckpointKey& f) {
     if (e.sceneHash != f.sceneHash)
         why << (why.tellp() > 0 ? "; " : "")
             << "another scene (its file, meshes or textures differ)";
+    if (e.environmentHash != f.environmentHash)
+        why << (why.tellp() > 0 ? "; " : "")
+            << "another environment (its radiance or its map's texels differ)";
     differs("seed", e.seed, f.seed);
     differs("width", e.width, f.width);
     differs("height", e.height, f.height);
@@ -158,6 +158,7 @@ void writeCheckpoint(const std::string& path, const Checkpoint& c,
     spec.attribute("spillway:checkpoint", 1);
     spec.attribute("spillway:version", c.key.version);
     spec.attribute("spillway:scene_hash", std::to_string(c.key.sceneHash));
+    spec.attribute("spillway:environment_hash", std::to_string(c.key.environmentHash));
     spec.attribute("spillway:seed", std::to_string(c.key.seed));
     spec.attribute("spillway:sample_base", c.key.sampleBase);
     spec.attribute("spillway:ray_format", c.key.rayFormat);
@@ -232,6 +233,7 @@ Checkpoint readCheckpoint(const std::string& path) {
     c.key.version = spec.get_string_attribute("spillway:version");
     try {
         c.key.sceneHash = std::stoull(spec.get_string_attribute("spillway:scene_hash"));
+        c.key.environmentHash = std::stoull(spec.get_string_attribute("spillway:environment_hash"));
         c.key.seed = std::uint32_t(std::stoul(spec.get_string_attribute("spillway:seed")));
         c.renderSeconds = std::stod(spec.get_string_attribute("spillway:render_seconds"));
         c.film.nonFinite = std::stoull(spec.get_string_attribute("spillway:non_finite_samples"));

@@ -19,6 +19,7 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 namespace spw {
 
@@ -26,8 +27,9 @@ namespace spw {
 // of it matches. The backend, threads, batch sizes, budgets and sort settings are not in it:
 // they change how fast, not what (compact rays aside, which is why the ray format is).
 struct CheckpointKey {
-    std::string version;         // Spillway's
-    std::uint64_t sceneHash = 0; // sceneHash()
+    std::string version;               // Spillway's
+    std::uint64_t sceneHash = 0;       // sceneHash()
+    std::uint64_t environmentHash = 0; // environmentHash()
     std::uint32_t seed = 0;
     int width = 0, height = 0;
     int sampleBase = 0;           // samples per pixel and iteration = sampleBase^2
@@ -48,10 +50,32 @@ struct Checkpoint {
     Film::State film;
 };
 
+// FNV-1a over 64-bit words: the digests of a render's identity.
+struct Fnv {
+    std::uint64_t h = 0xcbf29ce484222325ull;
+    void bytes(const void* data, size_t n);
+    void text(const std::string& s) {
+        const std::uint64_t n = s.size();
+        bytes(&n, sizeof n);
+        bytes(s.data(), s.size());
+    }
+    template <class T> void array(const std::vector<T>& v) {
+        const std::uint64_t n = v.size();
+        bytes(&n, sizeof n);
+        bytes(v.data(), v.size() * sizeof(T));
+    }
+    template <class T> Fnv& value(const T& v) {
+        bytes(&v, sizeof v);
+        return *this;
+    }
+};
+
 // The scene as rendered: its file's text, every mesh's vertices and triangles, and every image
 // texture's path, size and modification time (textures can be gigabytes; a changed file changes
-// those). FNV-1a over 64-bit words.
+// those).
 std::uint64_t sceneHash(const Scene& scene);
+// The environment as rendered: its radiance and every texel of its map (0 without one).
+std::uint64_t environmentHash(const Scene& scene);
 
 // The key of a render of `scene` with `config` (sampleBase from the sampling plan).
 CheckpointKey checkpointKey(const Scene& scene, const RenderConfig& config, int sampleBase);

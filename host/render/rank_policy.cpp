@@ -1,5 +1,7 @@
 #include "host/render/rank_policy.h"
 
+#include "host/backend/render_config.h"
+
 #include <algorithm>
 #include <string>
 #include <vector>
@@ -40,6 +42,24 @@ void addRanksToStats(const std::vector<std::string>& all, RenderStats& stats) {
 }
 
 } // namespace
+
+void RankSync::agreeIdentity(const std::function<RenderIdentity()>& identity) {
+    const RenderIdentity fields = identity();
+    std::vector<std::uint64_t> digests;
+    for (const auto& field : fields)
+        digests.push_back(field.second);
+    // A rank that failed before the render (its scene, its options) says so in an agreement:
+    // meet it there first, so that the exchange below only runs where every rank reached it.
+    ranks_.agree(false, false, false);
+    const std::vector<int> differs = ranks_.firstDifferences(digests);
+    for (size_t r = 0; r < differs.size(); ++r)
+        if (differs[r] >= 0) {
+            ranks_.finish(); // every rank leaves here, together: no collective follows
+            throw RenderRefused("rank " + std::to_string(r) + " would render another " +
+                                fields[size_t(differs[r])].first + " than rank 0 (every rank " +
+                                "must load the same scene and files with the same options)");
+        }
+}
 
 Ranks::Agreement RankSync::agreeBefore(bool stop, bool timeUp, StageTimes& stages) {
     StageTimer t(stages, "agree"); // waiting for the slowest rank, mostly

@@ -9,13 +9,25 @@
 #include "host/image/film.h"
 #include "host/render/ranks.h"
 
+#include <cstdint>
+#include <functional>
 #include <memory>
+#include <string>
+#include <utility>
+#include <vector>
 
 namespace spw {
+
+// What decides a render's image, field by field: a name for the user and a digest.
+using RenderIdentity = std::vector<std::pair<std::string, std::uint64_t>>;
 
 class RankPolicy {
   public:
     virtual ~RankPolicy() = default;
+    // Before anything else: whether every process renders the same thing. Throws RenderRefused
+    // on every process, naming the first rank and field that differ from rank 0's (`identity`
+    // is only called where there is more than one process).
+    virtual void agreeIdentity(const std::function<RenderIdentity()>& identity) = 0;
     // Whether this process writes the outputs and checkpoints (rank 0, or the only process).
     virtual bool writes() const = 0;
     // Gives the film this process's share of every iteration's camera samples.
@@ -36,6 +48,7 @@ class RankPolicy {
 class SingleProcess final : public RankPolicy {
   public:
     bool writes() const override { return true; }
+    void agreeIdentity(const std::function<RenderIdentity()>&) override {}
     void share(Film&) const override {}
     Ranks::Agreement agreeBefore(bool stop, bool timeUp, StageTimes&) override {
         Ranks::Agreement a;
@@ -53,6 +66,7 @@ class RankSync final : public RankPolicy {
   public:
     explicit RankSync(Ranks& ranks) : ranks_(ranks) {}
     bool writes() const override { return ranks_.rank() == 0; }
+    void agreeIdentity(const std::function<RenderIdentity()>& identity) override;
     void share(Film& film) const override { film.setShare(ranks_.rank(), ranks_.size()); }
     Ranks::Agreement agreeBefore(bool stop, bool timeUp, StageTimes& stages) override;
     bool agreeWhole(bool whole, StageTimes& stages) override;

@@ -39,6 +39,24 @@ Ranks::Agreement Ranks::agree(bool failed, bool stop, bool timeUp) {
     return a;
 }
 
+std::vector<int> Ranks::firstDifferences(const std::vector<std::uint64_t>& fields) {
+    // Rank 0's digests to everyone: a maximum where the other ranks bring -1 (the digests are
+    // cut to 62 bits, so they are never negative).
+    std::vector<std::int64_t> zero(fields.size(), -1);
+    if (rank() == 0)
+        for (size_t i = 0; i < fields.size(); ++i)
+            zero[i] = std::int64_t(fields[i] >> 2);
+    max(zero);
+    int mine = -1;
+    for (size_t i = 0; i < fields.size() && mine < 0; ++i)
+        if (std::int64_t(fields[i] >> 2) != zero[i]) mine = int(i);
+    // Then each rank's first difference to everyone.
+    std::vector<std::int64_t> all(size_t(size()), -1);
+    all[size_t(rank())] = mine;
+    max(all);
+    return std::vector<int>(all.begin(), all.end());
+}
+
 void Ranks::failed() {
     if (!finished_) agree(true, false, false);
 }

@@ -65,6 +65,10 @@ class Ranks {
     // A rank failed outside the render loop (scene, options, outputs): tells the others at their
     // next agreement, unless they already know or have finished.
     void failed();
+    // Collective, before any other of the render: every rank brings the digests of what decides
+    // its image (the same fields, in the same order, on every rank) and learns, for each rank,
+    // the first field where it differs from rank 0 (-1: none).
+    std::vector<int> firstDifferences(const std::vector<std::uint64_t>& fields);
     // The render's collectives are over (rank 0 is left to write its outputs).
     void finish() { finished_ = true; }
 

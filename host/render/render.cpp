@@ -82,6 +82,7 @@ class RenderSession {
 
   private:
     void checkConfig() const;
+    RenderIdentity identity() const;
     void chooseBackend();
     void build();
     void startAt();
@@ -122,6 +123,7 @@ class RenderSession {
 
 std::unique_ptr<RenderResult> RenderSession::run(const ProgressCallback& onIteration) {
     checkConfig();
+    sync_.agreeIdentity([&] { return identity(); });
     threads_ = config_.threads > 0 ? config_.threads : tbb::info::default_concurrency();
     threadLimit_.emplace(tbb::global_control::max_allowed_parallelism, size_t(threads_));
     chooseBackend();
@@ -129,6 +131,47 @@ std::unique_ptr<RenderResult> RenderSession::run(const ProgressCallback& onItera
     startAt();
     report(iterate(onIteration));
     return std::move(result_);
+}
+
+// What decides the image, field by field, for the ranks of a distributed render to compare
+// before any other collective: the checkpoint key's fields (scene, every input's content, seed,
+// size, sampler, ray format, ...), the samples asked for, and the checkpoint resumed from.
+RenderIdentity RenderSession::identity() const {
+    const CheckpointKey k = key_ ? *key_ : checkpointKey(scene_, config_, plan_.sampleBase);
+    const Settings& st = scene_.settings;
+    const std::pair<int, int> range = config_.sampleRange.value_or(std::pair<int, int>{-1, -1});
+    Fnv resume;
+    if (const Checkpoint* c = checkpoints_.resume) {
+        resume.value(c->iterations).value(c->firstIteration);
+        resume.array(c->film.sums);
+        resume.array(c->film.samples);
+    }
+    auto text = [](const std::string& t) {
+        Fnv f;
+        f.text(t);
+        return f.h;
+    };
+    return {
+        {"Spillway version", text(k.version)},
+        {"image size", Fnv().value(k.width).value(k.height).h},
+        {"number of samples (--spp)", Fnv().value(plan_.sampleBase).value(plan_.iterations).h},
+        {"sample range (--samples)", Fnv().value(range).h},
+        {"seed", Fnv().value(k.seed).h},
+        {"sampler", text(k.sampler)},
+        {"ray format, texture filter or sampling strategy",
+         Fnv().value(text(k.rayFormat)).value(text(k.textureFilter)).value(k.strategy).h},
+        {"depth, roulette or adaptive-sampling settings", Fnv()
+                                                              .value(st.minDepth)
+                                                              .value(st.maxDepth)
+                                                              .value(st.threshold)
+                                                              .value(k.adaptiveThreshold)
+                                                              .value(k.adaptiveMinSamples)
+                                                              .h},
+        {"checkpoint to resume from (--resume)", resume.h},
+        // Last: a scene file that differs in a setting above is named by the setting.
+        {"scene (its file, meshes or textures)", k.sceneHash},
+        {"environment (its radiance or map)", k.environmentHash},
+    };
 }
 
 void RenderSession::checkConfig() const {
@@ -202,7 +245,7 @@ void RenderSession::build() {
 // Where the render starts: a partial render's first iteration, and a checkpoint's progress.
 void RenderSession::startAt() {
     if (const std::string why = partialRenderProblem(scene_, config_, plan_); !why.empty())
-        throw std::invalid_argument(why);
+        throw RenderRefused(why);
     first_ = config_.sampleRange ? config_.sampleRange->first / spi_ : 0;
     end_ = config_.sampleRange ? config_.sampleRange->second / spi_ : plan_.iterations;
     done_ = first_;
@@ -215,11 +258,16 @@ void RenderSession::startAt() {
     const Checkpoint* c = checkpoints_.resume;
     if (!c) return;
     if (const std::string why = checkpointMismatch(*key_, c->key); !why.empty())
-        throw std::invalid_argument("the checkpoint is of another render: " + why);
+        throw RenderRefused("the checkpoint is of another render: " + why);
     if (c->firstIteration != first_)
-        throw std::invalid_argument("the checkpoint is of a partial render from sample " +
-                                    std::to_string(c->firstIteration * spi_) +
-                                    ", this render starts at " + std::to_string(first_ * spi_));
+        throw RenderRefused("the checkpoint is of a partial render from sample " +
+                            std::to_string(c->firstIteration * spi_) + ", this render starts at " +
+                            std::to_string(first_ * spi_));
+    if (c->iterations > end_ - first_)
+        throw RenderRefused("the checkpoint has " + std::to_string(c->iterations * spi_) +
+                            " samples per pixel done, more than this render's " +
+                            std::to_string((end_ - first_) * spi_) +
+                            " (ask for at least as many with --spp)");
     result_->film->restore(c->film);
     done_ = first_ + c->iterations;
     renderSeconds_ = c->renderSeconds;

@@ -163,5 +163,55 @@ TEST(Checkpoint, ACheckpointOfAnotherRenderIsRefused) {
     EXPECT_EQ(readCheckpoint(ck).iterations, c.iterations) << "a refused resume wrote to it";
 }
 
+// What a resume must refuse before any work, exit 2, naming it: an environment map swapped for
+// another of the same peak (its texels are in the checkpoint's identity, not only the scene
+// text), fewer samples than the checkpoint holds, and a partial render's checkpoint resumed
+// with another sample range. (Before: the first resumed silently into a wrong image, the second
+// wrote an image of more samples than asked and a checkpoint past its total, the third exited 1.)
+TEST(Checkpoint, AResumeOfAnotherEnvironmentFewerSamplesOrAnotherRangeIsRefused) {
+    TempDir dir;
+    ImageRGB sky{8, 4, std::vector<float>(8 * 4 * 3, 0.5f)};
+    sky.rgb[0] = 2.0f; // the peak
+    writeImage(dir.file("sky.exr"), sky);
+    const std::string scene =
+        dir.write("sky.yaml", readFile(smallCornellBox(dir, 24, 24)) +
+                                  "lights:\n  - {type: Environment, string: sky.exr}\n");
+    const std::string ck = dir.file("ck.exr"), part = dir.file("part.exr");
+    auto run = [&](std::vector<std::string> args) {
+        args.insert(args.end(), {"--backend", "cpu", "--quiet"});
+        return runChild(args);
+    };
+    ASSERT_EQ(
+        run({"render", scene, "--spp", "8", "--checkpoint", ck, "-o", dir.file("a.exr")}).status,
+        0);
+    ASSERT_EQ(run({"render", scene, "--spp", "8", "--samples", "0:4", "--partial", part}).status,
+              0);
+
+    struct Case {
+        std::vector<std::string> args;
+        const char* says;
+    };
+    const std::vector<Case> cases = {
+        {{"render", scene, "--spp", "4", "--resume", ck, "-o", dir.file("never.exr")},
+         "8 samples per pixel done, more than this render's 4"},
+        {{"render", scene, "--spp", "8", "--samples", "4:8", "--resume", part, "--partial",
+          dir.file("never.exr")},
+         "partial render from sample 0"},
+        // Last: the same peak, another texel.
+        {{"render", scene, "--spp", "16", "--resume", ck, "-o", dir.file("never.exr")},
+         "another environment"},
+    };
+    for (const Case& k : cases) {
+        if (std::string(k.says) == "another environment") {
+            sky.rgb[7] = 0.25f;
+            writeImage(dir.file("sky.exr"), sky);
+        }
+        const ChildResult r = run(k.args);
+        EXPECT_EQ(r.status, 2) << k.says << "\n" << r.output;
+        EXPECT_NE(r.output.find(k.says), std::string::npos) << k.says << "\n" << r.output;
+        EXPECT_FALSE(std::filesystem::exists(dir.file("never.exr"))) << k.says;
+    }
+}
+
 } // namespace
 } // namespace spw::test

@@ -1,6 +1,7 @@
 // Distributed rendering: `mpirun -np 2 spillway render ...` (host/render/ranks.h) makes the image
 // one process makes, bit for bit, on every backend; rank 0 writes the outputs and the stats of
 // every rank; a rank that fails fails the job with its own message and leaves no file.
+#include "host/image/image_io.h"
 #include "test_util.h"
 
 #include <nlohmann/json.hpp>
@@ -225,6 +226,63 @@ TEST(Mpi, ARankWithABadSceneFailsTheJob) {
     EXPECT_NE(r.output.find("rank 0 of 2: error: rank 1 failed"), std::string::npos) << r.output;
     EXPECT_FALSE(std::ifstream(out).good()) << "no image from a failed job";
     EXPECT_EQ(filesIn(dir.path()), 2u) << "only the two scenes";
+}
+
+// Ranks that would render different things are refused before any collective, on every rank
+// with exit 2, naming the rank and what differs: another image size, sample count, sample range,
+// seed, scene content, environment map or resumed checkpoint. (Before, these crashed with a
+// double free, deadlocked, or exited 0 with a checkerboard of both renders' tiles.)
+TEST(Mpi, RanksThatWouldRenderDifferentThingsAreRefusedNamingTheField) {
+    REQUIRE_MPI();
+    TempDir dir;
+    const std::string scene = smallCornellBox(dir, 16, 16);
+    const std::string wider = smallCornellBox(dir, 24, 16, "wider.yaml");
+    const std::string redder = smallCornellBox(dir, 16, 16, "redder.yaml", "[30, 5, 4]");
+    // Two hosts' copies of one scene whose environment maps differ: the same scene text, run
+    // from two directories (mpirun -wdir), each with its own sky.exr.
+    ImageRGB sky{8, 4, std::vector<float>(8 * 4 * 3, 0.5f)};
+    for (const char* host : {"host0", "host1"}) {
+        ASSERT_EQ(runShell("mkdir " + dir.file(host)).status, 0);
+        writeImage(dir.file(std::string(host) + "/sky.exr"), sky);
+        sky.rgb[5] = 0.7f;
+        dir.write(std::string(host) + "/sky.yaml",
+                  readFile(scene) + "lights:\n  - {type: Environment, string: sky.exr}\n");
+    }
+    const std::string checkpoint = dir.file("c.exr");
+    const std::string out = dir.file("out.exr");
+    const std::string common = " --backend cpu --threads 1 --quiet -o " + out;
+    ASSERT_EQ(runSpillway("render " + scene + " --spp 4 --quiet --checkpoint " + checkpoint +
+                          " -o " + dir.file("first.exr"))
+                  .status,
+              0);
+    struct Case {
+        std::string rank0, rank1, field;
+    };
+    const std::vector<Case> cases = {
+        {scene, wider, "image size"},
+        {scene + " --spp 8", scene + " --spp 16", "number of samples"},
+        {scene + " --spp 8 --samples 0:4 --partial " + dir.file("p.exr"),
+         scene + " --spp 8 --samples 4:8 --partial " + dir.file("p.exr"), "sample range"},
+        {scene + " --seed 1", scene + " --seed 2", "seed"},
+        {scene, redder, "scene (its file"},
+        {"-wdir " + dir.file("host0") + " SPILLWAY render sky.yaml",
+         "-wdir " + dir.file("host1") + " SPILLWAY render sky.yaml", "environment"},
+        {scene + " --spp 8 --resume " + checkpoint, scene + " --spp 8", "checkpoint to resume"},
+    };
+    for (const Case& c : cases) {
+        std::remove(out.c_str());
+        auto program = [&](const std::string& args) {
+            return args.find("SPILLWAY") != std::string::npos
+                       ? replaceAll(args, "SPILLWAY", binary())
+                       : binary() + " render " + args;
+        };
+        const CommandResult r =
+            launch("-np 1 " + program(c.rank0) + common + " : -np 1 " + program(c.rank1) + common);
+        EXPECT_EQ(r.status, 2) << c.field << "\n" << r.output;
+        EXPECT_NE(r.output.find("rank 1 would render another " + c.field), std::string::npos)
+            << r.output;
+        EXPECT_FALSE(std::ifstream(out).good()) << c.field << ": no image from a refused job";
+    }
 }
 
 // A rank that fails while rendering (it cannot create its spill file) stops every rank at the
