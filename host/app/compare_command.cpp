@@ -48,8 +48,9 @@ void printTable(const std::string& pathA, const std::string& pathB, const ImageM
                     m.maxAbsX, m.maxAbsY);
     else
         std::printf("  maxabs       %s\n", formatValue(m.maxAbs).c_str());
+    const bool identical = std::isinf(m.psnr) && m.nonFiniteA == 0 && m.nonFiniteB == 0;
     std::printf("  psnr         %s dB (peak 1.0, linear)%s\n\n", formatValue(m.psnr).c_str(),
-                std::isinf(m.psnr) ? ", images identical" : "");
+                identical ? ", images identical" : "");
     std::printf("  channel means  %-12s %-12s %s\n", "R", "G", "B");
     std::printf("  A              %-12s %-12s %s\n", formatValue(m.meanA[0]).c_str(),
                 formatValue(m.meanA[1]).c_str(), formatValue(m.meanA[2]).c_str());
@@ -62,6 +63,7 @@ struct CompareOptions {
     std::vector<Threshold> thresholds;
     std::string heatmapPath;
     bool json = false;
+    bool allowNonFinite = false; // thresholds judge the finite pixels alone
     bool help = false;
 };
 
@@ -84,6 +86,8 @@ CompareOptions parseCompareOptions(const std::vector<std::string>& args) {
         if (a == "-h" || a == "--help") {
             o.help = true;
             return o;
+        } else if (a == "--allow-nonfinite") {
+            o.allowNonFinite = true;
         } else if (a == "--json") {
             o.json = true;
         } else if (a == "--heatmap") {
@@ -118,8 +122,20 @@ struct Verdicts {
     std::vector<std::string> lines, failures;
 };
 
-Verdicts judge(const ImageMetrics& m, const std::vector<Threshold>& thresholds) {
+// A non-finite pixel in either image fails every threshold unless --allow-nonfinite: a NaN is
+// a defect a regression gate must catch, whatever the finite pixels' metrics say.
+Verdicts judge(const ImageMetrics& m, const std::vector<Threshold>& thresholds,
+               bool allowNonFinite) {
     Verdicts v;
+    const size_t nonFinite = m.nonFiniteA + m.nonFiniteB;
+    if (!thresholds.empty() && nonFinite > 0 && !allowNonFinite) {
+        v.passed = false;
+        v.lines.push_back("non-finite pixels: FAIL (A: " + std::to_string(m.nonFiniteA) +
+                          ", B: " + std::to_string(m.nonFiniteB) + ")");
+        v.failures.push_back(std::to_string(m.nonFiniteA) + " non-finite pixels in A and " +
+                             std::to_string(m.nonFiniteB) +
+                             " in B (--allow-nonfinite judges the finite ones alone)");
+    }
     for (const Threshold& t : thresholds) {
         const bool ok = meetsThreshold(m, t);
         const bool lowerBound = isLowerBound(t.metric);
@@ -184,7 +200,7 @@ int runCompare(const std::vector<std::string>& args) {
     const ImageMetrics m = compareImages(a, b);
     HeatmapInfo heat;
     if (!o.heatmapPath.empty()) heat = writeHeatmap(o.heatmapPath, a, b);
-    const Verdicts v = judge(m, o.thresholds);
+    const Verdicts v = judge(m, o.thresholds, o.allowNonFinite);
     printReport(o, m, heat, v);
     if (m.comparedPixels == 0)
         std::fprintf(stderr, "spillway compare: warning: no pixel is finite in both images\n");
@@ -206,6 +222,8 @@ per-channel means and the count of non-finite pixels in each.
   --heatmap FILE.png      write the per-pixel relative error as a false-colour picture
   --threshold METRIC=V    fail (exit 1) when METRIC exceeds V; psnr fails when below V.
                           METRIC: mse, rmse, relmse, mae, maxabs, psnr. May be repeated.
+                          A non-finite pixel in A or B fails every threshold.
+  --allow-nonfinite       let thresholds judge the finite pixels alone
 
 exit status: 0 within bounds, 1 a bound exceeded, 2 bad usage or unreadable input
 )";

@@ -209,6 +209,8 @@ Threshold parseThreshold(const std::string& text) {
     if (v.empty() || used != v.size() || std::isnan(t.bound))
         throw std::invalid_argument("the bound of " + t.metric + " must be a number, not '" + v +
                                     "'");
+    if (!findMetric(t.metric).lowerBound && !(t.bound >= 0.0))
+        throw std::invalid_argument("the bound of " + t.metric + " must be 0 or more, not " + v);
     return t;
 }
 

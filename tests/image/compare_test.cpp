@@ -272,6 +272,35 @@ TEST(CompareCommand, UsageErrorsExitTwo) {
     EXPECT_EQ(compareCli({"--help"}).status, 0);
 }
 
+// One NaN pixel in the test image against a clean reference: never "identical", and every
+// threshold fails (exit 1, naming the count) unless --allow-nonfinite asks to judge the finite
+// pixels alone. (Before: "images identical", and relmse=1e-3 passed.)
+TEST(CompareCommand, ANonFinitePixelFailsEveryThresholdUnlessAllowed) {
+    TempDir dir;
+    const ImageRGB ref = dyadicImage(16, 12);
+    ImageRGB nan = ref;
+    nan.rgb[7] = std::numeric_limits<float>::quiet_NaN();
+    const std::string a = dir.file("a.exr"), b = dir.file("b.exr");
+    writeImage(a, nan);
+    writeImage(b, ref);
+    const CliResult fail = compareCli({a, b, "--threshold", "relmse=1e-3"});
+    EXPECT_EQ(fail.status, 1) << fail.out << fail.err;
+    EXPECT_FALSE(contains(fail.out, "images identical")) << fail.out;
+    EXPECT_TRUE(contains(fail.err, "1 non-finite pixels in A")) << fail.err;
+    const CliResult allowed = compareCli({a, b, "--threshold", "relmse=1e-3", "--allow-nonfinite"});
+    EXPECT_EQ(allowed.status, 0) << allowed.out << allowed.err;
+    EXPECT_EQ(compareCli({b, a, "--threshold", "psnr=10"}).status, 1) << "a NaN in the reference";
+}
+
+// An upper bound below zero can never be met: refused as bad usage, not accepted.
+TEST(CompareCommand, ANegativeUpperBoundIsAUsageError) {
+    Pair p(0.0f);
+    const CliResult r = compareCli({p.a, p.b, "--threshold", "relmse=-1"});
+    EXPECT_EQ(r.status, 2);
+    EXPECT_TRUE(contains(r.err, "must be 0 or more")) << r.err;
+    EXPECT_EQ(compareCli({p.a, p.b, "--threshold", "psnr=-5"}).status, 0) << "psnr may be any";
+}
+
 TEST(CompareCommand, MismatchedSizesExitTwoNamingBothFiles) {
     TempDir dir;
     const std::string a = dir.file("small.exr"), b = dir.file("big.exr");
