@@ -8,8 +8,11 @@ namespace {
 std::atomic<int> gSignal{0};
 static_assert(std::atomic<int>::is_always_lock_free, "the handler needs a lock-free flag");
 
-struct sigaction gPrevious[2];
-constexpr int kSignals[2] = {SIGINT, SIGTERM};
+// SIGHUP too: a terminal or ssh connection that goes away is a stop, not a reason to lose the
+// finished iterations.
+constexpr int kSignals[] = {SIGINT, SIGTERM, SIGHUP};
+constexpr int kSignalCount = int(sizeof(kSignals) / sizeof(kSignals[0]));
+struct sigaction gPrevious[kSignalCount];
 
 extern "C" void onSignal(int sig) {
     int none = 0;
@@ -27,12 +30,12 @@ InterruptGuard::InterruptGuard() {
     action.sa_handler = onSignal;
     sigemptyset(&action.sa_mask);
     action.sa_flags = SA_RESTART;
-    for (int i = 0; i < 2; ++i)
+    for (int i = 0; i < kSignalCount; ++i)
         sigaction(kSignals[i], &action, &gPrevious[i]);
 }
 
 InterruptGuard::~InterruptGuard() {
-    for (int i = 0; i < 2; ++i)
+    for (int i = 0; i < kSignalCount; ++i)
         sigaction(kSignals[i], &gPrevious[i], nullptr);
 }
 

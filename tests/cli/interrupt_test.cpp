@@ -20,13 +20,13 @@ namespace {
 
 // SIGINT after the third iteration: exit 130, the image of every completed iteration (bit for
 // bit the image of an uninterrupted render of that many samples), --stats saying why; SIGTERM
-// likewise with 143. On every backend, the sorted ones with a budget small enough that the
+// likewise with 143, and SIGHUP (the terminal or ssh connection gone) with 129. On every backend, the sorted ones with a budget small enough that the
 // stop lands while batches are on disk.
 TEST(Interrupt, SignalKeepsEveryCompletedIterationOnEveryBackend) {
     TempDir dir, spill;
     const std::string scene = smallCornellBox(dir, 48, 48);
     for (const std::string& backend : backendsUnderTest())
-        for (int signal : {SIGINT, SIGTERM}) {
+        for (int signal : {SIGINT, SIGTERM, SIGHUP}) {
             const std::string tag = backend + "-" + std::to_string(signal);
             const std::string out = dir.file(tag + ".exr"), stats = dir.file(tag + ".json");
             bool seen = false;
