@@ -83,24 +83,36 @@ void writeImage8(const std::string& path, int width, int height, const unsigned 
     writeFileAtomically(path, bytes.data(), bytes.size());
 }
 
+std::string imageSizeProblem(const std::string& path, long long width, long long height) {
+    if (width >= 1 && height >= 1 && width <= kMaxImagePixels && height <= kMaxImagePixels &&
+        width * height <= kMaxImagePixels)
+        return "";
+    return "image '" + path + "' is " + std::to_string(width) + " x " + std::to_string(height) +
+           " pixels; Spillway reads images of 1 to 2^26 pixels";
+}
+
 ImageRGB readImage(const std::string& path) {
     auto in = OIIO::ImageInput::open(path);
     if (!in) throw std::runtime_error("cannot read image '" + path + "': " + OIIO::geterror());
     const OIIO::ImageSpec& spec = in->spec();
+    if (const std::string why = imageSizeProblem(path, spec.width, spec.height); !why.empty())
+        throw std::runtime_error(why);
+    if (spec.nchannels < 1) throw std::runtime_error("image '" + path + "' has no channel");
     ImageRGB img;
     img.width = spec.width;
     img.height = spec.height;
-    const int nc = spec.nchannels;
-    std::vector<float> all(size_t(spec.width) * spec.height * nc);
+    const int nc = std::min(spec.nchannels, 3); // RGB, or grey; never the file's other channels
+    const size_t pixels = size_t(spec.width) * size_t(spec.height);
+    std::vector<float> all(pixels * size_t(nc));
     if (!in->read_image(0, 0, 0, nc, OIIO::TypeDesc::FLOAT, all.data()))
         throw std::runtime_error("cannot read image '" + path + "': " + in->geterror());
     std::string cs = spec.get_string_attribute("oiio:ColorSpace");
     const bool srgb = cs == "sRGB" || (cs.empty() && spec.format == OIIO::TypeDesc::UINT8);
-    img.rgb.resize(size_t(spec.width) * spec.height * 3);
-    for (size_t i = 0; i < size_t(spec.width) * spec.height; ++i)
+    img.rgb.resize(pixels * 3);
+    for (size_t i = 0; i < pixels; ++i)
         for (int c = 0; c < 3; ++c) {
-            float v = all[i * nc + std::min(c, nc - 1)];
-            img.rgb[i * 3 + c] = srgb ? srgbToLinear(v) : v;
+            float v = all[i * size_t(nc) + size_t(std::min(c, nc - 1))];
+            img.rgb[i * 3 + size_t(c)] = srgb ? srgbToLinear(v) : v;
         }
     return img;
 }

@@ -34,7 +34,17 @@ void writeImage(const std::string& path, const ImageRGB& image);
 // way.
 void writeImage8(const std::string& path, int width, int height, const unsigned char* rgb,
                  const std::string& software, const std::string& description);
-// Reads any image OpenImageIO reads; 8-bit sRGB data are linearised. Throws on failure.
+// The most pixels an image Spillway renders, reads (a reference, a checkpoint, an environment
+// map) or compares may have: 2^26 keeps film and ray ids well inside 32-bit indices.
+constexpr long long kMaxImagePixels = 1LL << 26;
+
+// Whether a header's size is one Spillway reads: 1 .. kMaxImagePixels pixels. "" if so, else
+// why not, naming `path` (checked before any pixel is allocated: a header is a few bytes that
+// may claim gigabytes).
+std::string imageSizeProblem(const std::string& path, long long width, long long height);
+
+// Reads any image OpenImageIO reads (its first three channels, or its one); 8-bit sRGB data are
+// linearised. Throws on failure, and on a header larger than kMaxImagePixels before reading it.
 ImageRGB readImage(const std::string& path);
 
 } // namespace spw

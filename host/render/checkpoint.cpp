@@ -1,5 +1,6 @@
 #include "host/render/checkpoint.h"
 
+#include "host/image/image_io.h"
 #include "host/image/output_file.h"
 
 #include <OpenImageIO/filesystem.h>
@@ -222,6 +223,8 @@ Checkpoint readCheckpoint(const std::string& path) {
         notACheckpoint(path, "no spillway:checkpoint attribute");
     if (spec.nchannels != kChannels || spec.width <= 0 || spec.height <= 0)
         notACheckpoint(path, "not " + std::to_string(kChannels) + " channels");
+    if (const std::string why = imageSizeProblem(path, spec.width, spec.height); !why.empty())
+        notACheckpoint(path, why); // before the film's 132 bytes a pixel are allocated
     // The state channels by name: OpenEXR keeps channels sorted, and OpenImageIO may list a
     // file's channels in another order than they were written.
     std::vector<size_t> word; // each state word's place among the file's channels 3 .. N

@@ -32,8 +32,8 @@ namespace {
 
 using namespace scene_file;
 
-// Largest image the loader accepts; keeps film and ray ids well inside 32-bit indices.
-constexpr long long kMaxPixels = 1LL << 26;
+// Largest image the loader accepts (image_io.h).
+constexpr long long kMaxPixels = kMaxImagePixels;
 constexpr int kMaxDimension = 1 << 15;
 constexpr int kMaxSampleBase = 256;
 

@@ -181,6 +181,9 @@ std::string objScene(const std::string& obj) {
            "}\nimage: {width: 8, height: 8}\n";
 }
 
+// A Radiance HDR header that claims 100000 x 100000 texels, and no texel.
+const std::string kBombHdr = "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 100000 +X 100000\n";
+
 const BadInput kBadInputs[] = {
     // 1. OBJ indices that name no element.
     {"ObjFaceIndexPastInt",
@@ -514,6 +517,16 @@ const BadInput kBadInputs[] = {
      "",
      "spill file",
      "TMPDIR={dir}/missing "},
+    // 5. Header bombs: a 56-byte HDR that claims 100000 x 100000 texels is refused from its
+    //    header, before 120 GB are asked for (before: std::bad_alloc, or 4.8 GB and 33 s at
+    //    20000^2).
+    {"EnvironmentMapHeaderBomb",
+     {{"bomb.hdr", kBombHdr}},
+     kTri + "light: {type: Environment, string: bomb.hdr}\n",
+     "",
+     Expect::SceneError,
+     "scene.yaml:4",
+     "Spillway reads images of 1 to 2^26 pixels"},
 };
 
 INSTANTIATE_TEST_SUITE_P(Cli, BadInputs, ::testing::ValuesIn(kBadInputs),
@@ -527,6 +540,28 @@ TEST(BadInputs, RenderHelpPrintsUsageAndExitsZero) {
     EXPECT_EQ(r.status, 0) << r.output;
     EXPECT_NE(r.output.find("usage"), std::string::npos) << r.output;
     EXPECT_NE(r.output.find("exit status"), std::string::npos) << r.output;
+}
+
+// The same header bomb everywhere else an image is read, refused from its header with exit 2:
+// compare (either side) and render's --reference.
+TEST(BadInputs, ImageHeaderBombsAreRefusedBeforeAllocating) {
+    TempDir dir;
+    const std::string bomb = dir.write("bomb.hdr", kBombHdr);
+    const std::string ok = dir.file("ok.exr");
+    writeImage(ok, ImageRGB{8, 8, std::vector<float>(8 * 8 * 3, 0.5f)});
+    for (const std::string& args :
+         {"compare " + bomb + " " + ok, "compare " + ok + " " + bomb,
+          "render " + sourceDir() + "/scenes/cornell-box.yaml --spp 1 --quiet -o " +
+              dir.file("x.exr") + " --error-csv " + dir.file("e.csv") + " --reference " + bomb}) {
+        const Outcome r = runLimited(args, 60);
+        ASSERT_FALSE(r.signalled) << args << "\n" << r.output;
+        EXPECT_EQ(r.status, 2) << args << "\n" << r.output;
+        EXPECT_NE(r.output.find("is 100000 x 100000 pixels; Spillway reads images of 1 to 2^26"),
+                  std::string::npos)
+            << args << "\n"
+            << r.output;
+    }
+    EXPECT_FALSE(fs::exists(dir.file("x.exr")));
 }
 
 TEST(BadInputs, SceneMissingIsReportedWithoutALineNumber) {
