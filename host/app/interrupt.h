@@ -1,9 +1,10 @@
 // Ctrl-C keeps the work. While an InterruptGuard lives, the first SIGINT, SIGTERM or SIGHUP (the
 // terminal or ssh connection gone) only sets a flag (RenderConfig::stop): the render stops at the
 // next batch or tile boundary, discards the iteration in progress, and the CLI writes the image
-// of every completed iteration, then exits 130, 143 or 129 as a shell expects. A second signal ends the process at once by the signal's
-// default action; every file Spillway writes is anonymous until committed (output_file.h) and
-// the spill file has no name at all (batch_queue.h), so no temporary file survives either way.
+// of every completed iteration, then exits 130, 143 or 129 as a shell expects. A second signal ends
+// the process at once by the signal's default action; every file Spillway writes is anonymous until
+// committed (output_file.h) and the spill file has no name at all (batch_queue.h), so no temporary
+// file survives either way.
 #pragma once
 
 #include <atomic>

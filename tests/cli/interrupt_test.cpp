@@ -20,8 +20,8 @@ namespace {
 
 // SIGINT after the third iteration: exit 130, the image of every completed iteration (bit for
 // bit the image of an uninterrupted render of that many samples), --stats saying why; SIGTERM
-// likewise with 143, and SIGHUP (the terminal or ssh connection gone) with 129. On every backend, the sorted ones with a budget small enough that the
-// stop lands while batches are on disk.
+// likewise with 143, and SIGHUP (the terminal or ssh connection gone) with 129. On every backend,
+// the sorted ones with a budget small enough that the stop lands while batches are on disk.
 TEST(Interrupt, SignalKeepsEveryCompletedIterationOnEveryBackend) {
     TempDir dir, spill;
     const std::string scene = smallCornellBox(dir, 48, 48);
