@@ -7,6 +7,7 @@
 #include <OpenImageIO/imageio.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -38,6 +39,46 @@ const char* filterName(TextureFilter f) {
 
 [[noreturn]] void notACheckpoint(const std::string& path, const std::string& why) {
     throw std::runtime_error("'" + path + "' is not a Spillway checkpoint: " + why);
+}
+
+// A digest of everything a resume or a merge reads: the key, the progress and the film's exact
+// state (not the RGB preview, which nothing reads back). Written as spillway:checksum; a file
+// whose contents do not match it was damaged (a flipped bit near its end used to resume into an
+// image relMSE 3059 away) or edited.
+std::uint64_t checkpointChecksum(const Checkpoint& c) {
+    Fnv f;
+    const CheckpointKey& k = c.key;
+    f.text(k.version);
+    f.value(k.sceneHash).value(k.environmentHash).value(k.seed).value(k.width).value(k.height);
+    f.value(k.sampleBase).value(k.strategy).value(k.adaptiveMinSamples);
+    // The doubles as the file holds them (text), so that the reader's digest is the writer's.
+    f.text(std::to_string(k.adaptiveThreshold));
+    f.text(std::to_string(c.renderSeconds));
+    f.text(k.rayFormat);
+    f.text(k.textureFilter);
+    f.text(k.sampler);
+    f.value(c.iterations).value(c.firstIteration).value(c.totalIterations);
+    f.value(c.film.nonFinite).value(c.film.saturated);
+    f.value(c.film.scaleExponent).value(c.film.weightExponent);
+    f.array(c.film.sums);
+    f.array(c.film.samples);
+    return f.h;
+}
+
+// What a resume and a merge trust: progress within the render's own total, a sane time.
+void checkProgress(const std::string& path, const Checkpoint& c) {
+    const long long spi = (long long)c.key.sampleBase * c.key.sampleBase;
+    if (c.key.sampleBase > 256 || c.totalIterations < 1 || spi * c.totalIterations > 0xFFFFFFFFLL)
+        notACheckpoint(path, "its sample base " + std::to_string(c.key.sampleBase) + " and " +
+                                 std::to_string(c.totalIterations) +
+                                 " iterations are outside what a render takes");
+    if (c.firstIteration >= c.totalIterations ||
+        c.iterations > c.totalIterations - c.firstIteration)
+        notACheckpoint(path, "it claims " + std::to_string(c.iterations) +
+                                 " iterations from iteration " + std::to_string(c.firstIteration) +
+                                 " of a render of " + std::to_string(c.totalIterations));
+    if (!std::isfinite(c.renderSeconds) || c.renderSeconds < 0)
+        notACheckpoint(path, "its render time is not a time");
 }
 
 } // namespace
@@ -176,6 +217,7 @@ void writeCheckpoint(const std::string& path, const Checkpoint& c,
     spec.attribute("spillway:weight_exponent", c.film.weightExponent);
     spec.attribute("spillway:non_finite_samples", std::to_string(c.film.nonFinite));
     spec.attribute("spillway:saturated_samples", std::to_string(c.film.saturated));
+    spec.attribute("spillway:checksum", std::to_string(checkpointChecksum(c)));
 
     // Pixels as the channels lie: 3 floats, then 32 uint32 (the sums), then the sample count,
     // each 4 bytes.
@@ -279,6 +321,16 @@ Checkpoint readCheckpoint(const std::string& path) {
         }
         c.film.samples[p] = w[word.back()];
     }
+    std::uint64_t checksum = 0;
+    try {
+        checksum = std::stoull(spec.get_string_attribute("spillway:checksum"));
+    } catch (const std::exception&) {
+        notACheckpoint(path, "it has no spillway:checksum");
+    }
+    if (checksum != checkpointChecksum(c))
+        notACheckpoint(path, "its contents do not match its checksum (the file is damaged, or "
+                             "was edited)");
+    checkProgress(path, c);
     return c;
 }
 
