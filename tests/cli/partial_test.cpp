@@ -121,5 +121,42 @@ TEST(Partial, RangesOffIterationBoundariesAreUsageErrors) {
     EXPECT_FALSE(std::filesystem::exists(dir.file("p.exr")));
 }
 
+// The docs' Slurm recipe, run as written: each ```sh block with "#SBATCH --array=0-7" in the
+// README and docs/command-line.md, its task part once per SLURM_ARRAY_TASK_ID with `spillway`
+// this build, then its merge part; the merged frame is the single render of 1024 spp, bit for
+// bit. (The recipe as first written merged the tasks' own images too, and failed.)
+TEST(Partial, TheDocsSlurmRecipeRunsAsWritten) {
+    TempDir scenes;
+    const std::string shot = smallCornellBox(scenes, 8, 8, "shot.yaml");
+    int recipes = 0;
+    for (const char* doc : {"README.md", "docs/command-line.md"}) {
+        const std::string text = readFile(sourceDir() + "/" + doc);
+        const size_t at = text.find("#SBATCH --array=0-7");
+        ASSERT_NE(at, std::string::npos) << doc << " has no Slurm recipe";
+        const size_t begin = text.rfind("```sh\n", at) + 6, end = text.find("```", at);
+        std::string block = text.substr(begin, end - begin);
+        const size_t split = block.find("# then");
+        ASSERT_NE(split, std::string::npos) << doc;
+        const std::string task = block.substr(0, split), merge = block.substr(split);
+        TempDir dir;
+        const std::string prelude = "set -e; cd " + dir.path() + "; cp " + shot +
+                                    " shot.yaml; spillway() { " + binary() +
+                                    " \"$@\" --quiet 2>/dev/null || " + binary() + " \"$@\"; }; ";
+        for (int id = 0; id < 8; ++id) {
+            const CommandResult r = runShell("SLURM_ARRAY_TASK_ID=" + std::to_string(id) +
+                                             " bash -c '" + prelude + task + "'");
+            ASSERT_EQ(r.status, 0) << doc << ", task " << id << "\n" << r.output;
+        }
+        const CommandResult m = runShell("bash -c '" + prelude + merge + "'");
+        ASSERT_EQ(m.status, 0) << doc << "\n" << m.output;
+        ASSERT_EQ(runSpillway("render " + shot + " --spp 1024 --quiet -o " + dir.file("single.exr"))
+                      .status,
+                  0);
+        EXPECT_TRUE(samePixels(dir.file("shot.exr"), dir.file("single.exr"))) << doc;
+        ++recipes;
+    }
+    EXPECT_EQ(recipes, 2);
+}
+
 } // namespace
 } // namespace spw::test
