@@ -364,6 +364,11 @@ RenderOptions parseRenderOptions(const std::vector<std::string>& args) {
             if (o->value) {
                 if (i + 1 >= args.size()) throw UsageError(a + " needs a value");
                 v = args[++i];
+                // An empty file name (--resume "", an unset variable) is a mistake, never "none".
+                const std::string placeholder = o->value;
+                if (v.empty() &&
+                    (placeholder == "FILE" || placeholder.find('.') != std::string::npos))
+                    throw UsageError(a + " needs a file name, not an empty string");
             }
             o->apply(r, *o, v);
         } else if (!a.empty() && a[0] == '-')
