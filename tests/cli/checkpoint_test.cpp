@@ -186,7 +186,9 @@ TEST(Checkpoint, AResumeOfAnotherEnvironmentFewerSamplesOrAnotherRangeIsRefused)
     ASSERT_EQ(
         run({"render", scene, "--spp", "8", "--checkpoint", ck, "-o", dir.file("a.exr")}).status,
         0);
-    ASSERT_EQ(run({"render", scene, "--spp", "8", "--samples", "0:4", "--partial", part}).status,
+    ASSERT_EQ(run({"render", scene, "--spp", "8", "--samples", "0:4", "--partial", part, "-o",
+                   dir.file("part-image.exr")})
+                  .status,
               0);
 
     struct Case {
@@ -197,7 +199,7 @@ TEST(Checkpoint, AResumeOfAnotherEnvironmentFewerSamplesOrAnotherRangeIsRefused)
         {{"render", scene, "--spp", "4", "--resume", ck, "-o", dir.file("never.exr")},
          "8 samples per pixel done, more than this render's 4"},
         {{"render", scene, "--spp", "8", "--samples", "4:8", "--resume", part, "--partial",
-          dir.file("never.exr")},
+          dir.file("never.exr"), "-o", dir.file("never-image.exr")},
          "partial render from sample 0"},
         // Last: the same peak, another texel.
         {{"render", scene, "--spp", "16", "--resume", ck, "-o", dir.file("never.exr")},
