@@ -1,22 +1,26 @@
 #!/usr/bin/env bash
 # Builds the libFuzzer harnesses (tests/fuzz/) with clang, ASan and UBSan in build-fuzz/ and runs
-# each for SECONDS (default 60), both at once, on one core each. The working corpus grows
+# each for SECONDS (default 60), all at once: scripts/fuzz.sh [SECONDS [NAME...]] (NAME: scene,
+# obj, checkpoint; default all three). The working corpus grows
 # in build-fuzz/corpus/NAME (seeded from tests/fuzz/seeds/NAME); an input that crashes, hangs
 # (10 s) or leaks is written to tests/fuzz/crashers/NAME/, where the normal suite replays it.
 # Prints each run's executions, coverage and findings; exits 1 if any harness found something.
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 seconds="${1:-60}"
+shift || true
+names=("$@")
+[ ${#names[@]} -gt 0 ] || names=(scene obj checkpoint)
 "$root/scripts/install-deps.sh" --fuzz
 build="$root/build-fuzz"
 CC=clang CXX=clang++ cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
   -DSPILLWAY_FUZZ=ON -DBUILD_TESTING=OFF >/dev/null
-cmake --build "$build" --parallel "$(nproc)" --target scene_fuzzer obj_fuzzer
+cmake --build "$build" --parallel "$(nproc)" --target "${names[@]/%/_fuzzer}"
 # LeakSanitizer: oneTBB's and OpenImageIO's process-lifetime singletons are not leaks of ours.
 export ASAN_OPTIONS="${ASAN_OPTIONS:-detect_leaks=1:new_delete_type_mismatch=0}"
 export LSAN_OPTIONS="${LSAN_OPTIONS:-suppressions=$root/tests/fuzz/lsan.supp:print_suppressions=0}"
-# Both harnesses at once, one core each (the machine's two), then their reports.
-for name in scene obj; do
+# Every harness at once, then their reports.
+for name in "${names[@]}"; do
   corpus="$build/corpus/$name"
   crashers="$root/tests/fuzz/crashers/$name"
   mkdir -p "$corpus" "$crashers"
@@ -29,7 +33,7 @@ for name in scene obj; do
 done
 wait
 found=0
-for name in scene obj; do
+for name in "${names[@]}"; do
   log="$build/$name.log"
   status="$(cat "$build/$name.status")"
   echo "== $name" >&2

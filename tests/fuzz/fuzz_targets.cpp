@@ -1,6 +1,7 @@
 #include "fuzz_targets.h"
 
 #include "host/image/image_io.h"
+#include "host/render/checkpoint.h"
 #include "host/render/render.h"
 #include "host/scene/obj_mesh.h"
 #include "host/scene/scene.h"
@@ -86,6 +87,27 @@ Outcome obj(const std::uint8_t* data, std::size_t size, std::string* detail) {
     const std::string path = folder().write("alone.obj", reinterpret_cast<const char*>(data), size);
     return guarded([&] { loadObjMesh(path, glm::dmat4(1.0), glm::dvec3(0.0), "fuzz.yaml", 1); },
                    detail);
+}
+
+Outcome checkpoint(const std::uint8_t* data, std::size_t size, std::string* detail) {
+    const std::string path =
+        folder().write("checkpoint.exr", reinterpret_cast<const char*>(data), size);
+    try {
+        const Checkpoint c = readCheckpoint(path);
+        try {
+            mergePartials({{"a.exr", c}, {"b.exr", c}});
+        } catch (const std::invalid_argument&) {
+            // the overlap (or a gap) is reported, as it should be
+        }
+        return Outcome::Accepted;
+    } catch (const std::runtime_error&) {
+        return Outcome::Rejected;
+    } catch (const std::invalid_argument&) {
+        return Outcome::Rejected;
+    } catch (const std::exception& e) {
+        if (detail) *detail = e.what();
+        return Outcome::Unexpected;
+    }
 }
 
 } // namespace spw::fuzz

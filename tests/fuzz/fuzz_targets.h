@@ -22,5 +22,10 @@ enum class Outcome {
 Outcome scene(const std::uint8_t* data, std::size_t size, std::string* detail = nullptr);
 // An OBJ file alone, through the loader's OBJ reader with an identity transform.
 Outcome obj(const std::uint8_t* data, std::size_t size, std::string* detail = nullptr);
+// A checkpoint or partial render (an EXR with Spillway's state channels), through the reader
+// --resume and merge use; one that reads is merged with itself, as `merge A A` would. A file
+// that is not a valid checkpoint must be refused with a message (std::runtime_error or
+// std::invalid_argument: Rejected); anything else, an allocation failure included, is a bug.
+Outcome checkpoint(const std::uint8_t* data, std::size_t size, std::string* detail = nullptr);
 
 } // namespace spw::fuzz

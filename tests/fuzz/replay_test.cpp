@@ -32,7 +32,8 @@ fuzz::Outcome replay(Target target, const std::string& path, std::string* detail
 
 TEST(FuzzCorpus, SeedsLoadAndRender) {
     const std::pair<const char*, Target> kinds[] = {{"seeds/scene", fuzz::scene},
-                                                    {"seeds/obj", fuzz::obj}};
+                                                    {"seeds/obj", fuzz::obj},
+                                                    {"seeds/checkpoint", fuzz::checkpoint}};
     for (const auto& [dir, target] : kinds) {
         const std::vector<std::string> files = filesIn(dir);
         EXPECT_GE(files.size(), 3u) << dir;
@@ -45,7 +46,8 @@ TEST(FuzzCorpus, SeedsLoadAndRender) {
 
 TEST(FuzzCorpus, EveryCrasherFoundIsNowRejectedCleanly) {
     const std::pair<const char*, Target> kinds[] = {{"crashers/scene", fuzz::scene},
-                                                    {"crashers/obj", fuzz::obj}};
+                                                    {"crashers/obj", fuzz::obj},
+                                                    {"crashers/checkpoint", fuzz::checkpoint}};
     for (const auto& [dir, target] : kinds)
         for (const std::string& f : filesIn(dir)) {
             std::string detail;
