@@ -2,6 +2,7 @@
 
 #include "host/app/usage_error.h"
 #include "host/image/compare.h"
+#include "host/image/output_file.h"
 
 #include <algorithm>
 #include <cctype>
@@ -184,12 +185,28 @@ void printReport(const CompareOptions& o, const ImageMetrics& m, const HeatmapIn
     std::fflush(stdout);
 }
 
+// A failure to write an output (the heatmap): a runtime failure, exit 1, as render's are;
+// unreadable or mismatched inputs are bad input, exit 2.
+struct OutputFailure : std::runtime_error {
+    using std::runtime_error::runtime_error;
+};
+
+template <class Step> void outputStep(Step step) {
+    try {
+        step();
+    } catch (const std::exception& e) {
+        throw OutputFailure(e.what());
+    }
+}
+
 int runCompare(const std::vector<std::string>& args) {
     const CompareOptions o = parseCompareOptions(args);
     if (o.help) {
         std::fputs(compareUsage(), stdout);
         return 0;
     }
+    // The heatmap's folder is checked before the images are read, as render checks its outputs.
+    if (!o.heatmapPath.empty()) outputStep([&] { checkWritable(o.heatmapPath); });
     const ImageRGB a = readInput(o.files[0]);
     const ImageRGB b = readInput(o.files[1]);
     if (a.width != b.width || a.height != b.height)
@@ -199,7 +216,7 @@ int runCompare(const std::vector<std::string>& args) {
                                  std::to_string(b.height));
     const ImageMetrics m = compareImages(a, b);
     HeatmapInfo heat;
-    if (!o.heatmapPath.empty()) heat = writeHeatmap(o.heatmapPath, a, b);
+    if (!o.heatmapPath.empty()) outputStep([&] { heat = writeHeatmap(o.heatmapPath, a, b); });
     const Verdicts v = judge(m, o.thresholds, o.allowNonFinite);
     printReport(o, m, heat, v);
     if (m.comparedPixels == 0)
@@ -225,7 +242,8 @@ per-channel means and the count of non-finite pixels in each.
                           A non-finite pixel in A or B fails every threshold.
   --allow-nonfinite       let thresholds judge the finite pixels alone
 
-exit status: 0 within bounds, 1 a bound exceeded, 2 bad usage or unreadable input
+exit status: 0 within bounds, 1 a bound exceeded or the heatmap not written (disk), 2 bad
+usage or unreadable input
 )";
 }
 
@@ -235,6 +253,10 @@ int compareCommand(const std::vector<std::string>& args) {
     } catch (const UsageError& e) {
         std::fflush(stdout);
         std::fprintf(stderr, "spillway compare: %s\n(try spillway compare --help)\n", e.what());
+    } catch (const OutputFailure& e) {
+        std::fflush(stdout);
+        std::fprintf(stderr, "spillway: error: %s\n", e.what());
+        return 1;
     } catch (const std::exception& e) {
         std::fflush(stdout);
         std::fprintf(stderr, "spillway compare: %s\n", e.what());

@@ -2,14 +2,32 @@
 
 #include "host/image/image_io.h"
 
+#include <GL/glx.h>
 #include <GLFW/glfw3.h>
 
+#include <atomic>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <stdexcept>
+#include <thread>
 
 namespace spw {
 namespace {
+
+// The X server gone (an ssh connection with X forwarding dropped, the server killed): Xlib's
+// default is to print a line and exit(1), losing every finished iteration. These handlers only
+// note it (libX11 >= 1.7 lets the exit handler return), and the window is not touched again.
+std::atomic<bool> gDisplayLost{false};
+
+extern "C" int onIoError(Display*) {
+    gDisplayLost = true;
+    return 0;
+}
+
+extern "C" void onIoErrorExit(Display*, void*) {
+    gDisplayLost = true;
+}
 
 std::string lastGlfwError() {
     const char* what = nullptr;
@@ -46,6 +64,8 @@ void onKey(GLFWwindow* window, int key, int /*scancode*/, int action, int /*mods
 
 PreviewWindow::PreviewWindow(int width, int height, const std::string& title)
     : width_(width), height_(height), name_(title) {
+    gDisplayLost = false;
+    XSetIOErrorHandler(onIoError);
     if (!glfwInit()) throw std::runtime_error("--preview: no display (" + lastGlfwError() + ")");
     glfwWindowHint(GLFW_RESIZABLE, GLFW_FALSE);
     window_ = glfwCreateWindow(width, height, title.c_str(), nullptr, nullptr);
@@ -57,14 +77,22 @@ PreviewWindow::PreviewWindow(int width, int height, const std::string& title)
     glfwSetWindowUserPointer(window_, &exposure_);
     glfwSetKeyCallback(window_, onKey);
     glfwMakeContextCurrent(window_);
+    // GLFW's connection, the one its window and this context use.
+    if (Display* display = glXGetCurrentDisplay())
+        XSetIOErrorExitHandler(display, onIoErrorExit, nullptr);
     glfwSwapInterval(0);
     shown_.assign(size_t(width) * size_t(height) * 3, 0.0f);
     draw();
 }
 
 PreviewWindow::~PreviewWindow() {
+    if (gDisplayLost) return; // every call would go to a connection that is gone
     if (window_) glfwDestroyWindow(window_);
     glfwTerminate();
+}
+
+bool PreviewWindow::lost() const {
+    return gDisplayLost;
 }
 
 void PreviewWindow::publish(std::vector<float> rgb, const std::string& status) {
@@ -72,16 +100,21 @@ void PreviewWindow::publish(std::vector<float> rgb, const std::string& status) {
     pending_ = std::move(rgb);
     status_ = status;
     fresh_ = true;
-    glfwPostEmptyEvent(); // wakes pump()
+    wake();
 }
 
 void PreviewWindow::wake() {
-    glfwPostEmptyEvent();
+    if (!gDisplayLost) glfwPostEmptyEvent(); // wakes pump()
 }
 
 bool PreviewWindow::pump(double seconds) {
+    if (gDisplayLost) {
+        std::this_thread::sleep_for(std::chrono::duration<double>(seconds));
+        return false;
+    }
     const int exposure = exposure_;
     glfwWaitEventsTimeout(seconds);
+    if (gDisplayLost) return false;
     {
         std::lock_guard<std::mutex> lock(mutex_);
         if (fresh_) {

@@ -1,6 +1,8 @@
 // The --preview window (GLFW): the image as iterations complete, in sRGB with an exposure the
 // keys change (+/= brighter by a stop, - darker, 0 back to 0), the progress and the error
-// estimate in its title. Closing it, Esc or q stop the render as Ctrl-C does.
+// estimate in its title. Closing it, Esc or q stop the render as Ctrl-C does; so does losing the
+// display (the X server or an X-forwarding ssh connection gone), which Xlib would otherwise end
+// the process for.
 //
 // GLFW wants its window on the main thread, so the render runs on a thread of its own and
 // publish()es each iteration's image; the main thread pump()s events and redraws only when a new
@@ -31,8 +33,10 @@ class PreviewWindow {
     // Any thread: ends the main thread's current pump() wait early.
     void wake();
     // Main thread: handles events and redraws if something changed, waiting up to `seconds`
-    // for events. Returns false once the user asked to close the window.
+    // for events. Returns false once the user asked to close the window, or the display is lost.
     bool pump(double seconds);
+    // Whether the display went away; the window is not touched again once it did.
+    bool lost() const;
 
   private:
     void draw();

@@ -15,6 +15,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <csignal>
 #include <cstdio>
 #include <exception>
 #include <filesystem>
@@ -97,10 +98,9 @@ CheckpointOptions checkpointOptions(const RenderOptions& o, const Scene& scene,
                                   resume ? &*resume : nullptr, std::nullopt};
     if (o.checkpointPath.empty()) return checkpoints;
     checkpoints.key = checkpointKey(scene, o.config, plan.sampleBase);
-    const std::string why = resume ? checkpointMismatch(*checkpoints.key, resume->key) : "";
-    if (!why.empty())
-        throw UsageError("--resume " + o.resumePath +
-                         ": the checkpoint is of another render: " + why);
+    const std::string why =
+        resume ? resumeProblem(*checkpoints.key, resume->key, scene.image, o.config.spp) : "";
+    if (!why.empty()) throw UsageError("--resume " + o.resumePath + ": " + why);
     return checkpoints;
 }
 
@@ -132,7 +132,8 @@ renderBesideWindow(PreviewWindow& preview, InterruptGuard& interrupt,
         preview.wake();
     });
     while (!finished)
-        if (!preview.pump(0.1)) interrupt.requestStop(kStopByWindow);
+        if (!preview.pump(0.1))
+            interrupt.requestStop(preview.lost() ? kStopByLostDisplay : kStopByWindow);
     worker.join();
     if (failure) std::rethrow_exception(failure);
     return result;
@@ -221,15 +222,21 @@ int renderCommand(const std::vector<std::string>& args, Ranks* ranks) {
     preview.reset();
     progress.finish();
 
-    // Closing the preview window is a normal way to end a render: exit 0.
-    const int signal = std::max(0, interrupt.signal());
+    // Closing the preview window is a normal way to end a render: exit 0. Losing its display is
+    // the session going away, as SIGHUP is: 129.
+    const bool displayLost = interrupt.signal() == kStopByLostDisplay;
+    const int signal = displayLost ? SIGHUP : std::max(0, interrupt.signal());
     const int status = signal != 0 ? 128 + signal : 0;
     if (!writes) return status;
     if (interrupt.signal() != 0 && result->stats.iterations == 0) {
         std::fprintf(stderr, "spillway: stopped before an iteration completed; nothing written\n");
         return status;
     }
-    if (signal != 0)
+    if (displayLost)
+        std::fprintf(stderr,
+                     "spillway: the preview's display went away after %d spp; writing them\n",
+                     result->stats.spp);
+    else if (signal != 0)
         std::fprintf(stderr, "spillway: stopped by signal %d after %d spp; writing them\n", signal,
                      result->stats.spp);
     writeOutputs(o, scene, *result, errorCsv.get());

@@ -94,6 +94,8 @@ struct VulkanConfig {
 };
 
 constexpr int kStopByWindow = -1; // RenderConfig::stop's value when the preview window closed
+// RenderConfig::stop's value when the preview's display went away: a stop like SIGHUP's.
+constexpr int kStopByLostDisplay = -2;
 
 // The scene's settings (seed, budgets, adaptive sampling) are not here: the CLI's overrides of
 // them are applied to the scene once it is loaded (host/scene/settings_table.h).
@@ -112,7 +114,8 @@ struct RenderConfig {
     std::optional<double> targetError;
     // Nonzero: stop at the next batch (or tile) boundary and discard the iteration in progress;
     // the render keeps every completed iteration. Set from a signal handler (the CLI's).
-    // kStopByWindow when the preview window was closed, else the signal's number.
+    // kStopByWindow when the preview window was closed, kStopByLostDisplay when its display went
+    // away, else the signal's number.
     const std::atomic<int>* stop = nullptr;
     // A partial render: only samples [first, second) of the spp (iteration boundaries).
     std::optional<std::pair<int, int>> sampleRange;

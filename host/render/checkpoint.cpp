@@ -95,6 +95,23 @@ void Fnv::bytes(const void* data, size_t n) {
         h = (h ^ p[i]) * 0x100000001b3ull;
 }
 
+// Every byte of the file, read a MiB at a time (a multiple of Fnv's word). The path is not
+// hashed: the same texels from another folder render the same image.
+static void hashFileContents(Fnv& f, const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) {
+        f.text("unreadable: " + path);
+        return;
+    }
+    std::vector<char> chunk(size_t(1) << 20);
+    std::uint64_t total = 0;
+    while (in.read(chunk.data(), std::streamsize(chunk.size())) || in.gcount() > 0) {
+        f.bytes(chunk.data(), size_t(in.gcount()));
+        total += std::uint64_t(in.gcount());
+    }
+    f.value(total);
+}
+
 std::uint64_t environmentHash(const Scene& scene) {
     if (!scene.environment) return 0;
     const Environment& env = *scene.environment;
@@ -113,15 +130,8 @@ std::uint64_t sceneHash(const Scene& scene) {
         f.array(m.uvs);
         f.array(m.triangles);
     }
-    for (const Texture& t : scene.textures) {
-        if (t.type != TextureType::Standard) continue;
-        f.text(t.path);
-        std::error_code ec;
-        const std::uint64_t size = std::filesystem::file_size(t.path, ec);
-        const auto time = std::filesystem::last_write_time(t.path, ec).time_since_epoch().count();
-        f.bytes(&size, sizeof size);
-        f.bytes(&time, sizeof time);
-    }
+    for (const Texture& t : scene.textures)
+        if (t.type == TextureType::Standard) hashFileContents(f, t.path);
     return f.h;
 }
 

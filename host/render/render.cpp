@@ -67,6 +67,22 @@ SamplingPlan planSampling(const ImageSettings& image, std::optional<int> spp) {
     return {1, *spp};
 }
 
+std::string resumeProblem(const CheckpointKey& expected, const CheckpointKey& found,
+                          const ImageSettings& image, std::optional<int> spp) {
+    const std::string why = checkpointMismatch(expected, found);
+    if (why.empty()) return "";
+    if (spp && found.sampleBase == image.sampleBase && expected.sampleBase != found.sampleBase) {
+        const int n2 = found.sampleBase * found.sampleBase;
+        return "the checkpoint takes " + std::to_string(n2) +
+               " samples per pixel each iteration (the scene's sample base " +
+               std::to_string(found.sampleBase) + "), and --spp " + std::to_string(*spp) +
+               " is not a multiple of " + std::to_string(n2) +
+               " (this render would take 1 each iteration): ask for a multiple of " +
+               std::to_string(n2) + ", such as " + std::to_string((*spp / n2 + 1) * n2);
+    }
+    return "the checkpoint is of another render: " + why;
+}
+
 namespace {
 
 // One render from start to finish: what it is built of, where it starts, its loop and its report.
@@ -257,8 +273,9 @@ void RenderSession::startAt() {
         key_ = checkpointKey(scene_, config_, plan_.sampleBase);
     const Checkpoint* c = checkpoints_.resume;
     if (!c) return;
-    if (const std::string why = checkpointMismatch(*key_, c->key); !why.empty())
-        throw RenderRefused("the checkpoint is of another render: " + why);
+    if (const std::string why = resumeProblem(*key_, c->key, scene_.image, config_.spp);
+        !why.empty())
+        throw RenderRefused(why);
     if (c->firstIteration != first_)
         throw RenderRefused("the checkpoint is of a partial render from sample " +
                             std::to_string(c->firstIteration * spi_) + ", this render starts at " +

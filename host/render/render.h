@@ -40,6 +40,12 @@ struct SamplingPlan {
 };
 SamplingPlan planSampling(const ImageSettings& image, std::optional<int> spp);
 
+// Why a checkpoint (found) cannot be resumed by a render keyed `expected`, or "". Where the only
+// cause is an --spp the scene's n x n pattern does not divide (this render would take one sample
+// per pass), it says so, instead of naming a sample base the user never set.
+std::string resumeProblem(const CheckpointKey& expected, const CheckpointKey& found,
+                          const ImageSettings& image, std::optional<int> spp);
+
 // What is wrong with a partial render's sample range A:B (--samples), or "": it must lie within
 // the render's spp, on iteration boundaries (the message names them), without adaptive
 // sampling.

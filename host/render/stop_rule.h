@@ -38,7 +38,10 @@ class StopRule {
 
     // Why an iteration that did not complete stopped.
     const char* bySignal() const {
-        return config_.stop && *config_.stop == kStopByWindow ? "window" : "signal";
+        const int code = config_.stop ? config_.stop->load() : 0;
+        return code == kStopByWindow        ? "window"
+               : code == kStopByLostDisplay ? "display lost"
+                                            : "signal";
     }
 
   private:

@@ -128,9 +128,12 @@ Environment readEnvironment(const Reader& rd, const YAML::Node& n, const fs::pat
         rd.fail(file, "environment image '" + env.path + "' is " + std::to_string(img.width) +
                           " x " + std::to_string(img.height) +
                           "; Spillway takes maps of 1 to 2^26 texels");
+    // The map holds floats: a texel written as 1e20 reads as the float nearest it, a little
+    // above, and is as much within the range as the scene text's 1e20.
+    const double brightest = double(float(kMaxRadiance));
     for (size_t i = 0; i < img.rgb.size(); ++i) {
         const double v = double(img.rgb[i]) * double(env.radiance[int(i % 3)]);
-        if (!(v >= 0.0 && v <= kMaxRadiance)) {
+        if (!(v >= 0.0 && v <= brightest)) {
             const size_t texel = i / 3;
             rd.fail(file, "environment image '" + env.path + "' has radiance " + Reader::fmt(v) +
                               " at texel (" + std::to_string(texel % size_t(img.width)) + ", " +

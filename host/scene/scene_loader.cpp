@@ -54,7 +54,7 @@ void readImage(const Reader& rd, const YAML::Node& n, ImageSettings& img) {
     if ((long long)img.samplesPerIteration() * img.iterations > 0xFFFFFFFFLL)
         rd.fail(n, "sample base^2 x iterations = " +
                        std::to_string((long long)img.samplesPerIteration() * img.iterations) +
-                       " samples per pixel exceeds 2^32");
+                       " samples per pixel exceeds 2^32 - 1");
 }
 
 // Every key under `settings:`, read by the one table (host/scene/settings_table.h).
@@ -555,8 +555,9 @@ void SceneReader::finish(const YAML::Node& root) {
         }
     }
     if ((unsigned long long)img.width * img.height * img.samplesPerIteration() > 0xFFFFFFFFull)
-        rd_.fail(1, "width x height x sample base^2 exceeds 2^32 samples per iteration; lower the "
-                    "sample base and raise iterations");
+        rd_.fail(1,
+                 "width x height x sample base^2 exceeds 2^32 - 1 samples per iteration; lower the "
+                 "sample base and raise iterations");
 }
 
 } // namespace

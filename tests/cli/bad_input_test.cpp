@@ -3,6 +3,7 @@
 // asserts: no signal, no hang, exit 2 with FILE:LINE for a scene error and exit 1 for a runtime
 // failure, and no file left in the output folder (nor a changed one) on failure.
 #include "host/image/image_io.h"
+#include "host/scene/scene.h"
 #include "test_util.h"
 
 #include <gtest/gtest.h>
@@ -527,6 +528,16 @@ const BadInput kBadInputs[] = {
      Expect::SceneError,
      "scene.yaml:4",
      "Spillway reads images of 1 to 2^26 pixels"},
+    // 10. Samples per pixel past the documented 2^32 - 1 (indices are 32-bit): 256^2 x 65536 is
+    //     exactly 2^32, refused with the limit the docs give.
+    {"ExactlyTwoToThe32SamplesPerPixel",
+     {},
+     "shader: {type: Lambert}\nobject: {filename: tri.obj}\n"
+     "image: {width: 1, height: 1, sample base: 256, iterations: 65536}\n",
+     "",
+     Expect::SceneError,
+     "scene.yaml:3",
+     "4294967296 samples per pixel exceeds 2^32 - 1"},
 };
 
 INSTANTIATE_TEST_SUITE_P(Cli, BadInputs, ::testing::ValuesIn(kBadInputs),
@@ -562,6 +573,88 @@ TEST(BadInputs, ImageHeaderBombsAreRefusedBeforeAllocating) {
             << r.output;
     }
     EXPECT_FALSE(fs::exists(dir.file("x.exr")));
+}
+
+// 10. What the docs promise is what the loader takes: 2^32 - 65536 samples per pixel load, and
+// the docs name the limit the loader applies.
+TEST(BadInputs, TheSampleLimitIsTheDocumentedOne) {
+    TempDir dir;
+    dir.write("tri.obj", kTriangleObj);
+    const Scene s = loadScene(dir.write(
+        "scene.yaml", "shader: {type: Lambert}\nobject: {filename: tri.obj}\n"
+                      "image: {width: 1, height: 1, sample base: 256, iterations: 65535}\n"));
+    EXPECT_EQ(std::uint64_t(s.image.samplesPerIteration()) * std::uint64_t(s.image.iterations),
+              (1ull << 32) - 65536);
+    EXPECT_NE(readFile(sourceDir() + "/docs/scene-format.md")
+                  .find("The total samples per pixel are n² × iterations, at most 2^32 − 1"),
+              std::string::npos);
+}
+
+// 10. A map texel of exactly the brightest radiance the format takes (1e20, which a float file
+// holds as the float nearest it, a little above) renders; twice that is refused, naming it.
+TEST(BadInputs, AnEnvironmentTexelOfTheBrightestRadianceIsInRange) {
+    TempDir dir;
+    dir.write("tri.obj", kTriangleObj);
+    for (const float texel : {1e20f, 2e20f}) {
+        writeImage(dir.file("sky.exr"), ImageRGB{2, 1, {texel, 1, 1, 0, 0, 0}});
+        const std::string scene =
+            dir.write("scene.yaml", kTri + "light: {type: Environment, string: sky.exr}\n");
+        const Outcome r = runLimited("render " + scene + " --spp 1 --quiet -o " +
+                                         dir.file("out.exr") + " --backend reference",
+                                     60);
+        ASSERT_FALSE(r.signalled) << r.output;
+        if (texel == 1e20f) {
+            EXPECT_EQ(r.status, 0) << r.output;
+        } else {
+            EXPECT_EQ(r.status, 2) << r.output;
+            EXPECT_NE(r.output.find("has radiance 2e20 at texel (0, 0)"), std::string::npos)
+                << r.output;
+        }
+    }
+}
+
+// 10. A heatmap that cannot be written is a disk failure, exit 1 as the README's table says,
+// found before the images are read; unreadable inputs stay bad input, exit 2.
+TEST(BadInputs, CompareHeatmapIntoAMissingFolderIsADiskFailure) {
+    TempDir dir;
+    const std::string ok = dir.file("ok.exr");
+    writeImage(ok, ImageRGB{2, 2, std::vector<float>(2 * 2 * 3, 0.5f)});
+    const Outcome r =
+        runLimited("compare " + ok + " " + ok + " --heatmap " + dir.file("missing/h.png"), 30);
+    ASSERT_FALSE(r.signalled) << r.output;
+    EXPECT_EQ(r.status, 1) << r.output;
+    EXPECT_EQ(r.output.rfind("spillway: error: cannot write '" + dir.file("missing/h.png"), 0), 0u)
+        << r.output;
+    const Outcome unreadable = runLimited(
+        "compare " + dir.file("nosuch.exr") + " " + ok + " --heatmap " + dir.file("h.png"), 30);
+    EXPECT_EQ(unreadable.status, 2) << unreadable.output;
+    EXPECT_FALSE(fs::exists(dir.file("h.png")));
+}
+
+// 10. --spp that the scene's n x n pattern does not divide takes one sample per iteration, so a
+// checkpoint of the scene's own pattern cannot continue: the message says that, and how to ask,
+// instead of blaming a sample base the user never set.
+TEST(BadInputs, ResumeWithAnSppTheSampleBaseDoesNotDivideSaysWhy) {
+    TempDir dir;
+    dir.write("tri.obj", kTriangleObj);
+    const std::string scene =
+        dir.write("scene.yaml", "shader: {type: Lambert}\nobject: {filename: tri.obj}\n"
+                                "image: {width: 8, height: 8, sample base: 2, iterations: 2}\n");
+    const std::string common = " --quiet --backend cpu -o " + dir.file("out.exr");
+    ASSERT_EQ(
+        runLimited("render " + scene + common + " --checkpoint " + dir.file("ck.exr"), 60).status,
+        0);
+    const Outcome r =
+        runLimited("render " + scene + common + " --spp 10 --resume " + dir.file("ck.exr"), 60);
+    ASSERT_FALSE(r.signalled) << r.output;
+    EXPECT_EQ(r.status, 2) << r.output;
+    EXPECT_NE(r.output.find("--spp 10 is not a multiple of 4"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("such as 12"), std::string::npos) << r.output;
+    EXPECT_EQ(r.output.find("where this render has"), std::string::npos) << r.output;
+    EXPECT_EQ(
+        runLimited("render " + scene + common + " --spp 12 --resume " + dir.file("ck.exr"), 60)
+            .status,
+        0);
 }
 
 TEST(BadInputs, SceneMissingIsReportedWithoutALineNumber) {

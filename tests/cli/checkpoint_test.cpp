@@ -217,6 +217,36 @@ TEST(Checkpoint, AResumeOfAnotherEnvironmentFewerSamplesOrAnotherRangeIsRefused)
     }
 }
 
+// A texture swapped for another image of the same size, given the old modification time back (a
+// copy with `cp -p`, a sync tool): its texels are in the checkpoint's identity, so the resume is
+// refused, exit 2 (before: size and time alone were hashed, and it resumed into a wrong image).
+TEST(Checkpoint, ATextureSwappedForOneOfTheSameSizeAndTimeIsRefused) {
+    TempDir dir;
+    dir.write("quad.obj", "v -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nvt 0 0\nvt 1 0\nvt 1 1\n"
+                          "vt 0 1\nf 1/1 2/2 3/3\nf 1/1 3/3 4/4\n");
+    // A binary PPM: uncompressed, so one changed texel keeps the file's size.
+    std::string texels(4 * 4 * 3, char(128));
+    dir.write("tex.ppm", "P6\n4 4\n255\n" + texels);
+    const std::string scene = dir.write(
+        "scene.yaml", "image: {width: 8, height: 8}\n"
+                      "shader: {type: Lambert, texture: {type: Standard, filename: tex.ppm}}\n"
+                      "object: {filename: quad.obj, translation: [0, 0, -4]}\n"
+                      "light: {type: Environment}\n");
+    const std::string ck = dir.file("ck.exr");
+    auto run = [&](std::vector<std::string> args) {
+        args.insert(args.end(), {"--backend", "cpu", "--quiet", "-o", dir.file("out.exr")});
+        return runChild(args);
+    };
+    ASSERT_EQ(run({"render", scene, "--spp", "2", "--checkpoint", ck}).status, 0);
+    const auto time = std::filesystem::last_write_time(dir.file("tex.ppm"));
+    texels[5] = char(200);
+    dir.write("tex.ppm", "P6\n4 4\n255\n" + texels);
+    std::filesystem::last_write_time(dir.file("tex.ppm"), time);
+    const ChildResult r = run({"render", scene, "--spp", "4", "--resume", ck});
+    EXPECT_EQ(r.status, 2) << r.output;
+    EXPECT_NE(r.output.find("another scene"), std::string::npos) << r.output;
+}
+
 // A checkpoint's integrity. A bit flipped anywhere in the last 96 bytes (the final scanlines'
 // data) either is refused on resume (exit 2: the checksum over the film's state, or the EXR's
 // own decoding) or touched only the RGB preview, which nothing reads back: the resumed image is

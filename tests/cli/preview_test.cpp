@@ -54,9 +54,15 @@ class VirtualDisplay {
     }
     ~VirtualDisplay() {
         unsetenv("DISPLAY");
-        kill(pid_, SIGTERM);
-        waitpid(pid_, nullptr, 0);
+        stop(SIGTERM);
         std::filesystem::remove(log());
+    }
+    // Ends the server (SIGKILL: gone at once, as a dropped ssh connection's forwarded display).
+    void stop(int signal = SIGKILL) {
+        if (pid_ <= 0) return;
+        kill(pid_, signal);
+        waitpid(pid_, nullptr, 0);
+        pid_ = -1;
     }
     bool ready() const { return ready_; }
     std::string describe() const {
@@ -218,6 +224,35 @@ TEST(Preview, ScreenshotMatchesTheImageAndClosingStopsTheRender) {
     }
     EXPECT_LE(best, 1) << "the window shows neither the PNG of " << shown.spp << " spp nor of "
                        << shown.spp + 1;
+}
+
+// The display going away under the window (the X server killed; an ssh connection with X
+// forwarding dropped) stops the render as SIGHUP does: every completed iteration written, the
+// checkpoint too, exit 129, stop_reason "display lost". (Before: Xlib's default handler exited 1
+// with nothing written.)
+TEST(Preview, ALostDisplayKeepsTheFinishedWork) {
+    VirtualDisplay display;
+    ASSERT_TRUE(display.ready()) << readFile(VirtualDisplay::log()) << display.describe();
+    TempDir dir;
+    const std::string scene = smallCornellBox(dir, 32, 24);
+    ChildResult r = runChild({"render", scene, "--backend", "cpu", "--preview", "--progress",
+                              "lines", "--spp", "100000", "-o", dir.file("live.exr"), "--stats",
+                              dir.file("live.json"), "--checkpoint", dir.file("ck.exr")},
+                             [&](pid_t pid) {
+                                 if (waitForChildOutput(pid, "iteration 3/"))
+                                     display.stop();
+                                 else
+                                     kill(pid, SIGKILL);
+                             });
+    EXPECT_EQ(r.status, 129) << r.output;
+    EXPECT_NE(r.output.find("the preview's display went away after"), std::string::npos)
+        << r.output;
+    ASSERT_TRUE(std::filesystem::exists(dir.file("live.json"))) << r.output;
+    const nlohmann::json s = nlohmann::json::parse(std::ifstream(dir.file("live.json")));
+    EXPECT_EQ(s["stop_reason"], "display lost");
+    EXPECT_GE(s["spp"].get<int>(), 3);
+    EXPECT_TRUE(std::filesystem::exists(dir.file("live.exr")));
+    EXPECT_TRUE(std::filesystem::exists(dir.file("ck.exr")));
 }
 
 TEST(Preview, WithoutADisplayExitsTwoBeforeRendering) {
