@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
+#include <fstream>
 
 namespace spw {
 namespace {
@@ -91,7 +92,62 @@ std::string imageSizeProblem(const std::string& path, long long width, long long
            " pixels; Spillway reads images of 1 to 2^26 pixels";
 }
 
+std::string exrHeaderProblem(const std::string& path) {
+    std::ifstream in(path, std::ios::binary | std::ios::ate);
+    if (!in) return ""; // the reader says why it cannot open it
+    const std::uint64_t fileSize = std::uint64_t(in.tellg());
+    in.seekg(0);
+    unsigned char head[8] = {};
+    if (!in.read(reinterpret_cast<char*>(head), 8) || head[0] != 0x76 || head[1] != 0x2f ||
+        head[2] != 0x31 || head[3] != 0x01)
+        return ""; // not an EXR: its own reader's checks apply
+    const bool multipart = (head[5] & 0x10) != 0;
+    auto damaged = [&](const std::string& why) {
+        return "'" + path + "' is not an OpenEXR file Spillway reads: " + why;
+    };
+    auto readName = [&](std::string& name) {
+        name.clear();
+        for (char c; in.get(c);) {
+            if (c == '\0') return true;
+            if (name.size() >= 255) return false;
+            name += c;
+        }
+        return false;
+    };
+    for (int part = 0;; ++part) {
+        std::string name, type;
+        if (!readName(name)) return damaged("its header ends early");
+        if (name.empty()) {
+            if (!multipart || part > 0) return ""; // the end of the (last) header
+            return damaged("an empty header");
+        }
+        // One header's attributes, the first already named; an empty name ends it.
+        while (!name.empty()) {
+            unsigned char size[4];
+            if (!readName(type) || !in.read(reinterpret_cast<char*>(size), 4))
+                return damaged("its header ends early");
+            const std::uint32_t bytes = std::uint32_t(size[0]) | std::uint32_t(size[1]) << 8 |
+                                        std::uint32_t(size[2]) << 16 | std::uint32_t(size[3]) << 24;
+            if (std::uint64_t(in.tellg()) + bytes > fileSize)
+                return damaged("attribute '" + name + "' claims " + std::to_string(bytes) +
+                               " bytes, past the end of the file");
+            if (name == "dataWindow" && type == "box2i" && bytes == 16) {
+                std::int32_t box[4];
+                in.read(reinterpret_cast<char*>(box), 16);
+                const long long w = (long long)box[2] - box[0] + 1,
+                                h = (long long)box[3] - box[1] + 1;
+                if (const std::string why = imageSizeProblem(path, w, h); !why.empty()) return why;
+            } else {
+                in.seekg(std::streamoff(bytes), std::ios::cur);
+            }
+            if (!readName(name)) return damaged("its header ends early");
+        }
+        if (!multipart) return "";
+    }
+}
+
 ImageRGB readImage(const std::string& path) {
+    if (const std::string why = exrHeaderProblem(path); !why.empty()) throw std::runtime_error(why);
     auto in = OIIO::ImageInput::open(path);
     if (!in) throw std::runtime_error("cannot read image '" + path + "': " + OIIO::geterror());
     const OIIO::ImageSpec& spec = in->spec();

@@ -268,6 +268,7 @@ int stateChannel(const OIIO::ImageSpec& spec, const std::string& path, const std
 } // namespace
 
 Checkpoint readCheckpoint(const std::string& path) {
+    if (const std::string why = exrHeaderProblem(path); !why.empty()) notACheckpoint(path, why);
     auto in = OIIO::ImageInput::open(path);
     if (!in) throw std::runtime_error("cannot read checkpoint '" + path + "': " + OIIO::geterror());
     const OIIO::ImageSpec& spec = in->spec();

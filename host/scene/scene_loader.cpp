@@ -245,6 +245,7 @@ class TextureReader {
     // A file that is not an image is the scene's error, found now rather than mid-render. Only
     // the header is read: the pixels stay lazy, for the texture system.
     void checkImage(const YAML::Node& at, const std::string& path) const {
+        if (const std::string why = exrHeaderProblem(path); !why.empty()) rd_.fail(at, why);
         auto in = OIIO::ImageInput::open(path);
         if (!in) {
             std::string why = OIIO::geterror();

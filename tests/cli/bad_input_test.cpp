@@ -553,13 +553,68 @@ TEST(BadInputs, RenderHelpPrintsUsageAndExitsZero) {
     EXPECT_NE(r.output.find("exit status"), std::string::npos) << r.output;
 }
 
-// The same header bomb everywhere else an image is read, refused from its header with exit 2:
-// compare (either side) and render's --reference.
+// A valid 8 x 8 EXR whose header's data window is rewritten to claim 100000 x 100000 pixels:
+// OpenEXR would allocate its offset table from that before any check of ours.
+std::string exrBomb(const TempDir& dir) {
+    const std::string path = dir.file("bomb.exr");
+    writeImage(path, ImageRGB{8, 8, std::vector<float>(8 * 8 * 3, 0.5f)});
+    std::string bytes = readFile(path);
+    const std::string key = std::string("dataWindow") + '\0' + "box2i" + '\0';
+    const size_t at = bytes.find(key);
+    if (at == std::string::npos) return "";
+    const std::int32_t box[4] = {0, 0, 99999, 99999};
+    bytes.replace(at + key.size() + 4, 16, reinterpret_cast<const char*>(box), 16);
+    return dir.write("bomb.exr", bytes);
+}
+
+// The same EXR with its Software attribute claiming 2^31 - 1 bytes: OpenEXR allocates an
+// attribute's claimed size before reading it (fuzzing found it: 12 s per file under ASan).
+std::string exrAttributeBomb(const TempDir& dir) {
+    const std::string path = dir.file("attribute-bomb.exr");
+    writeImage(path, ImageRGB{8, 8, std::vector<float>(8 * 8 * 3, 0.5f)});
+    std::string bytes = readFile(path);
+    const std::string key = std::string("Software") + '\0' + "string" + '\0';
+    const size_t at = bytes.find(key);
+    if (at == std::string::npos) return "";
+    const std::int32_t size = 0x7FFFFFFF;
+    bytes.replace(at + key.size(), 4, reinterpret_cast<const char*>(&size), 4);
+    return dir.write("attribute-bomb.exr", bytes);
+}
+
+// The same header bombs everywhere else an image is read, refused from the header with exit 2:
+// compare (either side) and render's --reference; and an EXR's, whose header OpenEXR itself
+// would trust, as a checkpoint too.
 TEST(BadInputs, ImageHeaderBombsAreRefusedBeforeAllocating) {
     TempDir dir;
     const std::string bomb = dir.write("bomb.hdr", kBombHdr);
+    const std::string exr = exrBomb(dir);
+    ASSERT_FALSE(exr.empty()) << "no dataWindow in OpenImageIO's EXR header";
     const std::string ok = dir.file("ok.exr");
     writeImage(ok, ImageRGB{8, 8, std::vector<float>(8 * 8 * 3, 0.5f)});
+    for (const std::string& args :
+         {"compare " + exr + " " + ok, "merge " + exr + " -o " + dir.file("x.exr"),
+          "render " + sourceDir() + "/scenes/cornell-box.yaml --spp 1 --quiet -o " +
+              dir.file("x.exr") + " --resume " + exr}) {
+        const Outcome r = runLimited(args, 60);
+        ASSERT_FALSE(r.signalled) << args << "\n" << r.output;
+        EXPECT_EQ(r.status, 2) << args << "\n" << r.output;
+        EXPECT_NE(r.output.find("is 100000 x 100000 pixels; Spillway reads images of 1 to 2^26"),
+                  std::string::npos)
+            << args << "\n"
+            << r.output;
+    }
+    const std::string attribute = exrAttributeBomb(dir);
+    ASSERT_FALSE(attribute.empty()) << "no Software attribute in OpenImageIO's EXR header";
+    for (const std::string& args :
+         {"compare " + attribute + " " + ok, "merge " + attribute + " -o " + dir.file("x.exr")}) {
+        const Outcome r = runLimited(args, 60);
+        ASSERT_FALSE(r.signalled) << args << "\n" << r.output;
+        EXPECT_EQ(r.status, 2) << args << "\n" << r.output;
+        EXPECT_NE(r.output.find("attribute 'Software' claims 2147483647 bytes, past the end"),
+                  std::string::npos)
+            << args << "\n"
+            << r.output;
+    }
     for (const std::string& args :
          {"compare " + bomb + " " + ok, "compare " + ok + " " + bomb,
           "render " + sourceDir() + "/scenes/cornell-box.yaml --spp 1 --quiet -o " +
