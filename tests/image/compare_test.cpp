@@ -452,8 +452,9 @@ TEST(CompareHeatmap, CommandWritesAReadablePng) {
     EXPECT_GT(img.height, 40);
     EXPECT_LT(img.height, 40 + 100);
 
+    // A folder that is missing: a disk failure, exit 1 (the README's exit table).
     const CliResult bad = compareCli({p.a, p.b, "--heatmap", p.dir.file("no/such/dir/h.png")});
-    EXPECT_EQ(bad.status, 2);
+    EXPECT_EQ(bad.status, 1);
     EXPECT_TRUE(contains(bad.err, "no/such/dir/h.png")) << bad.err;
 }
 
