@@ -16,8 +16,10 @@ are noisy; ratios travel, absolute seconds do not).
                                --texture-filter finest (the thesis' regime: every lookup at the
                                finest level) and cone (the default). Writes
                                out/production/bench.json.
-  scripts/bench.py incore      in-core speed: the Cornell box at 64 and 256 spp and the
-                               1M-triangle scene; reference, cpu (fused stages, SIMD shading),
+  scripts/bench.py incore      in-core speed: the Cornell box at 64 and 256 spp, and at 64 spp
+                               with a Gaussian filter; the 1M-triangle scene; 64 shaders over
+                               layered image textures (the production generator at an in-core
+                               size, out/incore-textured) and its Constant-colour control; reference, cpu (fused stages, SIMD shading),
                                cpu with separate stages, cpu with scalar shading
                                (--simd-shading off), vulkan; runs alternate between configurations and
                                the best of N is kept. Per configuration: render seconds, ratio to
@@ -136,9 +138,27 @@ def bench_incore(spillway, repeat, baseline):
     heavy = subprocess.check_output([sys.executable, os.path.join(ROOT, "scripts", "make_heavy_scene.py"),
                                      os.path.join(ROOT, "out", "heavy")], text=True).strip()
     box = os.path.join(ROOT, "scenes", "cornell-box.yaml")
+    # The scenes users bring that the others miss: many shaders reading image textures (the
+    # production generator's 64 models, each a Lambert or Conductor over a Layered tree of 7
+    # tiled MIP-mapped images, at an in-core size, cone filter), its Constant-colour control, and
+    # the Cornell box with a wide pixel filter.
+    textured_dir = os.path.join(ROOT, "out", "incore-textured")
+    subprocess.check_output([sys.executable, os.path.join(ROOT, "scripts", "make_production_scene.py"),
+                             textured_dir, "--models", "64", "--triangles", "400000",
+                             "--texture-res", "256", "--width", "320", "--height", "180",
+                             "--spp", "16", "--max-depth", "2"], text=True)
+    gaussian = os.path.join(ROOT, "out", "bench", "cornell-gaussian.yaml")
+    os.makedirs(os.path.dirname(gaussian), exist_ok=True)
+    with open(gaussian, "w") as f:
+        f.write(open(box).read().replace("filter: {type: Box}", "filter: {type: Gaussian}")
+                .replace("filename: cornell-box/", "filename: %s/" % os.path.join(ROOT, "scenes", "cornell-box")))
     scenes = [("Cornell box 256x256, 64 spp", box, ["--spp", "64"]),
               ("Cornell box 256x256, 256 spp", box, ["--spp", "256"]),
-              ("1M triangles, 17 shaders, 640x480, 16 spp", heavy, [])]
+              ("Cornell box 256x256, 64 spp, Gaussian filter", gaussian, ["--spp", "64"]),
+              ("1M triangles, 17 shaders, 640x480, 16 spp", heavy, []),
+              ("64 textured shaders (7 images each, 256^2), 320x180, 16 spp, depth 2",
+               os.path.join(textured_dir, "scene.yaml"), []),
+              ("the same, every image a Constant of its mean", os.path.join(textured_dir, "control.yaml"), [])]
     configs = [("reference", spillway, ["--backend", "reference"]),
                ("cpu", spillway, ["--backend", "cpu"]),
                ("cpu, separate stages", spillway, ["--backend", "cpu", "--stages", "separate"]),

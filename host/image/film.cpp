@@ -37,6 +37,8 @@ Film::Film(int width, int height, const Filter& filter, float brightestRadiance,
       iterationSamples_(new std::atomic<std::uint32_t>[size_t(width) * height]),
       samples_(size_t(width) * height, 0u), tilesX_((width + kAdaptiveTile - 1) / kAdaptiveTile),
       tilesY_((height + kAdaptiveTile - 1) / kAdaptiveTile) {
+    if (!(filter.radius > 0.0f && filter.radius <= kMaxFilterRadius))
+        throw std::invalid_argument("a pixel filter's radius lies in (0, 16]");
     // No clamp on e: the scale is a double, and every emission the loader accepts (up to
     // kMaxRadiance, down to the smallest float) keeps its brightest sample at 2^40.
     const int e =
@@ -188,9 +190,21 @@ void Film::addSample(vec2 filmPos, uint sampleIndex) {
 }
 
 void Film::prefetch(vec2 filmPos) const {
-    const int px = std::clamp(int(filmPos.x), 0, width_ - 1);
-    const int py = std::clamp(int(filmPos.y), 0, height_ - 1);
-    __builtin_prefetch(&acc_[size_t(py) * width_ + size_t(px)], 1);
+    if (filter_.type == FilterType::Box) {
+        const int px = std::clamp(int(filmPos.x), 0, width_ - 1);
+        const int py = std::clamp(int(filmPos.y), 0, height_ - 1);
+        __builtin_prefetch(&acc_[size_t(py) * width_ + size_t(px)], 1);
+        return;
+    }
+    // Every pixel of the footprint (a line each): a wide filter's splat waits on all of them.
+    const float r = std::min(filter_.radius, 2.0f); // beyond 4 x 4, prefetching the centre will do
+    const int x0 = std::max(0, int(std::ceil(filmPos.x - 0.5f - r)));
+    const int x1 = std::min(width_ - 1, int(std::floor(filmPos.x - 0.5f + r)));
+    const int y0 = std::max(0, int(std::ceil(filmPos.y - 0.5f - r)));
+    const int y1 = std::min(height_ - 1, int(std::floor(filmPos.y - 0.5f + r)));
+    for (int y = y0; y <= y1; ++y)
+        for (int x = x0; x <= x1; ++x)
+            __builtin_prefetch(&acc_[size_t(y) * width_ + size_t(x)], 1);
 }
 
 int Film::halfOf(uint sampleIndex) const {
@@ -208,11 +222,17 @@ void Film::filtered(vec2 filmPos, int half, vec3 radiance, float weight, uint ke
     int x1 = std::min(width_ - 1, int(std::floor(filmPos.x - 0.5f + r)));
     int y0 = std::max(0, int(std::ceil(filmPos.y - 0.5f - r)));
     int y1 = std::min(height_ - 1, int(std::floor(filmPos.y - 0.5f + r)));
+    // The filter is separable: each column's weight once, not once per row (a Gaussian's two
+    // exp() calls each). The products are the same floats as before, so the film is too.
+    constexpr int kMaxReach = 2 * int(kMaxFilterRadius) + 2; // the widest footprint
+    float wx[kMaxReach];
+    for (int x = x0; x <= x1; ++x)
+        wx[x - x0] = filterWeight1D(filter_.type, float(x) + 0.5f - filmPos.x, r);
     for (int y = y0; y <= y1; ++y) {
         float wy = filterWeight1D(filter_.type, float(y) + 0.5f - filmPos.y, r);
         if (wy <= 0.0f) continue;
         for (int x = x0; x <= x1; ++x) {
-            float w = wy * filterWeight1D(filter_.type, float(x) + 0.5f - filmPos.x, r);
+            float w = wy * wx[x - x0];
             if (w > 0.0f) add(x, y, half, radiance * w, weight * w, key);
         }
     }

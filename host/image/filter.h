@@ -5,6 +5,8 @@
 namespace spw {
 
 enum class FilterType { Box, Tent, Gaussian };
+// The widest radius a scene may give (`filter: {width: ...}`), in pixels.
+constexpr float kMaxFilterRadius = 16.0f;
 struct Filter {
     FilterType type = FilterType::Box;
     float radius = 0.5f; // pixels; Box always covers its own pixel only

@@ -152,7 +152,7 @@ void readFilter(const Reader& rd, const YAML::Node& n, Filter& f) {
     else
         rd.fail(n["type"], "unknown filter type '" + t + "' (Box, Tent or Gaussian)");
     if (n["width"]) {
-        float w = float(rd.number(n["width"], "filter width", 1e-3, 16.0));
+        float w = float(rd.number(n["width"], "filter width", 1e-3, kMaxFilterRadius));
         if (f.type != FilterType::Box) f.radius = w;
     }
 }
