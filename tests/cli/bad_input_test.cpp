@@ -553,32 +553,34 @@ TEST(BadInputs, RenderHelpPrintsUsageAndExitsZero) {
     EXPECT_NE(r.output.find("exit status"), std::string::npos) << r.output;
 }
 
-// A valid 8 x 8 EXR whose header's data window is rewritten to claim 100000 x 100000 pixels:
-// OpenEXR would allocate its offset table from that before any check of ours.
-std::string exrBomb(const TempDir& dir) {
-    const std::string path = dir.file("bomb.exr");
+// A valid 8 x 8 EXR whose header attribute `name` of `type` has `bytes` written at `offset`
+// from the attribute's type name (0: its size field, 4: its value); "" if it has no such one.
+std::string patchedExr(const TempDir& dir, const std::string& file, const std::string& name,
+                       const std::string& type, size_t offset, const std::string& bytes) {
+    const std::string path = dir.file(file);
     writeImage(path, ImageRGB{8, 8, std::vector<float>(8 * 8 * 3, 0.5f)});
-    std::string bytes = readFile(path);
-    const std::string key = std::string("dataWindow") + '\0' + "box2i" + '\0';
-    const size_t at = bytes.find(key);
+    std::string exr = readFile(path);
+    const std::string key = name + '\0' + type + '\0';
+    const size_t at = exr.find(key);
     if (at == std::string::npos) return "";
-    const std::int32_t box[4] = {0, 0, 99999, 99999};
-    bytes.replace(at + key.size() + 4, 16, reinterpret_cast<const char*>(box), 16);
-    return dir.write("bomb.exr", bytes);
+    exr.replace(at + key.size() + offset, bytes.size(), bytes);
+    return dir.write(file, exr);
 }
 
-// The same EXR with its Software attribute claiming 2^31 - 1 bytes: OpenEXR allocates an
-// attribute's claimed size before reading it (fuzzing found it: 12 s per file under ASan).
+// Its data window rewritten to claim 100000 x 100000 pixels: OpenEXR would size its offset table
+// from that before any check of ours.
+std::string exrBomb(const TempDir& dir) {
+    const std::int32_t box[4] = {0, 0, 99999, 99999};
+    return patchedExr(dir, "bomb.exr", "dataWindow", "box2i", 4,
+                      std::string(reinterpret_cast<const char*>(box), 16));
+}
+
+// Its Software attribute claiming 2^31 - 1 bytes: OpenEXR allocates an attribute's claimed size
+// before reading it (fuzzing found it: 12 s per file under ASan).
 std::string exrAttributeBomb(const TempDir& dir) {
-    const std::string path = dir.file("attribute-bomb.exr");
-    writeImage(path, ImageRGB{8, 8, std::vector<float>(8 * 8 * 3, 0.5f)});
-    std::string bytes = readFile(path);
-    const std::string key = std::string("Software") + '\0' + "string" + '\0';
-    const size_t at = bytes.find(key);
-    if (at == std::string::npos) return "";
     const std::int32_t size = 0x7FFFFFFF;
-    bytes.replace(at + key.size(), 4, reinterpret_cast<const char*>(&size), 4);
-    return dir.write("attribute-bomb.exr", bytes);
+    return patchedExr(dir, "attribute-bomb.exr", "Software", "string", 0,
+                      std::string(reinterpret_cast<const char*>(&size), 4));
 }
 
 // The same header bombs everywhere else an image is read, refused from the header with exit 2:
