@@ -267,6 +267,41 @@ int stateChannel(const OIIO::ImageSpec& spec, const std::string& path, const std
 }
 } // namespace
 
+namespace {
+// The film's state channels, a block of rows at a time: what is allocated grows with the rows
+// actually read, so a header that claims many pixels over a short or damaged file fails at its
+// first missing block, having touched memory for the rows it held (fuzzing found files of a
+// few hundred bytes that cost gigabytes when the whole film was allocated up front).
+void readFilmState(OIIO::ImageInput& in, const std::string& path, const std::vector<size_t>& word,
+                   Film::State& film) {
+    const OIIO::ImageSpec& spec = in.spec();
+    const size_t width = size_t(spec.width);
+    constexpr size_t kWords = kChannels - 3; // per pixel, as the file lists them
+    const int rows = int(std::max<size_t>(1, (size_t(1) << 20) / (width * kWords)));
+    std::vector<std::uint32_t> words;
+    for (int y0 = 0; y0 < spec.height; y0 += rows) {
+        const int y1 = std::min(spec.height, y0 + rows);
+        words.resize(size_t(y1 - y0) * width * kWords);
+        if (!in.read_scanlines(0, 0, spec.y + y0, spec.y + y1, 0, 3, kChannels,
+                               OIIO::TypeDesc::UINT, words.data()))
+            throw std::runtime_error("cannot read checkpoint '" + path + "': " + in.geterror());
+        const size_t first = size_t(y0) * width, end = size_t(y1) * width;
+        film.sums.resize(end * kSumsPerPixel);
+        film.samples.resize(end);
+        for (size_t p = first; p < end; ++p) {
+            const std::uint32_t* w = &words[(p - first) * kWords];
+            for (size_t k = 0; k < kSumsPerPixel; ++k) {
+                unsigned __int128 bits = 0;
+                for (size_t j = 0; j < kWordsPerSum; ++j)
+                    bits = bits << 32 | w[word[kWordsPerSum * k + j]];
+                film.sums[p * kSumsPerPixel + k] = static_cast<Film::Fixed>(bits);
+            }
+            film.samples[p] = w[word.back()];
+        }
+    }
+}
+} // namespace
+
 Checkpoint readCheckpoint(const std::string& path) {
     if (const std::string why = exrHeaderProblem(path); !why.empty()) notACheckpoint(path, why);
     auto in = OIIO::ImageInput::open(path);
@@ -315,23 +350,7 @@ Checkpoint readCheckpoint(const std::string& path) {
     if (c.iterations < 0 || c.firstIteration < 0 || c.totalIterations < 0 || c.key.sampleBase <= 0)
         notACheckpoint(path, "its spillway:* metadata is incomplete");
 
-    const size_t pixels = size_t(spec.width) * size_t(spec.height);
-    constexpr size_t kWords = kChannels - 3; // per pixel, as the file lists them
-    std::vector<std::uint32_t> words(pixels * kWords);
-    if (!in->read_image(0, 0, 3, kChannels, OIIO::TypeDesc::UINT, words.data()))
-        throw std::runtime_error("cannot read checkpoint '" + path + "': " + in->geterror());
-    c.film.sums.resize(pixels * kSumsPerPixel);
-    c.film.samples.resize(pixels);
-    for (size_t p = 0; p < pixels; ++p) {
-        const std::uint32_t* w = &words[p * kWords];
-        for (size_t k = 0; k < kSumsPerPixel; ++k) {
-            unsigned __int128 bits = 0;
-            for (size_t j = 0; j < kWordsPerSum; ++j)
-                bits = bits << 32 | w[word[kWordsPerSum * k + j]];
-            c.film.sums[p * kSumsPerPixel + k] = static_cast<Film::Fixed>(bits);
-        }
-        c.film.samples[p] = w[word.back()];
-    }
+    readFilmState(*in, path, word, c.film);
     std::uint64_t checksum = 0;
     try {
         checksum = std::stoull(spec.get_string_attribute("spillway:checksum"));
