@@ -92,6 +92,77 @@ std::string imageSizeProblem(const std::string& path, long long width, long long
            " pixels; Spillway reads images of 1 to 2^26 pixels";
 }
 
+namespace {
+
+// What one EXR part's header says about its layout, as far as memory goes.
+struct ExrLayout {
+    long long width = 0, height = 0; // the data window; 0: none given
+    long long bytesPerPixel = 0;     // over the channel list
+    long long linesPerChunk = 1;     // from the compression
+    long long tileWidth = 0, tileHeight = 0;
+
+    // Why a file of `fileSize` bytes cannot hold this layout, or "". Its chunk offset table is
+    // in the file (8 bytes a chunk), and no codec OpenEXR has packs a chunk more than 4096 : 1
+    // (deflate's limit is 1032 : 1): OpenEXR sizes both its offset table and its chunk buffers
+    // from the header before reading any pixel.
+    std::string problem(std::uint64_t fileSize) const {
+        if (width <= 0 || height <= 0) return "";
+        const bool tiled = tileWidth > 0 && tileHeight > 0;
+        const long long chunks =
+            tiled ? ((width + tileWidth - 1) / tileWidth) * ((height + tileHeight - 1) / tileHeight)
+                  : (height + linesPerChunk - 1) / linesPerChunk;
+        const double chunkBytes = double(bytesPerPixel) * (tiled ? double(tileWidth) * tileHeight
+                                                                 : double(width) * linesPerChunk);
+        if (double(chunks) * 8.0 > double(fileSize))
+            return "its header claims " + std::to_string(chunks) + " chunks, more than its " +
+                   std::to_string(fileSize) + " bytes hold";
+        if (chunkBytes > 4096.0 * double(fileSize))
+            return "its header claims chunks of " + std::to_string((long long)chunkBytes) +
+                   " bytes, more than its " + std::to_string(fileSize) + " bytes could unpack to";
+        return "";
+    }
+};
+
+std::int32_t littleEndian32(const unsigned char* b) {
+    return std::int32_t(std::uint32_t(b[0]) | std::uint32_t(b[1]) << 8 | std::uint32_t(b[2]) << 16 |
+                        std::uint32_t(b[3]) << 24);
+}
+
+// Reads what ExrLayout needs from one attribute's value; returns why the value is damaged, or "".
+std::string noteAttribute(ExrLayout& layout, const std::string& name, const std::string& type,
+                          const std::vector<unsigned char>& v) {
+    if (name == "dataWindow" && type == "box2i" && v.size() == 16) {
+        layout.width = (long long)littleEndian32(&v[8]) - littleEndian32(&v[0]) + 1;
+        layout.height = (long long)littleEndian32(&v[12]) - littleEndian32(&v[4]) + 1;
+    } else if (name == "compression" && type == "compression" && v.size() == 1) {
+        constexpr int kLines[] = {1, 1, 1, 16, 32, 16, 32, 32, 32, 256}; // none .. dwab
+        layout.linesPerChunk = v[0] < 10 ? kLines[v[0]] : 256;
+    } else if (name == "tiles" && type == "tiledesc" && v.size() >= 8) {
+        layout.tileWidth = std::uint32_t(littleEndian32(&v[0]));
+        layout.tileHeight = std::uint32_t(littleEndian32(&v[4]));
+    } else if (name == "channels" && type == "chlist") {
+        // Entries of name\0, pixel type (0 uint, 1 half, 2 float), linear, 3 reserved, x and y
+        // sampling; an empty name ends the list, within the attribute.
+        size_t i = 0;
+        while (i < v.size() && v[i] != 0) {
+            const size_t start = i;
+            while (i < v.size() && v[i] != 0)
+                ++i;
+            if (i - start > 255 || i + 17 > v.size()) return "its channel list is damaged";
+            const std::int32_t pixelType = littleEndian32(&v[i + 1]);
+            if (pixelType < 0 || pixelType > 2 || littleEndian32(&v[i + 9]) < 1 ||
+                littleEndian32(&v[i + 13]) < 1)
+                return "its channel list is damaged";
+            layout.bytesPerPixel += pixelType == 1 ? 2 : 4;
+            i += 17;
+        }
+        if (i >= v.size()) return "its channel list is damaged";
+    }
+    return "";
+}
+
+} // namespace
+
 std::string exrHeaderProblem(const std::string& path) {
     std::ifstream in(path, std::ios::binary | std::ios::ate);
     if (!in) return ""; // the reader says why it cannot open it
@@ -122,26 +193,26 @@ std::string exrHeaderProblem(const std::string& path) {
             return damaged("an empty header");
         }
         // One header's attributes, the first already named; an empty name ends it.
+        ExrLayout layout;
         while (!name.empty()) {
             unsigned char size[4];
             if (!readName(type) || !in.read(reinterpret_cast<char*>(size), 4))
                 return damaged("its header ends early");
-            const std::uint32_t bytes = std::uint32_t(size[0]) | std::uint32_t(size[1]) << 8 |
-                                        std::uint32_t(size[2]) << 16 | std::uint32_t(size[3]) << 24;
+            const std::uint32_t bytes = std::uint32_t(littleEndian32(size));
             if (std::uint64_t(in.tellg()) + bytes > fileSize)
                 return damaged("attribute '" + name + "' claims " + std::to_string(bytes) +
                                " bytes, past the end of the file");
-            if (name == "dataWindow" && type == "box2i" && bytes == 16) {
-                std::int32_t box[4];
-                in.read(reinterpret_cast<char*>(box), 16);
-                const long long w = (long long)box[2] - box[0] + 1,
-                                h = (long long)box[3] - box[1] + 1;
-                if (const std::string why = imageSizeProblem(path, w, h); !why.empty()) return why;
-            } else {
-                in.seekg(std::streamoff(bytes), std::ios::cur);
-            }
+            std::vector<unsigned char> value(bytes);
+            if (!in.read(reinterpret_cast<char*>(value.data()), std::streamsize(bytes)))
+                return damaged("its header ends early");
+            if (const std::string why = noteAttribute(layout, name, type, value); !why.empty())
+                return damaged(why);
             if (!readName(name)) return damaged("its header ends early");
         }
+        if (const std::string why = imageSizeProblem(path, layout.width, layout.height);
+            layout.width != 0 && !why.empty())
+            return why;
+        if (const std::string why = layout.problem(fileSize); !why.empty()) return damaged(why);
         if (!multipart) return "";
     }
 }
