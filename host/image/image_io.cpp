@@ -128,9 +128,50 @@ std::int32_t littleEndian32(const unsigned char* b) {
                         std::uint32_t(b[3]) << 24);
 }
 
+// OpenEXR reads the attribute types it knows by their own size, not the size the header gives
+// (and a channel list up to its terminator): where the two differ, OpenEXR parses the rest of the
+// header from another place than this check does. So a known type's value must be exactly its
+// size. (A fuzzer's file did this: a channel list that ended early, then an attribute of 1.7 GB
+// that only OpenEXR saw.)
+std::string sizeProblem(const std::string& type, const std::vector<unsigned char>& v) {
+    static const std::pair<const char*, size_t> kFixed[] = {{"box2i", 16},
+                                                            {"box2f", 16},
+                                                            {"int", 4},
+                                                            {"float", 4},
+                                                            {"double", 8},
+                                                            {"v2i", 8},
+                                                            {"v2f", 8},
+                                                            {"v2d", 16},
+                                                            {"v3i", 12},
+                                                            {"v3f", 12},
+                                                            {"v3d", 24},
+                                                            {"m33f", 36},
+                                                            {"m33d", 72},
+                                                            {"m44f", 64},
+                                                            {"m44d", 128},
+                                                            {"compression", 1},
+                                                            {"lineOrder", 1},
+                                                            {"envmap", 1},
+                                                            {"deepImageState", 1},
+                                                            {"tiledesc", 9},
+                                                            {"chromaticities", 32},
+                                                            {"keycode", 28},
+                                                            {"timecode", 8},
+                                                            {"rational", 8}};
+    for (const auto& [name, size] : kFixed)
+        if (type == name && v.size() != size) return "an attribute of type " + type + " is damaged";
+    if (type == "preview") {
+        const std::uint64_t w = v.size() >= 8 ? std::uint32_t(littleEndian32(&v[0])) : 0,
+                            h = v.size() >= 8 ? std::uint32_t(littleEndian32(&v[4])) : 0;
+        if (v.size() < 8 || 8 + 4 * w * h != v.size()) return "its preview image is damaged";
+    }
+    return "";
+}
+
 // Reads what ExrLayout needs from one attribute's value; returns why the value is damaged, or "".
 std::string noteAttribute(ExrLayout& layout, const std::string& name, const std::string& type,
                           const std::vector<unsigned char>& v) {
+    if (const std::string why = sizeProblem(type, v); !why.empty()) return why;
     if (name == "dataWindow" && type == "box2i" && v.size() == 16) {
         layout.width = (long long)littleEndian32(&v[8]) - littleEndian32(&v[0]) + 1;
         layout.height = (long long)littleEndian32(&v[12]) - littleEndian32(&v[4]) + 1;
@@ -156,7 +197,7 @@ std::string noteAttribute(ExrLayout& layout, const std::string& name, const std:
             layout.bytesPerPixel += pixelType == 1 ? 2 : 4;
             i += 17;
         }
-        if (i >= v.size()) return "its channel list is damaged";
+        if (i + 1 != v.size()) return "its channel list is damaged"; // its terminator ends it
     }
     return "";
 }

@@ -304,8 +304,13 @@ void readFilmState(OIIO::ImageInput& in, const std::string& path, const std::vec
 
 Checkpoint readCheckpoint(const std::string& path) {
     if (const std::string why = exrHeaderProblem(path); !why.empty()) notACheckpoint(path, why);
-    auto in = OIIO::ImageInput::open(path);
-    if (!in) throw std::runtime_error("cannot read checkpoint '" + path + "': " + OIIO::geterror());
+    // The OpenEXR reader alone: a checkpoint is an EXR, and a file that fails it is not one.
+    // (ImageInput::open would then probe every other format's reader, a second or more each.)
+    auto in = OIIO::ImageInput::create("openexr");
+    OIIO::ImageSpec opened;
+    if (!in || !in->open(path, opened))
+        throw std::runtime_error("cannot read checkpoint '" + path +
+                                 "': " + (in ? in->geterror() : OIIO::geterror()));
     const OIIO::ImageSpec& spec = in->spec();
     if (spec.get_int_attribute("spillway:checkpoint") != 1)
         notACheckpoint(path, "no spillway:checkpoint attribute");
