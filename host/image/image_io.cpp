@@ -160,6 +160,14 @@ std::string sizeProblem(const std::string& type, const std::vector<unsigned char
                                                             {"rational", 8}};
     for (const auto& [name, size] : kFixed)
         if (type == name && v.size() != size) return "an attribute of type " + type + " is damaged";
+    if (type == "stringvector") { // each string's length, then the string: within the value
+        for (size_t i = 0; i < v.size();) {
+            if (i + 4 > v.size()) return "an attribute of type stringvector is damaged";
+            const std::uint64_t length = std::uint32_t(littleEndian32(&v[i]));
+            if (i + 4 + length > v.size()) return "an attribute of type stringvector is damaged";
+            i += 4 + size_t(length);
+        }
+    }
     if (type == "preview") {
         const std::uint64_t w = v.size() >= 8 ? std::uint32_t(littleEndian32(&v[0])) : 0,
                             h = v.size() >= 8 ? std::uint32_t(littleEndian32(&v[4])) : 0;
@@ -181,7 +189,7 @@ std::string noteAttribute(ExrLayout& layout, const std::string& name, const std:
     } else if (name == "tiles" && type == "tiledesc" && v.size() >= 8) {
         layout.tileWidth = std::uint32_t(littleEndian32(&v[0]));
         layout.tileHeight = std::uint32_t(littleEndian32(&v[4]));
-    } else if (name == "channels" && type == "chlist") {
+    } else if (type == "chlist") { // any of them: OpenEXR parses each to its terminator
         // Entries of name\0, pixel type (0 uint, 1 half, 2 float), linear, 3 reserved, x and y
         // sampling; an empty name ends the list, within the attribute.
         size_t i = 0;
@@ -194,7 +202,7 @@ std::string noteAttribute(ExrLayout& layout, const std::string& name, const std:
             if (pixelType < 0 || pixelType > 2 || littleEndian32(&v[i + 9]) < 1 ||
                 littleEndian32(&v[i + 13]) < 1)
                 return "its channel list is damaged";
-            layout.bytesPerPixel += pixelType == 1 ? 2 : 4;
+            if (name == "channels") layout.bytesPerPixel += pixelType == 1 ? 2 : 4;
             i += 17;
         }
         if (i + 1 != v.size()) return "its channel list is damaged"; // its terminator ends it
