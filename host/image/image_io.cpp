@@ -171,7 +171,9 @@ std::string sizeProblem(const std::string& type, const std::vector<unsigned char
     if (type == "preview") {
         const std::uint64_t w = v.size() >= 8 ? std::uint32_t(littleEndian32(&v[0])) : 0,
                             h = v.size() >= 8 ? std::uint32_t(littleEndian32(&v[4])) : 0;
-        if (v.size() < 8 || 8 + 4 * w * h != v.size()) return "its preview image is damaged";
+        const bool fits = w == 0 || h <= v.size() / 4 / w; // and w * h cannot wrap
+        if (v.size() < 8 || !fits || 8 + 4 * w * h != v.size())
+            return "its preview image is damaged";
     }
     return "";
 }
