@@ -583,6 +583,16 @@ std::string exrAttributeBomb(const TempDir& dir) {
                       std::string(reinterpret_cast<const char*>(&size), 4));
 }
 
+// Each command is refused as bad input (exit 2, no signal), its message saying `says`.
+void expectRefused(const std::vector<std::string>& commands, const std::string& says) {
+    for (const std::string& args : commands) {
+        const Outcome r = runLimited(args, 60);
+        ASSERT_FALSE(r.signalled) << args << "\n" << r.output;
+        EXPECT_EQ(r.status, 2) << args << "\n" << r.output;
+        EXPECT_NE(r.output.find(says), std::string::npos) << args << "\n" << r.output;
+    }
+}
+
 // The same header bombs everywhere else an image is read, refused from the header with exit 2:
 // compare (either side) and render's --reference; and an EXR's, whose header OpenEXR itself
 // would trust, as a checkpoint too.
@@ -593,42 +603,20 @@ TEST(BadInputs, ImageHeaderBombsAreRefusedBeforeAllocating) {
     ASSERT_FALSE(exr.empty()) << "no dataWindow in OpenImageIO's EXR header";
     const std::string ok = dir.file("ok.exr");
     writeImage(ok, ImageRGB{8, 8, std::vector<float>(8 * 8 * 3, 0.5f)});
-    for (const std::string& args :
-         {"compare " + exr + " " + ok, "merge " + exr + " -o " + dir.file("x.exr"),
-          "render " + sourceDir() + "/scenes/cornell-box.yaml --spp 1 --quiet -o " +
-              dir.file("x.exr") + " --resume " + exr}) {
-        const Outcome r = runLimited(args, 60);
-        ASSERT_FALSE(r.signalled) << args << "\n" << r.output;
-        EXPECT_EQ(r.status, 2) << args << "\n" << r.output;
-        EXPECT_NE(r.output.find("is 100000 x 100000 pixels; Spillway reads images of 1 to 2^26"),
-                  std::string::npos)
-            << args << "\n"
-            << r.output;
-    }
+    expectRefused({"compare " + exr + " " + ok, "merge " + exr + " -o " + dir.file("x.exr"),
+                   "render " + sourceDir() + "/scenes/cornell-box.yaml --spp 1 --quiet -o " +
+                       dir.file("x.exr") + " --resume " + exr},
+                  "is 100000 x 100000 pixels; Spillway reads images of 1 to 2^26");
     const std::string attribute = exrAttributeBomb(dir);
     ASSERT_FALSE(attribute.empty()) << "no Software attribute in OpenImageIO's EXR header";
-    for (const std::string& args :
-         {"compare " + attribute + " " + ok, "merge " + attribute + " -o " + dir.file("x.exr")}) {
-        const Outcome r = runLimited(args, 60);
-        ASSERT_FALSE(r.signalled) << args << "\n" << r.output;
-        EXPECT_EQ(r.status, 2) << args << "\n" << r.output;
-        EXPECT_NE(r.output.find("attribute 'Software' claims 2147483647 bytes, past the end"),
-                  std::string::npos)
-            << args << "\n"
-            << r.output;
-    }
-    for (const std::string& args :
-         {"compare " + bomb + " " + ok, "compare " + ok + " " + bomb,
-          "render " + sourceDir() + "/scenes/cornell-box.yaml --spp 1 --quiet -o " +
-              dir.file("x.exr") + " --error-csv " + dir.file("e.csv") + " --reference " + bomb}) {
-        const Outcome r = runLimited(args, 60);
-        ASSERT_FALSE(r.signalled) << args << "\n" << r.output;
-        EXPECT_EQ(r.status, 2) << args << "\n" << r.output;
-        EXPECT_NE(r.output.find("is 100000 x 100000 pixels; Spillway reads images of 1 to 2^26"),
-                  std::string::npos)
-            << args << "\n"
-            << r.output;
-    }
+    expectRefused(
+        {"compare " + attribute + " " + ok, "merge " + attribute + " -o " + dir.file("x.exr")},
+        "attribute 'Software' claims 2147483647 bytes, past the end");
+    expectRefused({"compare " + bomb + " " + ok, "compare " + ok + " " + bomb,
+                   "render " + sourceDir() + "/scenes/cornell-box.yaml --spp 1 --quiet -o " +
+                       dir.file("x.exr") + " --error-csv " + dir.file("e.csv") + " --reference " +
+                       bomb},
+                  "is 100000 x 100000 pixels; Spillway reads images of 1 to 2^26");
     EXPECT_FALSE(fs::exists(dir.file("x.exr")));
 }
 
