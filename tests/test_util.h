@@ -26,6 +26,9 @@ constexpr bool kAddressSanitizer = false;
 #else
 constexpr bool kAddressSanitizer = false;
 #endif
+// The long statistical tests take this many times fewer samples under the sanitizers, which
+// slow them 5-10x (their tolerances are computed from, or scaled with, the samples taken).
+constexpr int kSanitizedFewer = kAddressSanitizer ? 4 : 1;
 
 // A fresh folder under the system temp dir, removed with everything in it on destruction.
 class TempDir {
