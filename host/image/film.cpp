@@ -3,8 +3,16 @@
 #include "host/image/compare.h"
 #include "shared/rng.h"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
+
+#include <sys/mman.h>
+
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
+#include <new>
 #include <stdexcept>
 
 namespace spw {
@@ -27,16 +35,25 @@ uint roundingKey(uint key, uint sampleIndex) {
     return pcg4d(uvec4(key, sampleIndex, 0xF11Du, 0x2545F491u)).x;
 }
 
+// fn(begin, end) over ranges of the pixels, on the render's threads: every pass over the whole
+// film works pixel by pixel, so its result does not depend on how the range is cut.
+template <typename Fn> void forPixels(size_t pixels, const Fn& fn) {
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, pixels, 16384),
+                      [&](const tbb::blocked_range<size_t>& r) { fn(r.begin(), r.end()); });
+}
+
+std::uint64_t magnitude(std::int64_t v) {
+    return v < 0 ? std::uint64_t(0) - std::uint64_t(v) : std::uint64_t(v);
+}
+
 } // namespace
 
 Film::Film(int width, int height, const Filter& filter, float brightestRadiance,
            int samplesPerIteration)
     : width_(width), height_(height), samplesPerIteration_(uint(samplesPerIteration)),
-      filter_(filter), acc_(new PixelSums[size_t(width) * height]),
-      sum_(size_t(width) * height * 8, 0), lastIteration_(size_t(width) * height * 3, 0.0f),
-      iterationSamples_(new std::atomic<std::uint32_t>[size_t(width) * height]),
-      samples_(size_t(width) * height, 0u), tilesX_((width + kAdaptiveTile - 1) / kAdaptiveTile),
-      tilesY_((height + kAdaptiveTile - 1) / kAdaptiveTile) {
+      filter_(filter), tilesX_((width + kAdaptiveTile - 1) / kAdaptiveTile),
+      tilesY_((height + kAdaptiveTile - 1) / kAdaptiveTile),
+      tileSamples_(size_t(tilesX_) * size_t(tilesY_), 0u) {
     if (!(filter.radius > 0.0f && filter.radius <= kMaxFilterRadius))
         throw std::invalid_argument("a pixel filter's radius lies in (0, 16]");
     // No clamp on e: the scale is a double, and every emission the loader accepts (up to
@@ -55,14 +72,47 @@ Film::Film(int width, int height, const Filter& filter, float brightestRadiance,
     beginIteration();
 }
 
+void Film::FreeSums::operator()(PixelSums* p) const {
+    std::free(p);
+}
+
+Film::Sums Film::zeroedSums(size_t pixels) {
+    constexpr size_t kHugePage = size_t(2) << 20;
+    const size_t bytes = (pixels * sizeof(PixelSums) + kHugePage - 1) / kHugePage * kHugePage;
+    void* memory = std::aligned_alloc(kHugePage, bytes);
+    if (!memory) throw std::bad_alloc();
+    madvise(memory, bytes, MADV_HUGEPAGE); // a hint: without it, the same in 4 KiB pages
+    Sums sums(static_cast<PixelSums*>(memory));
+    forPixels(pixels, [&](size_t begin, size_t end) {
+        for (size_t i = begin; i < end; ++i) {
+            PixelSums* p = new (&sums[i]) PixelSums;
+            for (std::atomic<std::int64_t>& v : p->v)
+                v.store(0, std::memory_order_relaxed);
+        }
+    });
+    return sums;
+}
+
 void Film::beginIteration() {
     nonFiniteBefore_ = nonFinite_.load();
     saturatedBefore_ = saturated_.load();
-    for (size_t i = 0; i < size_t(width_) * height_; ++i) {
-        for (std::atomic<std::int64_t>& v : acc_[i].v)
-            v.store(0, std::memory_order_relaxed);
-        iterationSamples_[i].store(0, std::memory_order_relaxed);
+    if (!acc_) {
+        acc_ = zeroedSums(pixels());
+    } else if (!accZero_) {
+        forPixels(pixels(), [&](size_t begin, size_t end) {
+            for (size_t i = begin; i < end; ++i)
+                for (std::atomic<std::int64_t>& v : acc_[i].v)
+                    v.store(0, std::memory_order_relaxed);
+        });
     }
+    accZero_ = true;
+    open_ = true;
+    lastIteration_ = nullptr;
+}
+
+void Film::discardIteration() {
+    accZero_ = false;
+    beginIteration();
 }
 
 void Film::setAdaptive(double threshold, int minSamples) {
@@ -99,14 +149,13 @@ void Film::decideAdaptiveTiles() {
         for (int tx = 0; tx < tilesX_; ++tx) {
             double total = 0.0;
             size_t values = 0;
-            bool ready = true;
+            bool ready = tileSamples_[size_t(ty) * size_t(tilesX_) + size_t(tx)] >=
+                         std::uint32_t(adaptiveMinSamples_);
             for (int y = ty * kAdaptiveTile; y < std::min(height_, (ty + 1) * kAdaptiveTile); ++y)
                 for (int x = tx * kAdaptiveTile; x < std::min(width_, (tx + 1) * kAdaptiveTile);
                      ++x) {
                     const size_t i = size_t(y) * size_t(width_) + size_t(x);
-                    if (samples_[i] < std::uint32_t(adaptiveMinSamples_) ||
-                        !addHalfBufferRelMse(i, total, values))
-                        ready = false;
+                    if (!addHalfBufferRelMse(i, total, values)) ready = false;
                 }
             if (ready && values > 0 && total / double(values) < limit) {
                 active_[size_t(ty) * size_t(tilesX_) + size_t(tx)] = 0;
@@ -123,34 +172,49 @@ void Film::setShare(int index, int shares) {
 
 std::vector<std::int64_t> Film::iterationAccumulators() const {
     const size_t n = size_t(width_) * height_;
-    std::vector<std::int64_t> out(n * 9 + 2);
-    for (size_t i = 0; i < n; ++i) {
+    std::vector<std::int64_t> out(n * 8 + 2);
+    for (size_t i = 0; i < n; ++i)
         for (int k = 0; k < 8; ++k)
-            out[i * 9 + size_t(k)] = acc_[i].v[k].load(std::memory_order_relaxed);
-        out[i * 9 + 8] = iterationSamples_[i].load(std::memory_order_relaxed);
-    }
-    out[n * 9] = std::int64_t(nonFinite_.load() - nonFiniteBefore_);
-    out[n * 9 + 1] = std::int64_t(saturated_.load() - saturatedBefore_);
+            out[i * 8 + size_t(k)] = acc_[i].v[k].load(std::memory_order_relaxed);
+    out[n * 8] = std::int64_t(nonFinite_.load() - nonFiniteBefore_);
+    out[n * 8 + 1] = std::int64_t(saturated_.load() - saturatedBefore_);
     return out;
 }
 
 void Film::setIterationAccumulators(const std::vector<std::int64_t>& values) {
     const size_t n = size_t(width_) * height_;
-    if (values.size() != n * 9 + 2)
+    if (values.size() != n * 8 + 2)
         throw std::invalid_argument("iteration accumulators of another film size");
-    for (size_t i = 0; i < n; ++i) {
+    for (size_t i = 0; i < n; ++i)
         for (int k = 0; k < 8; ++k)
-            acc_[i].v[k].store(values[i * 9 + size_t(k)], std::memory_order_relaxed);
-        iterationSamples_[i].store(std::uint32_t(values[i * 9 + 8]), std::memory_order_relaxed);
-    }
-    nonFinite_ = nonFiniteBefore_ + std::uint64_t(values[n * 9]);
-    saturated_ = saturatedBefore_ + std::uint64_t(values[n * 9 + 1]);
+            acc_[i].v[k].store(values[i * 8 + size_t(k)], std::memory_order_relaxed);
+    accZero_ = false;
+    nonFinite_ = nonFiniteBefore_ + std::uint64_t(values[n * 8]);
+    saturated_ = saturatedBefore_ + std::uint64_t(values[n * 8 + 1]);
+}
+
+size_t Film::tileOf(size_t pixel) const {
+    const size_t x = pixel % size_t(width_), y = pixel / size_t(width_);
+    return y / kAdaptiveTile * size_t(tilesX_) + x / kAdaptiveTile;
+}
+
+std::vector<std::uint32_t> Film::sampleCounts() const {
+    std::vector<std::uint32_t> counts(pixels());
+    for (size_t i = 0; i < counts.size(); ++i)
+        counts[i] = tileSamples_[tileOf(i)];
+    return counts;
 }
 
 std::uint64_t Film::samplesTaken() const {
     std::uint64_t n = 0;
-    for (std::uint32_t s : samples_)
-        n += s;
+    for (int ty = 0; ty < tilesY_; ++ty)
+        for (int tx = 0; tx < tilesX_; ++tx) {
+            const std::uint64_t w =
+                std::uint64_t(std::min(kAdaptiveTile, width_ - tx * kAdaptiveTile));
+            const std::uint64_t h =
+                std::uint64_t(std::min(kAdaptiveTile, height_ - ty * kAdaptiveTile));
+            n += w * h * tileSamples_[size_t(ty) * size_t(tilesX_) + size_t(tx)];
+        }
     return n;
 }
 
@@ -183,9 +247,6 @@ void Film::splat(vec2 filmPos, uint sampleIndex, vec3 radiance, uint key) {
 }
 
 void Film::addSample(vec2 filmPos, uint sampleIndex) {
-    const int px = std::min(int(filmPos.x), width_ - 1), py = std::min(int(filmPos.y), height_ - 1);
-    iterationSamples_[size_t(py) * size_t(width_) + size_t(px)].fetch_add(
-        1, std::memory_order_relaxed);
     filtered(filmPos, halfOf(sampleIndex), vec3(0.0f), 1.0f, roundingKey(0u, sampleIndex));
 }
 
@@ -238,73 +299,180 @@ void Film::filtered(vec2 filmPos, int half, vec3 radiance, float weight, uint ke
     }
 }
 
-void Film::endIteration() {
-    const size_t n = size_t(width_) * height_;
-    for (size_t i = 0; i < n; ++i) {
-        std::int64_t it[4] = {0, 0, 0, 0};
-        for (int h = 0; h < 2; ++h)
-            for (int c = 0; c < 4; ++c) {
-                const std::int64_t v = acc_[i].v[h * 4 + c].load(std::memory_order_relaxed);
-                sum_[i * 8 + size_t(h) * 4 + size_t(c)] += v;
-                it[c] += v;
-            }
-        const double weight = double(it[3]) / weightScale_;
-        for (int c = 0; c < 3; ++c)
-            lastIteration_[i * 3 + c] = it[3] > 0 ? float(double(it[c]) / scale_ / weight) : 0.0f;
-        samples_[i] += iterationSamples_[i].load(std::memory_order_relaxed);
+// Converting a 64-bit integer to double is one instruction, a 128-bit one a library call: the
+// film reads the low words alone while they are the whole sums.
+void Film::pixelSums(size_t pixel, double* s) const {
+    for (int k = 0; k < 8; ++k) {
+        const double v = !sumLo_  ? 0.0
+                         : sumHi_ ? double(sumAt(pixel, k))
+                                  : double(sumLo_[pixel].v[k].load(std::memory_order_relaxed));
+        s[k] = v / (k % 4 == 3 ? weightScale_ : scale_);
     }
-    beginIteration();
+}
+
+Film::Fixed Film::sumAt(size_t i, int k) const {
+    if (!sumLo_) return 0;
+    const std::int64_t lo = sumLo_[i].v[k].load(std::memory_order_relaxed);
+    if (!sumHi_) return lo;
+    return Fixed(sumHi_[i * 8 + size_t(k)]) * (Fixed(1) << 64) + Fixed(std::uint64_t(lo));
+}
+
+void Film::widenSums() {
+    sumHi_.reset(new std::int64_t[pixels() * 8]);
+    forPixels(pixels(), [&](size_t begin, size_t end) {
+        for (size_t i = begin; i < end; ++i)
+            for (int k = 0; k < 8; ++k)
+                sumHi_[i * 8 + size_t(k)] =
+                    sumLo_[i].v[k].load(std::memory_order_relaxed) < 0 ? -1 : 0;
+    });
+}
+
+void Film::addIterationToSums() {
+    // An iteration's sum is at most 2^62 in magnitude (the clamp): the sums can only pass 2^63
+    // once the largest is over 2^62, and then each add is checked before any is made.
+    if (!sumHi_ && sumBound_ >= (std::uint64_t(1) << 62)) {
+        const bool overflows = tbb::parallel_reduce(
+            tbb::blocked_range<size_t>(0, pixels(), 16384), false,
+            [&](const tbb::blocked_range<size_t>& r, bool any) {
+                for (size_t i = r.begin(); i < r.end() && !any; ++i)
+                    for (int k = 0; k < 8; ++k) {
+                        std::int64_t out;
+                        any |= __builtin_add_overflow(
+                            sumLo_[i].v[k].load(std::memory_order_relaxed),
+                            acc_[i].v[k].load(std::memory_order_relaxed), &out);
+                    }
+                return any;
+            },
+            [](bool a, bool b) { return a || b; });
+        if (overflows) widenSums();
+    }
+    sumBound_ = tbb::parallel_reduce(
+        tbb::blocked_range<size_t>(0, pixels(), 16384), std::uint64_t(0),
+        [&](const tbb::blocked_range<size_t>& r, std::uint64_t bound) {
+            for (size_t i = r.begin(); i < r.end(); ++i)
+                for (int k = 0; k < 8; ++k) {
+                    const std::int64_t v = acc_[i].v[k].load(std::memory_order_relaxed);
+                    std::atomic<std::int64_t>& lo = sumLo_[i].v[k];
+                    if (!sumHi_) {
+                        const std::int64_t sum = lo.load(std::memory_order_relaxed) + v;
+                        lo.store(sum, std::memory_order_relaxed);
+                        bound = std::max(bound, magnitude(sum));
+                        continue;
+                    }
+                    // GCC's >> of a negative __int128 is arithmetic (the high word's sign).
+                    const Fixed sum = sumAt(i, k) + v;
+                    lo.store(std::int64_t(std::uint64_t(sum)), std::memory_order_relaxed);
+                    sumHi_[i * 8 + size_t(k)] = std::int64_t(sum >> 64);
+                }
+            return bound;
+        },
+        [](std::uint64_t a, std::uint64_t b) { return std::max(a, b); });
+}
+
+void Film::endIteration() {
+    if (!open_) throw std::logic_error("Film::endIteration without beginIteration");
+    if (!sumLo_) {
+        // The first iteration is the whole render so far: its sums become the render's, and
+        // the next iteration's are allocated when it begins.
+        sumLo_ = std::move(acc_);
+        sumBound_ = std::uint64_t(1) << 62; // unknown: at most the clamp
+        lastIteration_ = sumLo_.get();
+    } else {
+        addIterationToSums();
+        lastIteration_ = acc_.get();
+    }
+    accZero_ = false;
+    open_ = false;
+    // Every pixel of a tile that was sampling took the iteration's samples (in some process's
+    // share): the counts are the tiles'.
+    for (size_t t = 0; t < tileSamples_.size(); ++t)
+        if (active_.empty() || active_[t]) tileSamples_[t] += samplesPerIteration_;
     decideTiles();
 }
 
+std::vector<float> Film::lastIterationImage() const {
+    if (!lastIteration_)
+        throw std::logic_error("Film::lastIterationImage outside endIteration .. beginIteration");
+    std::vector<float> out(pixels() * 3, 0.0f);
+    forPixels(pixels(), [&](size_t begin, size_t end) {
+        for (size_t i = begin; i < end; ++i) {
+            std::int64_t it[4] = {0, 0, 0, 0};
+            for (int k = 0; k < 8; ++k)
+                it[k % 4] += lastIteration_[i].v[k].load(std::memory_order_relaxed);
+            const double weight = double(it[3]) / weightScale_;
+            for (int c = 0; c < 3; ++c)
+                out[i * 3 + c] = it[3] > 0 ? float(double(it[c]) / scale_ / weight) : 0.0f;
+        }
+    });
+    return out;
+}
+
 Film::State Film::state() const {
-    return {sum_,
-            samples_,
+    State s{std::vector<Fixed>(pixels() * 8),
+            sampleCounts(),
             nonFinite_.load(),
             saturated_.load(),
             std::ilogb(scale_),
             std::ilogb(weightScale_)};
+    forPixels(pixels(), [&](size_t begin, size_t end) {
+        for (size_t i = begin; i < end; ++i)
+            for (int k = 0; k < 8; ++k)
+                s.sums[i * 8 + size_t(k)] = sumAt(i, k);
+    });
+    return s;
 }
 
 void Film::restore(const State& state) {
-    if (state.sums.size() != sum_.size() || state.samples.size() != samples_.size())
+    if (state.sums.size() != pixels() * 8 || state.samples.size() != pixels())
         throw std::invalid_argument("a film state of another size");
+    std::vector<std::uint32_t> tiles(tileSamples_.size(), 0u);
+    for (size_t i = 0; i < pixels(); ++i) {
+        const size_t t = tileOf(i);
+        if (i % size_t(width_) % kAdaptiveTile == 0 && i / size_t(width_) % kAdaptiveTile == 0)
+            tiles[t] = state.samples[i];
+        else if (state.samples[i] != tiles[t])
+            throw std::invalid_argument("a film state whose sample counts differ within a tile");
+    }
     if (state.scaleExponent != std::ilogb(scale_) ||
         state.weightExponent != std::ilogb(weightScale_))
         throw std::invalid_argument("a film state of another fixed-point scale");
-    sum_ = state.sums;
-    samples_ = state.samples;
+    const auto fits = [](Fixed v) { return v == Fixed(std::int64_t(v)); };
+    sumLo_ = zeroedSums(pixels());
+    sumHi_.reset();
+    if (!std::all_of(state.sums.begin(), state.sums.end(), fits)) widenSums();
+    forPixels(pixels(), [&](size_t begin, size_t end) {
+        for (size_t i = begin; i < end; ++i)
+            for (int k = 0; k < 8; ++k) {
+                const Fixed v = state.sums[i * 8 + size_t(k)];
+                sumLo_[i].v[k].store(std::int64_t(std::uint64_t(v)), std::memory_order_relaxed);
+                if (sumHi_) sumHi_[i * 8 + size_t(k)] = std::int64_t(v >> 64);
+            }
+    });
+    sumBound_ = std::uint64_t(1) << 62; // unknown: at most the clamp
+    tileSamples_ = std::move(tiles);
     nonFinite_ = state.nonFinite;
     saturated_ = state.saturated;
-    beginIteration();
+    discardIteration();
     decideTiles();
 }
 
 namespace {
-// A pixel's eight sums in radiance and weight units.
-void toUnits(const Film::Fixed* sums, double scale, double weightScale, double* s) {
-    for (int k = 0; k < 8; ++k)
-        s[k] = double(sums[k]) / (k % 4 == 3 ? weightScale : scale);
-}
-
-std::vector<float> imageFromSums(const Film::Fixed* sums, size_t pixels, double scale,
-                                 double weightScale) {
-    std::vector<float> out(pixels * 3, 0.0f);
-    for (size_t i = 0; i < pixels; ++i) {
-        double s[8];
-        toUnits(sums + i * 8, scale, weightScale, s);
-        double w = s[3] + s[7];
-        if (w > 0)
+// The image of `pixels` pixels whose eight sums in radiance and weight units sums(i, s) gives.
+// Pixels first .. first + count - 1 of the image whose pixel i's eight sums, in radiance and
+// weight units, sums(i, s) gives, into out (3 floats a pixel).
+template <typename Sums>
+void imageFromSums(const Sums& sums, size_t first, size_t count, float* out) {
+    forPixels(count, [&](size_t begin, size_t end) {
+        for (size_t j = begin; j < end; ++j) {
+            double s[8];
+            sums(first + j, s);
+            const double w = s[3] + s[7];
             for (int c = 0; c < 3; ++c)
-                out[i * 3 + c] = float((s[c] + s[4 + c]) / w);
-    }
-    return out;
+                out[j * 3 + c] = w > 0 ? float((s[c] + s[4 + c]) / w) : 0.0f;
+        }
+    });
 }
 } // namespace
-
-void Film::pixelSums(size_t pixel, double* s) const {
-    toUnits(&sum_[pixel * 8], scale_, weightScale_, s);
-}
 
 bool Film::addHalfBufferRelMse(size_t pixel, double& total, size_t& count) const {
     double s[8];
@@ -319,13 +487,27 @@ bool Film::addHalfBufferRelMse(size_t pixel, double& total, size_t& count) const
 }
 
 std::vector<float> Film::image() const {
-    return imageFromSums(sum_.data(), size_t(width_) * height_, scale_, weightScale_);
+    std::vector<float> out(pixels() * 3);
+    imageRows(0, height_, out.data());
+    return out;
+}
+
+void Film::imageRows(int y0, int y1, float* rgb) const {
+    imageFromSums([&](size_t i, double* s) { pixelSums(i, s); }, size_t(y0) * size_t(width_),
+                  size_t(y1 - y0) * size_t(width_), rgb);
 }
 
 std::vector<float> Film::imageOf(const State& state) {
-    return imageFromSums(state.sums.data(), state.sums.size() / 8,
-                         std::ldexp(1.0, state.scaleExponent),
-                         std::ldexp(1.0, state.weightExponent));
+    const double scale = std::ldexp(1.0, state.scaleExponent),
+                 weightScale = std::ldexp(1.0, state.weightExponent);
+    std::vector<float> out(state.sums.size() / 8 * 3);
+    imageFromSums(
+        [&](size_t i, double* s) {
+            for (int k = 0; k < 8; ++k)
+                s[k] = double(state.sums[i * 8 + size_t(k)]) / (k % 4 == 3 ? weightScale : scale);
+        },
+        0, state.sums.size() / 8, out.data());
+    return out;
 }
 
 std::vector<float> Film::halfImage(int half) const {

@@ -7,6 +7,13 @@
 // film is exact end to end, so sums of any iterations, added in any grouping (checkpoints,
 // partial renders merged later), give the same image bit for bit.
 //
+// Memory (per pixel): the iteration's sums, 64 bytes; the whole render's, 64 bytes while every
+// sum fits 64 bits, which at the usual scale of 2^40 is 2^23 samples of the brightest emitter
+// in one pixel (the high halves, 64 bytes more, are added the first time a sum could pass 2^63).
+// Sample counts are kept per 8 x 8 tile. The first iteration's sums become the whole render's
+// without a copy, and the next iteration's are only allocated when it begins: a render of one
+// iteration holds 64 bytes a pixel, of more iterations 128.
+//
 // No accumulator can wrap: at most N = (samples per pixel and iteration) x (pixels a filter
 // reaches) adds land in one in an iteration, and each add is clamped (and counted as saturated)
 // at 2^62 / N. The fixed-point scale puts one sample of the scene's brightest emitter at 2^40,
@@ -60,9 +67,12 @@ class Film {
     int width() const { return width_; }
     int height() const { return height_; }
 
+    // Before each iteration's samples (the constructor begins the first): clears the
+    // iteration's sums. Between endIteration() and this, lastIterationImage() is that
+    // iteration's image.
     void beginIteration();
-    // Thread-safe. Once per camera sample: adds the sample's filter weight, and counts the sample
-    // in its pixel.
+    // Thread-safe. Once per camera sample: adds the sample's filter weight. (Samples are counted
+    // by tile at endIteration(): every pixel of a sampling tile takes the iteration's samples.)
     void addSample(vec2 filmPos, uint sampleIndex);
     // Thread-safe. Any number of times per sample: adds radiance it carried to the camera.
     // `key` makes the stochastic rounding deterministic (filmKey()).
@@ -72,13 +82,17 @@ class Film {
     // add to a line not in cache stalls the core until it arrives; prefetching a chunk's splats
     // before adding them overlaps those misses.
     void prefetch(vec2 filmPos) const;
+    // Adds the iteration to the whole render's sums (throws std::logic_error without a
+    // beginIteration() since the last).
     void endIteration();
     // Drops the iteration in progress (a stopped render): the film is as after endIteration()
-    // of the last whole iteration.
-    void discardIteration() { beginIteration(); }
+    // of the last whole iteration, and a new iteration has begun.
+    void discardIteration();
 
     // The render so far: sum of weighted radiance / sum of weights, RGB, row-major.
     std::vector<float> image() const;
+    // Rows y0 .. y1 - 1 of image() into rgb (width x (y1 - y0) x 3 floats).
+    void imageRows(int y0, int y1, float* rgb) const;
     // The render of one half's samples alone (half 0 or 1).
     std::vector<float> halfImage(int half) const;
     // relMSE of image() estimated from the halves: per value (A - B)^2 / 4 / (m^2 + 0.01),
@@ -87,8 +101,9 @@ class Film {
     // The same, or nothing while no pixel has samples in both halves (one iteration of one
     // sample per pixel): then there is no estimate yet, rather than an estimate of 0.
     std::optional<double> halfBufferRelMseEstimate() const;
-    // The last completed iteration alone (for per-iteration statistics).
-    std::vector<float> lastIterationImage() const { return lastIteration_; }
+    // The last completed iteration alone (for per-iteration statistics), between endIteration()
+    // and the next beginIteration() (throws std::logic_error otherwise).
+    std::vector<float> lastIterationImage() const;
 
     // Adaptive sampling: `threshold` 0 turns it off (every pixel samples); tiles decide once
     // their pixels hold `minSamples` samples. Takes effect from the next iteration.
@@ -109,13 +124,14 @@ class Film {
     // iteration. The processes' iteration accumulators are then added together
     // (iterationAccumulators, setIterationAccumulators) before endIteration().
     void setShare(int index, int shares);
-    // The iteration's integer accumulators: 8 sums and a sample count per pixel, then the
-    // iteration's non-finite and saturated counts.
+    // The iteration's integer accumulators: 8 sums per pixel, then the iteration's non-finite
+    // and saturated counts. (endIteration() counts the samples of every tile still sampling, in
+    // any share: with shares, the accumulators are the sum over the shares by then.)
     std::vector<std::int64_t> iterationAccumulators() const;
     // Replaces them, with their sum over the processes (the same layout).
     void setIterationAccumulators(const std::vector<std::int64_t>& values);
     // Camera samples each pixel took in whole iterations, and their total.
-    const std::vector<std::uint32_t>& sampleCounts() const { return samples_; }
+    std::vector<std::uint32_t> sampleCounts() const;
     std::uint64_t samplesTaken() const;
 
     // The film's whole state between iterations, exactly: what a checkpoint keeps.
@@ -137,6 +153,12 @@ class Film {
     double fixedPointScale() const { return scale_; }
 
   private:
+    size_t pixels() const { return size_t(width_) * size_t(height_); }
+    size_t tileOf(size_t pixel) const;
+    // The whole render's sum k (0 .. 7) of pixel i, in fixed-point units.
+    Fixed sumAt(size_t i, int k) const;
+    void widenSums(); // adds the high halves, sign-extending every sum
+    void addIterationToSums();
     int halfOf(uint sampleIndex) const; // (iteration + index within it) mod 2
     void decideTiles();                 // the tiles this process samples: adaptive mask and share
     void decideAdaptiveTiles();         // the adaptive mask, from the sums and counts
@@ -158,15 +180,32 @@ class Film {
     struct alignas(64) PixelSums {
         std::atomic<std::int64_t> v[8];
     };
-    std::unique_ptr<PixelSums[]> acc_;
-    std::vector<Fixed> sum_; // 8 per pixel, whole render, in fixed-point units
-    std::vector<float> lastIteration_;
+    struct FreeSums {
+        void operator()(PixelSums* p) const;
+    };
+    using Sums = std::unique_ptr<PixelSums[], FreeSums>;
+    // Allocated with every sum 0, in huge pages where the system gives them (a 16-Mpixel film's
+    // first touch is then 2 thousand page faults rather than a quarter million), zeroed in
+    // parallel.
+    static Sums zeroedSums(size_t pixels);
+    Sums acc_;             // this iteration; null until it begins
+    bool open_ = false;    // an iteration has begun and not ended
+    bool accZero_ = false; // acc_ holds only zeros
+    // The whole render's sums, in fixed-point units: the low 64 bits (null: all 0), and the high
+    // 64 bits (null while every sum fits in 64 bits, the low word then sign-extended).
+    Sums sumLo_;
+    std::unique_ptr<std::int64_t[]> sumHi_;
+    std::uint64_t sumBound_ = 0; // while sumHi_ is null: the largest |sum|
+    // The last ended iteration's sums (acc_, or sumLo_ when it was the first); null once the
+    // next iteration begins.
+    const PixelSums* lastIteration_ = nullptr;
     std::atomic<std::uint64_t> nonFinite_{0}, saturated_{0};
-    std::unique_ptr<std::atomic<std::uint32_t>[]> iterationSamples_; // per pixel, this iteration
-    std::vector<std::uint32_t> samples_;                             // per pixel, whole render
     double adaptiveThreshold_ = 0.0;
     int adaptiveMinSamples_ = 0;
     int tilesX_ = 0, tilesY_ = 0;
+    // Camera samples each pixel of a tile took in whole iterations: all of a tile's pixels
+    // sample together (adaptive sampling and the shares decide by tile), so one count a tile.
+    std::vector<std::uint32_t> tileSamples_;
     std::vector<std::uint8_t> active_; // per tile; empty: adaptive sampling off
     size_t activeTiles_ = 1;
     int share_ = 0, shares_ = 1;

@@ -314,6 +314,10 @@ const char* RenderSession::iterate(const ProgressCallback& onIteration) {
             sync_.agreeBefore(stop_.stopAsked(), stop_.timeUp(ran, renderSeconds_), stats_.stages);
         if (const char* why = stop_.before(ran, agreed, film)) return why;
         const auto iterationStart = std::chrono::steady_clock::now();
+        {
+            StageTimer t(stats_.stages, "accumulate");
+            film.beginIteration();
+        }
         bool whole = backend_->renderIteration(uint(done_), film);
         embree_->checkError("tracing");
         textures_->checkErrors();

@@ -40,6 +40,7 @@ TEST(Film, RoundingIsUnbiasedAcrossIterations) {
     const float value = float(step * 0.3); // 0.3 of one fixed-point step
     const int iterations = 4000;
     for (int it = 0; it < iterations; ++it) {
+        film.beginIteration();
         film.addSample(vec2(0.5f), uint(it));
         film.splat(vec2(0.5f), uint(it), vec3(value), 7u); // same path key every iteration
         film.endIteration();
@@ -67,6 +68,64 @@ TEST(Film, NoAccumulatorWrapsAtTheMostSamplesAFilterGathers) {
     const std::vector<float> img = film.image();
     for (float v : img)
         EXPECT_NEAR(v, 8.0f, 8e-6f);
+}
+
+// The whole render's sums start at 64 bits and gain their high words the first time a sum could
+// pass 2^63: 24 iterations of a sample at 2^61 (radiance 2^21 at the scale 2^40) sum to 1.5 x
+// 2^65 per channel, and the image is still exactly 2^21, as are a checkpoint's state of the
+// film and a film restored from it, which goes on summing. A negative sum (a filter's negative
+// lobe) sign-extends.
+TEST(Film, SumsWidenPast64BitsWithoutLosingAnything) {
+    Film film(2, 1, Filter{}, 1.0f);
+    ASSERT_EQ(film.fixedPointScale(), std::ldexp(1.0, 40));
+    const float big = std::ldexp(1.0f, 21);
+    for (int it = 0; it < 24; ++it) {
+        if (it > 0) film.beginIteration();
+        film.addSample(vec2(0.5f), uint(it));
+        film.addSample(vec2(1.5f), uint(it));
+        film.splat(vec2(0.5f), uint(it), vec3(big, 1.0f, 0.5f), 1u);
+        film.splat(vec2(1.5f), uint(it), vec3(0.25f), 2u);
+        film.endIteration();
+        EXPECT_EQ(film.lastIterationImage()[0], big) << it;
+    }
+    EXPECT_EQ(film.saturatedSamples(), 0u);
+    const std::vector<float> img = film.image();
+    EXPECT_EQ(img[0], big);
+    EXPECT_EQ(img[1], 1.0f);
+    EXPECT_EQ(img[2], 0.5f);
+    EXPECT_EQ(img[3], 0.25f);
+    const Film::State state = film.state();
+    // Half 0 took the even iterations' samples (sample index 0, iteration it: half it mod 2).
+    EXPECT_EQ(state.sums[0], Film::Fixed(12) << 61);
+    EXPECT_EQ(Film::imageOf(state), img);
+    Film resumed(2, 1, Filter{}, 1.0f);
+    resumed.restore(state);
+    EXPECT_EQ(resumed.image(), img);
+    resumed.addSample(vec2(0.5f), 24u);
+    resumed.splat(vec2(0.5f), 24u, vec3(big), 1u);
+    resumed.endIteration();
+    EXPECT_EQ(resumed.image()[0], big);
+    EXPECT_EQ(resumed.state().sums[0], Film::Fixed(13) << 61);
+
+    Film negative(1, 1, Filter{}, 1.0f);
+    for (int it = 0; it < 8; ++it) {
+        if (it > 0) negative.beginIteration();
+        negative.addSample(vec2(0.5f), 0u);
+        negative.splat(vec2(0.5f), 0u, vec3(-big, big, 1.0f), 1u);
+        negative.endIteration();
+    }
+    EXPECT_EQ(negative.image(), (std::vector<float>{-big, big, 1.0f}));
+    EXPECT_EQ(negative.state().sums[0], -(Film::Fixed(8) << 61));
+}
+
+// An iteration ends only after it began: a loop that forgets beginIteration() would add the
+// same sums twice.
+TEST(Film, AnIterationEndsOnceItBegan) {
+    Film film(1, 1, Filter{}, 1.0f);
+    film.endIteration();
+    EXPECT_THROW(film.endIteration(), std::logic_error);
+    film.beginIteration();
+    EXPECT_THROW(film.lastIterationImage(), std::logic_error);
 }
 
 // The usual film keeps its brightest emitter's sample at 2^40 (a box filter, up to 64 samples
