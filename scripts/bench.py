@@ -39,10 +39,15 @@ are noisy; ratios travel, absolute seconds do not).
                                each iteration (waiting for the slowest rank, mostly; the most of
                                any rank), and the ratios to one process.
                                Writes out/bench/mpi.json.
+  scripts/bench.py large       large images: the Cornell box at 4000x4000, 1 spp, on every
+                               backend (and --baseline's): peak RSS above the same render at
+                               16x16 (the fixed costs), in bytes per pixel; the seconds to write
+                               the 16-Mpixel EXR; render and wall seconds. Best of N, alternating.
+                               Writes out/bench/large.json.
   scripts/bench.py all         reference and pipeline (default)
 
 Options: --repeat N (best of N, default 3; production: 1), --spillway PATH (default
-build/spillway), --baseline PATH (incore), --depths 1,2,3 and --exponents 8,11,14,17 (production), --scene-args "..."
+build/spillway), --baseline PATH (incore, large), --depths 1,2,3 and --exponents 8,11,14,17 (production), --scene-args "..."
 (production: options for make_production_scene.py).
 """
 import argparse
@@ -351,16 +356,57 @@ def bench_mpi(spillway, repeat, ranks_list, threads_per_rank, one_process_thread
         json.dump(results, f, indent=1)
 
 
+def bench_large(spillway, repeat, baseline):
+    box = os.path.join(ROOT, "scenes", "cornell-box.yaml")
+    os.makedirs(os.path.join(ROOT, "out", "bench"), exist_ok=True)
+    scenes = {}
+    for size in (16, 4000):
+        path = os.path.join(ROOT, "out", "bench", "cornell-%d.yaml" % size)
+        with open(path, "w") as f:
+            f.write(open(box).read()
+                    .replace("image: {width: 256, height: 256, sample base: 2, iterations: 16}",
+                             "image: {width: %d, height: %d, sample base: 1, iterations: 1}" % (size, size))
+                    .replace("filename: cornell-box/", "filename: %s/" % os.path.join(ROOT, "scenes", "cornell-box")))
+        scenes[size] = path
+    builds = [("", spillway)] + ([("baseline ", baseline)] if baseline else [])
+    configs = [(label + backend, binary, backend) for label, binary in builds
+               for backend in ("reference", "cpu", "vulkan")]
+    best = {}
+    for _ in range(repeat):  # alternating: one run of every configuration per round
+        for name, binary, backend in configs:
+            small, small_rss = run(binary, scenes[16], ["--backend", backend], 1)
+            big, big_rss = run(binary, scenes[4000], ["--backend", backend], 1)
+            if small is None or big is None:
+                continue
+            row = {"bytes_per_pixel": (big_rss - small_rss) * 1048576 / 16e6,
+                   "peak_rss_mib": big_rss, "fixed_rss_mib": small_rss,
+                   "write_image_seconds": big["stage_seconds"].get("write image", 0.0),
+                   "render_seconds": big["render_seconds"], "wall_seconds": big["wall_seconds"]}
+            if name not in best or row["wall_seconds"] < best[name]["wall_seconds"]:
+                best[name] = row
+    print("Cornell box 4000x4000, 1 spp (16 Mpixels), best of %d, alternating" % repeat)
+    print("%-22s %14s %10s %12s %10s %8s" % ("", "bytes/pixel", "peak MiB", "write image", "render", "wall"))
+    for name, _, _ in configs:
+        r = best.get(name)
+        if r is None:
+            print("%-22s (did not run)" % name)
+            continue
+        print("%-22s %14.1f %10.0f %11.2fs %9.2fs %7.2fs" % (
+            name, r["bytes_per_pixel"], r["peak_rss_mib"], r["write_image_seconds"],
+            r["render_seconds"], r["wall_seconds"]))
+    json.dump(best, open(os.path.join(ROOT, "out", "bench", "large.json"), "w"), indent=2)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("what", nargs="?", default="all",
-                    choices=["reference", "pipeline", "production", "incore", "mpi", "all"])
+                    choices=["reference", "pipeline", "production", "incore", "mpi", "large", "all"])
     ap.add_argument("--repeat", type=int)
     ap.add_argument("--depths", default="1,2,3")
     ap.add_argument("--exponents", default="8,11,14,17")
     ap.add_argument("--scene-args", default="")
     ap.add_argument("--spillway", default=os.path.join(ROOT, "build", "spillway"))
-    ap.add_argument("--baseline", help="another build's spillway binary (incore: before/after)")
+    ap.add_argument("--baseline", help="another build's spillway binary (incore, large: before/after)")
     ap.add_argument("--ranks", default="2", help="mpi: rank counts to run, e.g. 2,4,8,16")
     ap.add_argument("--threads-per-rank", type=int, default=0,
                     help="mpi: threads of each rank (default: --threads / ranks)")
@@ -373,6 +419,9 @@ def main():
     a.repeat = a.repeat or 3
     if a.what == "incore":
         bench_incore(a.spillway, a.repeat, a.baseline)
+        return
+    if a.what == "large":
+        bench_large(a.spillway, a.repeat, a.baseline)
         return
     if a.what == "mpi":
         bench_mpi(a.spillway, a.repeat, [int(r) for r in a.ranks.split(",")], a.threads_per_rank, a.threads)

@@ -158,9 +158,9 @@ void writeOutputs(const RenderOptions& o, const Scene& scene, RenderResult& resu
     OutputFile image(o.output);
     {
         StageTimer t(result.stats.stages, "write image");
-        const std::vector<unsigned char> bytes =
-            encodeImage(o.output, {scene.image.width, scene.image.height, result.film->image()});
-        image.write(bytes.data(), bytes.size());
+        const Film& film = *result.film;
+        writeImageRows(image, o.output, scene.image.width, scene.image.height,
+                       [&](int y0, int y1, float* rgb) { film.imageRows(y0, y1, rgb); });
         image.flush();
     }
     std::unique_ptr<OutputFile> stats;

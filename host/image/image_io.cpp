@@ -41,6 +41,8 @@ namespace {
 std::vector<unsigned char> encode(const std::string& path, const OIIO::ImageSpec& spec,
                                   OIIO::TypeDesc format, const void* data) {
     std::vector<unsigned char> bytes;
+    // Room for the pixels uncompressed and a header: the buffer is never copied as it grows.
+    bytes.reserve(spec.image_bytes() + 65536);
     OIIO::Filesystem::IOVecOutput proxy(bytes);
     auto out = OIIO::ImageOutput::create(path, &proxy);
     if (!out) throw std::runtime_error("cannot write '" + path + "': " + OIIO::geterror());
@@ -53,20 +55,103 @@ std::vector<unsigned char> encode(const std::string& path, const OIIO::ImageSpec
 
 } // namespace
 
-std::vector<unsigned char> encodeImage(const std::string& path, const ImageRGB& image) {
+namespace {
+
+// The spec Spillway writes `path` with: linear float EXR or 8-bit sRGB PNG.
+OIIO::ImageSpec outputSpec(const std::string& path, int width, int height) {
     if (!isSupportedOutput(path))
         throw std::runtime_error("cannot write '" + path + "': use .exr or .png");
     const bool png = extension(path) == ".png";
-    OIIO::ImageSpec spec(image.width, image.height, 3,
-                         png ? OIIO::TypeDesc::UINT8 : OIIO::TypeDesc::FLOAT);
+    OIIO::ImageSpec spec(width, height, 3, png ? OIIO::TypeDesc::UINT8 : OIIO::TypeDesc::FLOAT);
     spec.attribute("oiio:ColorSpace", png ? "sRGB" : "Linear");
     spec.attribute("Software", "Spillway");
-    if (png) {
-        std::vector<std::uint8_t> bytes(image.rgb.size());
-        std::transform(image.rgb.begin(), image.rgb.end(), bytes.begin(), linearToSrgb8);
+    // OpenEXR's default, zip, packs a rendered float image 5 % smaller than RLE, at 3x the time:
+    // 3.9 s against 1.3 s for 16 Mpixels on 2 threads (a render's mantissas are noise to a
+    // compressor). Large images are written with RLE, which still packs black and flat regions.
+    if (!png && std::int64_t(width) * height > kZipImagePixels)
+        spec.attribute("compression", "rle");
+    return spec;
+}
+
+std::vector<std::uint8_t> toSrgb8(const float* rgb, size_t values) {
+    std::vector<std::uint8_t> bytes(values);
+    std::transform(rgb, rgb + values, bytes.begin(), linearToSrgb8);
+    return bytes;
+}
+
+// OpenImageIO's writers write through this into an OutputFile, at the offsets they ask for
+// (OpenEXR goes back to fill in its chunk table). An error is kept and reported as a short
+// write, which the writer turns into its own failure; writeImageRows then throws the kept one.
+class OutputFileProxy : public OIIO::Filesystem::IOProxy {
+  public:
+    explicit OutputFileProxy(OutputFile& file) : IOProxy("", Write), file_(file) {}
+    const char* proxytype() const override { return "spillway-output"; }
+    size_t write(const void* buf, size_t size) override {
+        const size_t n = pwrite(buf, size, m_pos);
+        m_pos += int64_t(n);
+        return n;
+    }
+    size_t pwrite(const void* buf, size_t size, int64_t offset) override {
+        if (!failure_.empty()) return 0;
+        try {
+            file_.writeAt(std::uint64_t(offset), buf, size);
+        } catch (const std::exception& e) {
+            failure_ = e.what();
+            return 0;
+        }
+        size_ = std::max(size_, size_t(offset) + size);
+        return size;
+    }
+    size_t size() const override { return size_; }
+    const std::string& failure() const { return failure_; }
+
+  private:
+    OutputFile& file_;
+    size_t size_ = 0;
+    std::string failure_;
+};
+
+} // namespace
+
+std::vector<unsigned char> encodeImage(const std::string& path, const ImageRGB& image) {
+    const OIIO::ImageSpec spec = outputSpec(path, image.width, image.height);
+    if (spec.format == OIIO::TypeDesc::UINT8) {
+        const std::vector<std::uint8_t> bytes = toSrgb8(image.rgb.data(), image.rgb.size());
         return encode(path, spec, OIIO::TypeDesc::UINT8, bytes.data());
     }
     return encode(path, spec, OIIO::TypeDesc::FLOAT, image.rgb.data());
+}
+
+void writeImageRows(OutputFile& file, const std::string& path, int width, int height,
+                    const ImageRows& rows) {
+    const OIIO::ImageSpec spec = outputSpec(path, width, height);
+    if (!file.seekable()) { // a FIFO: encoded in memory, then written in order
+        ImageRGB image{width, height, std::vector<float>(size_t(width) * height * 3)};
+        rows(0, height, image.rgb.data());
+        const std::vector<unsigned char> bytes = encodeImage(path, image);
+        file.write(bytes.data(), bytes.size());
+        return;
+    }
+    OutputFileProxy proxy(file);
+    auto out = OIIO::ImageOutput::create(path, &proxy);
+    if (!out) throw std::runtime_error("cannot write '" + path + "': " + OIIO::geterror());
+    // Blocks of about 4 MiB of floats: enough lines for every thread of the EXR writer.
+    const int block = std::min(height, std::max(16, int((size_t(4) << 20) / (size_t(width) * 12))));
+    std::vector<float> rgb(size_t(width) * size_t(block) * 3);
+    bool ok = out->open(path, spec);
+    for (int y0 = 0; ok && y0 < height; y0 += block) {
+        const int y1 = std::min(height, y0 + block);
+        rows(y0, y1, rgb.data());
+        const size_t values = size_t(width) * size_t(y1 - y0) * 3;
+        ok = spec.format == OIIO::TypeDesc::UINT8
+                 ? out->write_scanlines(y0, y1, 0, OIIO::TypeDesc::UINT8,
+                                        toSrgb8(rgb.data(), values).data())
+                 : out->write_scanlines(y0, y1, 0, OIIO::TypeDesc::FLOAT, rgb.data());
+    }
+    std::string err = ok ? "" : out->geterror();
+    if (!out->close() && ok) err = out->geterror(), ok = false;
+    if (!proxy.failure().empty()) throw std::runtime_error(proxy.failure());
+    if (!ok) throw std::runtime_error("cannot write '" + path + "': " + err);
 }
 
 void writeImage(const std::string& path, const ImageRGB& image) {

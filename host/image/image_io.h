@@ -3,6 +3,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <functional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -27,6 +28,14 @@ std::uint8_t linearToSrgb8(float v);
 bool isSupportedOutput(const std::string& path);
 // The file's bytes, in the format the path's extension names (.exr float, .png 8-bit sRGB).
 std::vector<unsigned char> encodeImage(const std::string& path, const ImageRGB& image);
+class OutputFile;
+// Rows y0 .. y1 - 1 of an image, RGB floats, into `rgb` (width x (y1 - y0) x 3).
+using ImageRows = std::function<void(int y0, int y1, float* rgb)>;
+// Encodes a width x height image, a block of rows at a time, into `file` (not committed) in the
+// format `path`'s extension names: a 16-Mpixel render needs neither its whole float image nor
+// its encoded bytes in memory at once. Throws std::runtime_error naming the path.
+void writeImageRows(OutputFile& file, const std::string& path, int width, int height,
+                    const ImageRows& rows);
 // Writes the image whole or not at all (host/image/output_file.h). Throws std::runtime_error naming
 // the path when the file cannot be written.
 void writeImage(const std::string& path, const ImageRGB& image);
@@ -37,6 +46,9 @@ void writeImage8(const std::string& path, int width, int height, const unsigned 
 // The most pixels an image Spillway renders, reads (a reference, a checkpoint, an environment
 // map) or compares may have: 2^26 keeps film and ray ids well inside 32-bit indices.
 constexpr long long kMaxImagePixels = 1LL << 26;
+// EXR images up to this many pixels are zip-compressed (OpenEXR's default), larger ones RLE
+// (encodeImage says why).
+constexpr long long kZipImagePixels = 1LL << 22;
 
 // Whether a header's size is one Spillway reads: 1 .. kMaxImagePixels pixels. "" if so, else
 // why not, naming `path` (checked before any pixel is allocated: a header is a few bytes that

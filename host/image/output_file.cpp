@@ -96,6 +96,19 @@ void OutputFile::write(const void* data, std::size_t size) {
     }
 }
 
+void OutputFile::writeAt(std::uint64_t offset, const void* data, std::size_t size) {
+    const char* p = static_cast<const char*>(data);
+    while (size > 0) {
+        const ssize_t n = ::pwrite(fd_, p, size, off_t(offset));
+        if (n < 0 && errno == EINTR) continue;
+        if (n < 0) fail("", errno);
+        if (n == 0) fail("no space left", 0);
+        p += n;
+        offset += std::uint64_t(n);
+        size -= std::size_t(n);
+    }
+}
+
 void OutputFile::flush() {
     if (inPlace_ || flushed_) return;
     if (::fdatasync(fd_) != 0) fail("", errno);

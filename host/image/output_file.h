@@ -11,6 +11,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <string>
 
 namespace spw {
@@ -26,6 +27,11 @@ class OutputFile {
     // Throws std::runtime_error naming the path on any error (a full disk, a file-size limit).
     void write(const void* data, std::size_t size);
     void write(const std::string& text) { write(text.data(), text.size()); }
+    // Writes at `offset` from the start of the file (pwrite), where seekable(): an image writer
+    // that goes back to fill in a table. Throws like write().
+    void writeAt(std::uint64_t offset, const void* data, std::size_t size);
+    // Whether writeAt() can be used: not for a destination written in place (a FIFO).
+    bool seekable() const { return !inPlace_; }
     // Flushes to disk: where a late write-back error (a full disk) surfaces. Throws like write().
     void flush();
     // Flushes (if not done) and gives the file its name. Throws like write().
