@@ -3,10 +3,13 @@
 #include "host/cpu/simd_shading.h"
 #include "host/pipeline/slotted_engine.h"
 #include "host/pipeline/stages.h"
+#include "host/scene/surface_models.h"
 #include "host/simd/simd_random.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+
+#include <set>
 
 namespace spw {
 namespace {
@@ -46,6 +49,16 @@ class CpuShading : public SlottedEngine {
         SlottedEngine::publishStats(stats);
         if (fused_) stats.extra["stages"] = "fused"; // every per-hit stage chunk by chunk
         stats.extra["simd_shading"] = simd_ ? simdTarget() : "off";
+        // The scene's surface models by how their hits were shaded: a run at a time through
+        // their wide twin, or one hit at a time (kWideTwins).
+        std::set<uint> used;
+        for (const Shader& shader : ctx_.scene.shaders)
+            used.insert(shader.params.model);
+        nlohmann::json wide = nlohmann::json::array(), scalar = nlohmann::json::array();
+        for (uint model : used)
+            (simd_ && kWideTwins[model].kernel ? wide : scalar).push_back(surfaceModel(model)->name);
+        stats.extra["wide_models"] = wide;
+        stats.extra["scalar_models"] = scalar;
     }
 
     int slots() const override { return 1; }

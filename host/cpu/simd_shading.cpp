@@ -269,6 +269,15 @@ void takeLane(const ShaderParams& sh, const LambertResults& res, size_t k, const
 
 } // namespace
 
+const WideTwin kWideTwins[] = {
+    {kModelNull, nullptr}, // a Null hit only passes the path on (and emits, for a quad light)
+    {kModelLambert, "ShadeLambertLanes"},
+    {kModelConductor, nullptr},
+    {kModelDielectric, nullptr},
+};
+static_assert(sizeof(kWideTwins) / sizeof(kWideTwins[0]) == kModelCount,
+              "every registered surface model names its wide twin, or nullptr for none");
+
 bool simdShadingApplies(const SceneView& view) {
     for (uint i = 0; i < view.emitterCount; ++i)
         if (view.emitters[i].type != kEmitterTriangle) return false;
@@ -321,7 +330,7 @@ void shadeHits(const SceneView& view, const RenderParams& rp, bool simd, const S
     };
     for (size_t i = 0; i < n; ++i) {
         const ShaderParams& sh = view.shaders[in[i].hit.shader];
-        if (sh.model != kModelLambert) {
+        if (sh.model != kModelLambert) { // the one model with a kernel (kWideTwins)
             if (!shadeGoesOn(rp, sh, in[i].path)) {
                 shadeSurfaceWith(view, rp, in[i].hit, in[i].rayDir, in[i].path, vec4(0.0f),
                                  vec4(0.0f), out[i]);

@@ -20,6 +20,18 @@
 
 namespace spw {
 
+// Each registered surface model's wide twin in this engine, in the registry's order
+// (shaders/shared/surface_models.h): the kernel that shades a run of its hits SIMD-wide, or
+// nullptr where its hits go through shadeSurfaceWith() one at a time (their random numbers still
+// made SIMD-wide). A model added to the registry must be added here too (a static_assert counts
+// them), and the cpu backend's --stats names the scene's models that have no twin
+// (`scalar_models`), so that a model without one is never silently scalar.
+struct WideTwin {
+    uint model;         // kModel*
+    const char* kernel; // nullptr: none
+};
+extern const WideTwin kWideTwins[kModelCount];
+
 // Whether the kernel can shade this scene's Lambert hits: every emitter next-event estimation
 // picks is a triangle (point lights and the environment take shadeSurface()).
 bool simdShadingApplies(const SceneView& view);

@@ -4,12 +4,17 @@
 // sampler, paths before min depth, past it and at max depth, and Lambert hits mixed with other
 // models in runs that are not a multiple of the vector width.
 #include "host/cpu/simd_shading.h"
+#include "host/render/render.h"
+#include "host/scene/scene.h"
+#include "host/scene/surface_models.h"
 #include "host/simd/simd_random.h"
+#include "test_util.h"
 
 #include "shared/path.h"
 
 #include <gtest/gtest.h>
 #include <hwy/targets.h>
+#include <nlohmann/json.hpp>
 
 #include <cstring>
 #include <random>
@@ -228,6 +233,34 @@ TEST(SimdShading, RunsInTheWidestInstructionSetAndOnlyWhereEveryLightIsATriangle
     EXPECT_FALSE(simdShadingApplies(f.view()));
     f.emitters[1].type = kEmitterEnvironment;
     EXPECT_FALSE(simdShadingApplies(f.view()));
+}
+
+// The registry's every model names its wide twin in this engine, or none, in the registry's
+// order; and the cpu backend's stats say which of the scene's models were shaded a run at a
+// time and which one hit at a time (scenes/every-model.yaml: Lambert wide; Conductor,
+// Dielectric and its quad light's emissive Null not), all of them scalar with SIMD off.
+TEST(SimdShading, EveryModelNamesItsWideTwinAndTheStatsNameTheScalarOnes) {
+    for (size_t i = 0; i < kSurfaceModelCount; ++i) {
+        EXPECT_EQ(kWideTwins[i].model, kSurfaceModels[i].model) << kSurfaceModels[i].name;
+        EXPECT_EQ(kWideTwins[i].kernel != nullptr, kSurfaceModels[i].model == kModelLambert)
+            << kSurfaceModels[i].name;
+    }
+    Scene scene = loadScene(test::sourceDir() + "/scenes/every-model.yaml");
+    scene.image.width = scene.image.height = 16;
+    RenderConfig cfg;
+    cfg.backend = BackendKind::Cpu;
+    cfg.spp = 4;
+    using Names = std::vector<std::string>;
+    const std::unique_ptr<RenderResult> wide = render(scene, cfg);
+    const nlohmann::json& stats = wide->stats.extra;
+    EXPECT_EQ(stats["wide_models"].get<Names>(), Names{"Lambert"});
+    EXPECT_EQ(stats["scalar_models"].get<Names>(), (Names{"Null", "Conductor", "Dielectric"}));
+    cfg.pipeline.simdShading = false;
+    const std::unique_ptr<RenderResult> scalarRun = render(scene, cfg);
+    const nlohmann::json& scalar = scalarRun->stats.extra;
+    EXPECT_EQ(scalar["wide_models"].get<Names>(), Names{});
+    EXPECT_EQ(scalar["scalar_models"].get<Names>(),
+              (Names{"Null", "Lambert", "Conductor", "Dielectric"}));
 }
 
 } // namespace
