@@ -56,7 +56,8 @@ class CpuShading : public SlottedEngine {
             used.insert(shader.params.model);
         nlohmann::json wide = nlohmann::json::array(), scalar = nlohmann::json::array();
         for (uint model : used)
-            (simd_ && kWideTwins[model].kernel ? wide : scalar).push_back(surfaceModel(model)->name);
+            (simd_ && kWideTwins[model].kernel ? wide : scalar)
+                .push_back(surfaceModel(model)->name);
         stats.extra["wide_models"] = wide;
         stats.extra["scalar_models"] = scalar;
     }
