@@ -457,7 +457,6 @@ void Film::restore(const State& state) {
 }
 
 namespace {
-// The image of `pixels` pixels whose eight sums in radiance and weight units sums(i, s) gives.
 // Pixels first .. first + count - 1 of the image whose pixel i's eight sums, in radiance and
 // weight units, sums(i, s) gives, into out (3 floats a pixel).
 template <typename Sums>
