@@ -18,15 +18,6 @@
 namespace spw {
 namespace {
 
-float filterWeight1D(FilterType type, float d, float radius) {
-    d = std::fabs(d);
-    if (d >= radius) return 0.0f;
-    if (type == FilterType::Tent) return 1.0f - d / radius;
-    float sigma = radius * 0.5f; // Gaussian, shifted to reach 0 at the radius
-    float k = -0.5f / (sigma * sigma);
-    return std::exp(k * d * d) - std::exp(k * radius * radius);
-}
-
 // The stochastic rounding's key: the caller's (path and bounce within the iteration) mixed with
 // the render-wide sample index, so that every iteration rounds with fresh random numbers. Without
 // the sample index a pixel whose value repeats each iteration (a tiny light seen through the
@@ -47,6 +38,16 @@ std::uint64_t magnitude(std::int64_t v) {
 }
 
 } // namespace
+
+// The filter's 1D weight at distance d from the sample. The Gaussian's constant terms are the
+// film's (gaussK_, gaussTail_): the same floats as computed in place, without an exp() each.
+float Film::weight1D(float d) const {
+    d = std::fabs(d);
+    const float radius = filter_.radius;
+    if (d >= radius) return 0.0f;
+    if (filter_.type == FilterType::Tent) return 1.0f - d / radius;
+    return std::exp(gaussK_ * d * d) - gaussTail_; // Gaussian, shifted to reach 0 at the radius
+}
 
 Film::Film(int width, int height, const Filter& filter, float brightestRadiance,
            int samplesPerIteration)
@@ -69,6 +70,10 @@ Film::Film(int width, int height, const Filter& filter, float brightestRadiance,
     const int top = std::min(40, 62 - logAdds - 16); // the brightest sample's exponent
     scale_ = std::ldexp(1.0, top - e);
     weightScale_ = std::ldexp(1.0, std::min(40, 62 - logAdds - 1));
+    sampleCap_ = std::int64_t(maxAdd_);
+    const float sigma = filter.radius * 0.5f;
+    gaussK_ = -0.5f / (sigma * sigma);
+    gaussTail_ = std::exp(gaussK_ * filter.radius * filter.radius);
     beginIteration();
 }
 
@@ -108,10 +113,28 @@ void Film::beginIteration() {
     accZero_ = true;
     open_ = true;
     lastIteration_ = nullptr;
+    if (sumsSamples() && !samples_) {
+        // Zeroed once; finishSamples() zeroes each sum it reads, discardIteration() the rest.
+        const size_t n = pixels() * samplesPerIteration_;
+        samples_.reset(new SampleSum[n]);
+        forPixels(n, [&](size_t begin, size_t end) {
+            for (size_t i = begin; i < end; ++i)
+                for (std::atomic<std::int64_t>& v : samples_[i].rgb)
+                    v.store(0, std::memory_order_relaxed);
+        });
+    }
+    samplesPending_ = sumsSamples();
 }
 
 void Film::discardIteration() {
     accZero_ = false;
+    if (samples_) {
+        forPixels(pixels() * samplesPerIteration_, [&](size_t begin, size_t end) {
+            for (size_t i = begin; i < end; ++i)
+                for (std::atomic<std::int64_t>& v : samples_[i].rgb)
+                    v.store(0, std::memory_order_relaxed);
+        });
+    }
     beginIteration();
 }
 
@@ -170,7 +193,8 @@ void Film::setShare(int index, int shares) {
     decideTiles();
 }
 
-std::vector<std::int64_t> Film::iterationAccumulators() const {
+std::vector<std::int64_t> Film::iterationAccumulators() {
+    finishSamples();
     const size_t n = size_t(width_) * height_;
     std::vector<std::int64_t> out(n * 8 + 2);
     for (size_t i = 0; i < n; ++i)
@@ -218,6 +242,16 @@ std::uint64_t Film::samplesTaken() const {
     return n;
 }
 
+std::int64_t Film::quantize(double v, uint u) {
+    if (std::fabs(v) > maxAdd_) {
+        saturated_.fetch_add(1, std::memory_order_relaxed);
+        v = std::copysign(maxAdd_, v);
+    }
+    const double fl = std::floor(v);
+    // Round up with probability frac(v): E[rounded] = v exactly.
+    return std::int64_t(fl) + (double(uintToUnit(u)) < v - fl ? 1 : 0);
+}
+
 void Film::add(int px, int py, int half, vec3 value, float weight, uint key) {
     std::atomic<std::int64_t>* a = &acc_[size_t(py) * width_ + size_t(px)].v[half * 4];
     uvec4 h = pcg4d(uvec4(key, uint(py * width_ + px), 0x5157u, 0x9E3779B9u));
@@ -225,51 +259,103 @@ void Film::add(int px, int py, int half, vec3 value, float weight, uint key) {
                           weight * weightScale_};
     const uint rnd[4] = {h.x, h.y, h.z, h.w};
     for (int c = 0; c < 4; ++c) {
-        double v = in[c];
-        if (std::fabs(v) > maxAdd_) {
-            saturated_.fetch_add(1, std::memory_order_relaxed);
-            v = std::copysign(maxAdd_, v);
-        }
-        double fl = std::floor(v);
-        // Round up with probability frac(v): E[rounded] = v exactly.
-        std::int64_t q = std::int64_t(fl) + (double(uintToUnit(rnd[c])) < v - fl ? 1 : 0);
+        const std::int64_t q = quantize(in[c], rnd[c]);
         if (q != 0) a[c].fetch_add(q, std::memory_order_relaxed);
     }
 }
 
-void Film::splat(vec2 filmPos, uint sampleIndex, vec3 radiance, uint key) {
+void Film::splat(uint path, vec2 filmPos, uint sampleIndex, vec3 radiance, uint key) {
     if (!std::isfinite(radiance.x) || !std::isfinite(radiance.y) || !std::isfinite(radiance.z)) {
         nonFinite_.fetch_add(1, std::memory_order_relaxed);
         return;
     }
     if (radiance.x == 0.0f && radiance.y == 0.0f && radiance.z == 0.0f) return;
-    filtered(filmPos, halfOf(sampleIndex), radiance, 0.0f, roundingKey(key, sampleIndex));
+    if (sumsSamples())
+        addToSample(path, radiance, roundingKey(key, sampleIndex));
+    else
+        filtered(filmPos, halfOf(sampleIndex), radiance, 0.0f, roundingKey(key, sampleIndex));
 }
 
-void Film::addSample(vec2 filmPos, uint sampleIndex) {
-    filtered(filmPos, halfOf(sampleIndex), vec3(0.0f), 1.0f, roundingKey(0u, sampleIndex));
-}
-
-void Film::prefetch(vec2 filmPos) const {
-    if (filter_.type == FilterType::Box) {
-        const int px = std::clamp(int(filmPos.x), 0, width_ - 1);
-        const int py = std::clamp(int(filmPos.y), 0, height_ - 1);
-        __builtin_prefetch(&acc_[size_t(py) * width_ + size_t(px)], 1);
+void Film::addSample(uint path, vec2 filmPos, uint sampleIndex) {
+    if (!sumsSamples()) {
+        filtered(filmPos, halfOf(sampleIndex), vec3(0.0f), 1.0f, roundingKey(0u, sampleIndex));
         return;
     }
-    // Every pixel of the footprint (a line each): a wide filter's splat waits on all of them.
-    const float r = std::min(filter_.radius, 2.0f); // beyond 4 x 4, prefetching the centre will do
+    SampleSum& s = samples_[path];
+    s.x = filmPos.x;
+    s.y = filmPos.y;
+    sampleBase_.store(sampleIndex - sampleIndex % samplesPerIteration_, std::memory_order_relaxed);
+}
+
+void Film::addToSample(uint path, vec3 radiance, uint key) {
+    std::atomic<std::int64_t>* sum = samples_[path].rgb;
+    const uvec4 h = pcg4d(uvec4(key, path, 0x5157u, 0x9E3779B9u));
+    const float in[3] = {radiance.x, radiance.y, radiance.z};
+    const uint rnd[3] = {h.x, h.y, h.z};
+    for (int c = 0; c < 3; ++c) {
+        const std::int64_t q = quantize(double(in[c]) * scale_, rnd[c]);
+        if (q == 0) continue;
+        // Saturating: the sum stays within the clamp of one film add (both terms are within
+        // it, so their sum fits 64 bits).
+        std::int64_t v = sum[c].load(std::memory_order_relaxed) + q;
+        if (v > sampleCap_ || v < -sampleCap_) {
+            saturated_.fetch_add(1, std::memory_order_relaxed);
+            v = v > 0 ? sampleCap_ : -sampleCap_;
+        }
+        sum[c].store(v, std::memory_order_relaxed);
+    }
+}
+
+void Film::finishSamples() {
+    if (!samplesPending_) return;
+    samplesPending_ = false;
+    const uint spi = samplesPerIteration_, base = sampleBase_.load();
+    // A band of rows at a time, in pixel order, so that neighbouring samples' footprints share
+    // cache lines. A sample in row y reaches rows y - reach .. y + reach: bands 2 x reach rows
+    // high, the even ones and then the odd ones, never write the same pixel at once, so each
+    // add is a plain load and store rather than an atomic (a fifth of this pass's time).
+    const int reach = int(std::ceil(filter_.radius + 0.5f));
+    const int band = std::max(8, 2 * reach), bands = (height_ + band - 1) / band;
+    for (int parity = 0; parity < 2; ++parity)
+        tbb::parallel_for(0, (bands + 1 - parity) / 2, [&](int k) {
+            const int y0 = (2 * k + parity) * band, y1 = std::min(height_, y0 + band);
+            for (int y = y0; y < y1; ++y)
+                for (int x = 0; x < width_; ++x) {
+                    if (!sampling(x, y)) continue;
+                    const size_t pixel = size_t(y) * size_t(width_) + size_t(x);
+                    for (uint s = 0; s < spi; ++s) {
+                        const size_t path = pixel * spi + s;
+                        SampleSum& sum = samples_[path];
+                        std::int64_t rgb[3];
+                        for (int c = 0; c < 3; ++c) {
+                            rgb[c] = sum.rgb[c].load(std::memory_order_relaxed);
+                            sum.rgb[c].store(0, std::memory_order_relaxed);
+                        }
+                        filterSample(path, vec2(sum.x, sum.y), base + s, rgb);
+                    }
+                }
+        });
+}
+
+template <typename Fn> void Film::forFootprint(vec2 filmPos, const Fn& fn) const {
+    const float r = filter_.radius;
     const int x0 = std::max(0, int(std::ceil(filmPos.x - 0.5f - r)));
     const int x1 = std::min(width_ - 1, int(std::floor(filmPos.x - 0.5f + r)));
     const int y0 = std::max(0, int(std::ceil(filmPos.y - 0.5f - r)));
     const int y1 = std::min(height_ - 1, int(std::floor(filmPos.y - 0.5f + r)));
-    for (int y = y0; y <= y1; ++y)
-        for (int x = x0; x <= x1; ++x)
-            __builtin_prefetch(&acc_[size_t(y) * width_ + size_t(x)], 1);
-}
-
-int Film::halfOf(uint sampleIndex) const {
-    return int((sampleIndex / samplesPerIteration_ + sampleIndex % samplesPerIteration_) & 1u);
+    // The filter is separable: each column's weight once, not once per row.
+    constexpr int kMaxReach = 2 * int(kMaxFilterRadius) + 2; // the widest footprint
+    float wx[kMaxReach];
+    for (int x = x0; x <= x1; ++x)
+        wx[x - x0] = weight1D(float(x) + 0.5f - filmPos.x);
+    for (int y = y0; y <= y1; ++y) {
+        const float wy = weight1D(float(y) + 0.5f - filmPos.y);
+        if (wy <= 0.0f) continue;
+        for (int x = x0; x <= x1; ++x) {
+            const float w = wy * wx[x - x0];
+            if (w > 0.0f) fn(x, y, w);
+        }
+    }
 }
 
 void Film::filtered(vec2 filmPos, int half, vec3 radiance, float weight, uint key) {
@@ -278,25 +364,48 @@ void Film::filtered(vec2 filmPos, int half, vec3 radiance, float weight, uint ke
         add(px, py, half, radiance, weight, key);
         return;
     }
-    float r = filter_.radius;
-    int x0 = std::max(0, int(std::ceil(filmPos.x - 0.5f - r)));
-    int x1 = std::min(width_ - 1, int(std::floor(filmPos.x - 0.5f + r)));
-    int y0 = std::max(0, int(std::ceil(filmPos.y - 0.5f - r)));
-    int y1 = std::min(height_ - 1, int(std::floor(filmPos.y - 0.5f + r)));
-    // The filter is separable: each column's weight once, not once per row (a Gaussian's two
-    // exp() calls each). The products are the same floats as before, so the film is too.
-    constexpr int kMaxReach = 2 * int(kMaxFilterRadius) + 2; // the widest footprint
-    float wx[kMaxReach];
-    for (int x = x0; x <= x1; ++x)
-        wx[x - x0] = filterWeight1D(filter_.type, float(x) + 0.5f - filmPos.x, r);
-    for (int y = y0; y <= y1; ++y) {
-        float wy = filterWeight1D(filter_.type, float(y) + 0.5f - filmPos.y, r);
-        if (wy <= 0.0f) continue;
-        for (int x = x0; x <= x1; ++x) {
-            float w = wy * wx[x - x0];
-            if (w > 0.0f) add(x, y, half, radiance * w, weight * w, key);
-        }
+    forFootprint(filmPos,
+                 [&](int x, int y, float w) { add(x, y, half, radiance * w, weight * w, key); });
+}
+
+// The sample's weight is rounded with the key a sample's weight always had, so that the weight
+// sums are the same as if each contribution were filtered on its own; its radiance sum with a
+// key of its own path.
+void Film::filterSample(size_t path, vec2 filmPos, uint sampleIndex, const std::int64_t* rgb) {
+    const int half = halfOf(sampleIndex);
+    const uint weightKey = roundingKey(0u, sampleIndex);
+    const uint rgbKey = roundingKey(uint(path) ^ 0x5A3D0000u, sampleIndex);
+    const double value[3] = {double(rgb[0]), double(rgb[1]), double(rgb[2])};
+    const bool any = rgb[0] != 0 || rgb[1] != 0 || rgb[2] != 0;
+    forFootprint(filmPos, [&](int x, int y, float w) {
+        const uint pixel = uint(y * width_ + x);
+        std::atomic<std::int64_t>* a = &acc_[pixel].v[half * 4];
+        const uvec4 hw = pcg4d(uvec4(weightKey, pixel, 0x5157u, 0x9E3779B9u));
+        // No other thread adds to this pixel now (finishSamples).
+        auto addTo = [](std::atomic<std::int64_t>& v, std::int64_t q) {
+            v.store(v.load(std::memory_order_relaxed) + q, std::memory_order_relaxed);
+        };
+        addTo(a[3], quantize(double(1.0f * w) * weightScale_, hw.w));
+        if (!any) return;
+        const uvec4 h = pcg4d(uvec4(rgbKey, pixel, 0x5157u, 0x9E3779B9u));
+        const uint rnd[3] = {h.x, h.y, h.z};
+        for (int c = 0; c < 3; ++c)
+            addTo(a[c], quantize(value[c] * double(w), rnd[c]));
+    });
+}
+
+void Film::prefetch(uint path, vec2 filmPos) const {
+    if (sumsSamples()) {
+        __builtin_prefetch(&samples_[path], 1);
+        return;
     }
+    const int px = std::clamp(int(filmPos.x), 0, width_ - 1);
+    const int py = std::clamp(int(filmPos.y), 0, height_ - 1);
+    __builtin_prefetch(&acc_[size_t(py) * width_ + size_t(px)], 1);
+}
+
+int Film::halfOf(uint sampleIndex) const {
+    return int((sampleIndex / samplesPerIteration_ + sampleIndex % samplesPerIteration_) & 1u);
 }
 
 // Converting a 64-bit integer to double is one instruction, a 128-bit one a library call: the
@@ -371,6 +480,7 @@ void Film::addIterationToSums() {
 
 void Film::endIteration() {
     if (!open_) throw std::logic_error("Film::endIteration without beginIteration");
+    finishSamples();
     if (!sumLo_) {
         // The first iteration is the whole render so far: its sums become the render's, and
         // the next iteration's are allocated when it begins.

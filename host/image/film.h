@@ -21,6 +21,15 @@
 // at 2^40 or below the clamp likewise. For the usual N (up to 64) that is 2^40 and a clamp 2^20
 // times the brightest emitter. Non-finite samples are counted and dropped, never added.
 //
+// Wide filters (Tent, Gaussian): one film write per camera sample. A sample's contributions
+// (emission, shadow rays, escapes) are rounded into its own fixed-point sum, 3 x int64 in a
+// per-iteration sample buffer indexed by the path's id, and finishSamples() filters each sum
+// once through the footprint, with the sample's filter weight, in pixel order. The sample sums
+// are exact integer sums too, and each is clamped (saturating, counted) at the clamp of one add:
+// a path's contributions arrive one bounce after another on every backend, in the same order,
+// so even a clamped sum is the same for any thread count or batch. The Box filter reaches one
+// pixel, so its contributions go straight to the film, and no sample buffer is allocated.
+//
 // The samples accumulate in two half buffers, a sample's half being (iteration + its index
 // within the iteration) mod 2: over any two iterations each half takes every stratum of the
 // Stratified and Grid samplers once, so the halves are identically distributed and their
@@ -71,17 +80,28 @@ class Film {
     // iteration's sums. Between endIteration() and this, lastIterationImage() is that
     // iteration's image.
     void beginIteration();
-    // Thread-safe. Once per camera sample: adds the sample's filter weight. (Samples are counted
-    // by tile at endIteration(): every pixel of a sampling tile takes the iteration's samples.)
-    void addSample(vec2 filmPos, uint sampleIndex);
+    // Whether a sample's contributions are summed before they are filtered (every filter but
+    // Box): then splat() and prefetch() do not read their film position.
+    bool sumsSamples() const { return filter_.type != FilterType::Box; }
+    // Thread-safe. Once per camera sample: adds the sample's filter weight (or, when the film
+    // sums samples, notes where the sample lies, and finishSamples() adds it). `path`: the
+    // sample's path id within the iteration, pixel x samples per iteration + sample. (Samples
+    // are counted by tile at endIteration(): every pixel of a sampling tile takes the
+    // iteration's samples.)
+    void addSample(uint path, vec2 filmPos, uint sampleIndex);
     // Thread-safe. Any number of times per sample: adds radiance it carried to the camera.
-    // `key` makes the stochastic rounding deterministic (filmKey()).
-    void splat(vec2 filmPos, uint sampleIndex, vec3 radiance, uint key);
-    // A hint, thread-safe: starts bringing the accumulators that a splat at `filmPos` adds to
-    // into this core's cache. The sorted pipeline's splats land in no pixel order, and an atomic
-    // add to a line not in cache stalls the core until it arrives; prefetching a chunk's splats
-    // before adding them overlaps those misses.
-    void prefetch(vec2 filmPos) const;
+    // `key` makes the stochastic rounding deterministic (filmKey()). When the film sums samples,
+    // a path's contributions must arrive in path order (as every backend makes them: by bounce,
+    // the emission before the shadow ray), and filmPos is not read.
+    void splat(uint path, vec2 filmPos, uint sampleIndex, vec3 radiance, uint key);
+    // A hint, thread-safe: starts bringing the accumulators that a splat of `path` at `filmPos`
+    // adds to into this core's cache. The sorted pipeline's splats land in no pixel order, and
+    // an atomic add to a line not in cache stalls the core until it arrives; prefetching a
+    // chunk's splats before adding them overlaps those misses.
+    void prefetch(uint path, vec2 filmPos) const;
+    // After the iteration's last sample, before iterationAccumulators() and endIteration()
+    // (which call it if needed): filters the sample sums into the iteration's sums.
+    void finishSamples();
     // Adds the iteration to the whole render's sums (throws std::logic_error without a
     // beginIteration() since the last).
     void endIteration();
@@ -127,7 +147,7 @@ class Film {
     // The iteration's integer accumulators: 8 sums per pixel, then the iteration's non-finite
     // and saturated counts. (endIteration() counts the samples of every tile still sampling, in
     // any share: with shares, the accumulators are the sum over the shares by then.)
-    std::vector<std::int64_t> iterationAccumulators() const;
+    std::vector<std::int64_t> iterationAccumulators();
     // Replaces them, with their sum over the processes (the same layout).
     void setIterationAccumulators(const std::vector<std::int64_t>& values);
     // Camera samples each pixel took in whole iterations, and their total.
@@ -167,15 +187,25 @@ class Film {
     // Adds the pixel's three per-channel terms of the half-buffer relMSE, (A - B)^2 / 4 /
     // (m^2 + 0.01), to total and count; false (nothing added) while a half has no samples.
     bool addHalfBufferRelMse(size_t pixel, double& total, size_t& count) const;
+    float weight1D(float d) const;
+    // fn(x, y, w) for each pixel of the filter's footprint around filmPos, w > 0 its weight.
+    template <typename Fn> void forFootprint(vec2 filmPos, const Fn& fn) const;
     void filtered(vec2 filmPos, int half, vec3 radiance, float weight, uint key);
     void add(int px, int py, int half, vec3 value, float weight, uint key);
+    // v (fixed-point units) clamped (counted) and rounded stochastically with u: E = v.
+    std::int64_t quantize(double v, uint u);
+    // Sample sums (wide filters): the contribution into path's sum; the sum filtered.
+    void addToSample(uint path, vec3 radiance, uint key);
+    // Not thread-safe: finishSamples() keeps the threads' footprints apart.
+    void filterSample(size_t path, vec2 filmPos, uint sampleIndex, const std::int64_t* rgb);
 
     int width_, height_;
     uint samplesPerIteration_;
     Filter filter_;
-    double scale_;       // radiance units -> fixed-point units
-    double weightScale_; // filter weight -> fixed-point units
-    double maxAdd_;      // the clamp of one add, in fixed-point units
+    float gaussK_ = 0.0f, gaussTail_ = 0.0f; // the Gaussian's exponent factor and its value at r
+    double scale_;                           // radiance units -> fixed-point units
+    double weightScale_;                     // filter weight -> fixed-point units
+    double maxAdd_;                          // the clamp of one add, in fixed-point units
     // (r, g, b, weight) x 2 halves: one cache line per pixel, so that a splat is one line.
     struct alignas(64) PixelSums {
         std::atomic<std::int64_t> v[8];
@@ -210,6 +240,17 @@ class Film {
     size_t activeTiles_ = 1;
     int share_ = 0, shares_ = 1;
     std::vector<std::uint8_t> take_; // per tile: active and in this share; empty: every tile
+    // The iteration's sample sums (wide filters only; null until the first iteration begins):
+    // one per path id, and where the sample lies. A path's sum is only ever changed by one
+    // thread at a time (its contributions come in order), so each add is a load and a store.
+    struct SampleSum {
+        std::atomic<std::int64_t> rgb[3];
+        float x, y;
+    };
+    std::unique_ptr<SampleSum[]> samples_;
+    bool samplesPending_ = false;     // the iteration's sample sums are not yet filtered
+    std::atomic<uint> sampleBase_{0}; // the iteration's first sample index
+    std::int64_t sampleCap_ = 0;      // the clamp of a sample sum: maxAdd_ as an integer
     // nonFinite_ and saturated_ when the iteration began.
     std::uint64_t nonFiniteBefore_ = 0, saturatedBefore_ = 0;
 };

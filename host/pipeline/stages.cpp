@@ -99,11 +99,11 @@ void CameraRays::generate(const RenderContext& ctx, size_t count, Film& film,
             for (size_t j = 0; j < pending; ++j) {
                 const CameraRay cr =
                     camera.generate(x[j], y[j], sample[j], random ? u[j] : vec4(0.0f));
-                film.addSample(cr.filmPos, sampleIndex[j]);
                 RayState& r = rays[size_t(ray[j] - begin)];
                 r.origin = cr.origin;
                 r.dir = cr.dir;
                 r.path = cameraPath(rp_, pixel[j], sample[j], spread);
+                film.addSample(r.path.pathId, cr.filmPos, sampleIndex[j]);
             }
             pending = 0;
         };
@@ -296,9 +296,10 @@ void gatherShadowRays(const ShadeResult* results, size_t hitCount,
 }
 
 namespace {
-// One contribution for the film: where, which sample, what, and its rounding key.
+// One contribution for the film: which path, where, which sample, what, and its rounding key.
 struct Splat {
     vec2 pos;
+    uint path;
     uint sample;
     uint key;
     vec3 value;
@@ -308,39 +309,46 @@ struct Splat {
 // stalling one atomic add after another (the sorted order has no pixel locality).
 class SplatBatch {
   public:
-    explicit SplatBatch(Film& film) : film_(film) {}
+    explicit SplatBatch(Film& film) : film_(film), sums_(film.sumsSamples()) {}
     ~SplatBatch() { flush(); }
-    // Field by field into the slot: a Splat assembled and then copied goes through the stack in
-    // pieces that the copy's wider loads straddle, a store-forwarding stall.
-    void push(vec2 pos, uint sample, uint key, vec3 value) {
-        film_.prefetch(pos);
+    // A contribution of path `path` (its id) at bounce `bounce`. Field by field into the slot:
+    // a Splat assembled and then copied goes through the stack in pieces that the copy's wider
+    // loads straddle, a store-forwarding stall.
+    void push(const RenderContext& ctx, const RenderParams& rp, uint path, uint bounce, bool shadow,
+              vec3 value) {
+        // A film that sums samples does not need where the sample lies.
+        const vec2 pos = sums_ ? vec2(0.0f) : filmPosition(ctx, rp, path);
+        film_.prefetch(path, pos);
         Splat& s = splats_[count_++];
         s.pos = pos;
-        s.sample = sample;
-        s.key = key;
+        s.path = path;
+        s.sample = pathSample(rp, path);
+        s.key = filmKey(path, bounce, shadow);
         s.value = value;
         if (count_ == kSize) flush();
     }
     // What a hit emitted, or its unoccluded shadow ray brings, for path (pathId, bounce).
     void emitted(const RenderContext& ctx, const RenderParams& rp, const ShadeResult& res,
                  uvec2 path) {
-        push(filmPosition(ctx, rp, path.x), pathSample(rp, path.x), filmKey(path.x, path.y, false),
-             res.emitted);
+        push(ctx, rp, path.x, path.y, false, res.emitted);
     }
     void shadow(const RenderContext& ctx, const RenderParams& rp, const ShadeResult& res,
                 uvec2 path) {
-        push(filmPosition(ctx, rp, path.x), pathSample(rp, path.x), filmKey(path.x, path.y, true),
-             res.shadowContribution);
+        push(ctx, rp, path.x, path.y, true, res.shadowContribution);
     }
+    // In the order pushed: a path's contributions stay in order (Film::splat).
     void flush() {
-        for (size_t k = 0; k < count_; ++k)
-            film_.splat(splats_[k].pos, splats_[k].sample, splats_[k].value, splats_[k].key);
+        for (size_t k = 0; k < count_; ++k) {
+            const Splat& s = splats_[k];
+            film_.splat(s.path, s.pos, s.sample, s.value, s.key);
+        }
         count_ = 0;
     }
 
   private:
     static constexpr size_t kSize = 64;
     Film& film_;
+    const bool sums_;
     Splat splats_[kSize];
     size_t count_ = 0;
 };
@@ -380,9 +388,7 @@ void accumulateEscapes(const RenderContext& ctx, uint iteration, const std::vect
                           SplatBatch splats(film);
                           for (size_t i = r.begin(); i < r.end(); ++i) {
                               const RayState& ray = rays[order[i].index];
-                              const uint id = ray.path.pathId;
-                              splats.push(filmPosition(ctx, rp, id), pathSample(rp, id),
-                                          filmKey(id, ray.path.bounce, false),
+                              splats.push(ctx, rp, ray.path.pathId, ray.path.bounce, false,
                                           escapedRadiance(view, rp, ray.dir, ray.path));
                           }
                       });

@@ -31,15 +31,15 @@ bool ReferenceRenderer::renderIteration(uint iteration, Film& film) {
                         const uint sampleIndex = iteration * spi + s;
                         CameraRay cr =
                             ctx_.camera.generate(uint(x), uint(y), s, sampleIndex, rp.seed);
-                        film.addSample(cr.filmPos, sampleIndex);
                         PathState st = cameraPath(rp, pixel, s, ctx_.camera.pixelSpread());
+                        film.addSample(st.pathId, cr.filmPos, sampleIndex);
                         vec3 org = cr.origin, dir = cr.dir;
                         ++camera;
                         for (;;) {
                             const HitRecord h = intersectOne(embree, org, dir);
                             if (h.mesh == kNoHit) {
                                 if (rp.environment != kNoEmitter)
-                                    film.splat(cr.filmPos, sampleIndex,
+                                    film.splat(st.pathId, cr.filmPos, sampleIndex,
                                                escapedRadiance(view, rp, dir, st),
                                                filmKey(st.pathId, st.bounce, false));
                                 break;
@@ -50,13 +50,14 @@ bool ReferenceRenderer::renderIteration(uint iteration, Film& film) {
                             ShadeResult res;
                             shadeSurface(view, rp, hit, dir, st, res);
                             if (res.flags & kShadeEmitted)
-                                film.splat(cr.filmPos, sampleIndex, res.emitted,
+                                film.splat(st.pathId, cr.filmPos, sampleIndex, res.emitted,
                                            filmKey(st.pathId, st.bounce, false));
                             if (res.flags & kShadeShadow) {
                                 ++shadow;
                                 if (!occludedOne(embree,
                                                  {res.shadowOrigin, res.shadowDir, res.shadowTmax}))
-                                    film.splat(cr.filmPos, sampleIndex, res.shadowContribution,
+                                    film.splat(st.pathId, cr.filmPos, sampleIndex,
+                                               res.shadowContribution,
                                                filmKey(st.pathId, st.bounce, true));
                             }
                             if (!(res.flags & kShadeContinue)) break;

@@ -325,6 +325,10 @@ const char* RenderSession::iterate(const ProgressCallback& onIteration) {
             film.discardIteration(); // stopped part-way: keep only whole iterations
             return stop_.bySignal();
         }
+        {
+            StageTimer t(stats_.stages, "accumulate");
+            film.finishSamples(); // wide filters: each sample's sum through its footprint
+        }
         sync_.reduce(film, stats_.stages);
         {
             StageTimer t(stats_.stages, "accumulate");

@@ -15,12 +15,12 @@ TEST(Film, NonFiniteSamplesAreCountedAndDropped) {
     Film film(2, 1, Filter{}, 1.0f);
     const float nan = std::numeric_limits<float>::quiet_NaN(),
                 inf = std::numeric_limits<float>::infinity();
-    film.addSample(vec2(0.5f, 0.5f), 0);
-    film.addSample(vec2(1.5f, 0.5f), 0);
-    film.splat(vec2(0.5f, 0.5f), 0, vec3(0.25f, 0.5f, 1.0f), 1u);
-    film.splat(vec2(0.5f, 0.5f), 0, vec3(nan, 0.0f, 0.0f), 2u);
-    film.splat(vec2(0.5f, 0.5f), 0, vec3(0.0f, inf, 0.0f), 3u);
-    film.splat(vec2(1.5f, 0.5f), 0, vec3(0.0f, 0.0f, -inf), 4u);
+    film.addSample(0, vec2(0.5f, 0.5f), 0);
+    film.addSample(1, vec2(1.5f, 0.5f), 0);
+    film.splat(0, vec2(0.5f, 0.5f), 0, vec3(0.25f, 0.5f, 1.0f), 1u);
+    film.splat(0, vec2(0.5f, 0.5f), 0, vec3(nan, 0.0f, 0.0f), 2u);
+    film.splat(0, vec2(0.5f, 0.5f), 0, vec3(0.0f, inf, 0.0f), 3u);
+    film.splat(1, vec2(1.5f, 0.5f), 0, vec3(0.0f, 0.0f, -inf), 4u);
     film.endIteration();
     EXPECT_EQ(film.nonFiniteSamples(), 3u);
     const std::vector<float> img = film.image();
@@ -41,8 +41,8 @@ TEST(Film, RoundingIsUnbiasedAcrossIterations) {
     const int iterations = 4000;
     for (int it = 0; it < iterations; ++it) {
         film.beginIteration();
-        film.addSample(vec2(0.5f), uint(it));
-        film.splat(vec2(0.5f), uint(it), vec3(value), 7u); // same path key every iteration
+        film.addSample(0, vec2(0.5f), uint(it));
+        film.splat(0, vec2(0.5f), uint(it), vec3(value), 7u); // same path key every iteration
         film.endIteration();
     }
     const double mean = film.image()[0];
@@ -52,22 +52,107 @@ TEST(Film, RoundingIsUnbiasedAcrossIterations) {
 
 // No accumulator wraps, whatever the samples per iteration and the filter's reach: the film
 // clamps each add at 2^62 / N (N = samples per iteration x pixels a sample reaches) and scales
-// so that samples up to 2^16 times the brightest emitter stay below the clamp. 2^22 samples
-// 8x the brightest emitter, through a Gaussian of radius 16 with 4096 samples per iteration,
-// summed 2^63.4 in each half buffer at a fixed scale of 2^40 (a wrap to garbage, as it was);
-// here they average exactly 8.
+// so that samples up to 2^16 times the brightest emitter stay below the clamp. Through a
+// Gaussian of radius 16 with 4096 samples per iteration, 2^22 contributions 8x the brightest
+// emitter, 1024 into each of the 4096 samples, sum 2^63.4 in each half buffer at a fixed scale
+// of 2^40 (a wrap to garbage, as it was); here each sample sums exactly 8192, and so does the
+// image.
 TEST(Film, NoAccumulatorWrapsAtTheMostSamplesAFilterGathers) {
-    Film film(1, 1, Filter{FilterType::Gaussian, 16.0f}, 1.0f, 4096);
-    const int samples = 1 << 22;
-    for (int i = 0; i < samples; ++i) {
-        film.addSample(vec2(0.5f), uint(i));
-        film.splat(vec2(0.5f), uint(i), vec3(8.0f), uint(i));
-    }
+    const uint samples = 4096;
+    Film film(1, 1, Filter{FilterType::Gaussian, 16.0f}, 1.0f, int(samples));
+    ASSERT_TRUE(film.sumsSamples());
+    for (uint i = 0; i < samples; ++i)
+        film.addSample(i, vec2(0.5f), i);
+    for (int k = 0; k < 1024; ++k)
+        for (uint i = 0; i < samples; ++i)
+            film.splat(i, vec2(0.5f), i, vec3(8.0f), uint(k) * samples + i);
     film.endIteration();
     EXPECT_EQ(film.saturatedSamples(), 0u);
-    const std::vector<float> img = film.image();
-    for (float v : img)
-        EXPECT_NEAR(v, 8.0f, 8e-6f);
+    for (float v : film.image())
+        EXPECT_NEAR(v, 8192.0f, 8192.0f * 1e-6f);
+}
+
+// A wide filter sums each sample's contributions and filters the sum once: every pixel's
+// value is the closed form sum_k w_k S_k / sum_k w_k over the samples k that reach it, with
+// S_k the sum of sample k's contributions and w_k the Gaussian at the pixel's centre, whatever
+// the order in which the samples' contributions arrive.
+TEST(Film, WideFiltersFilterEachSampleSumOnce) {
+    const int width = 6, height = 5;
+    const Filter gaussian{FilterType::Gaussian, 1.5f};
+    struct Sample {
+        vec2 pos;
+        vec3 parts[3]; // its contributions, in path order
+    };
+    std::vector<Sample> samples;
+    for (int i = 0; i < width * height; ++i) {
+        const float x = float(i % width), y = float(i / width);
+        samples.push_back({vec2(x + 0.1f + 0.03f * float(i % 7), y + 0.9f - 0.05f * float(i % 5)),
+                           {vec3(0.1f * float(i % 3), 0.5f, 0.25f), vec3(0.0f),
+                            vec3(2.0f, 0.125f * float(i % 4), 1.0f)}});
+    }
+    auto render = [&](bool interleaved) {
+        Film film(width, height, gaussian, 4.0f);
+        EXPECT_TRUE(film.sumsSamples());
+        for (uint i = 0; i < samples.size(); ++i)
+            film.addSample(i, samples[i].pos, 0);
+        // The paths one after another, or bounce by bounce across the paths, the last first.
+        const uint n = uint(samples.size());
+        for (uint k = 0; k < 3 * n; ++k) {
+            const uint i = interleaved ? n - 1 - k % n : k / 3, c = interleaved ? k / n : k % 3;
+            film.splat(i, vec2(-1.0f), 0, samples[i].parts[c], filmKey(i, c, false));
+        }
+        film.endIteration();
+        return film.state();
+    };
+    const Film::State a = render(false), b = render(true);
+    EXPECT_EQ(a.sums, b.sums) << "sample sums are exact: no order shows";
+    const std::vector<float> img = Film::imageOf(a);
+    auto weight = [](double d) {
+        const double sigma = 0.75, k = -0.5 / (sigma * sigma);
+        return std::fabs(d) >= 1.5 ? 0.0 : std::exp(k * d * d) - std::exp(k * 1.5 * 1.5);
+    };
+    for (int y = 0; y < height; ++y)
+        for (int x = 0; x < width; ++x) {
+            double num[3] = {0, 0, 0}, den = 0;
+            for (const Sample& s : samples) {
+                const double w = weight(x + 0.5 - s.pos.x) * weight(y + 0.5 - s.pos.y);
+                const vec3 sum = s.parts[0] + s.parts[1] + s.parts[2];
+                den += w;
+                num[0] += w * sum.x;
+                num[1] += w * sum.y;
+                num[2] += w * sum.z;
+            }
+            for (int c = 0; c < 3; ++c)
+                EXPECT_NEAR(img[size_t(y * width + x) * 3 + size_t(c)], num[c] / den,
+                            1e-6 * (num[c] / den) + 1e-9)
+                    << x << ", " << y << " channel " << c;
+        }
+}
+
+// A sample's own sum cannot wrap: it saturates at the clamp of one film add, is counted, and
+// gives the same film whatever the other paths do meanwhile. 1000 contributions at 2^60 times
+// the brightest emitter (each clamped itself) fill one sample's sum; its neighbour's ordinary
+// contribution is untouched.
+TEST(Film, ASampleSumSaturatesAtTheClampAndIsCounted) {
+    auto render = [](bool neighbourFirst) {
+        Film film(2, 1, Filter{FilterType::Tent, 1.0f}, 1.0f);
+        film.addSample(0, vec2(0.5f), 0);
+        film.addSample(1, vec2(1.5f, 0.5f), 0);
+        if (neighbourFirst) film.splat(1, vec2(-1.0f), 0, vec3(0.5f), 1u);
+        for (uint k = 0; k < 1000; ++k)
+            film.splat(0, vec2(-1.0f), 0, vec3(std::ldexp(1.0f, 60)), 64u * k);
+        if (!neighbourFirst) film.splat(1, vec2(-1.0f), 0, vec3(0.5f), 1u);
+        film.endIteration();
+        return std::make_pair(film.image(), film.saturatedSamples());
+    };
+    const auto [img, saturated] = render(false);
+    EXPECT_EQ(render(true).first, img);
+    EXPECT_GE(saturated, 3000u) << "every clamped contribution and sum is counted";
+    // The clamp: 2^62 over 9 adds (a Tent of radius 1 reaches 3 x 3 pixels), rounded down to a
+    // power of 2, at the scale 2^40: 2^18 in radiance.
+    for (int c = 0; c < 3; ++c)
+        EXPECT_EQ(img[size_t(c)], std::ldexp(1.0f, 18)) << c;
+    EXPECT_FLOAT_EQ(img[3], 0.5f) << "the Tent of radius 1 keeps the samples apart";
 }
 
 // The whole render's sums start at 64 bits and gain their high words the first time a sum could
@@ -81,10 +166,10 @@ TEST(Film, SumsWidenPast64BitsWithoutLosingAnything) {
     const float big = std::ldexp(1.0f, 21);
     for (int it = 0; it < 24; ++it) {
         if (it > 0) film.beginIteration();
-        film.addSample(vec2(0.5f), uint(it));
-        film.addSample(vec2(1.5f), uint(it));
-        film.splat(vec2(0.5f), uint(it), vec3(big, 1.0f, 0.5f), 1u);
-        film.splat(vec2(1.5f), uint(it), vec3(0.25f), 2u);
+        film.addSample(0, vec2(0.5f), uint(it));
+        film.addSample(1, vec2(1.5f), uint(it));
+        film.splat(0, vec2(0.5f), uint(it), vec3(big, 1.0f, 0.5f), 1u);
+        film.splat(1, vec2(1.5f), uint(it), vec3(0.25f), 2u);
         film.endIteration();
         EXPECT_EQ(film.lastIterationImage()[0], big) << it;
     }
@@ -101,8 +186,8 @@ TEST(Film, SumsWidenPast64BitsWithoutLosingAnything) {
     Film resumed(2, 1, Filter{}, 1.0f);
     resumed.restore(state);
     EXPECT_EQ(resumed.image(), img);
-    resumed.addSample(vec2(0.5f), 24u);
-    resumed.splat(vec2(0.5f), 24u, vec3(big), 1u);
+    resumed.addSample(0, vec2(0.5f), 24u);
+    resumed.splat(0, vec2(0.5f), 24u, vec3(big), 1u);
     resumed.endIteration();
     EXPECT_EQ(resumed.image()[0], big);
     EXPECT_EQ(resumed.state().sums[0], Film::Fixed(13) << 61);
@@ -110,8 +195,8 @@ TEST(Film, SumsWidenPast64BitsWithoutLosingAnything) {
     Film negative(1, 1, Filter{}, 1.0f);
     for (int it = 0; it < 8; ++it) {
         if (it > 0) negative.beginIteration();
-        negative.addSample(vec2(0.5f), 0u);
-        negative.splat(vec2(0.5f), 0u, vec3(-big, big, 1.0f), 1u);
+        negative.addSample(0, vec2(0.5f), 0u);
+        negative.splat(0, vec2(0.5f), 0u, vec3(-big, big, 1.0f), 1u);
         negative.endIteration();
     }
     EXPECT_EQ(negative.image(), (std::vector<float>{-big, big, 1.0f}));
@@ -174,9 +259,9 @@ TEST(Film, SharesCoverEveryTileOnceAndAddUpToOneFilm) {
                 const vec3 v(float(x % 7) * 0.1f, float(y % 5) * 0.2f, 0.7f);
                 const uint key = uint(y * width + x);
                 for (Film* film : {&f, &whole}) {
-                    film->addSample(p, 0);
-                    film->splat(p, 0, v, key);
-                    if (x == 3 && y == 4) film->splat(p, 0, vec3(NAN, 0.0f, 0.0f), key);
+                    film->addSample(key, p, 0);
+                    film->splat(key, p, 0, v, key);
+                    if (x == 3 && y == 4) film->splat(key, p, 0, vec3(NAN, 0.0f, 0.0f), key);
                 }
             }
     for (int s = 0; s < shares; ++s) {
