@@ -5,11 +5,16 @@ Renders a reference once at high spp (or takes --reference), then renders the sc
 configuration, a backend and a sampler, with --error-csv against it, and writes
   OUT/convergence.csv   config, backend, sampler, iteration, spp, seconds, relmse, relmse_estimate
   OUT/convergence.png   log-log relMSE against seconds, one line per configuration
+  OUT/estimate.png      the reference-free estimate (--error-csv's relmse_estimate) against the
+                        true relMSE, over spp, one colour per configuration
 and prints for each configuration its last point, its efficiency 1 / (relMSE x seconds), the
 convergence slope (a least-squares fit of log relMSE against log seconds over the second half
 of its points: -1 is Monte Carlo's rate, steeper is better) and the equal-error time ratio: the
 seconds it takes to reach the first configuration's final error, over the first configuration's
-seconds (interpolated on its curve, or extrapolated along its slope, marked "~").
+seconds (interpolated on its curve, or extrapolated along its slope, marked "~"); then the
+estimate over the true relMSE at each power-of-4 spp. The true relMSE is the relMSE against the
+reference less the reference's own (its half-buffer estimate, from rendering it with
+--error-csv; unknown, and taken as 0, for a --reference given).
 
   scripts/convergence.py [SCENE] [--backends reference,cpu,vulkan] [--spp 256]
                          [--samplers Independent,Stratified,Sobol,Sobol+adaptive]
@@ -35,7 +40,8 @@ import sys
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
 
-FIELDS = ["config", "backend", "sampler", "iteration", "spp", "seconds", "relmse", "relmse_estimate"]
+FIELDS = ["config", "backend", "sampler", "iteration", "spp", "seconds", "relmse", "relmse_estimate",
+          "relmse_true"]
 
 
 def main():
@@ -57,17 +63,23 @@ def main():
     if a.replot:
         with open(out_csv) as f:
             rows = [dict(r, iteration=int(r["iteration"]), spp=int(r["spp"]), seconds=float(r["seconds"]),
-                         relmse=float(r["relmse"]), relmse_estimate=float(r["relmse_estimate"]))
+                         relmse=float(r["relmse"]), relmse_estimate=float(r["relmse_estimate"]),
+                         relmse_true=float(r.get("relmse_true", r["relmse"])))
                     for r in csv.DictReader(f)]
         report(a, rows)
         return
 
     ref = a.reference
+    ref_own = 0.0  # the reference's own relMSE, removed from the measured one
     if not ref:
         ref = os.path.join(a.out, "ground-truth.exr")  # not <backend>.exr: the reference backend writes that
+        ref_csv = os.path.join(a.out, "ground-truth.csv")
         print("rendering the reference: %d spp on the reference backend (seed 1000003)" % a.reference_spp)
         subprocess.check_call([a.spillway, "render", a.scene, "--backend", "reference", "--spp", str(a.reference_spp),
-                               "--seed", "1000003", "--quiet", "-o", ref])
+                               "--seed", "1000003", "--quiet", "-o", ref, "--error-csv", ref_csv])
+        with open(ref_csv) as f:
+            ref_own = float(list(csv.DictReader(f))[-1]["relmse_estimate"])
+        print("the reference's own relMSE (estimated): %.4g" % ref_own)
 
     rows = []
     samplers = a.samplers.split(",") if a.samplers else [""]
@@ -94,7 +106,8 @@ def main():
                     rows.append({"config": name, "backend": backend, "sampler": sampler or "scene",
                                  "iteration": int(r["iteration"]), "spp": int(r["spp"]),
                                  "seconds": float(r["seconds"]), "relmse": float(r["relmse"]),
-                                 "relmse_estimate": float(r["relmse_estimate"])})
+                                 "relmse_estimate": float(r["relmse_estimate"]),
+                                 "relmse_true": float(r["relmse"]) - ref_own})
     if not rows:
         sys.exit("no configuration rendered")
 
@@ -175,7 +188,39 @@ def report(a, rows):
     fig.tight_layout()
     png = os.path.join(a.out, "convergence.png")
     fig.savefig(png)
-    print("\nwrote %s and %s" % (out_csv, png))
+    estimate_png = report_estimate(a, configs, curves)
+    print("\nwrote %s, %s and %s" % (out_csv, png, estimate_png))
+
+
+def report_estimate(a, configs, curves):
+    """Prints the estimate over the true relMSE at 16, 64, 256, 1024 ... spp and plots both."""
+    import matplotlib.pyplot as plt
+    print("\nthe reference-free estimate over the true relMSE")
+    print("%-28s %s" % ("config", " ".join("%8s" % ("%d spp" % (4 ** k)) for k in range(2, 6))))
+    for c in configs:
+        by_spp = {r["spp"]: r for r in curves[c]}
+        cells = []
+        for k in range(2, 6):
+            r = by_spp.get(4 ** k)
+            ok = r and r["relmse_true"] > 0 and r["relmse_estimate"] > 0
+            cells.append("%8.3f" % (r["relmse_estimate"] / r["relmse_true"]) if ok else "%8s" % "-")
+        print("%-28s %s" % (c, " ".join(cells)))
+    fig, ax = plt.subplots(figsize=(6, 4.2), dpi=120)
+    for i, c in enumerate(configs):
+        pts = [r for r in curves[c] if r["relmse_true"] > 0 and r["relmse_estimate"] > 0]
+        colour = "C%d" % (i % 10)
+        ax.loglog([r["spp"] for r in pts], [r["relmse_true"] for r in pts], color=colour, label=c + ": true")
+        ax.loglog([r["spp"] for r in pts], [r["relmse_estimate"] for r in pts], color=colour, linestyle="--",
+                  label=c + ": estimate")
+    ax.set_xlabel("samples per pixel")
+    ax.set_ylabel("relMSE")
+    ax.set_title(os.path.basename(a.scene) + ": estimate (dashed) against truth")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=6)
+    fig.tight_layout()
+    png = os.path.join(a.out, "estimate.png")
+    fig.savefig(png)
+    return png
 
 
 if __name__ == "__main__":

@@ -36,6 +36,7 @@ void fitToRank(RenderOptions& o, Ranks* ranks, bool writes) {
     if (!writes) {
         o.preview = false;
         o.errorCsvPath.clear();
+        o.errorMapPath.clear();
         o.referencePath.clear();
         o.progress = "none";
     }
@@ -163,6 +164,14 @@ void writeOutputs(const RenderOptions& o, const Scene& scene, RenderResult& resu
                        [&](int y0, int y1, float* rgb) { film.imageRows(y0, y1, rgb); });
         image.flush();
     }
+    std::unique_ptr<OutputFile> errorMap;
+    if (!o.errorMapPath.empty()) {
+        errorMap = std::make_unique<OutputFile>(o.errorMapPath);
+        const Film& film = *result.film;
+        writeImageRows(*errorMap, o.errorMapPath, scene.image.width, scene.image.height,
+                       [&](int y0, int y1, float* rgb) { film.errorRows(y0, y1, rgb); });
+        errorMap->flush();
+    }
     std::unique_ptr<OutputFile> stats;
     if (!o.statsPath.empty()) {
         stats = std::make_unique<OutputFile>(o.statsPath);
@@ -172,6 +181,7 @@ void writeOutputs(const RenderOptions& o, const Scene& scene, RenderResult& resu
     if (errorCsv) errorCsv->flush();
     warnAboutSamples(result.stats);
     image.commit();
+    if (errorMap) errorMap->commit();
     if (stats) stats->commit();
     if (errorCsv) errorCsv->commit();
 }
@@ -186,7 +196,8 @@ int renderCommand(const std::vector<std::string>& args, Ranks* ranks) {
     }
     const bool writes = !ranks || ranks->rank() == 0;
     // Every output path is checked before any work, so that a typo costs no render.
-    for (const std::string* path : {&o.output, &o.statsPath, &o.errorCsvPath, &o.checkpointPath})
+    for (const std::string* path :
+         {&o.output, &o.statsPath, &o.errorCsvPath, &o.errorMapPath, &o.checkpointPath})
         if (!path->empty() && writes) checkWritable(*path);
     fitToRank(o, ranks, writes);
     const std::optional<Checkpoint> resume = readResume(o);

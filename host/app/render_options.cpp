@@ -135,6 +135,10 @@ const std::vector<CliOption> kOwnOptions = {
      "after every iteration, a row: seconds, spp, relMSE estimated from two half buffers, "
      "and with --reference the compare metrics",
      0, 0, [](O& r, const C&, const S& v) { r.errorCsvPath = v; }},
+    {"--error-map", nullptr, "FILE.exr", Section::Render,
+     "at the end, the per-pixel relMSE estimate from two half buffers, per channel (the "
+     "terms --error-csv averages): where the noise is",
+     0, 0, [](O& r, const C&, const S& v) { r.errorMapPath = v; }},
     {"--reference", nullptr, "REF.exr", Section::Render, "the reference image for --error-csv", 0,
      0, [](O& r, const C&, const S& v) { r.referencePath = v; }},
     {"--time-limit", nullptr, "SECONDS", Section::Render,
@@ -256,6 +260,10 @@ void checkRelations(RenderOptions& r) {
     if (!isSupportedOutput(r.output))
         throw UsageError("output '" + r.output + "' must end in .exr or .png");
     if (r.quiet) r.progress = "none";
+    if (!r.errorMapPath.empty() &&
+        !(r.errorMapPath.size() > 4 && r.errorMapPath.substr(r.errorMapPath.size() - 4) == ".exr"))
+        throw UsageError("--error-map '" + r.errorMapPath +
+                         "' must end in .exr: it holds linear values, not colours");
     if (!r.referencePath.empty() && r.errorCsvPath.empty())
         throw UsageError("--reference goes with --error-csv");
     if (!r.partialPath.empty() && !r.config.sampleRange)
@@ -294,6 +302,7 @@ void checkAliases(const RenderOptions& r) {
     const Named outputs[] = {{"-o", &r.output},
                              {"--stats", &r.statsPath},
                              {"--error-csv", &r.errorCsvPath},
+                             {"--error-map", &r.errorMapPath},
                              {checkpoint, &r.checkpointPath}};
     const Named inputs[] = {{"the scene", &r.scenePath},
                             {"--reference", &r.referencePath},

@@ -18,7 +18,7 @@ namespace spw {
 struct RenderOptions {
     std::string scenePath;
     std::string output; // default: the scene's name with .exr
-    std::string statsPath, errorCsvPath, referencePath;
+    std::string statsPath, errorCsvPath, errorMapPath, referencePath;
     std::string checkpointPath, resumePath, partialPath;
     double checkpointInterval = 0;
     std::optional<SamplerType> sampler; // --sampler: replaces the scene's

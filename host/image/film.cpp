@@ -50,9 +50,9 @@ float Film::weight1D(float d) const {
 }
 
 Film::Film(int width, int height, const Filter& filter, float brightestRadiance,
-           int samplesPerIteration)
+           int samplesPerIteration, Halves halves)
     : width_(width), height_(height), samplesPerIteration_(uint(samplesPerIteration)),
-      filter_(filter), tilesX_((width + kAdaptiveTile - 1) / kAdaptiveTile),
+      halves_(halves), filter_(filter), tilesX_((width + kAdaptiveTile - 1) / kAdaptiveTile),
       tilesY_((height + kAdaptiveTile - 1) / kAdaptiveTile),
       tileSamples_(size_t(tilesX_) * size_t(tilesY_), 0u) {
     if (!(filter.radius > 0.0f && filter.radius <= kMaxFilterRadius))
@@ -405,6 +405,7 @@ void Film::prefetch(uint path, vec2 filmPos) const {
 }
 
 int Film::halfOf(uint sampleIndex) const {
+    if (halves_ == Halves::ByStream) return int(sampleIndex & 1u);
     return int((sampleIndex / samplesPerIteration_ + sampleIndex % samplesPerIteration_) & 1u);
 }
 
@@ -583,16 +584,36 @@ void imageFromSums(const Sums& sums, size_t first, size_t count, float* out) {
 }
 } // namespace
 
-bool Film::addHalfBufferRelMse(size_t pixel, double& total, size_t& count) const {
+bool Film::halfBufferTerms(size_t pixel, double* terms) const {
     double s[8];
     pixelSums(pixel, s);
     if (!(s[3] > 0 && s[7] > 0)) return false;
     for (int c = 0; c < 3; ++c) {
         const double a = s[c] / s[3], b = s[4 + c] / s[7], m = (s[c] + s[4 + c]) / (s[3] + s[7]);
-        total += (a - b) * (a - b) / 4.0 / (m * m + kRelMseEpsilon);
-        ++count;
+        terms[c] = (a - b) * (a - b) / 4.0 / (m * m + kRelMseEpsilon);
     }
     return true;
+}
+
+bool Film::addHalfBufferRelMse(size_t pixel, double& total, size_t& count) const {
+    double terms[3];
+    if (!halfBufferTerms(pixel, terms)) return false;
+    for (double t : terms) // one at a time, as the sum always was
+        total += t;
+    count += 3;
+    return true;
+}
+
+void Film::errorRows(int y0, int y1, float* rgb) const {
+    const size_t first = size_t(y0) * size_t(width_);
+    forPixels(size_t(y1 - y0) * size_t(width_), [&](size_t begin, size_t end) {
+        for (size_t i = begin; i < end; ++i) {
+            double terms[3] = {0.0, 0.0, 0.0};
+            halfBufferTerms(first + i, terms);
+            for (int c = 0; c < 3; ++c)
+                rgb[i * 3 + size_t(c)] = float(terms[c]);
+        }
+    });
 }
 
 std::vector<float> Film::image() const {

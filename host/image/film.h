@@ -30,10 +30,12 @@
 // so even a clamped sum is the same for any thread count or batch. The Box filter reaches one
 // pixel, so its contributions go straight to the film, and no sample buffer is allocated.
 //
-// The samples accumulate in two half buffers, a sample's half being (iteration + its index
-// within the iteration) mod 2: over any two iterations each half takes every stratum of the
-// Stratified and Grid samplers once, so the halves are identically distributed and their
-// difference estimates the image's own error without a reference (halfBufferRelMse).
+// The samples accumulate in two half buffers, whose difference estimates the image's own error
+// without a reference (halfBufferRelMse); that needs the halves to be independent and
+// identically distributed. By stratum (Independent, Grid, Stratified), a sample's half is
+// (iteration + its index within the iteration) mod 2: over any two iterations each half takes
+// every stratum of the Stratified and Grid samplers once. By stream (Sobol), it is the sample
+// index mod 2: the sampler's two independent scrambled sequences (shared/rng.h, rand4).
 //
 // Adaptive sampling (setAdaptive): the image is cut into 8 x 8 tiles, as MoonRay does; after each
 // whole iteration a tile whose pixels have at least the minimum samples and whose error
@@ -69,9 +71,12 @@ class Film {
     // wrap.
     using Fixed = __int128;
 
+    // Which half buffer a sample goes to (above).
+    enum class Halves { ByStratum, ByStream };
+
     // `samplesPerIteration`: camera samples per pixel in one iteration (sample base^2).
     Film(int width, int height, const Filter& filter, float brightestRadiance,
-         int samplesPerIteration = 1);
+         int samplesPerIteration = 1, Halves halves = Halves::ByStratum);
 
     int width() const { return width_; }
     int height() const { return height_; }
@@ -118,6 +123,9 @@ class Film {
     // relMSE of image() estimated from the halves: per value (A - B)^2 / 4 / (m^2 + 0.01),
     // averaged; (A - B)^2 / 4 is an unbiased estimate of the variance of m = (A + B) / 2.
     double halfBufferRelMse() const;
+    // Its per-pixel terms, rows y0 .. y1 - 1 into rgb (width x (y1 - y0) x 3 floats): where the
+    // noise is (--error-map). A pixel whose halves do not both hold samples yet reads 0.
+    void errorRows(int y0, int y1, float* rgb) const;
     // The same, or nothing while no pixel has samples in both halves (one iteration of one
     // sample per pixel): then there is no estimate yet, rather than an estimate of 0.
     std::optional<double> halfBufferRelMseEstimate() const;
@@ -179,13 +187,15 @@ class Film {
     Fixed sumAt(size_t i, int k) const;
     void widenSums(); // adds the high halves, sign-extending every sum
     void addIterationToSums();
-    int halfOf(uint sampleIndex) const; // (iteration + index within it) mod 2
+    int halfOf(uint sampleIndex) const; // by stratum or by stream (halves_)
     void decideTiles();                 // the tiles this process samples: adaptive mask and share
     void decideAdaptiveTiles();         // the adaptive mask, from the sums and counts
     // Pixel `pixel`'s eight sums in radiance and weight units.
     void pixelSums(size_t pixel, double* s) const;
-    // Adds the pixel's three per-channel terms of the half-buffer relMSE, (A - B)^2 / 4 /
-    // (m^2 + 0.01), to total and count; false (nothing added) while a half has no samples.
+    // The pixel's three per-channel terms of the half-buffer relMSE, (A - B)^2 / 4 /
+    // (m^2 + 0.01), into terms; false (terms untouched) while a half has no samples.
+    bool halfBufferTerms(size_t pixel, double* terms) const;
+    // Adds them to total and count (nothing while a half has no samples).
     bool addHalfBufferRelMse(size_t pixel, double& total, size_t& count) const;
     float weight1D(float d) const;
     // fn(x, y, w) for each pixel of the filter's footprint around filmPos, w > 0 its weight.
@@ -201,6 +211,7 @@ class Film {
 
     int width_, height_;
     uint samplesPerIteration_;
+    Halves halves_;
     Filter filter_;
     float gaussK_ = 0.0f, gaussTail_ = 0.0f; // the Gaussian's exponent factor and its value at r
     double scale_;                           // radiance units -> fixed-point units

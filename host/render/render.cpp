@@ -246,9 +246,10 @@ void RenderSession::build() {
 
     ctx_.emplace(RenderContext{scene_, config_, *lights_, *embree_, *hitSetup_, *textures_,
                                *camera_, params, threads_, stats_});
-    result_->film =
-        std::make_unique<Film>(scene_.image.width, scene_.image.height, scene_.filter,
-                               lights_->brightestEmission(), int(params.samplesPerIteration));
+    result_->film = std::make_unique<Film>(
+        scene_.image.width, scene_.image.height, scene_.filter, lights_->brightestEmission(),
+        int(params.samplesPerIteration),
+        params.sampling == kSamplerSobol ? Film::Halves::ByStream : Film::Halves::ByStratum);
     if (choice_.kind == BackendKind::Reference)
         backend_ = std::make_unique<ReferenceRenderer>(*ctx_);
     else if (choice_.vulkan)

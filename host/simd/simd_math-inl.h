@@ -303,8 +303,10 @@ HWY_INLINE U4 rand4(uint sampling, uint seed, VU pixel, VU sampleIndex, VU bounc
     const DU du;
     const VU dimension = hn::Or(hn::ShiftLeft<8>(bounce), hn::Set(du, group));
     if (sampling == kSamplerSobol)
-        return scrambledSobol4(sampleIndex,
-                               {pixel, dimension, hn::Set(du, seed), hn::Set(du, 0x50B01u)});
+        return scrambledSobol4(
+            hn::ShiftRight<1>(sampleIndex),
+            {pixel, dimension, hn::Set(du, seed),
+             hn::Add(hn::Set(du, 0x50B01u), hn::And(sampleIndex, hn::Set(du, 1u)))});
     return pcg4d({pixel, sampleIndex, dimension, hn::Set(du, seed)});
 }
 

@@ -108,6 +108,9 @@ const BadUsage kBadUsages[] = {
      "--stats and --error-csv name the same file"},
     {"StatsIsTheScene", "{scene} -o {out} --stats {scene} --quiet",
      "--stats and the scene name the same file"},
+    {"ErrorMapAsPng", "{scene} -o {out} --error-map {dir}/e.png --quiet", "must end in .exr"},
+    {"ErrorMapIsTheOutput", "{scene} -o {dir}/x.exr --error-map {dir}/x.exr --quiet",
+     "-o and --error-map name the same file"},
 };
 
 INSTANTIATE_TEST_SUITE_P(Cli, CliBadUsage, ::testing::ValuesIn(kBadUsages),

@@ -50,8 +50,10 @@ struct Series {
     std::vector<float> image;
 };
 
-Series convergence(const std::string& backend, std::uint32_t seed, int size, int firstSpp) {
+Series convergence(const std::string& backend, std::uint32_t seed, int size, int firstSpp,
+                   SamplerType sampler = SamplerType::Stratified) {
     Scene scene = cornell(size);
+    scene.sampler = sampler;
     const Reference& ref = highSppReference(size);
     RenderConfig cfg;
     cfg.backend = parseBackend(backend);
@@ -96,19 +98,23 @@ Sample meanOf(const std::vector<double>& v) {
 }
 
 // Without a reference, the relMSE estimated from the two half buffers must be the true relMSE
-// (32^2 Cornell box, Stratified sample base 2 as shipped): the ratio of their means over 24
-// seeds, averaged over 64 to 1024 spp, within 10 % (its standard error is about 3 %; at each spp
-// alone, about 6 %, within 20 %), and the estimate's log-log slope within 0.07 of the true one
-// (standard error 0.03). A factor of 1.2 in the estimator fails, as do halves that each take
-// the same strata every iteration (the ratio then grows with spp, 10x by 1024). Below 64 spp
-// the estimate reads low (README: "Error against time").
-TEST(Convergence, HalfBufferEstimateTracksTrueRelMse) {
+// (32^2 Cornell box, sample base 2 as shipped), under the Stratified sampler (halves by
+// stratum) and under Sobol (the default: halves by stream, two independent scrambled
+// sequences): the ratio of their means over 24 seeds, averaged over 64 to 1024 spp, within 10 %
+// (its standard error is about 3 %; at each spp alone, about 6 %, within 20 %), and the
+// estimate's log-log slope within 0.07 of the true one (standard error 0.03). A factor of 1.2
+// in the estimator fails, as do halves that each take the same strata every iteration (the
+// ratio then grows with spp, 10x by 1024) and Sobol halves cut from one scrambled sequence
+// (2-3x too high). Below 64 spp the estimate reads low (README: "Error against time").
+class HalfBufferEstimate : public ::testing::TestWithParam<SamplerType> {};
+
+TEST_P(HalfBufferEstimate, TracksTrueRelMse) {
     // Under the sanitizers, 6 seeds: every standard error, and so every tolerance, doubles.
     constexpr int kSeeds = 24 / kSanitizedFewer;
     const double widen = std::sqrt(24.0 / kSeeds);
     std::vector<Series> runs;
     for (int seed = 1; seed <= kSeeds; ++seed)
-        runs.push_back(convergence("reference", std::uint32_t(seed), 32, 64));
+        runs.push_back(convergence("reference", std::uint32_t(seed), 32, 64, GetParam()));
     const int* spp = runs[0].spp;
     double est[5] = {}, tru[5] = {};
     std::vector<double> slopeDiff;
@@ -139,6 +145,12 @@ TEST(Convergence, HalfBufferEstimateTracksTrueRelMse) {
                 slopeEst, slopeTrue, d.mean, d.stderror);
     EXPECT_NEAR(slopeEst, slopeTrue, 0.07 * widen);
 }
+
+INSTANTIATE_TEST_SUITE_P(Convergence, HalfBufferEstimate,
+                         ::testing::Values(SamplerType::Stratified, SamplerType::Sobol),
+                         [](const ::testing::TestParamInfo<SamplerType>& p) {
+                             return std::string(samplerName(p.param));
+                         });
 
 // Every backend converges to the reference's image: no bias (the image mean, per channel,
 // within 4 standard errors of the reference's, the error computed from the pixels'
@@ -244,6 +256,31 @@ TEST(ErrorCsv, OneRowPerIterationWithAndWithoutReference) {
                     " --reference " + dir.file("ref.exr"));
     EXPECT_EQ(mismatch.status, 2) << mismatch.output;
     EXPECT_NE(mismatch.output.find("ref.exr"), std::string::npos) << mismatch.output;
+}
+
+// --error-map writes the terms the relMSE estimate averages, per pixel and channel: the map's
+// mean is the CSV's last estimate, its values are finite and non-negative, and they differ from
+// pixel to pixel by orders of magnitude, as the noise does (a uniform map would show nothing).
+TEST(ErrorMap, HoldsThePerPixelTermsOfTheEstimate) {
+    TempDir dir;
+    const std::string scene = sourceDir() + "/scenes/cornell-box.yaml";
+    CommandResult r =
+        runSpillway("render " + scene + " --quiet --spp 8 -o " + dir.file("a.exr") +
+                    " --error-csv " + dir.file("a.csv") + " --error-map " + dir.file("e.exr"));
+    ASSERT_EQ(r.status, 0) << r.output;
+    const ImageRGB map = readImage(dir.file("e.exr"));
+    ASSERT_EQ(map.width, 256);
+    ASSERT_EQ(map.height, 256);
+    double total = 0, lo = 1e30, hi = 0;
+    for (float v : map.rgb) {
+        ASSERT_TRUE(std::isfinite(v) && v >= 0.0f) << v;
+        total += v;
+        lo = std::min(lo, double(v));
+        hi = std::max(hi, double(v));
+    }
+    const double estimate = std::stod(readCsv(dir.file("a.csv")).back()["relmse_estimate"]);
+    EXPECT_NEAR(total / double(map.rgb.size()), estimate, 1e-5 * estimate);
+    EXPECT_GT(hi, 100.0 * lo + 1e-6) << "a map that is the same everywhere shows nothing";
 }
 
 // --time-limit stops after the iteration that crosses it and still writes a valid image.
