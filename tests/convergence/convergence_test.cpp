@@ -258,6 +258,42 @@ TEST(ErrorCsv, OneRowPerIterationWithAndWithoutReference) {
     EXPECT_NE(mismatch.output.find("ref.exr"), std::string::npos) << mismatch.output;
 }
 
+// --target-error stops within one iteration of where the true relMSE (against a 4096-spp
+// reference, its own noise removed) crosses the target, under the default sampler (Sobol), on
+// the 64^2 Cornell box: four seeds, a target the truth crosses near 32 spp, 4 spp an iteration.
+TEST(TargetError, StopsWithinAnIterationOfTheTrueCrossing) {
+    const int size = 64;
+    const Reference& ref = highSppReference(size);
+    const double target = 4e-3;
+    for (std::uint32_t seed = 1; seed <= 4; ++seed) {
+        Scene scene = cornell(size);
+        scene.sampler = SamplerType::Sobol;
+        scene.settings.seed = seed;
+        RenderConfig cfg;
+        cfg.backend = BackendKind::Reference;
+        cfg.spp = 256;
+        // The true relMSE after each iteration, without a target: the renders are the same
+        // iteration for iteration, so this is the curve the render with the target follows.
+        std::vector<double> truth;
+        render(scene, cfg, [&](int, int, const Film& film) {
+            truth.push_back(compareImages({size, size, film.image()}, ref.image).relMse -
+                            ref.ownRelMse);
+        });
+        size_t crossed = 0;
+        while (crossed < truth.size() && truth[crossed] > target)
+            ++crossed;
+        ASSERT_LT(crossed, truth.size()) << "the truth crosses the target within 256 spp";
+        cfg.targetError = target;
+        int stopped = 0;
+        render(scene, cfg, [&](int done, int, const Film&) { stopped = done; });
+        std::printf("seed %u: stopped after iteration %d; the true relMSE crossed %.4f at "
+                    "iteration %zu (%.5f, before it %.5f)\n",
+                    seed, stopped, target, crossed + 1, truth[crossed],
+                    crossed > 0 ? truth[crossed - 1] : 0.0);
+        EXPECT_LE(std::abs(stopped - int(crossed + 1)), 1) << "seed " << seed;
+    }
+}
+
 // --error-map writes the terms the relMSE estimate averages, per pixel and channel: the map's
 // mean is the CSV's last estimate, its values are finite and non-negative, and they differ from
 // pixel to pixel by orders of magnitude, as the noise does (a uniform map would show nothing).
