@@ -41,7 +41,7 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
 
 FIELDS = ["config", "backend", "sampler", "iteration", "spp", "seconds", "relmse", "relmse_estimate",
-          "relmse_true"]
+          "relmse_estimate_stderr", "relmse_true"]
 
 
 def main():
@@ -64,6 +64,7 @@ def main():
         with open(out_csv) as f:
             rows = [dict(r, iteration=int(r["iteration"]), spp=int(r["spp"]), seconds=float(r["seconds"]),
                          relmse=float(r["relmse"]), relmse_estimate=float(r["relmse_estimate"]),
+                         relmse_estimate_stderr=float(r.get("relmse_estimate_stderr", 0.0)),
                          relmse_true=float(r.get("relmse_true", r["relmse"])))
                     for r in csv.DictReader(f)]
         report(a, rows)
@@ -107,6 +108,7 @@ def main():
                                  "iteration": int(r["iteration"]), "spp": int(r["spp"]),
                                  "seconds": float(r["seconds"]), "relmse": float(r["relmse"]),
                                  "relmse_estimate": float(r["relmse_estimate"]),
+                                 "relmse_estimate_stderr": float(r["relmse_estimate_stderr"]),
                                  "relmse_true": float(r["relmse"]) - ref_own})
     if not rows:
         sys.exit("no configuration rendered")
@@ -212,9 +214,14 @@ def report_estimate(a, configs, curves):
         ax.loglog([r["spp"] for r in pts], [r["relmse_true"] for r in pts], color=colour, label=c + ": true")
         ax.loglog([r["spp"] for r in pts], [r["relmse_estimate"] for r in pts], color=colour, linestyle="--",
                   label=c + ": estimate")
+        # The estimate's standard error (from its own tiles) as a band of +- 2.
+        ax.fill_between([r["spp"] for r in pts],
+                        [max(r["relmse_estimate"] - 2 * r["relmse_estimate_stderr"], 1e-12) for r in pts],
+                        [r["relmse_estimate"] + 2 * r["relmse_estimate_stderr"] for r in pts],
+                        color=colour, alpha=0.2, linewidth=0)
     ax.set_xlabel("samples per pixel")
     ax.set_ylabel("relMSE")
-    ax.set_title(os.path.basename(a.scene) + ": estimate (dashed) against truth")
+    ax.set_title(os.path.basename(a.scene) + ": estimate (dashed, band: 2 s.e.) against truth", fontsize=9)
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=6)
     fig.tight_layout()

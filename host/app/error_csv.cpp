@@ -7,7 +7,7 @@ namespace spw {
 
 ErrorCsv::ErrorCsv(const std::string& path, std::optional<ImageRGB> reference)
     : out_(path), reference_(std::move(reference)) {
-    std::string header = "iteration,spp,seconds,relmse_estimate";
+    std::string header = "iteration,spp,seconds,relmse_estimate,relmse_estimate_stderr";
     if (reference_) header += ",mse,rmse,relmse,mae,psnr,maxabs";
     out_.write(header + "\n");
 }
@@ -15,7 +15,8 @@ ErrorCsv::ErrorCsv(const std::string& path, std::optional<ImageRGB> reference)
 void ErrorCsv::addRow(int iteration, int spp, double seconds, const Film& film) {
     std::ostringstream row;
     row.precision(9);
-    row << iteration << "," << spp << "," << seconds << "," << film.halfBufferRelMse();
+    row << iteration << "," << spp << "," << seconds << "," << film.halfBufferRelMse() << ","
+        << film.halfBufferRelMseStandardError();
     if (reference_) {
         ImageMetrics m = compareImages({film.width(), film.height(), film.image()}, *reference_);
         row << "," << m.mse << "," << m.rmse << "," << m.relMse << "," << m.mae << ","

@@ -1,7 +1,7 @@
 // Error against time while rendering (--error-csv): a CSV row after every iteration with the
 // render seconds so far (start-up, output and this bookkeeping excluded), the spp, the relMSE
-// estimated from the film's two half buffers, and, given a reference image, the metrics of
-// `spillway compare` against it.
+// estimated from the film's two half buffers and that estimate's standard error, and, given a
+// reference image, the metrics of `spillway compare` against it.
 #pragma once
 
 #include "host/image/compare.h"

@@ -132,8 +132,8 @@ const std::vector<CliOption> kOwnOptions = {
          r.progress = oneOf(o, v, "auto|bar|lines|none", "auto, bar, lines or none");
      }},
     {"--error-csv", nullptr, "FILE.csv", Section::Render,
-     "after every iteration, a row: seconds, spp, relMSE estimated from two half buffers, "
-     "and with --reference the compare metrics",
+     "after every iteration, a row: seconds, spp, relMSE estimated from two half buffers and "
+     "that estimate's standard error, and with --reference the compare metrics",
      0, 0, [](O& r, const C&, const S& v) { r.errorCsvPath = v; }},
     {"--error-map", nullptr, "FILE.exr", Section::Render,
      "at the end, the per-pixel relMSE estimate from two half buffers, per channel (the "

@@ -658,6 +658,23 @@ double Film::halfBufferRelMse() const {
     return halfBufferRelMseEstimate().value_or(0.0);
 }
 
+double Film::halfBufferRelMseStandardError() const {
+    // A pixel's term sum P (its three channels, whose noise is mostly shared) is a scaled
+    // chi-square of one degree of freedom where the halves' difference is Gaussian: its
+    // variance is 2/3 of E[P^2], and P^2 estimates E[P^2] from the pixel alone. Pixels are
+    // independent (up to the filter's reach), so the variances add.
+    double squares = 0.0;
+    size_t n = 0;
+    for (size_t i = 0; i < pixels(); ++i) {
+        double terms[3];
+        if (!halfBufferTerms(i, terms)) continue;
+        const double p = terms[0] + terms[1] + terms[2];
+        squares += p * p;
+        n += 3;
+    }
+    return n > 0 ? std::sqrt(2.0 / 3.0 * squares) / double(n) : 0.0;
+}
+
 std::optional<double> Film::halfBufferRelMseEstimate() const {
     const size_t n = size_t(width_) * height_;
     double total = 0;

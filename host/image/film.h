@@ -126,6 +126,12 @@ class Film {
     // Its per-pixel terms, rows y0 .. y1 - 1 into rgb (width x (y1 - y0) x 3 floats): where the
     // noise is (--error-map). A pixel whose halves do not both hold samples yet reads 0.
     void errorRows(int y0, int y1, float* rgb) const;
+    // The standard error of halfBufferRelMse() from its own terms: sqrt(2/3 sum_i P_i^2) / N,
+    // P_i a pixel's three terms summed, N the terms (film.cpp says why). It matches the
+    // estimate's spread over seeds to within a few per cent (HalfBufferEstimate tests). What it
+    // cannot see is a bias of the estimate: an error that no pixel's samples have shown yet (a
+    // bright light a few samples hit) is in no term.
+    double halfBufferRelMseStandardError() const;
     // The same, or nothing while no pixel has samples in both halves (one iteration of one
     // sample per pixel): then there is no estimate yet, rather than an estimate of 0.
     std::optional<double> halfBufferRelMseEstimate() const;

@@ -46,7 +46,7 @@ const Reference& highSppReference(int size) {
 // reference, the reference's own removed), the half-buffer estimate, and the final image.
 struct Series {
     int spp[5];
-    double trueRelMse[5], estimate[5];
+    double trueRelMse[5], estimate[5], standardError[5];
     std::vector<float> image;
 };
 
@@ -68,6 +68,7 @@ Series convergence(const std::string& backend, std::uint32_t seed, int size, int
             s.trueRelMse[k] =
                 compareImages({size, size, film.image()}, ref.image).relMse - ref.ownRelMse;
             s.estimate[k] = film.halfBufferRelMse();
+            s.standardError[k] = film.halfBufferRelMseStandardError();
             ++k;
         }
     });
@@ -144,6 +145,25 @@ TEST_P(HalfBufferEstimate, TracksTrueRelMse) {
     std::printf("log-log slope: estimate %.3f, true %.3f (per seed difference %.3f +- %.3f)\n",
                 slopeEst, slopeTrue, d.mean, d.stderror);
     EXPECT_NEAR(slopeEst, slopeTrue, 0.07 * widen);
+    // The estimate's own standard error, from its tiles, against the spread of the estimate
+    // over the seeds: their ratio, pooled over the sample counts, within 0.75-1.33 (the spread
+    // of 24 values is itself uncertain by about 15 %; a standard error off by sqrt(2) fails).
+    double ratio = 0;
+    for (int k = 0; k < 5; ++k) {
+        std::vector<double> values;
+        double reported = 0;
+        for (const Series& r : runs) {
+            values.push_back(r.estimate[k]);
+            reported += r.standardError[k] / kSeeds;
+        }
+        const double spread = meanOf(values).stderror * std::sqrt(double(kSeeds));
+        std::printf("%4d spp: the estimate's standard error %.3g, its spread over the seeds %.3g\n",
+                    spp[k], reported, spread);
+        ratio += reported / spread / 5;
+    }
+    std::printf("standard error over spread, pooled %.3f\n", ratio);
+    EXPECT_GT(ratio, 1.0 / (1.0 + 0.33 * widen));
+    EXPECT_LT(ratio, 1.0 + 0.33 * widen);
 }
 
 INSTANTIATE_TEST_SUITE_P(Convergence, HalfBufferEstimate,
@@ -235,7 +255,8 @@ TEST(ErrorCsv, OneRowPerIterationWithAndWithoutReference) {
         double t = std::stod(rows[i]["seconds"]);
         EXPECT_GT(t, last);
         last = t;
-        for (const char* k : {"relmse_estimate", "mse", "rmse", "relmse", "mae", "psnr", "maxabs"})
+        for (const char* k : {"relmse_estimate", "relmse_estimate_stderr", "mse", "rmse", "relmse",
+                              "mae", "psnr", "maxabs"})
             EXPECT_TRUE(std::isfinite(std::stod(rows[i][k]))) << k;
     }
     // The last row's metrics are the final image's, as `spillway compare` computes them.
