@@ -3,8 +3,9 @@
 #   scripts/check-identical.sh [REVISION]     (default: HEAD)
 # For a change that must not alter any image (a refactoring, a move, a rename). It builds
 # REVISION once in a cached copy (under ${SPILLWAY_IDENTICAL_CACHE:-/tmp/spillway-identical}),
-# builds the working tree in build/, renders the Cornell box and scenes/every-model.yaml (every
-# surface model, a Layered image texture, thin lens, Gaussian filter) with both binaries on
+# builds the working tree in build/, renders the Cornell box, scenes/every-model.yaml (every
+# surface model, a Layered image texture, thin lens, Gaussian filter), scenes/open-box-lights.yaml
+# and, where it has been made, the in-core benchmark's textured scene with both binaries on
 # every backend and pipeline variant below, and compares the pixels (`spillway compare` says
 # "images identical" only when every value is equal). Exit 0 when all are identical, 1 when any
 # differs; the Vulkan variants are skipped, and said so, where no Vulkan device exists.
@@ -42,8 +43,13 @@ variants=(
 have_vulkan=1
 "$root/build/spillway" devices 2>/dev/null | grep -q usable || have_vulkan=0
 
+# The many-shader textured scene (64 shaders, 7 MIP-mapped 8-bit images each) too where
+# `scripts/bench.py incore` has made it.
+scenes=(scenes/cornell-box.yaml scenes/every-model.yaml scenes/open-box-lights.yaml)
+[[ -f "$root/out/incore-textured/scene.yaml" ]] && scenes+=(out/incore-textured/scene.yaml)
+
 failed=0
-for scene in scenes/cornell-box.yaml scenes/every-model.yaml scenes/open-box-lights.yaml; do
+for scene in "${scenes[@]}"; do
     for v in "${variants[@]}"; do
         name="${v%%|*}"
         read -r -a flags <<<"${v#*|}"

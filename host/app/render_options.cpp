@@ -218,7 +218,8 @@ const std::vector<CliOption> kOwnOptions = {
      }},
     {"--simd-shading", nullptr, "on|off", Section::Pipeline,
      "cpu: shade Lambert hits 4, 8 or 16 at a time in SIMD registers (default on, where every "
-     "light is a triangle; the image is the same either way)",
+     "light is a triangle), and filter runs of 8-bit texture lookups so; the image is the same "
+     "either way",
      0, 0,
      [](O& r, const C& o, const S& v) {
          r.config.pipeline.simdShading = oneOf(o, v, "on|off", "on or off") == "on";

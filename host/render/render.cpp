@@ -227,7 +227,7 @@ void RenderSession::build() {
     }
     hitSetup_.emplace(scene_, *lights_);
     textures_.emplace(scene_, scene_.settings.textureCacheMiB,
-                      config_.textureFilter == TextureFilter::Cone);
+                      config_.textureFilter == TextureFilter::Cone, config_.pipeline.simdShading);
     camera_.emplace(scene_, plan_.sampleBase);
 
     RenderParams params{};

@@ -1,6 +1,7 @@
 #include "host/scene/textures.h"
 
 #include "host/image/image_io.h"
+#include "host/scene/wide_texels.h"
 
 #include <OpenImageIO/half.h>
 #include <OpenImageIO/imagecache.h>
@@ -19,6 +20,9 @@
 
 namespace spw {
 
+// The most MIP levels read of an image (a 2^31-texel side has 32).
+constexpr size_t kMaxLevels = 32;
+
 struct TextureResolver::Impl {
     OIIO::ImageCache* cache = nullptr;
     struct Level {
@@ -27,6 +31,7 @@ struct TextureResolver::Impl {
     struct Image {
         OIIO::ImageCache::ImageHandle* handle = nullptr;
         bool srgb = false;
+        bool eightBit = false; // its texels are 8-bit integers (the wide filter reads those)
         int channels = 3;
         float finest = 1.0f;       // the finest level's larger side, texels
         std::vector<Level> levels; // finest first
@@ -41,6 +46,7 @@ struct TextureResolver::Impl {
     mutable std::atomic<std::uint64_t> peakCacheBytes{0};
     std::atomic<std::uint64_t> lookups{0};
     bool filtered = true;
+    bool wide = true; // runs of 8-bit lookups filtered SIMD-wide
     // A tile a thread holds a reference to (so the cache cannot evict it), with what reading its
     // pixels needs.
     struct Held {
@@ -120,23 +126,143 @@ class TexelReader {
         : impl_(impl), thread_(thread), index_(index), image_(impl.images[size_t(index)]),
           held_(thread.held.data() + image_.firstHeld) {}
 
-    // The filtered value at (s, t) (image space: t grows downwards) for a footprint of
-    // `footprint` (uv units): bilinear within a level, blended between the two levels whose texels
-    // bracket the footprint's size (trilinear); the finest level alone for footprints under a
-    // texel. Repeats in both directions.
-    vec3 lookup(float s, float t, float footprint) {
-        const float texels = footprint * image_.finest;
+    // The filtered values for n hits at uv[k] (OBJ's v, growing upwards) for footprints
+    // footprint[k] (uv units; footprint null: 0): bilinear within a level, blended between the
+    // two levels whose texels bracket the footprint's size (trilinear); the finest level alone
+    // for footprints under a texel. Repeats in both directions.
+    //
+    // Level by level: every hit's finer level, then the coarser level of those that blend two,
+    // so the tile reads of one file rarely alternate between levels. Within a level, a run of
+    // hits whose texels lie in the tile held for it is filtered SIMD-wide (wide_texels.h) where
+    // the image is 8-bit; the rest, and other formats, one hit at a time (bilinear(), the
+    // oracle the wide filter equals bit for bit).
+    void lookups(size_t n, const vec2* uv, const float* footprint, vec3* out) {
+        thread_local std::vector<LevelQuery> queries;
+        queries.resize(n);
         const int last = int(image_.levels.size()) - 1;
-        if (!(texels > 1.0f) || last == 0) return bilinear(0, s, t);
-        const float lod = std::log2(texels);
-        if (!(lod < float(last))) return bilinear(last, s, t); // an infinite footprint too
-        const int level = int(lod);
-        const float blend = lod - float(level);
-        const vec3 fine = bilinear(level, s, t), coarse = bilinear(level + 1, s, t);
-        return fine + blend * (coarse - fine);
+        for (size_t k = 0; k < n; ++k) {
+            LevelQuery& q = queries[k];
+            q.s = uv[k].x, q.t = 1.0f - uv[k].y;
+            q.level = 0, q.blend = -1.0f;
+            const float texels = (footprint ? footprint[k] : 0.0f) * image_.finest;
+            if (!(texels > 1.0f) || last == 0) continue;
+            const float lod = std::log2(texels);
+            if (!(lod < float(last))) { // an infinite footprint too
+                q.level = last;
+                continue;
+            }
+            q.level = int(lod);
+            q.blend = lod - float(q.level);
+        }
+        filterLevel(queries.data(), n, 0, out);
+        thread_local std::vector<vec3> coarse;
+        coarse.resize(n);
+        filterLevel(queries.data(), n, 1, coarse.data());
+        for (size_t k = 0; k < n; ++k) {
+            const LevelQuery& q = queries[k];
+            if (q.blend >= 0.0f) out[k] = out[k] + q.blend * (coarse[k] - out[k]);
+        }
     }
 
   private:
+    struct LevelQuery {
+        float s, t;  // image space
+        int level;   // the finer (or only) level read
+        float blend; // toward level + 1; negative: that level alone
+    };
+
+    // out[k] = bilinear(q.level + up, q.s, q.t) for the queries q = queries[k] that read that
+    // level: every query (up 0), or those that blend two levels (up 1).
+    void filterLevel(const LevelQuery* queries, size_t n, int up, vec3* out) {
+        // Fewer hits than this are filtered one at a time: a vector's setup would cost more.
+        constexpr size_t kWideFrom = 4;
+        const bool wide = impl_.wide && image_.eightBit && n >= kWideFrom;
+        TexelLanes lanes;
+        float* const s = lanes.s;
+        float* const t = lanes.t;
+        std::uint32_t hitOf[kTexelBlock];
+        size_t count = 0;
+        int blockLevel = -1;
+        // The block's hits in the tile held for their level SIMD-wide; then the first hit of
+        // those left one at a time (which holds its tile), and the rest wide again, until none
+        // is left.
+        auto run = [&] {
+            while (count > 0) {
+                size_t left = 0;
+                const TexelTile tile = heldTile(blockLevel);
+                if (tile.bytes >= 4 && count >= kWideFrom) {
+                    const size_t end =
+                        (count + kTexelMaxLanes - 1) / kTexelMaxLanes * kTexelMaxLanes;
+                    for (size_t k = count; k < end; ++k) // padding repeats the last lane
+                        s[k] = s[count - 1], t[k] = t[count - 1];
+                    bilinearInTile(tile, levelView(blockLevel), end, lanes);
+                    for (size_t k = 0; k < count; ++k) {
+                        if (lanes.done[k]) {
+                            out[hitOf[k]] = vec3(lanes.r[k], lanes.g[k], lanes.b[k]);
+                            continue;
+                        }
+                        s[left] = s[k], t[left] = t[k], hitOf[left++] = hitOf[k];
+                    }
+                } else {
+                    left = count;
+                }
+                count = left;
+                if (left == 0) break;
+                out[hitOf[0]] = bilinear(blockLevel, s[0], t[0]);
+                for (size_t k = 1; k < left; ++k)
+                    s[k - 1] = s[k], t[k - 1] = t[k], hitOf[k - 1] = hitOf[k];
+                count = left - 1;
+            }
+        };
+        if (!wide) {
+            for (size_t k = 0; k < n; ++k) {
+                const LevelQuery& q = queries[k];
+                if (up == 0 || q.blend >= 0.0f) out[k] = bilinear(q.level + up, q.s, q.t);
+            }
+            return;
+        }
+        // The hits in order of their level (a counting sort: a run's footprints differ, and its
+        // levels with them, so hits of one level would otherwise come a few at a time).
+        std::array<std::uint32_t, kMaxLevels + 1> first{};
+        for (size_t k = 0; k < n; ++k)
+            if (up == 0 || queries[k].blend >= 0.0f) ++first[size_t(queries[k].level + up) + 1];
+        for (size_t l = 1; l <= kMaxLevels; ++l)
+            first[l] += first[l - 1];
+        thread_local std::vector<std::uint32_t> byLevel;
+        byLevel.resize(n);
+        for (size_t k = 0; k < n; ++k)
+            if (up == 0 || queries[k].blend >= 0.0f)
+                byLevel[first[size_t(queries[k].level + up)]++] = std::uint32_t(k);
+        const size_t total = first[kMaxLevels - 1];
+        for (size_t i = 0; i < total; ++i) {
+            const std::uint32_t k = byLevel[i];
+            const int level = queries[k].level + up;
+            if (level != blockLevel || count == kTexelBlock) {
+                run();
+                blockLevel = level;
+            }
+            s[count] = queries[k].s, t[count] = queries[k].t, hitOf[count++] = k;
+        }
+        run();
+    }
+
+    // The tile held for a level as the wide filter reads it (bytes 0: none).
+    TexelTile heldTile(int levelIndex) const {
+        const Held& h = held_[size_t(levelIndex)];
+        TexelTile tile;
+        if (!h.tile || h.type != OIIO::TypeDesc::UINT8) return tile;
+        tile.pixels = h.pixels;
+        tile.x0 = h.x0, tile.y0 = h.y0, tile.x1 = h.x1, tile.y1 = h.y1;
+        tile.pixelBytes = int(h.pixelBytes), tile.rowBytes = int(h.rowBytes);
+        tile.bytes = int(h.bytes()), tile.channels = std::min(image_.channels, 3);
+        tile.decode = image_.srgb ? srgbTable().data() : linearTable().data();
+        return tile;
+    }
+    TexelLevel levelView(int levelIndex) const {
+        const Impl::Level& l = image_.levels[size_t(levelIndex)];
+        return {l.x, l.y, l.width, l.height};
+    }
+
     // A texel index on a periodic level of n texels, for the i in [-1, n - 1] that bilinear()
     // makes from a coordinate in [0, 1] (no division on this path).
     static int wrap(int i, int n) { return i < 0 ? i + n : i; }
@@ -216,9 +342,9 @@ class TexelReader {
         float v[3] = {0.0f, 0.0f, 0.0f};
         const int nc = std::min(image_.channels, 3);
         if (h.type == OIIO::TypeDesc::UINT8) {
-            const std::array<float, 256>& srgb = srgbTable();
+            const std::array<float, 256>& table = image_.srgb ? srgbTable() : linearTable();
             for (int c = 0; c < nc; ++c)
-                v[c] = image_.srgb ? srgb[p[c]] : float(p[c]) * (1.0f / 255.0f);
+                v[c] = table[p[c]];
         } else {
             for (int c = 0; c < nc; ++c)
                 v[c] = image_.srgb ? srgbToLinear(channel(p, c, h.type)) : channel(p, c, h.type);
@@ -231,6 +357,16 @@ class TexelReader {
             std::array<float, 256> t{};
             for (int i = 0; i < 256; ++i)
                 t[size_t(i)] = srgbToLinear(float(i) * (1.0f / 255.0f));
+            return t;
+        }();
+        return table;
+    }
+
+    static const std::array<float, 256>& linearTable() {
+        static const std::array<float, 256> table = [] {
+            std::array<float, 256> t{};
+            for (int i = 0; i < 256; ++i)
+                t[size_t(i)] = float(i) * (1.0f / 255.0f);
             return t;
         }();
         return table;
@@ -281,7 +417,7 @@ void visit(const Scene& scene, int t, std::vector<int>& slotOf, std::vector<int>
 
 } // namespace
 
-TextureResolver::TextureResolver(const Scene& scene, double cacheMiB, bool filtered)
+TextureResolver::TextureResolver(const Scene& scene, double cacheMiB, bool filtered, bool wide)
     : scene_(scene) {
     programs_.resize(scene.textures.size());
     for (const Shader& sh : scene.shaders) {
@@ -305,6 +441,7 @@ TextureResolver::TextureResolver(const Scene& scene, double cacheMiB, bool filte
     if (standard == 0) return;
     impl_ = std::make_unique<Impl>();
     impl_->filtered = filtered;
+    impl_->wide = wide;
     impl_->cache = OIIO::ImageCache::create(false);
     impl_->cache->attribute("max_memory_MB", float(cacheMiB));
     // Keep every texture file open if the process may (OpenImageIO's default of 100 made the
@@ -327,11 +464,12 @@ TextureResolver::TextureResolver(const Scene& scene, double cacheMiB, bool filte
             throw std::runtime_error("cannot read texture '" + t.path +
                                      "': " + impl_->cache->geterror());
         img.channels = spec->nchannels;
+        img.eightBit = spec->format == OIIO::TypeDesc::UINT8;
         std::string cs = spec->get_string_attribute("oiio:ColorSpace");
         img.srgb = cs == "sRGB" || (cs.empty() && spec->format == OIIO::TypeDesc::UINT8);
         img.finest = float(std::max(spec->width, spec->height));
         // Its MIP levels, as many as the file has (an image without them is its own only level).
-        for (int level = 0; level < 32; ++level) {
+        for (int level = 0; level < int(kMaxLevels); ++level) {
             const OIIO::ImageSpec* ls =
                 level == 0 ? spec : impl_->cache->imagespec(img.handle, nullptr, 0, level);
             if (!ls || ls->width < 1 || ls->height < 1) break;
@@ -421,12 +559,9 @@ void TextureResolver::albedos(const Shader& shader, size_t n, const vec2* uv,
             break;
         }
         case TextureType::Standard: {
-            TexelReader reader(*impl_, *thread, op.texture);
-            for (size_t k = 0; k < n; ++k) {
-                // OBJ's v grows upwards, image rows downwards. The footprint is isotropic.
-                const float width = impl_->filtered ? footprint[k] : 0.0f;
-                v[k] = reader.lookup(uv[k].x, 1.0f - uv[k].y, width);
-            }
+            // OBJ's v grows upwards, image rows downwards. The footprint is isotropic.
+            TexelReader(*impl_, *thread, op.texture)
+                .lookups(n, uv, impl_->filtered ? footprint : nullptr, v);
             impl_->lookups.fetch_add(n, std::memory_order_relaxed);
             break;
         }

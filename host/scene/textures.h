@@ -35,7 +35,9 @@ class TextureResolver {
   public:
     // cacheMiB: the tile cache's size (settings: texture cache, or --texture-cache). filtered:
     // lookups take their footprint (MIP levels, trilinear); otherwise the finest level always.
-    TextureResolver(const Scene& scene, double cacheMiB, bool filtered = true);
+    // wide: albedos() filters runs of lookups in 8-bit images SIMD-wide (wide_texels.h); false
+    // filters one at a time. The values are the same to the bit.
+    TextureResolver(const Scene& scene, double cacheMiB, bool filtered = true, bool wide = true);
     ~TextureResolver();
     TextureResolver(const TextureResolver&) = delete;
     TextureResolver& operator=(const TextureResolver&) = delete;
@@ -45,7 +47,8 @@ class TextureResolver {
     // Thread-safe.
     vec3 albedo(const Shader& shader, vec2 uv, float footprint) const;
     // The same for `n` hits of one shader (each out[k] what that hit alone gets, bit for bit),
-    // evaluated texture by texture: every hit's lookup in one file, then in the next. The
+    // evaluated texture by texture: every hit's lookups in one file, then in the next; within a
+    // file MIP level by level, and SIMD-wide where the image is 8-bit. The
     // sorted pipeline's hits of a shader arrive together, near each other in texture space, so
     // consecutive lookups read the tiles the previous one held, where one hit's lookups in turn
     // would switch file every time.

@@ -6,11 +6,17 @@
 #include "host/scene/textures.h"
 #include "test_util.h"
 
+#include <OpenImageIO/imagebuf.h>
+#include <OpenImageIO/imagebufalgo.h>
 #include <OpenImageIO/imageio.h>
 #include <OpenImageIO/texture.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
+#include <cstring>
 #include <filesystem>
+#include <limits>
 #include <random>
 
 namespace spw::test {
@@ -109,6 +115,96 @@ TEST(TextureLookup, EightBitSrgbTexelsAreLinearisedBeforeTheyAreBlended) {
     EXPECT_FLOAT_EQ(textures.albedo(scene.shaders[0], vec2(0.5f, 0.5f), 0.0f).y, 0.5f);
     // Repeating: u = 0 lies halfway between the last texel and the first.
     EXPECT_FLOAT_EQ(textures.albedo(scene.shaders[0], vec2(0.0f, 0.5f), 0.0f).z, 0.5f);
+}
+
+// An 8-bit image of `channels` pseudo-random channels, w x h: made a tiled, MIP-mapped TIFF
+// texture (tiles of `tile` texels) by OpenImageIO's maketx, or written untiled with one level
+// (tile 0) in the format `path` names; `colourSpace` in its header if not empty (PNG keeps
+// "Linear", as gamma 1).
+void writeTexture8(const std::string& path, int w, int h, int channels, int tile,
+                   const std::string& colourSpace) {
+    OIIO::ImageSpec spec(w, h, channels, OIIO::TypeDesc::UINT8);
+    if (!colourSpace.empty()) spec.attribute("oiio:ColorSpace", colourSpace);
+    OIIO::ImageBuf image(spec);
+    std::mt19937 rng(unsigned(w * 31 + h * 7 + channels));
+    std::vector<unsigned char> pixels(size_t(w) * size_t(h) * size_t(channels));
+    for (unsigned char& p : pixels)
+        p = static_cast<unsigned char>(rng() & 0xFF);
+    ASSERT_TRUE(image.set_pixels(OIIO::ROI::All(), OIIO::TypeDesc::UINT8, pixels.data()));
+    if (tile == 0) {
+        ASSERT_TRUE(image.write(path)) << image.geterror();
+        return;
+    }
+    OIIO::ImageSpec config;
+    config.tile_width = config.tile_height = tile;
+    config.attribute("maketx:filtername", "box");
+    ASSERT_TRUE(
+        OIIO::ImageBufAlgo::make_texture(OIIO::ImageBufAlgo::MakeTxTexture, image, path, config))
+        << OIIO::geterror();
+}
+
+// Runs of lookups in 8-bit images are filtered SIMD-wide (wide_texels.h); one lookup at a
+// time is the oracle. They agree to the bit for grey, RGB and RGBA images, sRGB and linear,
+// tiled with edge tiles or untiled, MIP-mapped, at coordinates in runs (as sorted hits come),
+// far, negative, infinite and NaN, and footprints from none through every level to infinite;
+// and so with a cache small enough that a thread lets its tiles go as it reads new ones.
+TEST(TextureLookup, WideFilteringIsTheScalarLookupBitForBit) {
+    TempDir dir;
+    struct Case {
+        const char* file;
+        int width, height, channels, tile;
+        const char* colourSpace;
+        double cacheMiB;
+    };
+    const Case cases[] = {
+        {"rgb.tif", 100, 60, 3, 16, "", 4.0},   {"grey.tif", 64, 64, 1, 16, "", 4.0},
+        {"rgba.tif", 37, 53, 4, 16, "", 4.0},   {"linear.png", 64, 32, 3, 0, "Linear", 4.0},
+        {"untiled.tif", 29, 31, 3, 0, "", 4.0}, {"small-cache.tif", 256, 256, 3, 16, "", 0.02},
+    };
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<float> centre(-2.0f, 3.0f), near(-0.02f, 0.02f),
+        level(-1.0f, 10.0f), unit(0.0f, 1.0f);
+    const float inf = std::numeric_limits<float>::infinity(),
+                nan = std::numeric_limits<float>::quiet_NaN();
+    for (const Case& c : cases) {
+        writeTexture8(dir.file(c.file), c.width, c.height, c.channels, c.tile, c.colourSpace);
+        const Scene scene = texturedScene(dir, c.file);
+        const TextureResolver wide(scene, c.cacheMiB, true, true),
+            scalar(scene, c.cacheMiB, true, false);
+        size_t compared = 0, differing = 0;
+        for (int run = 0; run < 200; ++run) {
+            constexpr size_t kRun = 128;
+            std::vector<vec2> uv(kRun);
+            std::vector<float> footprint(kRun);
+            const vec2 at(centre(rng), centre(rng));
+            for (size_t k = 0; k < kRun; ++k) {
+                uv[k] = at + vec2(near(rng), near(rng));
+                footprint[k] = std::exp2(level(rng)) / float(std::max(c.width, c.height));
+                const float odd = unit(rng);
+                if (odd < 0.02f)
+                    uv[k] = vec2(centre(rng), centre(rng)) * 1e6f;
+                else if (odd < 0.03f)
+                    uv[k].x = nan;
+                else if (odd < 0.04f)
+                    uv[k].y = -inf;
+                else if (odd < 0.06f)
+                    footprint[k] = 0.0f;
+                else if (odd < 0.07f)
+                    footprint[k] = inf;
+                else if (odd < 0.08f)
+                    footprint[k] = nan;
+            }
+            std::vector<vec3> a(kRun), b(kRun);
+            wide.albedos(scene.shaders[0], kRun, uv.data(), footprint.data(), a.data());
+            scalar.albedos(scene.shaders[0], kRun, uv.data(), footprint.data(), b.data());
+            compared += kRun;
+            for (size_t k = 0; k < kRun; ++k)
+                differing += std::memcmp(&a[k], &b[k], sizeof(vec3)) != 0;
+        }
+        EXPECT_EQ(differing, 0u) << c.file << ": of " << compared;
+        wide.checkErrors();
+        scalar.checkErrors();
+    }
 }
 
 // A texture file that is readable when the scene loads but whose pixels are not: the lookup
