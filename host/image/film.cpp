@@ -1,5 +1,7 @@
 #include "host/image/film.h"
 
+#include "host/simd/film_rounding.h"
+
 #include "host/image/compare.h"
 #include "shared/rng.h"
 
@@ -309,7 +311,6 @@ void Film::addToSample(uint path, vec3 radiance, uint key) {
 void Film::finishSamples() {
     if (!samplesPending_) return;
     samplesPending_ = false;
-    const uint spi = samplesPerIteration_, base = sampleBase_.load();
     // A band of rows at a time, in pixel order, so that neighbouring samples' footprints share
     // cache lines. A sample in row y reaches rows y - reach .. y + reach: bands 2 x reach rows
     // high, the even ones and then the odd ones, never write the same pixel at once, so each
@@ -318,23 +319,79 @@ void Film::finishSamples() {
     const int band = std::max(8, 2 * reach), bands = (height_ + band - 1) / band;
     for (int parity = 0; parity < 2; ++parity)
         tbb::parallel_for(0, (bands + 1 - parity) / 2, [&](int k) {
-            const int y0 = (2 * k + parity) * band, y1 = std::min(height_, y0 + band);
-            for (int y = y0; y < y1; ++y)
-                for (int x = 0; x < width_; ++x) {
-                    if (!sampling(x, y)) continue;
-                    const size_t pixel = size_t(y) * size_t(width_) + size_t(x);
-                    for (uint s = 0; s < spi; ++s) {
-                        const size_t path = pixel * spi + s;
-                        SampleSum& sum = samples_[path];
-                        std::int64_t rgb[3];
-                        for (int c = 0; c < 3; ++c) {
-                            rgb[c] = sum.rgb[c].load(std::memory_order_relaxed);
-                            sum.rgb[c].store(0, std::memory_order_relaxed);
-                        }
-                        filterSample(path, vec2(sum.x, sum.y), base + s, rgb);
-                    }
-                }
+            const int y0 = (2 * k + parity) * band;
+            filterSamples(y0, std::min(height_, y0 + band));
         });
+}
+
+namespace {
+// The (pixel, sample) pairs of footprints waiting to be rounded (roundFootprint) and added.
+struct FootprintBatch {
+    FootprintLanes lanes;
+    FootprintAdds adds;
+    std::atomic<std::int64_t>* target[simd::kBlock]; // the pixel's half's four sums
+    size_t count = 0;
+};
+} // namespace
+
+// The sums of the samples of rows [y0, y1), each filtered into its footprint, and zeroed. A
+// sample's weight is rounded with the key a sample's weight always had, so that the weight sums
+// are the same as if each contribution were filtered on its own; its radiance sum with a key of
+// its own path. The rounding is SIMD-wide, over the pixels of many samples' footprints at once.
+void Film::filterSamples(int y0, int y1) {
+    const uint spi = samplesPerIteration_, base = sampleBase_.load();
+    FootprintBatch batch;
+    auto flush = [&] {
+        const size_t end = simd::wholeVectors(batch.count);
+        for (size_t k = batch.count; k < end; ++k) { // padding: no weight, nothing added
+            batch.lanes.pixel.v[k] = batch.lanes.weightKey.v[k] = batch.lanes.rgbKey.v[k] = 0;
+            batch.lanes.weight.v[k] = 0.0f;
+            batch.lanes.r[k] = batch.lanes.g[k] = batch.lanes.b[k] = 0.0;
+        }
+        const size_t saturated =
+            roundFootprint(batch.lanes, end, weightScale_, maxAdd_, batch.adds);
+        if (saturated) saturated_.fetch_add(saturated, std::memory_order_relaxed);
+        // No other thread adds to these pixels now (finishSamples).
+        auto addTo = [](std::atomic<std::int64_t>& v, std::int64_t q) {
+            if (q != 0) v.store(v.load(std::memory_order_relaxed) + q, std::memory_order_relaxed);
+        };
+        for (size_t k = 0; k < batch.count; ++k) {
+            std::atomic<std::int64_t>* a = batch.target[k];
+            addTo(a[0], batch.adds.r[k]);
+            addTo(a[1], batch.adds.g[k]);
+            addTo(a[2], batch.adds.b[k]);
+            addTo(a[3], batch.adds.w[k]);
+        }
+        batch.count = 0;
+    };
+    for (int y = y0; y < y1; ++y)
+        for (int x = 0; x < width_; ++x) {
+            if (!sampling(x, y)) continue;
+            const size_t pixel = size_t(y) * size_t(width_) + size_t(x);
+            for (uint s = 0; s < spi; ++s) {
+                const size_t path = pixel * spi + s;
+                SampleSum& sum = samples_[path];
+                double rgb[3];
+                for (int c = 0; c < 3; ++c) {
+                    rgb[c] = double(sum.rgb[c].load(std::memory_order_relaxed));
+                    sum.rgb[c].store(0, std::memory_order_relaxed);
+                }
+                const int half = halfOf(base + s);
+                const uint weightKey = roundingKey(0u, base + s);
+                const uint rgbKey = roundingKey(uint(path) ^ 0x5A3D0000u, base + s);
+                forFootprint(vec2(sum.x, sum.y), [&](int px, int py, float w) {
+                    const uint at = uint(py * width_ + px);
+                    FootprintLanes& l = batch.lanes;
+                    const size_t k = batch.count++;
+                    l.pixel.v[k] = at, l.weightKey.v[k] = weightKey, l.rgbKey.v[k] = rgbKey;
+                    l.weight.v[k] = w;
+                    l.r[k] = rgb[0], l.g[k] = rgb[1], l.b[k] = rgb[2];
+                    batch.target[k] = &acc_[at].v[half * 4];
+                    if (batch.count == simd::kBlock) flush();
+                });
+            }
+        }
+    flush();
 }
 
 template <typename Fn> void Film::forFootprint(vec2 filmPos, const Fn& fn) const {
@@ -366,32 +423,6 @@ void Film::filtered(vec2 filmPos, int half, vec3 radiance, float weight, uint ke
     }
     forFootprint(filmPos,
                  [&](int x, int y, float w) { add(x, y, half, radiance * w, weight * w, key); });
-}
-
-// The sample's weight is rounded with the key a sample's weight always had, so that the weight
-// sums are the same as if each contribution were filtered on its own; its radiance sum with a
-// key of its own path.
-void Film::filterSample(size_t path, vec2 filmPos, uint sampleIndex, const std::int64_t* rgb) {
-    const int half = halfOf(sampleIndex);
-    const uint weightKey = roundingKey(0u, sampleIndex);
-    const uint rgbKey = roundingKey(uint(path) ^ 0x5A3D0000u, sampleIndex);
-    const double value[3] = {double(rgb[0]), double(rgb[1]), double(rgb[2])};
-    const bool any = rgb[0] != 0 || rgb[1] != 0 || rgb[2] != 0;
-    forFootprint(filmPos, [&](int x, int y, float w) {
-        const uint pixel = uint(y * width_ + x);
-        std::atomic<std::int64_t>* a = &acc_[pixel].v[half * 4];
-        const uvec4 hw = pcg4d(uvec4(weightKey, pixel, 0x5157u, 0x9E3779B9u));
-        // No other thread adds to this pixel now (finishSamples).
-        auto addTo = [](std::atomic<std::int64_t>& v, std::int64_t q) {
-            v.store(v.load(std::memory_order_relaxed) + q, std::memory_order_relaxed);
-        };
-        addTo(a[3], quantize(double(1.0f * w) * weightScale_, hw.w));
-        if (!any) return;
-        const uvec4 h = pcg4d(uvec4(rgbKey, pixel, 0x5157u, 0x9E3779B9u));
-        const uint rnd[3] = {h.x, h.y, h.z};
-        for (int c = 0; c < 3; ++c)
-            addTo(a[c], quantize(value[c] * double(w), rnd[c]));
-    });
 }
 
 void Film::prefetch(uint path, vec2 filmPos) const {

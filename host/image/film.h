@@ -210,10 +210,10 @@ class Film {
     void add(int px, int py, int half, vec3 value, float weight, uint key);
     // v (fixed-point units) clamped (counted) and rounded stochastically with u: E = v.
     std::int64_t quantize(double v, uint u);
-    // Sample sums (wide filters): the contribution into path's sum; the sum filtered.
+    // Sample sums (wide filters): the contribution into path's sum; the sums of rows [y0, y1)
+    // filtered (not thread-safe: finishSamples() keeps the threads' footprints apart).
     void addToSample(uint path, vec3 radiance, uint key);
-    // Not thread-safe: finishSamples() keeps the threads' footprints apart.
-    void filterSample(size_t path, vec2 filmPos, uint sampleIndex, const std::int64_t* rgb);
+    void filterSamples(int y0, int y1);
 
     int width_, height_;
     uint samplesPerIteration_;

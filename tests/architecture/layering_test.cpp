@@ -2,8 +2,8 @@
 // the layers, never up or sideways, and Embree stays inside host/accel/.
 //
 //   app -> render -> {reference, cpu and vk (the shading engines) -> pipeline}
-//       -> {pipeline -> accel (Embree), simd (Highway)} -> backend (what every backend is
-//       handed) -> scene -> image -> shaders/shared
+//       -> {pipeline -> accel (Embree)} -> backend (what every backend is handed) -> scene
+//       -> image -> simd (Highway: the SIMD twins of shared functions) -> shaders/shared
 #include "test_util.h"
 
 #include <gtest/gtest.h>
@@ -32,19 +32,20 @@ std::string layerOf(const std::string& path) {
 // What each layer may include besides itself.
 const std::map<std::string, std::set<std::string>> kMayInclude = {
     {"shared", {}},
-    {"image", {"shared"}},
-    {"scene", {"image", "shared"}},
-    {"backend", {"scene", "image", "shared"}},
     {"simd", {"shared"}},
-    {"accel", {"backend", "scene", "image", "shared"}},
-    {"pipeline", {"accel", "simd", "backend", "scene", "image", "shared"}},
-    {"cpu", {"pipeline", "accel", "simd", "backend", "scene", "image", "shared"}},
-    {"vk", {"pipeline", "backend", "scene", "image", "shared"}},
-    {"reference", {"accel", "backend", "scene", "image", "shared"}},
+    {"image", {"simd", "shared"}},
+    {"scene", {"image", "simd", "shared"}},
+    {"backend", {"scene", "image", "simd", "shared"}},
+    {"accel", {"backend", "scene", "image", "simd", "shared"}},
+    {"pipeline", {"accel", "backend", "scene", "image", "simd", "shared"}},
+    {"cpu", {"pipeline", "accel", "backend", "scene", "image", "simd", "shared"}},
+    {"vk", {"pipeline", "backend", "scene", "image", "simd", "shared"}},
+    {"reference", {"accel", "backend", "scene", "image", "simd", "shared"}},
     {"render",
-     {"reference", "cpu", "vk", "pipeline", "accel", "backend", "scene", "image", "shared"}},
+     {"reference", "cpu", "vk", "pipeline", "accel", "backend", "scene", "image", "simd",
+      "shared"}},
     {"app",
-     {"render", "reference", "cpu", "vk", "pipeline", "accel", "backend", "scene", "image",
+     {"render", "reference", "cpu", "vk", "pipeline", "accel", "backend", "scene", "image", "simd",
       "shared"}},
 };
 
