@@ -11,6 +11,7 @@
 #include <OpenImageIO/imageio.h>
 #include <OpenImageIO/texture.h>
 #include <gtest/gtest.h>
+#include <hwy/targets.h>
 
 #include <algorithm>
 #include <cmath>
@@ -145,9 +146,10 @@ void writeTexture8(const std::string& path, int w, int h, int channels, int tile
 
 // Runs of lookups in 8-bit images are filtered SIMD-wide (wide_texels.h); one lookup at a
 // time is the oracle. They agree to the bit for grey, RGB and RGBA images, sRGB and linear,
-// tiled with edge tiles or untiled, MIP-mapped, at coordinates in runs (as sorted hits come),
-// far, negative, infinite and NaN, and footprints from none through every level to infinite;
-// and so with a cache small enough that a thread lets its tiles go as it reads new ones.
+// tiled with edge tiles or untiled, MIP-mapped, in every instruction set this machine has, at
+// coordinates in runs (as sorted hits come), far, negative, infinite and NaN, and footprints
+// from none through every level to infinite; and so with a cache small enough that a thread
+// lets its tiles go as it reads new ones.
 TEST(TextureLookup, WideFilteringIsTheScalarLookupBitForBit) {
     TempDir dir;
     struct Case {
@@ -166,6 +168,8 @@ TEST(TextureLookup, WideFilteringIsTheScalarLookupBitForBit) {
         level(-1.0f, 10.0f), unit(0.0f, 1.0f);
     const float inf = std::numeric_limits<float>::infinity(),
                 nan = std::numeric_limits<float>::quiet_NaN();
+    const std::vector<std::int64_t> targets = hwy::SupportedAndGeneratedTargets();
+    ASSERT_FALSE(targets.empty());
     for (const Case& c : cases) {
         writeTexture8(dir.file(c.file), c.width, c.height, c.channels, c.tile, c.colourSpace);
         const Scene scene = texturedScene(dir, c.file);
@@ -195,12 +199,15 @@ TEST(TextureLookup, WideFilteringIsTheScalarLookupBitForBit) {
                     footprint[k] = nan;
             }
             std::vector<vec3> a(kRun), b(kRun);
+            // Each run in the next instruction set this machine has.
+            hwy::SetSupportedTargetsForTest(targets[size_t(run) % targets.size()]);
             wide.albedos(scene.shaders[0], kRun, uv.data(), footprint.data(), a.data());
             scalar.albedos(scene.shaders[0], kRun, uv.data(), footprint.data(), b.data());
             compared += kRun;
             for (size_t k = 0; k < kRun; ++k)
                 differing += std::memcmp(&a[k], &b[k], sizeof(vec3)) != 0;
         }
+        hwy::SetSupportedTargetsForTest(0);
         EXPECT_EQ(differing, 0u) << c.file << ": of " << compared;
         wide.checkErrors();
         scalar.checkErrors();
