@@ -171,79 +171,75 @@ class TexelReader {
         float blend; // toward level + 1; negative: that level alone
     };
 
+    // Fewer hits than this are filtered one at a time: a vector's setup would cost more.
+    static constexpr size_t kWideFrom = 4;
+
     // out[k] = bilinear(q.level + up, q.s, q.t) for the queries q = queries[k] that read that
     // level: every query (up 0), or those that blend two levels (up 1).
     void filterLevel(const LevelQuery* queries, size_t n, int up, vec3* out) {
-        // Fewer hits than this are filtered one at a time: a vector's setup would cost more.
-        constexpr size_t kWideFrom = 4;
-        const bool wide = impl_.wide && image_.eightBit && n >= kWideFrom;
-        TexelLanes lanes;
-        float* const s = lanes.s;
-        float* const t = lanes.t;
-        std::uint32_t hitOf[kTexelBlock];
-        size_t count = 0;
-        int blockLevel = -1;
-        // The block's hits in the tile held for their level SIMD-wide; then the first hit of
-        // those left one at a time (which holds its tile), and the rest wide again, until none
-        // is left.
-        auto run = [&] {
-            while (count > 0) {
-                size_t left = 0;
-                const TexelTile tile = heldTile(blockLevel);
-                if (tile.bytes >= 4 && count >= kWideFrom) {
-                    const size_t end =
-                        (count + kTexelMaxLanes - 1) / kTexelMaxLanes * kTexelMaxLanes;
-                    for (size_t k = count; k < end; ++k) // padding repeats the last lane
-                        s[k] = s[count - 1], t[k] = t[count - 1];
-                    bilinearInTile(tile, levelView(blockLevel), end, lanes);
-                    for (size_t k = 0; k < count; ++k) {
-                        if (lanes.done[k]) {
-                            out[hitOf[k]] = vec3(lanes.r[k], lanes.g[k], lanes.b[k]);
-                            continue;
-                        }
-                        s[left] = s[k], t[left] = t[k], hitOf[left++] = hitOf[k];
-                    }
-                } else {
-                    left = count;
-                }
-                count = left;
-                if (left == 0) break;
-                out[hitOf[0]] = bilinear(blockLevel, s[0], t[0]);
-                for (size_t k = 1; k < left; ++k)
-                    s[k - 1] = s[k], t[k - 1] = t[k], hitOf[k - 1] = hitOf[k];
-                count = left - 1;
-            }
-        };
-        if (!wide) {
-            for (size_t k = 0; k < n; ++k) {
-                const LevelQuery& q = queries[k];
-                if (up == 0 || q.blend >= 0.0f) out[k] = bilinear(q.level + up, q.s, q.t);
-            }
+        auto reads = [&](size_t k) { return up == 0 || queries[k].blend >= 0.0f; };
+        if (!(impl_.wide && image_.eightBit && n >= kWideFrom)) {
+            for (size_t k = 0; k < n; ++k)
+                if (reads(k)) out[k] = bilinear(queries[k].level + up, queries[k].s, queries[k].t);
             return;
         }
         // The hits in order of their level (a counting sort: a run's footprints differ, and its
         // levels with them, so hits of one level would otherwise come a few at a time).
         std::array<std::uint32_t, kMaxLevels + 1> first{};
         for (size_t k = 0; k < n; ++k)
-            if (up == 0 || queries[k].blend >= 0.0f) ++first[size_t(queries[k].level + up) + 1];
+            if (reads(k)) ++first[size_t(queries[k].level + up) + 1];
         for (size_t l = 1; l <= kMaxLevels; ++l)
             first[l] += first[l - 1];
         thread_local std::vector<std::uint32_t> byLevel;
         byLevel.resize(n);
         for (size_t k = 0; k < n; ++k)
-            if (up == 0 || queries[k].blend >= 0.0f)
-                byLevel[first[size_t(queries[k].level + up)]++] = std::uint32_t(k);
-        const size_t total = first[kMaxLevels - 1];
-        for (size_t i = 0; i < total; ++i) {
+            if (reads(k)) byLevel[first[size_t(queries[k].level + up)]++] = std::uint32_t(k);
+        // Blocks of one level's hits.
+        TexelLanes lanes;
+        std::uint32_t hitOf[kTexelBlock];
+        size_t count = 0;
+        int blockLevel = -1;
+        for (size_t i = 0, total = first[kMaxLevels - 1]; i < total; ++i) {
             const std::uint32_t k = byLevel[i];
             const int level = queries[k].level + up;
             if (level != blockLevel || count == kTexelBlock) {
-                run();
+                filterBlock(blockLevel, lanes, hitOf, count, out);
                 blockLevel = level;
+                count = 0;
             }
-            s[count] = queries[k].s, t[count] = queries[k].t, hitOf[count++] = k;
+            lanes.s[count] = queries[k].s, lanes.t[count] = queries[k].t, hitOf[count++] = k;
         }
-        run();
+        filterBlock(blockLevel, lanes, hitOf, count, out);
+    }
+
+    // out[hitOf[k]] = bilinear(level, lanes.s[k], lanes.t[k]) for k in [0, count): the hits in
+    // the tile held for the level SIMD-wide; then the first of those left one at a time (which
+    // holds its tile), and the rest wide again, until none is left. Overwrites the lanes.
+    void filterBlock(int level, TexelLanes& lanes, std::uint32_t* hitOf, size_t count, vec3* out) {
+        float *const s = lanes.s, *const t = lanes.t;
+        while (count > 0) {
+            size_t left = 0;
+            const TexelTile tile = heldTile(level);
+            if (tile.bytes >= 4 && count >= kWideFrom) {
+                const size_t end = (count + kTexelMaxLanes - 1) / kTexelMaxLanes * kTexelMaxLanes;
+                for (size_t k = count; k < end; ++k) // padding repeats the last lane
+                    s[k] = s[count - 1], t[k] = t[count - 1];
+                bilinearInTile(tile, levelView(level), end, lanes);
+                for (size_t k = 0; k < count; ++k) {
+                    if (lanes.done[k])
+                        out[hitOf[k]] = vec3(lanes.r[k], lanes.g[k], lanes.b[k]);
+                    else
+                        s[left] = s[k], t[left] = t[k], hitOf[left++] = hitOf[k];
+                }
+            } else {
+                left = count;
+            }
+            if (left == 0) return;
+            out[hitOf[0]] = bilinear(level, s[0], t[0]);
+            for (size_t k = 1; k < left; ++k)
+                s[k - 1] = s[k], t[k - 1] = t[k], hitOf[k - 1] = hitOf[k];
+            count = left - 1;
+        }
     }
 
     // The tile held for a level as the wide filter reads it (bytes 0: none).
