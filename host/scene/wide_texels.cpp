@@ -8,17 +8,14 @@
 #include <hwy/foreach_target.h> // must come before highway.h
 #include <hwy/highway.h>
 
+#include "host/simd/simd_math-inl.h" // D, DU, V, VU
+
 #include <cstdint>
 
 HWY_BEFORE_NAMESPACE();
 namespace spw::HWY_NAMESPACE {
-namespace hn = hwy::HWY_NAMESPACE;
-using D = hn::ScalableTag<float>;
 using DI = hn::RebindToSigned<D>;
-using DU = hn::RebindToUnsigned<D>;
-using V = hn::Vec<D>;
 using VI = hn::Vec<DI>;
-using VU = hn::Vec<DU>;
 using MI = hn::Mask<DI>;
 
 // A coordinate's fraction (periodic), a NaN's read as 0: s - floor(s), then 0 unless in [0, 1].
