@@ -340,6 +340,13 @@ struct FootprintBatch {
 // its own path. The rounding is SIMD-wide, over the pixels of many samples' footprints at once.
 void Film::filterSamples(int y0, int y1) {
     const uint spi = samplesPerIteration_, base = sampleBase_.load();
+    // What depends on the sample's index alone: its half and its weight's rounding key.
+    thread_local std::vector<int> halves;
+    thread_local std::vector<uint> weightKeys;
+    halves.resize(spi);
+    weightKeys.resize(spi);
+    for (uint s = 0; s < spi; ++s)
+        halves[s] = halfOf(base + s), weightKeys[s] = roundingKey(0u, base + s);
     FootprintBatch batch;
     auto flush = [&] {
         const size_t end = simd::wholeVectors(batch.count);
@@ -376,8 +383,8 @@ void Film::filterSamples(int y0, int y1) {
                     rgb[c] = double(sum.rgb[c].load(std::memory_order_relaxed));
                     sum.rgb[c].store(0, std::memory_order_relaxed);
                 }
-                const int half = halfOf(base + s);
-                const uint weightKey = roundingKey(0u, base + s);
+                const int half = halves[s];
+                const uint weightKey = weightKeys[s];
                 const uint rgbKey = roundingKey(uint(path) ^ 0x5A3D0000u, base + s);
                 forFootprint(vec2(sum.x, sum.y), [&](int px, int py, float w) {
                     const uint at = uint(py * width_ + px);

@@ -196,38 +196,38 @@ class TexelReader {
             if (reads(k)) byLevel[first[size_t(queries[k].level + up)]++] = std::uint32_t(k);
         // Blocks of one level's hits.
         TexelLanes lanes;
-        std::uint32_t hitOf[kTexelBlock];
+        std::uint32_t hitOf[simd::kBlock];
         size_t count = 0;
         int blockLevel = -1;
         for (size_t i = 0, total = first[kMaxLevels - 1]; i < total; ++i) {
             const std::uint32_t k = byLevel[i];
             const int level = queries[k].level + up;
-            if (level != blockLevel || count == kTexelBlock) {
+            if (level != blockLevel || count == simd::kBlock) {
                 filterBlock(blockLevel, lanes, hitOf, count, out);
                 blockLevel = level;
                 count = 0;
             }
-            lanes.s[count] = queries[k].s, lanes.t[count] = queries[k].t, hitOf[count++] = k;
+            lanes.s.v[count] = queries[k].s, lanes.t.v[count] = queries[k].t, hitOf[count++] = k;
         }
         filterBlock(blockLevel, lanes, hitOf, count, out);
     }
 
-    // out[hitOf[k]] = bilinear(level, lanes.s[k], lanes.t[k]) for k in [0, count): the hits in
+    // out[hitOf[k]] = bilinear(level, lanes.s.v[k], lanes.t.v[k]) for k in [0, count): the hits in
     // the tile held for the level SIMD-wide; then the first of those left one at a time (which
     // holds its tile), and the rest wide again, until none is left. Overwrites the lanes.
     void filterBlock(int level, TexelLanes& lanes, std::uint32_t* hitOf, size_t count, vec3* out) {
-        float *const s = lanes.s, *const t = lanes.t;
+        float *const s = lanes.s.v, *const t = lanes.t.v;
         while (count > 0) {
             size_t left = 0;
             const TexelTile tile = heldTile(level);
             if (tile.bytes >= 4 && count >= kWideFrom) {
-                const size_t end = (count + kTexelMaxLanes - 1) / kTexelMaxLanes * kTexelMaxLanes;
+                const size_t end = simd::wholeVectors(count);
                 for (size_t k = count; k < end; ++k) // padding repeats the last lane
                     s[k] = s[count - 1], t[k] = t[count - 1];
                 bilinearInTile(tile, levelView(level), end, lanes);
                 for (size_t k = 0; k < count; ++k) {
-                    if (lanes.done[k])
-                        out[hitOf[k]] = vec3(lanes.r[k], lanes.g[k], lanes.b[k]);
+                    if (lanes.done.v[k])
+                        out[hitOf[k]] = vec3(lanes.r.v[k], lanes.g.v[k], lanes.b.v[k]);
                     else
                         s[left] = s[k], t[left] = t[k], hitOf[left++] = hitOf[k];
                 }

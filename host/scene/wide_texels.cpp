@@ -87,11 +87,11 @@ void BilinearInTile(const spw::TexelTile& tile, const spw::TexelLevel& level, si
     for (size_t i = 0; i < count; i += hn::Lanes(d)) {
         VI x0, x1, y0, y1;
         V ax, ay;
-        axis(fraction(hn::Load(d, lanes.s + i)), level.x, level.width, x0, x1, ax);
-        axis(fraction(hn::Load(d, lanes.t + i)), level.y, level.height, y0, y1, ay);
+        axis(fraction(hn::Load(d, lanes.s.v + i)), level.x, level.width, x0, x1, ax);
+        axis(fraction(hn::Load(d, lanes.t.v + i)), level.y, level.height, y0, y1, ay);
         const MI in = hn::And(hn::And(within(x0, tile.x0, tile.x1), within(x1, tile.x0, tile.x1)),
                               hn::And(within(y0, tile.y0, tile.y1), within(y1, tile.y0, tile.y1)));
-        hn::Store(hn::BitCast(du, hn::VecFromMask(di, in)), du, lanes.done + i);
+        hn::Store(hn::BitCast(du, hn::VecFromMask(di, in)), du, lanes.done.v + i);
         if (hn::AllFalse(di, in)) continue;
         // Byte offsets in the tile; lanes outside it read its first texel.
         const VI pixel = hn::Set(di, tile.pixelBytes), row = hn::Set(di, tile.rowBytes);
@@ -104,9 +104,9 @@ void BilinearInTile(const spw::TexelTile& tile, const spw::TexelLevel& level, si
         const Texel c = fetch(tile, hn::IfThenElseZero(in, hn::Add(r1, c0)));
         const Texel e = fetch(tile, hn::IfThenElseZero(in, hn::Add(r1, c1)));
         const Texel value = lerp(lerp(a, b, ax), lerp(c, e, ax), ay);
-        hn::Store(value.r, d, lanes.r + i);
-        hn::Store(value.g, d, lanes.g + i);
-        hn::Store(value.b, d, lanes.b + i);
+        hn::Store(value.r, d, lanes.r.v + i);
+        hn::Store(value.g, d, lanes.g.v + i);
+        hn::Store(value.b, d, lanes.b.v + i);
     }
 }
 

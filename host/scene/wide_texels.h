@@ -5,8 +5,9 @@
 // the same decoding table (TextureLookup.WideFilteringIsTheScalarLookupBitForBit).
 #pragma once
 
+#include "host/simd/lanes.h"
+
 #include <cstddef>
-#include <cstdint>
 
 namespace spw {
 
@@ -26,19 +27,14 @@ struct TexelLevel {
     int x = 0, y = 0, width = 1, height = 1;
 };
 
-// A block of lookups, a row of lanes per value (host/simd/lanes.h's layout; the scene layer
-// keeps its own, below the SIMD layer). kTexelBlock is a multiple of every vector width.
-constexpr size_t kTexelBlock = 64, kTexelMaxLanes = 16;
+// A block of lookups, a row of lanes per value (host/simd/lanes.h).
 struct TexelLanes {
-    alignas(64) float s[kTexelBlock]; // image-space coordinates (t grows downwards)
-    alignas(64) float t[kTexelBlock];
-    alignas(64) float r[kTexelBlock]; // the filtered value
-    alignas(64) float g[kTexelBlock];
-    alignas(64) float b[kTexelBlock];
-    alignas(64) std::uint32_t done[kTexelBlock]; // all ones: r, g, b are the lane's value
+    simd::Floats s, t;    // image-space coordinates (t grows downwards)
+    simd::Floats r, g, b; // the filtered value
+    simd::Uints done;     // all ones: r, g, b are the lane's value
 };
 
-// Lanes [0, count) (count a multiple of kTexelMaxLanes, at most kTexelBlock) of `lanes`: where
+// Lanes [0, count) (count a multiple of simd::kMaxLanes, at most simd::kBlock) of `lanes`: where
 // all four texels a lane's bilinear filter reads lie in `tile`, r, g, b are the filtered value
 // and `done` all ones; elsewhere `done` is 0 and r, g, b are not to be read. Needs
 // tile.bytes >= 4 (it reads texels as 32-bit words).
