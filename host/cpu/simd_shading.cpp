@@ -1,12 +1,12 @@
-// The SIMD Lambert kernel (simd_shading.h). Highway compiles the part between
+// The SIMD shading kernels (simd_shading.h). Highway compiles the part between
 // HWY_BEFORE_NAMESPACE and HWY_AFTER_NAMESPACE once per instruction set (this file includes
 // itself through foreach_target.h) and picks the best the processor has at the first call.
 //
-// The kernel is shadeSurface() (shared/path.h) for the Lambert model (shared/lambert.h) and
-// triangle emitters, written with the SIMD twins of the shared functions
-// (host/simd/simd_math-inl.h, each checked against its scalar function lane by lane); what the
-// kernel itself adds is the control flow, and normalize written as glm does it,
-// v * (1 / sqrt(dot(v, v))).
+// Each kernel is shadeSurface() (shared/path.h) for one surface model (shared/lambert.h,
+// conductor.h, dielectric.h) and triangle emitters: shadeLanes() is its control flow, and a
+// small struct per model supplies bsdfEval, bsdfSample and bsdfIsDelta as the SIMD twins of the
+// model's shared functions (host/simd/simd_math-inl.h, each checked against its scalar function
+// lane by lane).
 #include "host/cpu/simd_shading.h"
 
 #include "host/simd/lanes.h"
@@ -36,23 +36,24 @@ struct RandomLanes {
     Floats uBsdfX, uBsdfY, uBsdfZ;             // rand4(kDimBsdf).xyz
 };
 
-// The kernel's inputs for up to kBlock Lambert hits.
-struct LambertLanes {
+// A kernel's inputs for up to kBlock hits of one surface model.
+struct SurfaceLanes {
     Vec3s p, ng, ns, albedo, wo, beta; // the hit, -rayDir, the path's throughput
     Floats offset;
-    Uints live;     // bounce < max depth: the path goes on from here
-    Uints roulette; // bounce >= min depth
+    Floats alpha, ior; // the shader's GGX width and index of refraction
+    Uints live;        // bounce < max depth: the path goes on from here
+    Uints roulette;    // bounce >= min depth
     RandomLanes random;
     Vec3s e0, e1, e2, eNormal, eRadiance; // the picked emitter (a triangle)
     Floats ePickPdf, eArea;
     Uints eTwoSided;
 };
-static_assert(sizeof(LambertLanes) % sizeof(Floats) == 0, "rows only");
+static_assert(sizeof(SurfaceLanes) % sizeof(Floats) == 0, "rows only");
 static_assert(sizeof(RandomLanes) % sizeof(Floats) == 0, "rows only");
 
-// What the kernel writes; shadeHits() puts it into the ShadeResults.
-struct LambertResults {
-    Uints shadow, next; // kShadeShadow, kShadeContinue
+// What a kernel writes; shadeHits() puts it into the ShadeResults.
+struct SurfaceResults {
+    Uints shadow, next, specular; // kShadeShadow, kShadeContinue, kPathSpecular
     Vec3s shadowOrigin, shadowDir, shadowContribution, nextOrigin, nextDir, nextBeta;
     Floats shadowTmax, nextPdf;
 };
@@ -87,50 +88,115 @@ void MakeRandomNumbers(simd_shading::RandomLanes& lanes, size_t count, uint samp
     }
 }
 
-// Steps 2 and 3 of shadeSurface for lanes [0, count), count a multiple of the vector width.
-void ShadeLambertLanes(const simd_shading::LambertLanes& in, size_t count, bool nee, bool mis,
-                       float threshold, simd_shading::LambertResults& out) {
+// One vector of hits: what every model's eval and sample read.
+struct HitVector {
+    V3 ng, albedo, wo;
+    V ngDotWo, alpha, ior;
+    V3 n; // facingShadingNormal
+};
+
+// Each model's eval, sample and delta test on a vector of hits, as the twins of its registry
+// functions (shared/bsdf.h): bsdfEval's fcos and pdf, bsdfSample, bsdfIsDelta.
+struct LambertLanesModel {
+    explicit LambertLanesModel(const HitVector&) {}
+    M delta(const HitVector&) const { return hn::FirstN(D(), 0); }
+    V3 eval(const HitVector& h, V3 wi, V& pdf) const {
+        return lambertEval(h.albedo, h.ng, h.ngDotWo, h.n, wi, pdf);
+    }
+    BsdfSample sample(const HitVector& h, V ux, V uy, V /*uz*/) const { // lambertSample
+        const V zero = hn::Zero(D());
+        const V3 local = sampleCosineHemisphere(ux, uy);
+        BsdfSample s;
+        s.wi = normalize(toWorld(local, h.n));
+        s.ok = hn::Not(
+            hn::Or(hn::Le(hn::Mul(h.ngDotWo, dot(h.ng, s.wi)), zero), hn::Le(local.z, zero)));
+        s.specular = hn::FirstN(D(), 0);
+        s.weight = h.albedo;
+        s.pdf = hn::Mul(local.z, hn::Set(D(), kInvPi));
+        return s;
+    }
+};
+struct ConductorLanesModel {
+    Frame frame;
+    explicit ConductorLanesModel(const HitVector& h) : frame(shadingFrame(h.n)) {}
+    M delta(const HitVector& h) const { return ggxIsSmooth(h.alpha); }
+    V3 eval(const HitVector& h, V3 wi, V& pdf) const {
+        return conductorEval(h.albedo, h.alpha, h.ng, h.ngDotWo, frame, h.wo, wi, pdf);
+    }
+    BsdfSample sample(const HitVector& h, V ux, V uy, V /*uz*/) const {
+        return conductorSample(h.albedo, h.alpha, h.ng, h.ngDotWo, frame, h.wo, ux, uy);
+    }
+};
+struct DielectricLanesModel {
+    Frame frame;
+    explicit DielectricLanesModel(const HitVector& h) : frame(shadingFrame(h.n)) {}
+    M delta(const HitVector& h) const { return ggxIsSmooth(h.alpha); }
+    V3 eval(const HitVector& h, V3 wi, V& pdf) const {
+        return dielectricEval(h.ior, h.alpha, h.ng, h.ngDotWo, frame, h.wo, wi, pdf);
+    }
+    BsdfSample sample(const HitVector& h, V ux, V uy, V uz) const {
+        return dielectricSample(h.ior, h.alpha, h.ng, h.ngDotWo, frame, h.wo, ux, uy, uz);
+    }
+};
+
+// Step 2 of shadeSurface, next-event estimation toward a point of the picked triangle
+// (sampleEmitter), for the lanes `shadowing` selects; the mask of those that send a shadow ray.
+template <class Model>
+M shadowLanes(const simd_shading::SurfaceLanes& in, size_t i, const HitVector& h,
+              const Model& model, V3 p, V3 beta, V offset, M shadowing, bool mis,
+              simd_shading::SurfaceResults& out) {
+    const D d;
+    const V zero = hn::Zero(d);
+    const V3 e0 = load(in.e0, i), e1 = load(in.e1, i), e2 = load(in.e2, i);
+    const V3 eNormal = load(in.eNormal, i);
+    const V3 q = emitterPoint(e0, e1, e2, load(in.random.uLightY, i), load(in.random.uLightZ, i));
+    const V3 dq = sub(q, p);
+    const V dist = hn::Sqrt(dot(dq, dq));
+    const V3 wi = div(dq, dist);
+    const V cosLight = emitterCosine(eNormal, loadMask(in.eTwoSided, i), neg(wi));
+    const V pdf = emitterSolidAnglePdf(load(in.ePickPdf, i), load(in.eArea, i), dist, cosLight);
+    const V offsetQ = surfaceOffset(q, e0, add(e0, e1), add(e0, e2), eNormal);
+    const V tmax = shadowRayTmax(dist, offset, offsetQ, cosLight);
+    shadowing = hn::And(shadowing, hn::And(hn::Gt(dist, zero), hn::Gt(pdf, zero)));
+
+    V bsdfPdf;
+    const V3 fcos = model.eval(h, wi, bsdfPdf);
+    shadowing = hn::And(shadowing, hn::Gt(maxComponent(fcos), zero));
+
+    const V w = mis ? powerHeuristic(pdf, quantizePdf(bsdfPdf)) : hn::Set(d, 1.0f);
+    const V3 radiance = load(in.eRadiance, i);
+    store(shadowing, offsetOrigin(p, h.ng, offset, wi), out.shadowOrigin, i);
+    store(shadowing, wi, out.shadowDir, i);
+    store(hn::IfThenElseZero(shadowing, tmax), out.shadowTmax, i);
+    store(shadowing, mul(mul(mul(beta, fcos), radiance), hn::Div(w, pdf)), out.shadowContribution,
+          i);
+    return hn::And(shadowing, hn::Gt(tmax, zero));
+}
+
+// Steps 2 and 3 of shadeSurface for lanes [0, count) of one model's hits, count a multiple of
+// the vector width.
+template <class Model>
+void shadeLanes(const simd_shading::SurfaceLanes& in, size_t count, bool nee, bool mis,
+                float threshold, simd_shading::SurfaceResults& out) {
     const D d;
     const V zero = hn::Zero(d);
     const V one = hn::Set(d, 1.0f);
-    const V invPi = hn::Set(d, kInvPi);
     for (size_t i = 0; i < count; i += hn::Lanes(d)) {
-        const V3 p = load(in.p, i), ng = load(in.ng, i), ns = load(in.ns, i);
-        const V3 albedo = load(in.albedo, i), wo = load(in.wo, i), beta = load(in.beta, i);
+        HitVector h;
+        const V3 p = load(in.p, i), ns = load(in.ns, i), beta = load(in.beta, i);
+        h.ng = load(in.ng, i), h.albedo = load(in.albedo, i), h.wo = load(in.wo, i);
+        h.alpha = load(in.alpha, i), h.ior = load(in.ior, i);
+        h.ngDotWo = dot(h.ng, h.wo);
+        h.n = facingShadingNormal(ns, h.ng, h.ngDotWo);
+        const Model model(h);
         const V offset = load(in.offset, i);
         const M live = loadMask(in.live, i);
-        const V ngDotWo = dot(ng, wo);
-        const V3 n = facingShadingNormal(ns, ng, ngDotWo);
 
-        // 2. Next-event estimation toward a point of the picked triangle (sampleEmitter).
-        M shadowing = hn::And(live, hn::MaskFromVec(nee ? hn::Not(zero) : zero));
+        // 2. Next-event estimation, where the BSDF is not delta lobes alone.
+        M shadowing = hn::AndNot(model.delta(h), live);
+        if (!nee) shadowing = hn::FirstN(d, 0);
         if (!hn::AllFalse(d, shadowing)) {
-            const V3 e0 = load(in.e0, i), e1 = load(in.e1, i), e2 = load(in.e2, i);
-            const V3 eNormal = load(in.eNormal, i);
-            const V3 q =
-                emitterPoint(e0, e1, e2, load(in.random.uLightY, i), load(in.random.uLightZ, i));
-            const V3 dq = sub(q, p);
-            const V dist = hn::Sqrt(dot(dq, dq));
-            const V3 wi = div(dq, dist);
-            const V cosLight = emitterCosine(eNormal, loadMask(in.eTwoSided, i), neg(wi));
-            const V pdf =
-                emitterSolidAnglePdf(load(in.ePickPdf, i), load(in.eArea, i), dist, cosLight);
-            const V offsetQ = surfaceOffset(q, e0, add(e0, e1), add(e0, e2), eNormal);
-            const V tmax = shadowRayTmax(dist, offset, offsetQ, cosLight);
-            shadowing = hn::And(shadowing, hn::And(hn::Gt(dist, zero), hn::Gt(pdf, zero)));
-
-            V bsdfPdf;
-            const V3 fcos = lambertEval(albedo, ng, ngDotWo, n, wi, bsdfPdf);
-            shadowing = hn::And(shadowing, hn::Gt(maxComponent(fcos), zero));
-
-            const V w = mis ? powerHeuristic(pdf, quantizePdf(bsdfPdf)) : one;
-            const V3 radiance = load(in.eRadiance, i);
-            store(shadowing, offsetOrigin(p, ng, offset, wi), out.shadowOrigin, i);
-            store(shadowing, wi, out.shadowDir, i);
-            store(hn::IfThenElseZero(shadowing, tmax), out.shadowTmax, i);
-            store(shadowing, mul(mul(mul(beta, fcos), radiance), hn::Div(w, pdf)),
-                  out.shadowContribution, i);
-            shadowing = hn::And(shadowing, hn::Gt(tmax, zero));
+            shadowing = shadowLanes(in, i, h, model, p, beta, offset, shadowing, mis, out);
         } else {
             const V3 none = {zero, zero, zero};
             store(shadowing, none, out.shadowOrigin, i);
@@ -140,25 +206,37 @@ void ShadeLambertLanes(const simd_shading::LambertLanes& in, size_t count, bool 
         }
         store(shadowing, out.shadow, i);
 
-        // 3. Continuation: lambertSample, then Russian roulette.
-        const V3 local =
-            sampleCosineHemisphere(load(in.random.uBsdfX, i), load(in.random.uBsdfY, i));
-        const V3 world = toWorld(local, n);
-        const V3 wi = mul(world, hn::Div(one, hn::Sqrt(dot(world, world))));
-        M next = hn::And(live, hn::Not(hn::Or(hn::Le(hn::Mul(ngDotWo, dot(ng, wi)), zero),
-                                              hn::Le(local.z, zero))));
-        V3 nextBeta = mul(beta, albedo);
+        // 3. Continuation: the BSDF's sample, then Russian roulette.
+        const BsdfSample s = model.sample(h, load(in.random.uBsdfX, i), load(in.random.uBsdfY, i),
+                                          load(in.random.uBsdfZ, i));
+        M next = hn::And(live, s.ok);
+        V3 nextBeta = mul(beta, s.weight);
         const V q = gmin(one, hn::Div(maxComponent(nextBeta), hn::Set(d, threshold)));
         const M roulette = loadMask(in.roulette, i);
         next = hn::And(next, hn::Or(hn::Not(roulette), hn::Lt(load(in.random.uLightW, i), q)));
         nextBeta = select(roulette, div(nextBeta, q), nextBeta);
         next = hn::And(next, hn::Gt(maxComponent(nextBeta), zero));
         store(next, out.next, i);
-        store(next, offsetOrigin(p, ng, offset, wi), out.nextOrigin, i);
-        store(next, wi, out.nextDir, i);
+        store(hn::And(next, s.specular), out.specular, i);
+        store(next, offsetOrigin(p, h.ng, offset, s.wi), out.nextOrigin, i);
+        store(next, s.wi, out.nextDir, i);
         store(next, nextBeta, out.nextBeta, i);
-        store(hn::IfThenElseZero(next, quantizePdf(hn::Mul(local.z, invPi))), out.nextPdf, i);
+        store(hn::IfThenElseZero(next, quantizePdf(s.pdf)), out.nextPdf, i);
     }
+}
+
+// The wide twins kWideTwins names.
+void ShadeLambertLanes(const simd_shading::SurfaceLanes& in, size_t count, bool nee, bool mis,
+                       float threshold, simd_shading::SurfaceResults& out) {
+    shadeLanes<LambertLanesModel>(in, count, nee, mis, threshold, out);
+}
+void ShadeConductorLanes(const simd_shading::SurfaceLanes& in, size_t count, bool nee, bool mis,
+                         float threshold, simd_shading::SurfaceResults& out) {
+    shadeLanes<ConductorLanesModel>(in, count, nee, mis, threshold, out);
+}
+void ShadeDielectricLanes(const simd_shading::SurfaceLanes& in, size_t count, bool nee, bool mis,
+                          float threshold, simd_shading::SurfaceResults& out) {
+    shadeLanes<DielectricLanesModel>(in, count, nee, mis, threshold, out);
 }
 
 } // namespace spw::HWY_NAMESPACE
@@ -167,12 +245,14 @@ HWY_AFTER_NAMESPACE();
 #if HWY_ONCE
 namespace spw {
 HWY_EXPORT(ShadeLambertLanes);
+HWY_EXPORT(ShadeConductorLanes);
+HWY_EXPORT(ShadeDielectricLanes);
 HWY_EXPORT(MakeRandomNumbers);
 
 using simd::kBlock;
 using simd::wholeVectors;
-using simd_shading::LambertLanes;
-using simd_shading::LambertResults;
+using simd_shading::SurfaceLanes;
+using simd_shading::SurfaceResults;
 
 namespace {
 
@@ -198,7 +278,7 @@ void setRandomLane(const RenderParams& rp, const PathState& st, simd_shading::Ra
 
 // Lane k from hit `in`: what the kernel reads, and (scalar) the emission into `out`.
 void fillLane(const SceneView& scene, const RenderParams& rp, const ShadeInput& in,
-              LambertLanes& lanes, size_t k, ShadeResult& out) {
+              SurfaceLanes& lanes, size_t k, ShadeResult& out) {
     const SurfaceHit& hit = in.hit;
     const PathState& st = in.path;
     const vec3 wo = -in.rayDir;
@@ -212,6 +292,9 @@ void fillLane(const SceneView& scene, const RenderParams& rp, const ShadeInput& 
     set(lanes.wo, k, wo);
     set(lanes.beta, k, st.beta);
     lanes.offset.v[k] = hit.offset;
+    const ShaderParams& sh = scene.shaders[hit.shader];
+    lanes.alpha.v[k] = sh.alpha;
+    lanes.ior.v[k] = sh.ior;
     const bool live = st.bounce < rp.maxDepth;
     lanes.live.v[k] = mask(live);
     lanes.roulette.v[k] = mask(st.bounce >= rp.minDepth);
@@ -220,7 +303,7 @@ void fillLane(const SceneView& scene, const RenderParams& rp, const ShadeInput& 
 
 // Lane k's emitter, picked with the random number MakeRandomNumbers made (zeros where the path ends
 // here or nothing is sampled, so that the kernel reads defined values).
-void pickLaneEmitter(const SceneView& scene, const RenderParams& rp, bool nee, LambertLanes& lanes,
+void pickLaneEmitter(const SceneView& scene, const RenderParams& rp, bool nee, SurfaceLanes& lanes,
                      size_t k) {
     static const Emitter kNone{};
     const Emitter& e =
@@ -246,7 +329,7 @@ template <class Lanes> void padLanes(Lanes& lanes, size_t count, size_t end) {
 }
 
 // The kernel's results for lane k into `out` (whose emission fillLane wrote).
-void takeLane(const ShaderParams& sh, const LambertResults& res, size_t k, const ShadeInput& in,
+void takeLane(const ShaderParams& sh, const SurfaceResults& res, size_t k, const ShadeInput& in,
               ShadeResult& out) {
     const PathState& st = in.path;
     out.shadowOrigin = get(res.shadowOrigin, k);
@@ -261,9 +344,10 @@ void takeLane(const ShaderParams& sh, const LambertResults& res, size_t k, const
     out.next.beta = get(res.nextBeta, k);
     out.next.prevPdf = res.nextPdf.v[k];
     out.next.bounce = st.bounce + 1u;
-    out.next.flags = 0u;
-    out.next.cone =
-        packCone(coneWidthAt(st.cone, in.hit.t), coneSpread(st.cone) + bsdfConeSpread(sh, false));
+    const bool specular = res.specular.v[k] != 0u;
+    out.next.flags = specular ? kPathSpecular : 0u;
+    out.next.cone = packCone(coneWidthAt(st.cone, in.hit.t),
+                             coneSpread(st.cone) + bsdfConeSpread(sh, specular));
     out.flags |= kShadeContinue;
 }
 
@@ -272,8 +356,8 @@ void takeLane(const ShaderParams& sh, const LambertResults& res, size_t k, const
 const WideTwin kWideTwins[] = {
     {kModelNull, nullptr}, // a Null hit only passes the path on (and emits, for a quad light)
     {kModelLambert, "ShadeLambertLanes"},
-    {kModelConductor, nullptr},
-    {kModelDielectric, nullptr},
+    {kModelConductor, "ShadeConductorLanes"},
+    {kModelDielectric, "ShadeDielectricLanes"},
 };
 static_assert(sizeof(kWideTwins) / sizeof(kWideTwins[0]) == kModelCount,
               "every registered surface model names its wide twin, or nullptr for none");
@@ -311,26 +395,44 @@ void shadeHits(const SceneView& view, const RenderParams& rp, bool simd, const S
         }
         otherCount = 0;
     };
-    LambertLanes lanes;
-    LambertResults results;
-    std::uint32_t hitOf[kBlock];
-    size_t count = 0;
-    auto run = [&] {
-        const size_t end = wholeVectors(count);
-        padLanes(lanes, count, end);
-        HWY_DYNAMIC_DISPATCH(MakeRandomNumbers)(lanes.random, end, rp.sampling, rp.seed);
+    // A block of hits per model with a kernel, filled as the hits come: runs of one shader
+    // where the hits are sorted, interleaved models where they are not.
+    struct Block {
+        SurfaceLanes lanes;
+        std::uint32_t hitOf[kBlock];
+        size_t count = 0;
+    };
+    Block blocks[kModelCount];
+    SurfaceResults results;
+    auto run = [&](uint model) {
+        Block& b = blocks[model];
+        const size_t end = wholeVectors(b.count);
+        padLanes(b.lanes, b.count, end);
+        HWY_DYNAMIC_DISPATCH(MakeRandomNumbers)(b.lanes.random, end, rp.sampling, rp.seed);
         for (size_t k = 0; k < end; ++k)
-            pickLaneEmitter(view, rp, nee, lanes, k);
-        HWY_DYNAMIC_DISPATCH(ShadeLambertLanes)(lanes, end, nee, mis, rp.threshold, results);
-        for (size_t k = 0; k < count; ++k) {
-            const ShadeInput& hit = in[hitOf[k]];
-            takeLane(view.shaders[hit.hit.shader], results, k, hit, out[hitOf[k]]);
+            pickLaneEmitter(view, rp, nee, b.lanes, k);
+        switch (model) {
+        case kModelLambert:
+            HWY_DYNAMIC_DISPATCH(ShadeLambertLanes)(b.lanes, end, nee, mis, rp.threshold, results);
+            break;
+        case kModelConductor:
+            HWY_DYNAMIC_DISPATCH(ShadeConductorLanes)
+            (b.lanes, end, nee, mis, rp.threshold, results);
+            break;
+        case kModelDielectric:
+            HWY_DYNAMIC_DISPATCH(ShadeDielectricLanes)
+            (b.lanes, end, nee, mis, rp.threshold, results);
+            break;
         }
-        count = 0;
+        for (size_t k = 0; k < b.count; ++k) {
+            const ShadeInput& hit = in[b.hitOf[k]];
+            takeLane(view.shaders[hit.hit.shader], results, k, hit, out[b.hitOf[k]]);
+        }
+        b.count = 0;
     };
     for (size_t i = 0; i < n; ++i) {
         const ShaderParams& sh = view.shaders[in[i].hit.shader];
-        if (sh.model != kModelLambert) { // the one model with a kernel (kWideTwins)
+        if (!kWideTwins[sh.model].kernel) { // shadeSurfaceWith, one hit at a time
             if (!shadeGoesOn(rp, sh, in[i].path)) {
                 shadeSurfaceWith(view, rp, in[i].hit, in[i].rayDir, in[i].path, vec4(0.0f),
                                  vec4(0.0f), out[i]);
@@ -341,11 +443,13 @@ void shadeHits(const SceneView& view, const RenderParams& rp, bool simd, const S
             if (otherCount == kBlock) runOthers();
             continue;
         }
-        fillLane(view, rp, in[i], lanes, count, out[i]);
-        hitOf[count++] = std::uint32_t(i);
-        if (count == kBlock) run();
+        Block& b = blocks[sh.model];
+        fillLane(view, rp, in[i], b.lanes, b.count, out[i]);
+        b.hitOf[b.count++] = std::uint32_t(i);
+        if (b.count == kBlock) run(sh.model);
     }
-    if (count > 0) run();
+    for (uint model = 0; model < kModelCount; ++model)
+        if (blocks[model].count > 0) run(model);
     if (otherCount > 0) runOthers();
 }
 

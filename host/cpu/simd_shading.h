@@ -1,14 +1,16 @@
 // Shading a run of hits SIMD-wide: the cpu engine's shade step, where the sort has made the work
-// homogeneous. Hits of the Lambert model (the diffuse surfaces most scenes are made of) go
-// through a structure-of-arrays kernel that runs shadeSurface()'s arithmetic on 4, 8 or 16
-// hits at once, in the widest instruction set the processor has (Google Highway's dynamic
-// dispatch: SSE4, AVX2 or AVX-512); every other hit goes through shadeSurfaceWith(), with its
-// random numbers made SIMD-wide too (the scrambled Sobol sequence is most of a rand4's cost).
+// homogeneous. Hits of each model with a kernel (Lambert, Conductor, Dielectric: kWideTwins) go
+// through a structure-of-arrays kernel that runs shadeSurface()'s arithmetic on 4, 8 or 16 hits
+// of that model at once, in the widest instruction set the processor has (Google Highway's
+// dynamic dispatch: SSE4, AVX2 or AVX-512); a hit of a model without one would go through
+// shadeSurfaceWith(), with its random numbers made SIMD-wide too (the scrambled Sobol sequence
+// is most of a rand4's cost). Unsorted hits fill one block per model, so interleaved models
+// still make full vectors.
 //
 // The kernel is shadeSurface() to the bit: the same operations in the same order, each rounded
 // once (no fused multiply-add), so an image does not depend on which hits were shaded
 // together, on the instruction set, or on whether the kernel ran at all
-// (SimdShading.LambertHitsAreShadeSurfaceToTheBit). What stays scalar, per hit: the emitter
+// (SimdShading.EveryModelsHitsAreShadeSurfaceToTheBit). What stays scalar, per hit: the emitter
 // pick (a binary search), gathering the emitter and the hit into rows, and the emission of an
 // emitter that was hit.
 #pragma once
@@ -32,8 +34,8 @@ struct WideTwin {
 };
 extern const WideTwin kWideTwins[kModelCount];
 
-// Whether the kernel can shade this scene's Lambert hits: every emitter next-event estimation
-// picks is a triangle (point lights and the environment take shadeSurface()).
+// Whether the kernels can shade this scene's hits: every emitter next-event estimation picks is
+// a triangle (point lights and the environment take shadeSurface()).
 bool simdShadingApplies(const SceneView& view);
 
 // out[i] = shadeSurface(view, rp, in[i]) for i in [0, n); `simd` false shades every hit with

@@ -166,15 +166,20 @@ HWY_INLINE V3 sampleCosineHemisphere(V ux, V uy) {
     const M centre = hn::And(hn::Eq(dx, zero), hn::Eq(dy, zero));
     return select(centre, V3{zero, zero, one}, V3{x, y, z});
 }
-// Twin of toWorld (shared/sampling.h): makeFrame, then local.x t + local.y b + local.z n.
-HWY_INLINE V3 toWorld(V3 local, V3 n) {
+// Twin of makeFrame (shared/sampling.h).
+HWY_INLINE void makeFrame(V3 n, V3& t, V3& b) {
     const V one = hn::Set(D(), 1.0f);
     const V s = sign(hn::Ge(n.z, hn::Zero(D())));
     const V a = hn::Div(hn::Set(D(), -1.0f), hn::Add(s, n.z));
     const V c = hn::Mul(hn::Mul(n.x, n.y), a);
-    const V3 t = {hn::Add(one, hn::Mul(hn::Mul(hn::Mul(s, n.x), n.x), a)), hn::Mul(s, c),
-                  hn::Mul(hn::Neg(s), n.x)};
-    const V3 b = {c, hn::Add(s, hn::Mul(hn::Mul(n.y, n.y), a)), hn::Neg(n.y)};
+    t = {hn::Add(one, hn::Mul(hn::Mul(hn::Mul(s, n.x), n.x), a)), hn::Mul(s, c),
+         hn::Mul(hn::Neg(s), n.x)};
+    b = {c, hn::Add(s, hn::Mul(hn::Mul(n.y, n.y), a)), hn::Neg(n.y)};
+}
+// Twin of toWorld (shared/sampling.h).
+HWY_INLINE V3 toWorld(V3 local, V3 n) {
+    V3 t, b;
+    makeFrame(n, t, b);
     return add(add(mul(t, local.x), mul(b, local.y)), mul(n, local.z));
 }
 
@@ -214,6 +219,271 @@ HWY_INLINE V3 lambertEval(V3 albedo, V3 ng, V ngDotWo, V3 n, V3 wi, V& pdf) {
     const V cosPi = hn::Mul(c, hn::Set(D(), kInvPi));
     pdf = hn::IfThenElseZero(evaluated, cosPi);
     return select(evaluated, mul(albedo, cosPi), V3{zero, zero, zero});
+}
+
+// --- GGX (shared/ggx.h), Conductor (shared/conductor.h) and Dielectric (shared/dielectric.h) ---
+
+HWY_INLINE V3 cross(V3 a, V3 b) { // glm's order
+    return {hn::Sub(hn::Mul(a.y, b.z), hn::Mul(b.y, a.z)),
+            hn::Sub(hn::Mul(a.z, b.x), hn::Mul(b.z, a.x)),
+            hn::Sub(hn::Mul(a.x, b.y), hn::Mul(b.x, a.y))};
+}
+// glm's normalize, v * inversesqrt(dot(v, v)), inversesqrt being 1 / sqrt.
+HWY_INLINE V3 normalize(V3 v) {
+    return mul(v, hn::Div(hn::Set(D(), 1.0f), hn::Sqrt(dot(v, v))));
+}
+HWY_INLINE M selectMask(M m, M a, M b) { // m ? a : b
+    return hn::Or(hn::And(m, a), hn::AndNot(m, b));
+}
+HWY_INLINE V clamp01(V x) { // glm::clamp(x, 0, 1)
+    return gmin(gmax(x, hn::Zero(D())), hn::Set(D(), 1.0f));
+}
+// The scalar code's libm cos and sin, lane by lane: Highway's polynomials round differently.
+HWY_INLINE void cosSin(V phi, V& c, V& s) {
+    const D d;
+    alignas(64) float x[simd::kMaxLanes], cs[simd::kMaxLanes], sn[simd::kMaxLanes];
+    hn::Store(phi, d, x);
+    for (size_t k = 0; k < hn::Lanes(d); ++k) {
+        cs[k] = std::cos(x[k]);
+        sn[k] = std::sin(x[k]);
+    }
+    c = hn::Load(d, cs);
+    s = hn::Load(d, sn);
+}
+// Twin of Frame and shadingFrame (shared/ggx.h), given facingShadingNormal's n.
+struct Frame {
+    V3 t, b, n;
+};
+HWY_INLINE Frame shadingFrame(V3 n) {
+    Frame f;
+    f.n = n;
+    makeFrame(n, f.t, f.b);
+    return f;
+}
+HWY_INLINE V3 frameToLocal(const Frame& f, V3 w) {
+    return {dot(w, f.t), dot(w, f.b), dot(w, f.n)};
+}
+HWY_INLINE V3 frameToWorld(const Frame& f, V3 l) {
+    return normalize(add(add(mul(f.t, l.x), mul(f.b, l.y)), mul(f.n, l.z)));
+}
+// Twin of ggxIsSmooth (shared/ggx.h).
+HWY_INLINE M ggxIsSmooth(V alpha) {
+    return hn::Not(hn::Ge(alpha, hn::Set(D(), kGgxSmoothAlpha)));
+}
+// Twin of ggxD (shared/ggx.h).
+HWY_INLINE V ggxD(V3 h, V alpha) {
+    const D d;
+    const V a2 = hn::Mul(alpha, alpha);
+    const V q =
+        hn::Add(hn::Add(hn::Mul(h.x, h.x), hn::Mul(h.y, h.y)), hn::Mul(hn::Mul(a2, h.z), h.z));
+    const V ndf = hn::Div(a2, hn::Mul(hn::Set(d, kPi), gmax(hn::Mul(q, q), hn::Set(d, 1e-37f))));
+    return hn::IfThenZeroElse(hn::Le(h.z, hn::Zero(d)), ndf);
+}
+// Twin of ggxA (shared/ggx.h).
+HWY_INLINE V ggxA(V3 w, V alpha) {
+    return hn::Sqrt(
+        hn::Add(hn::Mul(w.z, w.z),
+                hn::Mul(hn::Mul(alpha, alpha), hn::Add(hn::Mul(w.x, w.x), hn::Mul(w.y, w.y)))));
+}
+// Twin of ggxG2Denominator (shared/ggx.h).
+HWY_INLINE V ggxG2Denominator(V3 wo, V3 wi, V alpha) {
+    return hn::Add(hn::Mul(ggxA(wo, alpha), hn::Abs(wi.z)),
+                   hn::Mul(ggxA(wi, alpha), hn::Abs(wo.z)));
+}
+// Twin of ggxSampleVisibleNormal (shared/ggx.h).
+HWY_INLINE V3 ggxSampleVisibleNormal(V3 wo, V alpha, V ux, V uy) {
+    const D d;
+    const V zero = hn::Zero(d), one = hn::Set(d, 1.0f);
+    const V3 vh = normalize({hn::Mul(alpha, wo.x), hn::Mul(alpha, wo.y), wo.z});
+    const V lensq = hn::Add(hn::Mul(vh.x, vh.x), hn::Mul(vh.y, vh.y));
+    const M tilted = hn::Gt(lensq, zero);
+    const V3 t1 = select(tilted, mul(V3{hn::Neg(vh.y), vh.x, zero}, hn::Div(one, hn::Sqrt(lensq))),
+                         V3{one, zero, zero});
+    const V3 t2 = cross(vh, t1);
+    const V r = hn::Sqrt(ux);
+    V c, s;
+    cosSin(hn::Mul(hn::Set(d, 2.0f * kPi), uy), c, s);
+    const V p1 = hn::Mul(r, c);
+    const V h = hn::Mul(hn::Set(d, 0.5f), hn::Add(one, vh.z));
+    const V p2 =
+        hn::Add(hn::Mul(hn::Sub(one, h), hn::Sqrt(gmax(zero, hn::Sub(one, hn::Mul(p1, p1))))),
+                hn::Mul(h, hn::Mul(r, s)));
+    const V up = hn::Sqrt(gmax(zero, hn::Sub(hn::Sub(one, hn::Mul(p1, p1)), hn::Mul(p2, p2))));
+    const V3 nh = add(add(mul(t1, p1), mul(t2, p2)), mul(vh, up));
+    return normalize({hn::Mul(alpha, nh.x), hn::Mul(alpha, nh.y), gmax(zero, nh.z)});
+}
+// Twin of schlickFresnel (shared/conductor.h).
+HWY_INLINE V3 schlickFresnel(V3 f0, V cosTheta) {
+    const V one = hn::Set(D(), 1.0f);
+    const V m = clamp01(hn::Sub(one, cosTheta));
+    const V m2 = hn::Mul(m, m);
+    return add(f0, mul(sub(V3{one, one, one}, f0), hn::Mul(hn::Mul(m2, m2), m)));
+}
+// Twin of conductorEval (shared/conductor.h), given dot(ng, wo) and shadingFrame's frame.
+HWY_INLINE V3 conductorEval(V3 f0, V alpha, V3 ng, V ngDotWo, const Frame& f, V3 wo, V3 wi,
+                            V& pdf) {
+    const D d;
+    const V zero = hn::Zero(d), two = hn::Set(d, 2.0f);
+    const V3 lo = frameToLocal(f, wo), li = frameToLocal(f, wi);
+    V3 h = add(lo, li);
+    const V len2 = dot(h, h);
+    h = mul(h, hn::Div(hn::Set(d, 1.0f), hn::Sqrt(len2)));
+    const V ndf = ggxD(h, alpha);
+    const V denom = ggxG2Denominator(lo, li, alpha);
+    const M evaluated =
+        hn::AndNot(hn::Or(hn::Or(ggxIsSmooth(alpha), hn::Le(hn::Mul(ngDotWo, dot(ng, wi)), zero)),
+                          hn::Or(hn::Le(lo.z, zero), hn::Le(li.z, zero))),
+                   hn::And(hn::Gt(len2, zero), hn::Gt(denom, zero)));
+    pdf = hn::IfThenElseZero(evaluated, hn::Div(ndf, hn::Mul(two, hn::Add(lo.z, ggxA(lo, alpha)))));
+    const V3 fcos =
+        mul(schlickFresnel(f0, dot(lo, h)), hn::Div(hn::Mul(ndf, li.z), hn::Mul(two, denom)));
+    return select(evaluated, fcos, V3{zero, zero, zero});
+}
+// What a BSDF sample twin gives where `ok` holds (the scalar function's out-parameters).
+struct BsdfSample {
+    M ok, specular;
+    V3 wi, weight;
+    V pdf;
+};
+// Twin of conductorSample (shared/conductor.h), given dot(ng, wo) and shadingFrame's frame.
+HWY_INLINE BsdfSample conductorSample(V3 f0, V alpha, V3 ng, V ngDotWo, const Frame& f, V3 wo, V ux,
+                                      V uy) {
+    const D d;
+    const V zero = hn::Zero(d), two = hn::Set(d, 2.0f);
+    const V3 lo = frameToLocal(f, wo);
+    const M smooth = ggxIsSmooth(alpha);
+    BsdfSample s;
+    s.specular = smooth;
+    // The mirror direction.
+    s.wi = normalize(sub(mul(f.n, hn::Mul(two, lo.z)), wo));
+    s.weight = schlickFresnel(f0, lo.z);
+    s.pdf = zero;
+    s.ok = smooth;
+    if (!hn::AllTrue(d, smooth)) { // a visible microfacet normal
+        const V3 h = ggxSampleVisibleNormal(lo, alpha, ux, uy);
+        const V oh = dot(lo, h);
+        const V3 li = sub(mul(h, hn::Mul(two, oh)), lo);
+        const V3 wi = frameToWorld(f, li);
+        const V ao = ggxA(lo, alpha);
+        const V denom = ggxG2Denominator(lo, li, alpha);
+        const V pdf = hn::Div(ggxD(h, alpha), hn::Mul(two, hn::Add(lo.z, ao)));
+        const V3 weight =
+            mul(schlickFresnel(f0, oh), hn::Div(hn::Mul(li.z, hn::Add(lo.z, ao)), denom));
+        const M rough =
+            hn::And(hn::Not(smooth), hn::Not(hn::Or(hn::Le(oh, zero), hn::Le(li.z, zero))));
+        s.wi = select(smooth, s.wi, wi);
+        s.weight = select(smooth, s.weight, weight);
+        s.pdf = hn::IfThenZeroElse(smooth, pdf);
+        s.ok = hn::Or(smooth, hn::And(rough, hn::Gt(pdf, zero)));
+    }
+    s.ok =
+        hn::AndNot(hn::Or(hn::Le(lo.z, zero), hn::Le(hn::Mul(ngDotWo, dot(ng, s.wi)), zero)), s.ok);
+    return s;
+}
+// Twin of fresnelDielectric (shared/dielectric.h).
+HWY_INLINE V fresnelDielectric(V cosI, V eta, V& cosT) {
+    const D d;
+    const V one = hn::Set(d, 1.0f);
+    const V ci = clamp01(cosI);
+    const V sin2T = hn::Div(hn::Sub(one, hn::Mul(ci, ci)), hn::Mul(eta, eta));
+    const M total = hn::Ge(sin2T, one);
+    const V ct = hn::Sqrt(hn::Sub(one, sin2T));
+    const V rs = hn::Div(hn::Sub(ci, hn::Mul(eta, ct)), hn::Add(ci, hn::Mul(eta, ct)));
+    const V rp = hn::Div(hn::Sub(hn::Mul(eta, ci), ct), hn::Add(hn::Mul(eta, ci), ct));
+    cosT = hn::IfThenZeroElse(total, ct);
+    return hn::IfThenElse(total, one,
+                          hn::Mul(hn::Set(d, 0.5f), hn::Add(hn::Mul(rs, rs), hn::Mul(rp, rp))));
+}
+// Twin of dielectricEta (shared/dielectric.h), given dot(ng, wo).
+HWY_INLINE V dielectricEta(V ior, V ngDotWo) {
+    return hn::IfThenElse(hn::Gt(ngDotWo, hn::Zero(D())), ior, hn::Div(hn::Set(D(), 1.0f), ior));
+}
+// Twin of dielectricEval (shared/dielectric.h), given dot(ng, wo) and shadingFrame's frame.
+HWY_INLINE V3 dielectricEval(V ior, V alpha, V3 ng, V go, const Frame& f, V3 wo, V3 wi, V& pdf) {
+    const D d;
+    const V zero = hn::Zero(d), one = hn::Set(d, 1.0f), two = hn::Set(d, 2.0f);
+    const V gi = dot(ng, wi);
+    const M reflection = hn::Gt(hn::Mul(go, gi), zero);
+    const V eta = dielectricEta(ior, go);
+    const V3 lo = frameToLocal(f, wo), li = frameToLocal(f, wi);
+    M evaluated = hn::Not(hn::Or(hn::Or(ggxIsSmooth(alpha), hn::Eq(go, zero)), hn::Eq(gi, zero)));
+    const M liUp = hn::Gt(li.z, zero);
+    evaluated = hn::AndNot(
+        hn::Or(hn::Or(hn::Le(lo.z, zero), hn::Xor(liUp, reflection)), hn::Eq(li.z, zero)),
+        evaluated);
+    V3 h = select(reflection, add(lo, li), add(lo, mul(li, eta)));
+    const V len2 = dot(h, h);
+    evaluated = hn::And(evaluated, hn::Gt(len2, zero));
+    h = mul(h, hn::Div(one, hn::Sqrt(len2)));
+    h = select(hn::Lt(h.z, zero), neg(h), h);
+    const V oh = dot(lo, h), ih = dot(li, h);
+    evaluated = hn::AndNot(
+        hn::Or(hn::Le(oh, zero), selectMask(reflection, hn::Le(ih, zero), hn::Ge(ih, zero))),
+        evaluated);
+    V cosT;
+    const V F = fresnelDielectric(oh, eta, cosT);
+    const V ndf = ggxD(h, alpha);
+    const V ao = ggxA(lo, alpha);
+    const V ci = hn::Abs(li.z);
+    const V denomG = ggxG2Denominator(lo, li, alpha);
+    evaluated = hn::And(evaluated, hn::Gt(denomG, zero));
+    const V reflectPdf = hn::Div(hn::Mul(F, ndf), hn::Mul(two, hn::Add(lo.z, ao)));
+    const V reflectF = hn::Div(hn::Mul(hn::Mul(F, ndf), ci), hn::Mul(two, denomG));
+    const V s = hn::Add(ih, hn::Div(oh, eta));
+    const V s2 = hn::Mul(s, s);
+    const V oneF = hn::Sub(one, F);
+    const V dv = hn::Div(hn::Mul(hn::Mul(two, oh), ndf), hn::Add(lo.z, ao));
+    const V refractPdf = hn::Div(hn::Mul(hn::Mul(oneF, dv), hn::Neg(ih)), s2);
+    const V refractF =
+        hn::Div(hn::Mul(hn::Mul(hn::Mul(hn::Mul(hn::Mul(oneF, ndf), two), ci), hn::Neg(ih)), oh),
+                hn::Mul(hn::Mul(hn::Mul(denomG, s2), eta), eta));
+    evaluated = hn::And(evaluated, hn::Or(reflection, hn::Gt(s2, zero)));
+    pdf = hn::IfThenElseZero(evaluated, hn::IfThenElse(reflection, reflectPdf, refractPdf));
+    const V value = hn::IfThenElseZero(evaluated, hn::IfThenElse(reflection, reflectF, refractF));
+    return {value, value, value};
+}
+// Twin of dielectricSample (shared/dielectric.h), given dot(ng, wo) and shadingFrame's frame.
+HWY_INLINE BsdfSample dielectricSample(V ior, V alpha, V3 ng, V go, const Frame& f, V3 wo, V ux,
+                                       V uy, V uz) {
+    const D d;
+    const V zero = hn::Zero(d), one = hn::Set(d, 1.0f), two = hn::Set(d, 2.0f);
+    const V eta = dielectricEta(ior, go);
+    const V3 lo = frameToLocal(f, wo);
+    const M smooth = ggxIsSmooth(alpha);
+    V3 h = {zero, zero, one};
+    if (!hn::AllTrue(d, smooth)) h = select(smooth, h, ggxSampleVisibleNormal(lo, alpha, ux, uy));
+    const V oh = dot(lo, h);
+    V cosT;
+    const V F = fresnelDielectric(oh, eta, cosT);
+    const M reflection = hn::Lt(uz, F);
+    const V3 li = select(reflection, sub(mul(h, hn::Mul(two, oh)), lo),
+                         sub(mul(h, hn::Sub(hn::Div(oh, eta), cosT)), div(lo, eta)));
+    BsdfSample s;
+    s.wi = frameToWorld(f, li);
+    const V etaScale = hn::IfThenElse(reflection, one, hn::Div(one, hn::Mul(eta, eta)));
+    s.ok = hn::Not(hn::Or(hn::Or(hn::Eq(go, zero), hn::Le(lo.z, zero)), hn::Le(oh, zero)));
+    s.ok = hn::AndNot(selectMask(reflection, hn::Le(li.z, zero), hn::Ge(li.z, zero)), s.ok);
+    s.ok = hn::AndNot(hn::Xor(hn::Gt(hn::Mul(go, dot(ng, s.wi)), zero), reflection), s.ok);
+    s.specular = smooth;
+    const V ao = ggxA(lo, alpha);
+    const V denomG = ggxG2Denominator(lo, li, alpha);
+    const V ndf = ggxD(h, alpha);
+    const V reflectPdf = hn::Div(hn::Mul(F, ndf), hn::Mul(two, hn::Add(lo.z, ao)));
+    const V ih = dot(li, h);
+    const V sum = hn::Add(ih, hn::Div(oh, eta));
+    const V refractPdf =
+        hn::Div(hn::Mul(hn::Mul(hn::Sub(one, F),
+                                hn::Div(hn::Mul(hn::Mul(two, oh), ndf), hn::Add(lo.z, ao))),
+                        hn::Neg(ih)),
+                gmax(hn::Mul(sum, sum), hn::Set(d, 1e-37f)));
+    const V pdf = hn::IfThenElse(reflection, reflectPdf, refractPdf);
+    const V roughWeight =
+        hn::Mul(hn::Div(hn::Mul(hn::Abs(li.z), hn::Add(lo.z, ao)), denomG), etaScale);
+    s.pdf = hn::IfThenZeroElse(smooth, pdf);
+    const V weight = hn::IfThenElse(smooth, etaScale, roughWeight);
+    s.weight = {weight, weight, weight};
+    s.ok = hn::And(s.ok, hn::Or(smooth, hn::And(hn::Gt(pdf, zero), hn::Gt(denomG, zero))));
+    return s;
 }
 
 // --- rand4 (shared/rng.h) ----------------------------------------------------------------------

@@ -40,6 +40,31 @@ void storeU4(U4 v, TwinResults& out, size_t i) {
     storeU(v.w, out, 3, i);
 }
 
+// A BSDF sample twin's results: ok u0, specular u1, wi f0-2, weight f3-5, pdf f6, zero where
+// the sample failed (the scalar function leaves them unwritten).
+void storeSample(const BsdfSample& s, TwinResults& out, size_t i) {
+    const V zero = hn::Zero(D());
+    store(s.ok, out.u[0], i);
+    store(hn::And(s.ok, s.specular), out.u[1], i);
+    store3(select(s.ok, s.wi, V3{zero, zero, zero}), out, 0, i);
+    store3(select(s.ok, s.weight, V3{zero, zero, zero}), out, 3, i);
+    store(hn::IfThenElseZero(s.ok, s.pdf), out.f[6], i);
+}
+// dot(ng, wo) and the shading frame, from ns, ng and wo in rows nsRow, ngRow and woRow.
+struct FrameArgs {
+    V3 ng, wo;
+    V ngDotWo;
+    Frame frame;
+};
+FrameArgs frameArgs(const TwinLanes& in, int ngRow, int nsRow, int woRow, size_t i) {
+    FrameArgs a;
+    a.ng = load3(in, ngRow, i);
+    a.wo = load3(in, woRow, i);
+    a.ngDotWo = dot(a.ng, a.wo);
+    a.frame = shadingFrame(facingShadingNormal(load3(in, nsRow, i), a.ng, a.ngDotWo));
+    return a;
+}
+
 // The twin on the vector of lanes starting at i.
 void runVector(Twin twin, const TwinLanes& in, size_t i, TwinResults& out) {
     auto f = [&](int row) { return load(in.f[row], i); };
@@ -87,6 +112,48 @@ void runVector(Twin twin, const TwinLanes& in, size_t i, TwinResults& out) {
         V pdf;
         store3(lambertEval(load3(in, 0, i), ng, ngDotWo, n, load3(in, 12, i), pdf), out, 0, i);
         return store(pdf, out.f[3], i);
+    }
+    case Twin::ggxD: // h f0-2, alpha f3 -> f0
+        return store(ggxD(load3(in, 0, i), f(3)), out.f[0], i);
+    case Twin::ggxA: // w f0-2, alpha f3 -> f0
+        return store(ggxA(load3(in, 0, i), f(3)), out.f[0], i);
+    case Twin::ggxG2Denominator: // wo f0-2, wi f3-5, alpha f6 -> f0
+        return store(ggxG2Denominator(load3(in, 0, i), load3(in, 3, i), f(6)), out.f[0], i);
+    case Twin::ggxSampleVisibleNormal: // wo f0-2, alpha f3, u f4-5 -> f0-2
+        return store3(ggxSampleVisibleNormal(load3(in, 0, i), f(3), f(4), f(5)), out, 0, i);
+    case Twin::schlickFresnel: // f0 f0-2, cosTheta f3 -> f0-2
+        return store3(schlickFresnel(load3(in, 0, i), f(3)), out, 0, i);
+    case Twin::conductorEval: { // f0 f0-2, alpha f3, ng f4-6, ns f7-9, wo f10-12, wi f13-15
+        const FrameArgs a = frameArgs(in, 4, 7, 10, i);
+        V pdf;
+        store3(conductorEval(load3(in, 0, i), f(3), a.ng, a.ngDotWo, a.frame, a.wo,
+                             load3(in, 13, i), pdf),
+               out, 0, i); // -> f0-2, pdf f3
+        return store(pdf, out.f[3], i);
+    }
+    case Twin::conductorSample: { // f0 f0-2, alpha f3, ng f4-6, ns f7-9, wo f10-12, u f13-14
+        const FrameArgs a = frameArgs(in, 4, 7, 10, i);
+        return storeSample(
+            conductorSample(load3(in, 0, i), f(3), a.ng, a.ngDotWo, a.frame, a.wo, f(13), f(14)),
+            out, i);
+    }
+    case Twin::fresnelDielectric: { // cosI f0, eta f1 -> f0, cosT f1
+        V cosT;
+        store(fresnelDielectric(f(0), f(1), cosT), out.f[0], i);
+        return store(cosT, out.f[1], i);
+    }
+    case Twin::dielectricEval: { // ior f0, alpha f1, ng f2-4, ns f5-7, wo f8-10, wi f11-13
+        const FrameArgs a = frameArgs(in, 2, 5, 8, i);
+        V pdf;
+        store3(dielectricEval(f(0), f(1), a.ng, a.ngDotWo, a.frame, a.wo, load3(in, 11, i), pdf),
+               out, 0, i); // -> f0-2, pdf f3
+        return store(pdf, out.f[3], i);
+    }
+    case Twin::dielectricSample: { // ior f0, alpha f1, ng f2-4, ns f5-7, wo f8-10, u f11-13
+        const FrameArgs a = frameArgs(in, 2, 5, 8, i);
+        return storeSample(
+            dielectricSample(f(0), f(1), a.ng, a.ngDotWo, a.frame, a.wo, f(11), f(12), f(13)), out,
+            i);
     }
     case Twin::pcg4d: // v u0-3 -> u0-3
         return storeU4(pcg4d(loadU4(in, 0, i)), out, i);

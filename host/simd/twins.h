@@ -28,6 +28,16 @@
     X(emitterCosine, "light_sample.h")                                                             \
     X(emitterSolidAnglePdf, "light_sample.h")                                                      \
     X(lambertEval, "lambert.h")                                                                    \
+    X(ggxD, "ggx.h")                                                                               \
+    X(ggxA, "ggx.h")                                                                               \
+    X(ggxG2Denominator, "ggx.h")                                                                   \
+    X(ggxSampleVisibleNormal, "ggx.h")                                                             \
+    X(schlickFresnel, "conductor.h")                                                               \
+    X(conductorEval, "conductor.h")                                                                \
+    X(conductorSample, "conductor.h")                                                              \
+    X(fresnelDielectric, "dielectric.h")                                                           \
+    X(dielectricEval, "dielectric.h")                                                              \
+    X(dielectricSample, "dielectric.h")                                                            \
     X(pcg4d, "rng.h")                                                                              \
     X(laineKarrasPermutation, "rng.h")                                                             \
     X(scrambledSobol4, "rng.h")                                                                    \
@@ -55,15 +65,16 @@ inline constexpr TwinInfo kTwins[] = {
 
 // A twin's arguments and results as rows of lanes: f[k] and u[k] are the k-th float and uint
 // argument (a vec3 takes three rows, x y z), in the order of the scalar function's parameters;
-// results the same way (a returned value first, then out-parameters). twins.cpp says per twin
+// results the same way (a returned value first, then out-parameters; a BSDF sample's `ok` and
+// `specular` as masks u0 and u1, its out-parameters zero where it fails). twins.cpp says per twin
 // which rows it reads; `uniform` holds the arguments that are one value for every lane.
 struct TwinLanes {
-    Floats f[15];
+    Floats f[16];
     Uints u[5];
     std::uint32_t uniform[3];
 };
 struct TwinResults {
-    Floats f[4];
+    Floats f[8];
     Uints u[4];
 };
 

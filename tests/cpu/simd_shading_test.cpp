@@ -1,8 +1,9 @@
-// The SIMD Lambert kernel (host/cpu/simd_shading.h) against shadeSurface(), hit by hit and
-// bit by bit, on random hits that reach every branch: both sides of the surface, shading normals
-// on the wrong side, emitters seen from behind and one- and two-sided, every strategy and
-// sampler, paths before min depth, past it and at max depth, and Lambert hits mixed with other
-// models in runs that are not a multiple of the vector width.
+// The SIMD kernels (host/cpu/simd_shading.h) against shadeSurface(), hit by hit and bit by bit,
+// on random hits that reach every branch: both sides of the surface, shading normals on the
+// wrong side, emitters seen from behind and one- and two-sided, every strategy and sampler,
+// paths before min depth, past it and at max depth, rough and smooth Conductors and Dielectrics
+// (reflection, refraction, total internal reflection), and every model's hits mixed in runs
+// that are not a multiple of the vector width.
 #include "host/cpu/simd_shading.h"
 #include "host/render/render.h"
 #include "host/scene/scene.h"
@@ -17,6 +18,7 @@
 #include <nlohmann/json.hpp>
 
 #include <cstring>
+#include <map>
 #include <random>
 #include <set>
 #include <string>
@@ -47,13 +49,21 @@ vec3 unitVector(std::mt19937& rng) {
 Fixture makeFixture(std::mt19937& rng, int emitters) {
     Fixture f;
     std::uniform_real_distribution<float> u(0.0f, 1.0f);
-    for (uint model : {kModelLambert, kModelLambert, kModelConductor, kModelLambert, kModelNull}) {
+    struct Model {
+        uint model;
+        float alpha, ior;
+    };
+    for (Model m : {Model{kModelLambert, 0.0f, 1.5f}, Model{kModelLambert, 0.0f, 1.5f},
+                    Model{kModelConductor, 0.3f, 1.5f}, Model{kModelLambert, 0.0f, 1.5f},
+                    Model{kModelNull, 0.0f, 1.5f}, Model{kModelConductor, 0.0f, 1.5f},
+                    Model{kModelDielectric, 0.2f, 1.5f}, Model{kModelConductor, 1e-3f, 1.5f},
+                    Model{kModelDielectric, 0.0f, 1.33f}}) {
         ShaderParams sh{};
-        sh.model = model;
+        sh.model = m.model;
         sh.colour = vec3(0.8f);
         sh.reflectance = 1.0f;
-        sh.alpha = 0.3f;
-        sh.ior = 1.5f;
+        sh.alpha = m.alpha;
+        sh.ior = m.ior;
         f.shaders.push_back(sh);
     }
     float total = 0.0f;
@@ -92,7 +102,8 @@ std::vector<ShadeInput> randomHits(std::mt19937& rng, const Fixture& f, size_t n
         h.ng = unitVector(rng);
         // Mostly a shading normal near ng, sometimes one beyond the geometric surface.
         h.ns = u(rng) < 0.1f ? -h.ng : normalize(h.ng + 0.3f * unitVector(rng));
-        h.shader = uint(i * 7 % f.shaders.size());
+        // Runs of one shader, of every length from 1 to 8, in a changing order.
+        h.shader = uint((i / (1 + i % 8) * 7) % f.shaders.size());
         h.emitter = !f.emitters.empty() && u(rng) < 0.1f ? uint(i % f.emitters.size()) : kNoEmitter;
         h.albedo = vec3(u(rng), u(rng), u(rng));
         h.offset = 1e-6f * (1.0f + u(rng));
@@ -110,7 +121,8 @@ std::vector<ShadeInput> randomHits(std::mt19937& rng, const Fixture& f, size_t n
 
 // How many results have each flag, so that a test can check it exercised them.
 struct FlagCounts {
-    size_t emitted = 0, shadow = 0, next = 0;
+    size_t emitted = 0, shadow = 0, next = 0, specular = 0;
+    std::map<uint, size_t> nextOf, shadowOf; // by model
 };
 
 FlagCounts compareWithShadeSurface(const SceneView& view, const RenderParams& rp,
@@ -132,12 +144,17 @@ FlagCounts compareWithShadeSurface(const SceneView& view, const RenderParams& rp
         counts.emitted += (scalar[i].flags & kShadeEmitted) != 0;
         counts.shadow += (scalar[i].flags & kShadeShadow) != 0;
         counts.next += (scalar[i].flags & kShadeContinue) != 0;
+        counts.specular +=
+            (scalar[i].flags & kShadeContinue) != 0 && (scalar[i].next.flags & kPathSpecular) != 0;
+        const uint model = view.shaders[hits[i].hit.shader].model;
+        counts.nextOf[model] += (scalar[i].flags & kShadeContinue) != 0;
+        counts.shadowOf[model] += (scalar[i].flags & kShadeShadow) != 0;
     }
     EXPECT_EQ(mismatches, 0u) << what << ": of " << hits.size() << " hits";
     return counts;
 }
 
-void expectLambertHitsAreShadeSurface();
+void expectEveryModelsHitsAreShadeSurface();
 
 RenderParams params(uint strategy, uint sampling, uint emitters) {
     RenderParams rp{};
@@ -156,7 +173,7 @@ RenderParams params(uint strategy, uint sampling, uint emitters) {
 
 // In every instruction set this machine has that the kernel was compiled for (SSE4, AVX2,
 // AVX-512, and Highway's portable 128-bit emulation).
-TEST(SimdShading, LambertHitsAreShadeSurfaceToTheBit) {
+TEST(SimdShading, EveryModelsHitsAreShadeSurfaceToTheBit) {
     std::vector<int64_t> targets = hwy::SupportedAndGeneratedTargets();
     ASSERT_FALSE(targets.empty());
     std::set<std::string> ran;
@@ -164,19 +181,19 @@ TEST(SimdShading, LambertHitsAreShadeSurfaceToTheBit) {
         hwy::SetSupportedTargetsForTest(target);
         ran.insert(simdTarget());
         SCOPED_TRACE(simdTarget());
-        expectLambertHitsAreShadeSurface();
+        expectEveryModelsHitsAreShadeSurface();
     }
     hwy::SetSupportedTargetsForTest(0);
     EXPECT_EQ(ran.size(), targets.size()); // each target ran its own code
 }
 
-void expectLambertHitsAreShadeSurface() {
+void expectEveryModelsHitsAreShadeSurface() {
     std::mt19937 rng(2024);
     for (int emitters : {3, 1, 0}) {
         const Fixture f = makeFixture(rng, emitters);
         ASSERT_TRUE(simdShadingApplies(f.view()));
-        // 1003 hits: blocks of 64 Lambert hits and a ragged last one.
-        const std::vector<ShadeInput> hits = randomHits(rng, f, 1003);
+        // 2003 hits: blocks of one model's hits, some full (64), most ragged.
+        const std::vector<ShadeInput> hits = randomHits(rng, f, 2003);
         for (uint strategy : {kStrategyMis, kStrategyLight, kStrategyBsdf})
             for (uint sampling : {kSamplerIndependent, kSamplerSobol}) {
                 const std::string what = std::to_string(emitters) + " emitters, strategy " +
@@ -185,9 +202,14 @@ void expectLambertHitsAreShadeSurface() {
                 const FlagCounts c = compareWithShadeSurface(
                     f.view(), params(strategy, sampling, uint(emitters)), hits, what.c_str());
                 // The comparison reached every outcome it can have here.
-                EXPECT_GT(c.next, 200u) << what;
+                EXPECT_GT(c.next, 400u) << what;
+                EXPECT_GT(c.specular, 40u) << what;
+                for (uint model : {kModelLambert, kModelConductor, kModelDielectric})
+                    EXPECT_GT(c.nextOf.at(model), 40u) << what << ", model " << model;
                 if (emitters > 0 && strategy != kStrategyBsdf) {
-                    EXPECT_GT(c.shadow, 100u) << what;
+                    EXPECT_GT(c.shadow, 200u) << what;
+                    for (uint model : {kModelLambert, kModelConductor, kModelDielectric})
+                        EXPECT_GT(c.shadowOf.at(model), 10u) << what << ", model " << model;
                 }
                 if (emitters > 0) {
                     EXPECT_GT(c.emitted, 5u) << what;
@@ -237,12 +259,13 @@ TEST(SimdShading, RunsInTheWidestInstructionSetAndOnlyWhereEveryLightIsATriangle
 
 // The registry's every model names its wide twin in this engine, or none, in the registry's
 // order; and the cpu backend's stats say which of the scene's models were shaded a run at a
-// time and which one hit at a time (scenes/every-model.yaml: Lambert wide; Conductor,
-// Dielectric and its quad light's emissive Null not), all of them scalar with SIMD off.
+// time and which one hit at a time (scenes/every-model.yaml: Lambert, Conductor and Dielectric
+// wide; its quad light's emissive Null, which only passes the path on, not), all of them
+// scalar with SIMD off.
 TEST(SimdShading, EveryModelNamesItsWideTwinAndTheStatsNameTheScalarOnes) {
     for (size_t i = 0; i < kSurfaceModelCount; ++i) {
         EXPECT_EQ(kWideTwins[i].model, kSurfaceModels[i].model) << kSurfaceModels[i].name;
-        EXPECT_EQ(kWideTwins[i].kernel != nullptr, kSurfaceModels[i].model == kModelLambert)
+        EXPECT_EQ(kWideTwins[i].kernel != nullptr, kSurfaceModels[i].model != kModelNull)
             << kSurfaceModels[i].name;
     }
     Scene scene = loadScene(test::sourceDir() + "/scenes/every-model.yaml");
@@ -253,8 +276,8 @@ TEST(SimdShading, EveryModelNamesItsWideTwinAndTheStatsNameTheScalarOnes) {
     using Names = std::vector<std::string>;
     const std::unique_ptr<RenderResult> wide = render(scene, cfg);
     const nlohmann::json& stats = wide->stats.extra;
-    EXPECT_EQ(stats["wide_models"].get<Names>(), Names{"Lambert"});
-    EXPECT_EQ(stats["scalar_models"].get<Names>(), (Names{"Null", "Conductor", "Dielectric"}));
+    EXPECT_EQ(stats["wide_models"].get<Names>(), (Names{"Lambert", "Conductor", "Dielectric"}));
+    EXPECT_EQ(stats["scalar_models"].get<Names>(), Names{"Null"});
     cfg.pipeline.simdShading = false;
     const std::unique_ptr<RenderResult> scalarRun = render(scene, cfg);
     const nlohmann::json& scalar = scalarRun->stats.extra;

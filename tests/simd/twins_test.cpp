@@ -7,6 +7,8 @@
 #include "host/simd/twins.h"
 #include "test_util.h"
 
+#include "shared/conductor.h"
+#include "shared/dielectric.h"
 #include "shared/lambert.h"
 #include "shared/path.h"
 
@@ -68,6 +70,43 @@ struct Inputs {
         for (size_t k = 0; k < kLanes; ++k)
             set3(row, k, direction());
     }
+    // GGX widths: smooth (below kGgxSmoothAlpha), its edge, near-mirrors and rough.
+    void setAlpha(int row) {
+        for (float& a : lanes.f[row].v) {
+            switch (rng() % 6) {
+            case 0:
+                a = rng() % 2 ? 0.0f : 0.5f * kGgxSmoothAlpha;
+                break;
+            case 1:
+                a = kGgxSmoothAlpha;
+                break;
+            case 2:
+                a = std::ldexp(unit(), -8);
+                break;
+            default:
+                a = unit();
+            }
+        }
+    }
+    void setRange(int row, float lo, float hi) {
+        for (float& x : lanes.f[row].v)
+            x = std::uniform_real_distribution<float>(lo, hi)(rng);
+    }
+    // A geometric normal, and a shading normal near it (or anywhere, now and then).
+    void setNormals(int ngRow, int nsRow) {
+        for (size_t k = 0; k < kLanes; ++k) {
+            const vec3 ng = direction();
+            set3(ngRow, k, ng);
+            set3(nsRow, k, rng() % 4 ? normalize(ng + 0.3f * direction()) : direction());
+        }
+    }
+    // A direction on the side of the normal in row ngRow, mostly.
+    void setAbove(int row, int ngRow) {
+        for (size_t k = 0; k < kLanes; ++k) {
+            const vec3 w = direction();
+            set3(row, k, rng() % 4 && dot(w, get3(ngRow, k)) < 0.0f ? -w : w);
+        }
+    }
     void set3(int row, size_t k, vec3 v) {
         lanes.f[row].v[k] = v.x;
         lanes.f[row + 1].v[k] = v.y;
@@ -82,7 +121,7 @@ struct Inputs {
 
 // The scalar side's results for lane k, as the twin writes them.
 struct Expected {
-    float f[4] = {};
+    float f[8] = {};
     std::uint32_t u[4] = {};
     int floats = 0, uints = 0;
     void put(float x) { f[floats++] = x; }
@@ -91,6 +130,16 @@ struct Expected {
     void putU(std::uint32_t x) { u[uints++] = x; }
     void putU(uvec4 v) { putU(v.x), putU(v.y), putU(v.z), putU(v.w); }
 };
+
+// A BSDF sample as its twin writes it: ok and specular as masks, the out-parameters zero where
+// the sample failed (the scalar function leaves them unwritten then).
+void putSample(Expected& e, bool ok, bool specular, vec3 wi, vec3 weight, float pdf) {
+    e.putU(ok ? ~0u : 0u);
+    e.putU(ok && specular ? ~0u : 0u);
+    e.put(ok ? wi : vec3(0.0f));
+    e.put(ok ? weight : vec3(0.0f));
+    e.put(ok ? pdf : 0.0f);
+}
 
 // Each twin: how its arguments are drawn, and its scalar function on lane k.
 struct ScalarSide {
@@ -188,6 +237,91 @@ const std::map<Twin, ScalarSide>& scalarSides() {
               e.put(lambertEval(in.get3(0, k), in.get3(3, k), in.get3(6, k), in.get3(9, k),
                                 in.get3(12, k), pdf));
               e.put(pdf);
+          }}},
+        {Twin::ggxD,
+         {[](Inputs& in) { in.setDirection(0), in.setAlpha(3); },
+          [](const Inputs& in, size_t k, Expected& e) { e.put(ggxD(in.get3(0, k), in.f(3, k))); }}},
+        {Twin::ggxA,
+         {[](Inputs& in) { in.setDirection(0), in.setAlpha(3); },
+          [](const Inputs& in, size_t k, Expected& e) { e.put(ggxA(in.get3(0, k), in.f(3, k))); }}},
+        {Twin::ggxG2Denominator,
+         {[](Inputs& in) { in.setDirection(0), in.setDirection(3), in.setAlpha(6); },
+          [](const Inputs& in, size_t k, Expected& e) {
+              e.put(ggxG2Denominator(in.get3(0, k), in.get3(3, k), in.f(6, k)));
+          }}},
+        {Twin::ggxSampleVisibleNormal,
+         {[](Inputs& in) {
+              in.setDirection(0), in.setAlpha(3), in.setUnit(4), in.setUnit(5);
+              for (float& z : in.lanes.f[2].v)
+                  z = std::fabs(z);
+          },
+          [](const Inputs& in, size_t k, Expected& e) {
+              e.put(
+                  ggxSampleVisibleNormal(in.get3(0, k), in.f(3, k), vec2(in.f(4, k), in.f(5, k))));
+          }}},
+        {Twin::schlickFresnel,
+         {[](Inputs& in) {
+              in.setUnit(0), in.setUnit(1), in.setUnit(2), in.setRange(3, -0.5f, 1.5f);
+          },
+          [](const Inputs& in, size_t k, Expected& e) {
+              e.put(schlickFresnel(in.get3(0, k), in.f(3, k)));
+          }}},
+        {Twin::conductorEval,
+         {[](Inputs& in) {
+              in.setUnit(0), in.setUnit(1), in.setUnit(2), in.setAlpha(3), in.setNormals(4, 7);
+              in.setAbove(10, 4), in.setAbove(13, 4);
+          },
+          [](const Inputs& in, size_t k, Expected& e) {
+              float pdf;
+              e.put(conductorEval(in.get3(0, k), in.f(3, k), in.get3(4, k), in.get3(7, k),
+                                  in.get3(10, k), in.get3(13, k), pdf));
+              e.put(pdf);
+          }}},
+        {Twin::conductorSample,
+         {[](Inputs& in) {
+              in.setUnit(0), in.setUnit(1), in.setUnit(2), in.setAlpha(3), in.setNormals(4, 7);
+              in.setAbove(10, 4), in.setUnit(13), in.setUnit(14);
+          },
+          [](const Inputs& in, size_t k, Expected& e) {
+              vec3 wi, weight;
+              float pdf;
+              bool specular;
+              const bool ok = conductorSample(
+                  in.get3(0, k), in.f(3, k), in.get3(4, k), in.get3(7, k), in.get3(10, k),
+                  vec2(in.f(13, k), in.f(14, k)), wi, weight, pdf, specular);
+              putSample(e, ok, specular, wi, weight, pdf);
+          }}},
+        {Twin::fresnelDielectric,
+         {[](Inputs& in) { in.setRange(0, -0.2f, 1.2f), in.setRange(1, 0.1f, 10.0f); },
+          [](const Inputs& in, size_t k, Expected& e) {
+              float cosT;
+              e.put(fresnelDielectric(in.f(0, k), in.f(1, k), cosT));
+              e.put(cosT);
+          }}},
+        {Twin::dielectricEval,
+         {[](Inputs& in) {
+              in.setRange(0, 1.01f, 10.0f), in.setAlpha(1), in.setNormals(2, 5);
+              in.setAbove(8, 2), in.setDirection(11);
+          },
+          [](const Inputs& in, size_t k, Expected& e) {
+              float pdf;
+              e.put(dielectricEval(in.f(0, k), in.f(1, k), in.get3(2, k), in.get3(5, k),
+                                   in.get3(8, k), in.get3(11, k), pdf));
+              e.put(pdf);
+          }}},
+        {Twin::dielectricSample,
+         {[](Inputs& in) {
+              in.setRange(0, 1.01f, 10.0f), in.setAlpha(1), in.setNormals(2, 5);
+              in.setDirection(8), in.setUnit(11), in.setUnit(12), in.setUnit(13);
+          },
+          [](const Inputs& in, size_t k, Expected& e) {
+              vec3 wi, weight;
+              float pdf;
+              bool specular;
+              const bool ok = dielectricSample(
+                  in.f(0, k), in.f(1, k), in.get3(2, k), in.get3(5, k), in.get3(8, k),
+                  vec3(in.f(11, k), in.f(12, k), in.f(13, k)), wi, weight, pdf, specular);
+              putSample(e, ok, specular, wi, weight, pdf);
           }}},
         {Twin::pcg4d,
          {[](Inputs&) {},
