@@ -78,7 +78,7 @@ ShaderParams kernelShader(uint i) {
     s.flags = w2.x;
     s.ior = uintBitsToFloat(w2.y);
     s.alpha = uintBitsToFloat(w2.z);
-    s.pad0 = w2.w;
+    s.metallic = uintBitsToFloat(w2.w);
 #ifdef SPW_KERNEL_MODEL
     s.model = SPW_KERNEL_MODEL;
 #endif

@@ -358,6 +358,7 @@ const WideTwin kWideTwins[] = {
     {kModelLambert, "ShadeLambertLanes"},
     {kModelConductor, "ShadeConductorLanes"},
     {kModelDielectric, "ShadeDielectricLanes"},
+    {kModelMetallicRoughness, nullptr},
 };
 static_assert(sizeof(kWideTwins) / sizeof(kWideTwins[0]) == kModelCount,
               "every registered surface model names its wide twin, or nullptr for none");

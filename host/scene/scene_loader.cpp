@@ -7,6 +7,7 @@
 #include "host/scene/settings_table.h"
 #include "host/scene/surface_models.h"
 #include "host/scene/yaml_reader.h"
+#include "shared/gltf.h"
 
 #include <OpenImageIO/imageio.h>
 #include <glm/gtc/matrix_transform.hpp>
@@ -289,7 +290,9 @@ void readShader(const Reader& rd, const YAML::Node& n, TextureReader& textures, 
                             {kTakesColour, "colour"},
                             {kTakesTexture, "texture"},
                             {kTakesAlpha, "alpha"},
-                            {kTakesIor, "ior"}})
+                            {kTakesIor, "ior"},
+                            {kTakesMetallic, "metallic"},
+                            {kTakesRoughness, "roughness"}})
         if (takes & bit) keys.push_back(key);
     rd.checkKeys(n, t + " shader", keys);
     if (t == "Emissive" && !n["emission"]) rd.fail(n, "Emissive shader needs 'emission'");
@@ -315,6 +318,11 @@ void readShader(const Reader& rd, const YAML::Node& n, TextureReader& textures, 
     }
     if (n["ior"]) p.ior = float(rd.number(n["ior"], "ior", 1.01, 10.0));
     if (n["alpha"]) p.alpha = float(rd.number(n["alpha"], "alpha", 0.0, 1.0));
+    if (takes & kTakesMetallic) {
+        p.metallic = n["metallic"] ? float(rd.number(n["metallic"], "metallic", 0.0, 1.0)) : 1.0f;
+        p.alpha = gltfAlpha(n["roughness"] ? float(rd.number(n["roughness"], "roughness", 0.0, 1.0))
+                                           : 1.0f);
+    }
     if (n["emission"]) p.emission = rd.vec<3>(n["emission"], "emission", 0.0, kMaxRadiance);
     if (n["two sided"] && rd.boolean(n["two sided"], "two sided")) p.flags |= kShaderTwoSided;
     scene.shaders.push_back(s);

@@ -22,6 +22,7 @@
     X(Null, 0u, null, kNoParams)                                                                   \
     X(Lambert, 1u, lambert, kTakesReflectance | kTakesColour | kTakesTexture)                      \
     X(Conductor, 2u, conductor, kTakesColour | kTakesTexture | kTakesAlpha)                        \
-    X(Dielectric, 3u, dielectric, kTakesIor | kTakesAlpha)
+    X(Dielectric, 3u, dielectric, kTakesIor | kTakesAlpha)                                         \
+    X(MetallicRoughness, 4u, gltf, kTakesColour | kTakesTexture | kTakesMetallic | kTakesRoughness)
 
 #endif

@@ -28,8 +28,9 @@ struct ShaderParams {
     float reflectance; // albedo scale
     uint flags;        // kShader*
     float ior;         // Dielectric: index of refraction of the back (inside) of the surface
-    float alpha;       // Conductor, Dielectric: GGX width; below kGgxSmoothAlpha a delta lobe
-    uint pad0;
+    float alpha;    // Conductor, Dielectric, MetallicRoughness: GGX width; below kGgxSmoothAlpha a
+                    // delta lobe
+    float metallic; // MetallicRoughness: glTF's metallic factor
 };
 
 // What next-event estimation picks, with probability pickPdf, proportional to its power

@@ -9,6 +9,8 @@
 #include "host/scene/surface_models.h"
 #include "test_util.h"
 
+#include "shared/gltf.h"
+
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -47,7 +49,9 @@ TEST(SurfaceModels, TheLoaderTakesEachModelWithExactlyItsRegisteredKeys) {
         {kTakesColour, "colour: [0.5, 0.5, 0.5]"},
         {kTakesTexture, "texture: {type: Constant, colour: [0.5, 0.5, 0.5]}"},
         {kTakesAlpha, "alpha: 0.5"},
-        {kTakesIor, "ior: 1.33"}};
+        {kTakesIor, "ior: 1.33"},
+        {kTakesMetallic, "metallic: 0.5"},
+        {kTakesRoughness, "roughness: 0.5"}};
     TempDir dir;
     for (const SurfaceModelInfo& m : kSurfaceModels) {
         const std::string type = std::string("type: ") + m.name;
@@ -63,6 +67,26 @@ TEST(SurfaceModels, TheLoaderTakesEachModelWithExactlyItsRegisteredKeys) {
             }
         }
     }
+}
+
+// The scene format: roughness is glTF's perceptual roughness (alpha = roughness^2, floored at
+// 0.045^2), and both factors default to glTF's 1.
+TEST(SurfaceModels, MetallicRoughnessTakesGltfFactorsAndDefaults) {
+    TempDir dir;
+    const auto load = [&](const std::string& keys) {
+        return loadScene(dir.write("s.yaml", shaderScene("type: MetallicRoughness" + keys)))
+            .shaders.at(0)
+            .params;
+    };
+    const ShaderParams plain = load("");
+    EXPECT_EQ(plain.metallic, 1.0f);
+    EXPECT_EQ(plain.alpha, 1.0f);
+    const ShaderParams set = load(", metallic: 0.25, roughness: 0.5");
+    EXPECT_EQ(set.metallic, 0.25f);
+    EXPECT_EQ(set.alpha, 0.25f);
+    EXPECT_EQ(load(", roughness: 0").alpha, kGltfMinAlpha);
+    EXPECT_THROW(load(", roughness: 1.5"), SceneError);
+    EXPECT_THROW(load(", alpha: 0.5"), SceneError);
 }
 
 } // namespace

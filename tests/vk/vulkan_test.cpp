@@ -327,9 +327,11 @@ Scene everyModelScene(const TempDir& dir) {
                    "  - {type: Conductor, colour: [0.95, 0.64, 0.54], alpha: 0.3}\n"
                    "  - {type: Conductor, colour: [0.9, 0.9, 0.9]}\n"
                    "  - {type: Dielectric, ior: 1.5, alpha: 0.2}\n"
-                   "  - {type: Dielectric, ior: 1.33}\n",
+                   "  - {type: Dielectric, ior: 1.33}\n"
+                   "  - {type: MetallicRoughness, colour: [0.8, 0.6, 0.3], metallic: 0.4, "
+                   "roughness: 0.35}\n",
                    {"white.obj, shader: 0", "red.obj, shader: 1", "green.obj, shader: 2",
-                    "blocks.obj, shader: 3", "blocks.obj, shader: 4"});
+                    "blocks.obj, shader: 3", "blocks.obj, shader: 4", "blocks.obj, shader: 5"});
 }
 
 // |a - b| over the vector's size, in float epsilons (2^-23): a direction or a position rounded

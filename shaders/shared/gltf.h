@@ -1,0 +1,120 @@
+// MetallicRoughness: glTF 2.0's metallic-roughness material (the glTF 2.0 specification,
+// appendix B, "BRDF implementation"), reflection only.
+//   parameters: colour [r, g, b] ([1, 1, 1]) or texture: the base colour; metallic (1) in
+//   [0, 1]; roughness (1) in [0, 1], the perceptual roughness: GGX alpha = roughness^2, at least
+//   kGltfMinAlpha. glTF's defaults (metallicFactor and roughnessFactor 1).
+//   c_diff = colour (1 - metallic), f0 = mix(0.04, colour, metallic),
+//   F = f0 + (1 - f0) (1 - |wo.h|)^5 (Schlick, as conductor.h),
+//   f = (1 - F) c_diff / pi + F D G2 / (4 |co| |ci|)
+//   with GGX D and the height-correlated Smith G2 of ggx.h (the specification's V is
+//   G2 / (4 |co| |ci|)). The diffuse term takes (1 - F) with the half vector's F, as the
+//   specification's implementation does.
+//   Sampling: the specular lobe through GGX's visible normals (as conductor.h) with probability
+//   pSpecular, the diffuse one cosine-weighted otherwise; pdf = the mixture's, weight = fcos /
+//   pdf. pSpecular = Fs / (Fs + Fd) from the lobes' weights seen from wo (Fs = mean of
+//   F(f0, cos wo), Fd = mean of c_diff (1 - F(f0, cos wo))), within [0.25, 0.9] while there is a
+//   diffuse lobe (so neither lobe is starved), 1 without one (a pure metal).
+//   alpha is floored at kGltfMinAlpha = 0.045^2 (Filament's floor on perceptual roughness): a
+//   roughness of 0 is a very narrow GGX lobe, never a delta lobe mixed with a diffuse one.
+#ifndef SPILLWAY_SHARED_GLTF_H
+#define SPILLWAY_SHARED_GLTF_H
+#include "conductor.h"
+#include "sampling.h"
+#include "types.h"
+
+SHARED_BEGIN
+
+const float kGltfMinAlpha = 0.045f * 0.045f;
+const float kGltfDielectricF0 = 0.04f;
+
+// GGX alpha from glTF's perceptual roughness.
+SHARED_FN float gltfAlpha(float roughness) {
+    return max(roughness * roughness, kGltfMinAlpha);
+}
+
+// The probability of sampling the specular lobe, seen from wo at cosine cosO to the shading
+// normal.
+SHARED_FN float gltfSpecularProbability(vec3 f0, vec3 cDiff, float cosO) {
+    vec3 F = schlickFresnel(f0, cosO);
+    float fs = (F.x + F.y + F.z) / 3.0f;
+    vec3 d = cDiff * (vec3(1.0f) - F);
+    float fd = (d.x + d.y + d.z) / 3.0f;
+    if (!(fd > 0.0f)) return 1.0f;
+    return clamp(fs / (fs + fd), 0.25f, 0.9f);
+}
+
+SHARED_FN vec3 gltfEval(vec3 colour, float metallic, float alpha, vec3 ng, vec3 ns, vec3 wo,
+                        vec3 wi, OUT(float) pdf) {
+    pdf = 0.0f;
+    if (dot(ng, wo) * dot(ng, wi) <= 0.0f) return vec3(0.0f);
+    Frame f = shadingFrame(ns, ng, wo);
+    vec3 lo = frameToLocal(f, wo);
+    vec3 li = frameToLocal(f, wi);
+    if (lo.z <= 0.0f || li.z <= 0.0f) return vec3(0.0f);
+    vec3 h = lo + li;
+    float len2 = dot(h, h);
+    if (!(len2 > 0.0f)) return vec3(0.0f);
+    h = h * inversesqrt(len2);
+    vec3 f0 = mix(vec3(kGltfDielectricF0), colour, metallic);
+    vec3 cDiff = colour * (1.0f - metallic);
+    vec3 F = schlickFresnel(f0, dot(lo, h));
+    float d = ggxD(h, alpha);
+    float denom = ggxG2Denominator(lo, li, alpha);
+    vec3 specular = denom > 0.0f ? F * (d * li.z / (2.0f * denom)) : vec3(0.0f);
+    vec3 diffuse = (vec3(1.0f) - F) * cDiff * (li.z * kInvPi);
+    float pSpecular = gltfSpecularProbability(f0, cDiff, lo.z);
+    pdf =
+        pSpecular * (d / (2.0f * (lo.z + ggxA(lo, alpha)))) + (1.0f - pSpecular) * (li.z * kInvPi);
+    return specular + diffuse;
+}
+
+SHARED_FN bool gltfSample(vec3 colour, float metallic, float alpha, vec3 ng, vec3 ns, vec3 wo,
+                          vec3 u, OUT(vec3) wi, OUT(vec3) weight, OUT(float) pdf,
+                          OUT(bool) specular) {
+    wi = vec3(0.0f);
+    weight = vec3(0.0f);
+    pdf = 0.0f;
+    specular = false;
+    Frame f = shadingFrame(ns, ng, wo);
+    vec3 lo = frameToLocal(f, wo);
+    if (lo.z <= 0.0f) return false;
+    vec3 f0 = mix(vec3(kGltfDielectricF0), colour, metallic);
+    vec3 cDiff = colour * (1.0f - metallic);
+    vec3 li;
+    if (u.z < gltfSpecularProbability(f0, cDiff, lo.z)) {
+        vec3 h = ggxSampleVisibleNormal(lo, alpha, vec2(u.x, u.y));
+        float oh = dot(lo, h);
+        if (oh <= 0.0f) return false;
+        li = 2.0f * oh * h - lo;
+    } else {
+        li = sampleCosineHemisphere(vec2(u.x, u.y));
+    }
+    if (li.z <= 0.0f) return false; // below the surface: absorbed
+    wi = frameToWorld(f, li);
+    vec3 fcos = gltfEval(colour, metallic, alpha, ng, ns, wo, wi, pdf);
+    if (!(pdf > 0.0f)) return false;
+    weight = fcos / pdf;
+    return true;
+}
+
+// The registry's interface (shared/bsdf.h dispatches here).
+SHARED_FN bool gltfBsdfIsDelta(ShaderParams sh) {
+    UNUSED(sh);
+    return false;
+}
+// A pure metal spreads a cone by about alpha, as the conductor; with a diffuse lobe, as Lambert.
+SHARED_FN float gltfBsdfConeSpread(ShaderParams sh) {
+    return sh.metallic >= 1.0f ? max(sh.alpha, kGltfMinAlpha) : 1.0f;
+}
+SHARED_FN vec3 gltfBsdfEval(ShaderParams sh, vec3 albedo, vec3 ng, vec3 ns, vec3 wo, vec3 wi,
+                            OUT(float) pdf) {
+    return gltfEval(albedo, sh.metallic, max(sh.alpha, kGltfMinAlpha), ng, ns, wo, wi, pdf);
+}
+SHARED_FN bool gltfBsdfSample(ShaderParams sh, vec3 albedo, vec3 ng, vec3 ns, vec3 wo, vec3 u,
+                              OUT(vec3) wi, OUT(vec3) weight, OUT(float) pdf, OUT(bool) specular) {
+    return gltfSample(albedo, sh.metallic, max(sh.alpha, kGltfMinAlpha), ng, ns, wo, u, wi, weight,
+                      pdf, specular);
+}
+
+SHARED_END
+#endif
