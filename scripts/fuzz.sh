@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Builds the libFuzzer harnesses (tests/fuzz/) with clang, ASan and UBSan in build-fuzz/ and runs
 # each for SECONDS (default 60), all at once: scripts/fuzz.sh [SECONDS [NAME...]] (NAME: scene,
-# obj, checkpoint; default all three). The working corpus grows
+# obj, gltf, checkpoint; default all four). The working corpus grows
 # in build-fuzz/corpus/NAME (seeded from tests/fuzz/seeds/NAME); an input that crashes, hangs
 # (10 s) or leaks is written to tests/fuzz/crashers/NAME/, where the normal suite replays it.
 # Prints each run's executions, coverage and findings; exits 1 if any harness found something.
@@ -10,7 +10,7 @@ root="$(cd "$(dirname "$0")/.." && pwd)"
 seconds="${1:-60}"
 shift || true
 names=("$@")
-[ ${#names[@]} -gt 0 ] || names=(scene obj checkpoint)
+[ ${#names[@]} -gt 0 ] || names=(scene obj gltf checkpoint)
 "$root/scripts/install-deps.sh" --fuzz
 build="$root/build-fuzz"
 CC=clang CXX=clang++ cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \

@@ -13,6 +13,7 @@ packages=(
   libhwy-dev                               # SIMD shading of Lambert hits (Google Highway)
   nlohmann-json3-dev                       # --stats JSON and reading it back in tests
   libtinyobjloader-dev                     # OBJ meshes
+  libtinygltf-dev                          # glTF 2.0 files
   libglfw3-dev libgl-dev libx11-dev        # the --preview window (GLFW, OpenGL, X11)
   xvfb x11-apps x11-utils                  # its test: a virtual display, xwd, xwininfo
   libopenmpi-dev openmpi-bin               # distributed rendering (mpirun -np N spillway render)

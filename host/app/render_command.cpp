@@ -58,6 +58,8 @@ std::optional<Checkpoint> readResume(const RenderOptions& o) {
 Scene loadForRender(const RenderOptions& o, bool writes) {
     Scene scene = loadScene(o.scenePath);
     applyOverrides(o, scene);
+    for (const std::string& w : scene.warnings)
+        if (writes) std::fprintf(stderr, "spillway: warning: %s\n", w.c_str());
     for (const Mesh& m : scene.meshes)
         if (m.droppedTriangles > 0 && writes)
             std::fprintf(stderr, "spillway: warning: %s: dropped %d zero-area triangle%s\n",

@@ -4,6 +4,7 @@
 #include "host/image/image_io.h"
 #include "host/image/output_file.h"
 
+#include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <filesystem>
@@ -109,6 +110,14 @@ const std::vector<CliOption> kOwnOptions = {
      "first usable one; with auto, a GPU, see `spillway devices`, or the device the Vulkan "
      "driver variables name)",
      0, 0, [](O& r, const C&, const S& v) { r.config.vulkan.device = v; }},
+    {"--width", nullptr, "N", Section::Render,
+     "image width in pixels (overrides the scene's; without --height the height keeps the "
+     "scene's aspect ratio)",
+     1, 1 << 15, [](O& r, const C& o, const S& v) { r.width = int(integerValue(o, v)); }},
+    {"--height", nullptr, "N", Section::Render,
+     "image height in pixels (overrides the scene's; without --width the width keeps the "
+     "scene's aspect ratio)",
+     1, 1 << 15, [](O& r, const C& o, const S& v) { r.height = int(integerValue(o, v)); }},
     {"--threads", nullptr, "N", Section::Render, "worker threads (default: every core)", 1, 1024,
      [](O& r, const C& o, const S& v) { r.config.threads = int(integerValue(o, v)); }},
     {"--sampler", nullptr, "TYPE", Section::Render,
@@ -403,6 +412,25 @@ std::string renderOptionsHelp() {
 void applyOverrides(const RenderOptions& options, Scene& scene) {
     applySettingOverrides(scene.settings, options.settings);
     if (options.sampler) scene.sampler = *options.sampler;
+    ImageSettings& img = scene.image;
+    const double aspect = double(img.width) / double(img.height);
+    if (options.width && options.height) {
+        img.width = *options.width, img.height = *options.height;
+    } else if (options.width) {
+        img.width = *options.width;
+        img.height = std::max(1, int(std::lround(*options.width / aspect)));
+    } else if (options.height) {
+        img.height = *options.height;
+        img.width = std::max(1, int(std::lround(*options.height * aspect)));
+    }
+    img.width = std::clamp(img.width, 1, 1 << 15), img.height = std::clamp(img.height, 1, 1 << 15);
+    if ((long long)img.width * img.height > kMaxImagePixels)
+        throw UsageError("--width and --height: an image of " + std::to_string(img.width) + "x" +
+                         std::to_string(img.height) + " pixels is larger than the " +
+                         std::to_string(kMaxImagePixels) + " pixels Spillway renders");
+    if ((unsigned long long)img.width * img.height * img.samplesPerIteration() > 0xFFFFFFFFull)
+        throw UsageError("--width x --height x the scene's sample base^2 exceeds 2^32 - 1 samples "
+                         "per iteration");
 }
 
 } // namespace spw

@@ -22,6 +22,7 @@ struct RenderOptions {
     std::string checkpointPath, resumePath, partialPath;
     double checkpointInterval = 0;
     std::optional<SamplerType> sampler; // --sampler: replaces the scene's
+    std::optional<int> width, height;   // --width, --height: replace the image's size
     SettingOverrides settings;          // --seed, --bin-exponent, ...: replace the scene's
     bool preview = false;
     std::string progress = "auto"; // auto | bar | lines | none (also after --quiet)
@@ -41,8 +42,9 @@ RenderOptions parseRenderOptions(const std::vector<std::string>& args);
 // The options part of `spillway --help`, made from the table.
 std::string renderOptionsHelp();
 
-// The scene's settings and sampler with the command line's overrides: applied once, right after
-// loading, so that the scene then holds what the render uses.
+// The scene's settings, sampler and image size with the command line's overrides: applied once,
+// right after loading, so that the scene then holds what the render uses. Throws UsageError for
+// a size whose samples per iteration pass 2^32 - 1.
 void applyOverrides(const RenderOptions& options, Scene& scene);
 
 } // namespace spw

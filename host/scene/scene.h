@@ -170,6 +170,8 @@ struct Scene {
     int quadLightCount = 0;
     std::vector<PunctualLight> punctualLights;
     std::optional<Environment> environment;
+    // What the file holds that is not rendered ("file: what"), once each: the CLI prints them.
+    std::vector<std::string> warnings;
 
     bool usesTextures() const;
 };
@@ -178,7 +180,8 @@ struct Scene {
 // says so, naming `what` (the loader and the OBJ reader report it at their own file and line).
 std::string beyondReach(const glm::dvec3& p, const std::string& what);
 
-// Parses and validates a scene file. Throws SceneError (file:line: message) on any problem.
+// Parses and validates a scene file, or a glTF file (.gltf, .glb: host/scene/gltf_loader.h).
+// Throws SceneError (file:line: message) on any problem.
 Scene loadScene(const std::string& path);
 
 } // namespace spw

@@ -1,6 +1,7 @@
 // The YAML scene loader: docs/scene-format.md made executable. Every value is checked for type and
 // range where it is read, and every error names the file and line of the offending node.
 #include "host/image/image_io.h"
+#include "host/scene/gltf_loader.h"
 #include "host/scene/light_loader.h"
 #include "host/scene/obj_mesh.h"
 #include "host/scene/scene.h"
@@ -572,6 +573,7 @@ void SceneReader::finish(const YAML::Node& root) {
 } // namespace
 
 Scene loadScene(const std::string& path) {
+    if (isGltfPath(path)) return loadGltfScene(path);
     Scene scene;
     scene.file = path;
     const Reader rd(path);

@@ -7,6 +7,7 @@
 #include "host/scene/scene.h"
 
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <unistd.h>
@@ -44,6 +45,19 @@ const Folder& folder() {
     return f;
 }
 
+// A loaded scene rendered by the reference backend at 4 x 4 pixels, 1 sample, depth <= 3.
+void renderSmall(Scene s) {
+    s.image.width = std::min(s.image.width, 4);
+    s.image.height = std::min(s.image.height, 4);
+    s.image.sampleBase = 1;
+    s.image.iterations = 1;
+    s.settings.maxDepth = std::min(s.settings.maxDepth, 3);
+    RenderConfig config;
+    config.backend = BackendKind::Reference;
+    config.threads = 1;
+    render(s, config);
+}
+
 template <class Body> Outcome guarded(Body body, std::string* detail) {
     try {
         body();
@@ -67,20 +81,14 @@ Outcome scene(const std::uint8_t* data, std::size_t size, std::string* detail) {
         at == std::string::npos ? std::string() : text.substr(at + marker.size());
     folder().write("mesh.obj", objText.data(), objText.size());
     const std::string path = folder().write("scene.yaml", yaml.data(), yaml.size());
-    return guarded(
-        [&] {
-            Scene s = loadScene(path);
-            s.image.width = std::min(s.image.width, 4);
-            s.image.height = std::min(s.image.height, 4);
-            s.image.sampleBase = 1;
-            s.image.iterations = 1;
-            s.settings.maxDepth = std::min(s.settings.maxDepth, 3);
-            RenderConfig config;
-            config.backend = BackendKind::Reference;
-            config.threads = 1;
-            render(s, config);
-        },
-        detail);
+    return guarded([&] { renderSmall(loadScene(path)); }, detail);
+}
+
+Outcome gltf(const std::uint8_t* data, std::size_t size, std::string* detail) {
+    const bool binary = size >= 4 && std::memcmp(data, "glTF", 4) == 0;
+    const std::string path = folder().write(binary ? "model.glb" : "model.gltf",
+                                            reinterpret_cast<const char*>(data), size);
+    return guarded([&] { renderSmall(loadScene(path)); }, detail);
 }
 
 Outcome obj(const std::uint8_t* data, std::size_t size, std::string* detail) {

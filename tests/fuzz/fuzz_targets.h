@@ -20,6 +20,10 @@ enum class Outcome {
 // that loads is rendered by the reference backend at 4 x 4 pixels, 1 sample, depth <= 3: every
 // ray Embree sees must be valid.
 Outcome scene(const std::uint8_t* data, std::size_t size, std::string* detail = nullptr);
+// A glTF file: bytes that begin with the binary container's magic ("glTF") written as model.glb,
+// the rest as model.gltf, into the same private folder (tex.png beside it); one that loads is
+// rendered as a scene is.
+Outcome gltf(const std::uint8_t* data, std::size_t size, std::string* detail = nullptr);
 // An OBJ file alone, through the loader's OBJ reader with an identity transform.
 Outcome obj(const std::uint8_t* data, std::size_t size, std::string* detail = nullptr);
 // A checkpoint or partial render (an EXR with Spillway's state channels), through the reader

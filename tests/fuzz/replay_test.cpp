@@ -33,6 +33,7 @@ fuzz::Outcome replay(Target target, const std::string& path, std::string* detail
 TEST(FuzzCorpus, SeedsLoadAndRender) {
     const std::pair<const char*, Target> kinds[] = {{"seeds/scene", fuzz::scene},
                                                     {"seeds/obj", fuzz::obj},
+                                                    {"seeds/gltf", fuzz::gltf},
                                                     {"seeds/checkpoint", fuzz::checkpoint}};
     for (const auto& [dir, target] : kinds) {
         const std::vector<std::string> files = filesIn(dir);
@@ -47,6 +48,7 @@ TEST(FuzzCorpus, SeedsLoadAndRender) {
 TEST(FuzzCorpus, EveryCrasherFoundIsNowRejectedCleanly) {
     const std::pair<const char*, Target> kinds[] = {{"crashers/scene", fuzz::scene},
                                                     {"crashers/obj", fuzz::obj},
+                                                    {"crashers/gltf", fuzz::gltf},
                                                     {"crashers/checkpoint", fuzz::checkpoint}};
     for (const auto& [dir, target] : kinds)
         for (const std::string& f : filesIn(dir)) {

@@ -1,0 +1,662 @@
+// A glTF 2.0 file into a Scene (gltf_loader.h). tinygltf parses the JSON and the buffers; every
+// index, accessor and value is checked here before it is used, so that a malformed file is a
+// SceneError naming the JSON pointer, never a crash.
+#include "host/scene/gltf_loader.h"
+
+#include "shared/gltf.h"
+
+#include <OpenImageIO/imageio.h>
+#include <glm/gtc/matrix_inverse.hpp>
+#include <glm/gtc/quaternion.hpp>
+#include <tiny_gltf.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <limits>
+#include <set>
+
+namespace spw {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// The extensions this loader honours: a file may require them.
+const std::set<std::string> kHonoured = {"KHR_lights_punctual", "KHR_materials_emissive_strength"};
+
+// The image of a `spillway render model.glb` without an aspect ratio: 640 pixels wide.
+constexpr int kDefaultWidth = 640;
+constexpr double kDefaultAspect = 4.0 / 3.0;
+
+// glTF's photometric units into the radiometric ones Spillway's lights take, as Blender's glTF
+// importer converts them (683 lm/W): a point light's candela into W/sr, a directional light's
+// lux into W/m^2.
+constexpr double kLumensPerWatt = 683.0;
+
+// tinygltf reads every image's bytes; the pixels are left to OpenImageIO's texture cache, which
+// reads the file itself (or, for an embedded image, nothing yet: a warning says so).
+bool keepImageUndecoded(tinygltf::Image*, const int, std::string*, std::string*, int, int,
+                        const unsigned char*, int, void*) {
+    return true;
+}
+
+std::string lower(std::string s) {
+    for (char& c : s)
+        c = char(std::tolower(static_cast<unsigned char>(c)));
+    return s;
+}
+
+class GltfReader {
+  public:
+    GltfReader(const std::string& path, Scene& scene)
+        : path_(path), dir_(fs::path(path).parent_path()), scene_(scene) {}
+
+    void read() {
+        parse();
+        checkExtensions();
+        const int sceneIndex = model_.defaultScene >= 0 ? model_.defaultScene : 0;
+        if (model_.scenes.empty()) fail("/scenes", "the file has no scene");
+        if (sceneIndex >= int(model_.scenes.size()))
+            fail("/scene", "names scene " + std::to_string(sceneIndex) + " of " +
+                               std::to_string(model_.scenes.size()));
+        const tinygltf::Scene& s = model_.scenes[size_t(sceneIndex)];
+        // Two passes over the node graph: the camera first (the world is camera-relative), then
+        // the meshes and lights, placed relative to it.
+        for (size_t i = 0; i < s.nodes.size(); ++i)
+            visit(s.nodes[i], glm::dmat4(1.0),
+                  "/scenes/" + std::to_string(sceneIndex) + "/nodes/" + std::to_string(i),
+                  Pass::Camera, 0);
+        for (size_t i = 0; i < s.nodes.size(); ++i)
+            visit(s.nodes[i], glm::dmat4(1.0),
+                  "/scenes/" + std::to_string(sceneIndex) + "/nodes/" + std::to_string(i),
+                  Pass::Geometry, 0);
+        if (!cameraFound_) frameBounds();
+        warnUnrendered();
+        scene_.objectCount = int(scene_.meshes.size());
+        bool emissive = !scene_.punctualLights.empty();
+        for (const Mesh& m : scene_.meshes)
+            emissive = emissive || scene_.shaders[size_t(m.shader)].params.emission != vec3(0.0f);
+        if (!emissive) scene_.environment = Environment{}; // radiance 1 from everywhere
+        if (scene_.shaders.empty()) scene_.shaders.push_back(defaultShader());
+    }
+
+  private:
+    enum class Pass { Camera, Geometry };
+
+    [[noreturn]] void fail(const std::string& pointer, const std::string& message) const {
+        throw SceneError(path_, 0, (pointer.empty() ? "" : pointer + ": ") + message);
+    }
+    void warn(const std::string& message) {
+        if (warned_.insert(message).second) scene_.warnings.push_back(path_ + ": " + message);
+    }
+
+    void parse() {
+        std::error_code ec;
+        if (!fs::is_regular_file(path_, ec))
+            throw SceneError(path_, 0, "cannot open the glTF file: not a readable file");
+        tinygltf::TinyGLTF loader;
+        loader.SetImageLoader(keepImageUndecoded, nullptr);
+        std::string err, warnings;
+        const bool binary = lower(fs::path(path_).extension().string()) == ".glb";
+        const bool ok = binary ? loader.LoadBinaryFromFile(&model_, &err, &warnings, path_)
+                               : loader.LoadASCIIFromFile(&model_, &err, &warnings, path_);
+        if (!ok || !err.empty()) {
+            while (!err.empty() && (err.back() == '\n' || err.back() == '\r'))
+                err.pop_back();
+            throw SceneError(path_, 0,
+                             "not a glTF 2.0 file Spillway can read: " +
+                                 (err.empty() ? std::string("tinygltf refused it") : err));
+        }
+    }
+
+    void checkExtensions() {
+        for (const std::string& e : model_.extensionsRequired)
+            if (!kHonoured.count(e))
+                fail("/extensionsRequired",
+                     "requires the extension " + e + ", which Spillway does not render");
+        for (const std::string& e : model_.extensionsUsed)
+            if (!kHonoured.count(e)) warn("uses the extension " + e + ", not rendered");
+    }
+
+    // The node's local transform: its matrix, or translation x rotation x scale.
+    glm::dmat4 localTransform(const tinygltf::Node& n, const std::string& at) const {
+        if (!n.matrix.empty()) {
+            if (n.matrix.size() != 16) fail(at + "/matrix", "a matrix has 16 numbers");
+            glm::dmat4 m;
+            for (int c = 0; c < 4; ++c)
+                for (int r = 0; r < 4; ++r)
+                    m[c][r] = n.matrix[size_t(4 * c + r)];
+            return finite(m, at + "/matrix");
+        }
+        glm::dmat4 m(1.0);
+        if (!n.translation.empty()) {
+            if (n.translation.size() != 3) fail(at + "/translation", "a translation has 3 numbers");
+            m = glm::translate(m, glm::dvec3(n.translation[0], n.translation[1], n.translation[2]));
+        }
+        if (!n.rotation.empty()) {
+            if (n.rotation.size() != 4) fail(at + "/rotation", "a rotation has 4 numbers");
+            // glTF's quaternions are (x, y, z, w); glm's constructor takes w first.
+            const glm::dquat q(n.rotation[3], n.rotation[0], n.rotation[1], n.rotation[2]);
+            const double len = glm::length(q);
+            if (!(len > 0.0) || !std::isfinite(len))
+                fail(at + "/rotation", "a rotation must be a non-zero quaternion");
+            m = m * glm::mat4_cast(q / len);
+        }
+        if (!n.scale.empty()) {
+            if (n.scale.size() != 3) fail(at + "/scale", "a scale has 3 numbers");
+            m = glm::scale(m, glm::dvec3(n.scale[0], n.scale[1], n.scale[2]));
+        }
+        return finite(m, at);
+    }
+    glm::dmat4 finite(const glm::dmat4& m, const std::string& at) const {
+        for (int c = 0; c < 4; ++c)
+            for (int r = 0; r < 4; ++r)
+                if (!std::isfinite(m[c][r])) fail(at, "the transform is not finite");
+        return m;
+    }
+
+    void visit(int index, const glm::dmat4& parent, const std::string& at, Pass pass, int depth) {
+        if (index < 0 || index >= int(model_.nodes.size()))
+            fail(at, "names node " + std::to_string(index) + " of " +
+                         std::to_string(model_.nodes.size()));
+        if (onPath_.count(index))
+            fail("/nodes/" + std::to_string(index),
+                 "the node graph is recursive: this node is its own ancestor");
+        if (depth > 1024) fail(at, "nodes nest more than 1024 deep");
+        const tinygltf::Node& n = model_.nodes[size_t(index)];
+        const std::string self = "/nodes/" + std::to_string(index);
+        const glm::dmat4 world = finite(parent * localTransform(n, self), self);
+        if (pass == Pass::Camera) {
+            if (n.camera >= 0 && !cameraFound_) readCamera(n.camera, world, self + "/camera");
+        } else {
+            if (n.mesh >= 0) readMesh(n.mesh, world, self + "/mesh");
+            readLight(n, world, self);
+            if (n.skin >= 0) warn("has skins: rendered in their bind pose");
+        }
+        onPath_.insert(index);
+        for (size_t c = 0; c < n.children.size(); ++c)
+            visit(n.children[c], world, self + "/children/" + std::to_string(c), pass, depth + 1);
+        onPath_.erase(index);
+    }
+
+    void readCamera(int index, const glm::dmat4& world, const std::string& at) {
+        if (index >= int(model_.cameras.size()))
+            fail(at, "names camera " + std::to_string(index) + " of " +
+                         std::to_string(model_.cameras.size()));
+        const tinygltf::Camera& c = model_.cameras[size_t(index)];
+        if (c.type != "perspective") {
+            warn("has an orthographic camera, not rendered: a camera framing the scene instead");
+            return;
+        }
+        const double yfov = c.perspective.yfov;
+        if (!(yfov > 1e-6 && yfov < M_PI * 0.999))
+            fail("/cameras/" + std::to_string(index) + "/perspective/yfov",
+                 "yfov must lie in (0, pi)");
+        const double aspect =
+            c.perspective.aspectRatio > 0.0 ? c.perspective.aspectRatio : kDefaultAspect;
+        placeCamera(world, yfov, aspect);
+        cameraFound_ = true;
+    }
+
+    // The camera at `world`'s origin, looking along its -Z with +Y up (scale taken out).
+    void placeCamera(const glm::dmat4& world, double yfov, double aspect) {
+        glm::dmat4 m(1.0);
+        for (int c = 0; c < 3; ++c) {
+            const glm::dvec3 axis(world[c]);
+            const double len = glm::length(axis);
+            if (!(len > 1e-30)) fail("", "the camera's node has a zero scale");
+            m[c] = glm::dvec4(axis / len, 0.0);
+        }
+        scene_.origin = glm::dvec3(world[3]);
+        scene_.camera = Camera{};
+        scene_.camera.cameraToWorld = mat4(m);
+        const double tanX = std::tan(0.5 * yfov) * aspect;
+        scene_.camera.fovDegrees = float(glm::degrees(2.0 * std::atan(tanX)));
+        if (!(*scene_.camera.fovDegrees < 179.9f))
+            fail("", "the camera's horizontal field of view reaches 180 degrees");
+        scene_.image.width = kDefaultWidth;
+        scene_.image.height = std::max(1, int(std::lround(kDefaultWidth / aspect)));
+    }
+
+    // Without a camera: one on the scene's +Z side looking at the centre of its bounds, far
+    // enough back that a 40-degree vertical field of view holds the bounding sphere.
+    void frameBounds() {
+        const glm::dvec3 lo = bounded_ ? lo_ : glm::dvec3(0.0), hi = bounded_ ? hi_ : lo;
+        const glm::dvec3 centre = 0.5 * (lo + hi);
+        const double radius = std::max(0.5 * glm::length(hi - lo), 1e-3);
+        const double yfov = glm::radians(40.0);
+        const double distance = 1.1 * radius / std::sin(0.5 * yfov);
+        glm::dmat4 world(1.0);
+        world[3] = glm::dvec4(centre + glm::dvec3(0.0, 0.0, distance), 1.0);
+        const glm::dvec3 shift = glm::dvec3(world[3]); // the origin moves: shift what was read
+        placeCamera(world, yfov, kDefaultAspect);
+        for (Mesh& m : scene_.meshes)
+            for (vec3& p : m.positions)
+                p = vec3(glm::dvec3(p) - shift);
+        for (PunctualLight& l : scene_.punctualLights)
+            l.position = vec3(glm::dvec3(l.position) - shift);
+        if (const std::string far = beyondReach(hi - glm::dvec3(world[3]), "the scene's bounds");
+            !far.empty())
+            fail("", far);
+        if (const std::string far = beyondReach(lo - glm::dvec3(world[3]), "the scene's bounds");
+            !far.empty())
+            fail("", far);
+    }
+    void include(const glm::dvec3& p) {
+        lo_ = bounded_ ? glm::min(lo_, p) : p;
+        hi_ = bounded_ ? glm::max(hi_, p) : p;
+        bounded_ = true;
+    }
+
+    // --- accessors -------------------------------------------------------------------------
+
+    // Accessor `index` as `count` elements of `components` doubles each (normalized integers
+    // mapped to [0, 1] or [-1, 1]); every byte it reads checked to lie inside its buffer.
+    std::vector<double> readAccessor(int index, int components, const std::string& at,
+                                     bool integersOnly = false) const {
+        if (index < 0 || index >= int(model_.accessors.size()))
+            fail(at, "names accessor " + std::to_string(index) + " of " +
+                         std::to_string(model_.accessors.size()));
+        const std::string self = "/accessors/" + std::to_string(index);
+        const tinygltf::Accessor& a = model_.accessors[size_t(index)];
+        if (a.sparse.isSparse) fail(self + "/sparse", "sparse accessors are not supported");
+        const int have = tinygltf::GetNumComponentsInType(uint32_t(a.type));
+        if (have != components)
+            fail(self + "/type", "has " + std::to_string(have) + " components where " +
+                                     std::to_string(components) + " are needed");
+        const int size = tinygltf::GetComponentSizeInBytes(uint32_t(a.componentType));
+        if (size <= 0) fail(self + "/componentType", "unknown component type");
+        const bool isFloat = a.componentType == TINYGLTF_COMPONENT_TYPE_FLOAT;
+        if (integersOnly && isFloat) fail(self + "/componentType", "indices must be integers");
+        std::vector<double> out(a.count * size_t(components), 0.0);
+        if (a.bufferView < 0) return out; // all zeros (the specification's rule)
+        if (a.bufferView >= int(model_.bufferViews.size()))
+            fail(self + "/bufferView", "names buffer view " + std::to_string(a.bufferView) +
+                                           " of " + std::to_string(model_.bufferViews.size()));
+        const tinygltf::BufferView& v = model_.bufferViews[size_t(a.bufferView)];
+        if (v.buffer < 0 || v.buffer >= int(model_.buffers.size()))
+            fail("/bufferViews/" + std::to_string(a.bufferView) + "/buffer", "names no buffer");
+        const std::vector<unsigned char>& data = model_.buffers[size_t(v.buffer)].data;
+        const size_t element = size_t(size) * size_t(components);
+        const size_t stride = v.byteStride ? v.byteStride : element;
+        if (stride < element)
+            fail("/bufferViews/" + std::to_string(a.bufferView) + "/byteStride",
+                 "is smaller than an element");
+        if (v.byteOffset > data.size() || v.byteLength > data.size() - v.byteOffset)
+            fail("/bufferViews/" + std::to_string(a.bufferView),
+                 "reaches past the end of its buffer");
+        const size_t room = a.byteOffset <= v.byteLength ? v.byteLength - a.byteOffset : 0;
+        if (a.byteOffset > v.byteLength ||
+            (a.count > 0 && (room < element || (a.count - 1) > (room - element) / stride)))
+            fail(self, "reaches past the end of its buffer view");
+        const unsigned char* base = data.data() + v.byteOffset + a.byteOffset;
+        for (size_t i = 0; i < a.count; ++i)
+            for (int k = 0; k < components; ++k)
+                out[i * size_t(components) + size_t(k)] =
+                    component(base + i * stride + size_t(k) * size_t(size), a);
+        return out;
+    }
+    static double component(const unsigned char* p, const tinygltf::Accessor& a) {
+        auto get = [&](auto type) {
+            decltype(type) x;
+            std::memcpy(&x, p, sizeof x);
+            return x;
+        };
+        const bool norm = a.normalized;
+        switch (a.componentType) {
+        case TINYGLTF_COMPONENT_TYPE_FLOAT:
+            return get(float{});
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE:
+            return norm ? get(uint8_t{}) / 255.0 : get(uint8_t{});
+        case TINYGLTF_COMPONENT_TYPE_BYTE:
+            return norm ? std::max(get(int8_t{}) / 127.0, -1.0) : get(int8_t{});
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT:
+            return norm ? get(uint16_t{}) / 65535.0 : get(uint16_t{});
+        case TINYGLTF_COMPONENT_TYPE_SHORT:
+            return norm ? std::max(get(int16_t{}) / 32767.0, -1.0) : get(int16_t{});
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT:
+            return get(uint32_t{});
+        case TINYGLTF_COMPONENT_TYPE_INT:
+            return get(int32_t{});
+        default:
+            return 0.0;
+        }
+    }
+
+    // --- meshes ----------------------------------------------------------------------------
+
+    void readMesh(int index, const glm::dmat4& world, const std::string& at) {
+        if (index >= int(model_.meshes.size()))
+            fail(at, "names mesh " + std::to_string(index) + " of " +
+                         std::to_string(model_.meshes.size()));
+        const tinygltf::Mesh& mesh = model_.meshes[size_t(index)];
+        for (size_t p = 0; p < mesh.primitives.size(); ++p)
+            readPrimitive(mesh.primitives[p], world,
+                          "/meshes/" + std::to_string(index) + "/primitives/" + std::to_string(p),
+                          mesh.name.empty() ? "mesh " + std::to_string(index) : mesh.name);
+    }
+
+    void readPrimitive(const tinygltf::Primitive& prim, const glm::dmat4& world,
+                       const std::string& at, const std::string& name) {
+        const int mode = prim.mode < 0 ? TINYGLTF_MODE_TRIANGLES : prim.mode;
+        if (mode != TINYGLTF_MODE_TRIANGLES && mode != TINYGLTF_MODE_TRIANGLE_STRIP &&
+            mode != TINYGLTF_MODE_TRIANGLE_FAN) {
+            warn("has points or lines (primitive mode " + std::to_string(mode) + "), not rendered");
+            return;
+        }
+        if (!prim.targets.empty()) warn("has morph targets: rendered without them");
+        const auto position = prim.attributes.find("POSITION");
+        if (position == prim.attributes.end()) fail(at + "/attributes", "has no POSITION");
+        const std::vector<double> pos =
+            readAccessor(position->second, 3, at + "/attributes/POSITION");
+        const size_t vertices = pos.size() / 3;
+        Mesh m;
+        m.name = path_ + ": " + name;
+        m.shader = shaderFor(prim.material, at + "/material");
+        m.positions.resize(vertices);
+        for (size_t i = 0; i < vertices; ++i) {
+            const glm::dvec3 local(pos[3 * i], pos[3 * i + 1], pos[3 * i + 2]);
+            const glm::dvec3 w = glm::dvec3(world * glm::dvec4(local, 1.0));
+            if (!std::isfinite(w.x) || !std::isfinite(w.y) || !std::isfinite(w.z))
+                fail("/accessors/" + std::to_string(position->second),
+                     "position " + std::to_string(i) + " is not finite");
+            include(w);
+            const glm::dvec3 rel = w - scene_.origin;
+            if (const std::string far = beyondReach(rel, "position " + std::to_string(i));
+                !far.empty())
+                fail("/accessors/" + std::to_string(position->second), far);
+            m.positions[i] = vec3(rel);
+        }
+        const glm::dmat3 normalMatrix = glm::inverseTranspose(glm::dmat3(world));
+        if (const auto n = prim.attributes.find("NORMAL"); n != prim.attributes.end()) {
+            const std::vector<double> nor = readAccessor(n->second, 3, at + "/attributes/NORMAL");
+            if (nor.size() != pos.size())
+                fail(at + "/attributes/NORMAL", "has another count than POSITION");
+            m.normals.resize(vertices);
+            for (size_t i = 0; i < vertices && !m.normals.empty(); ++i) {
+                const glm::dvec3 w =
+                    normalMatrix * glm::dvec3(nor[3 * i], nor[3 * i + 1], nor[3 * i + 2]);
+                const double len = glm::length(w);
+                if (!(len > 1e-30) || !std::isfinite(len)) {
+                    warn("has zero or non-finite normals: its faces' own normals used there");
+                    m.normals.clear();
+                } else {
+                    m.normals[i] = vec3(w / len);
+                }
+            }
+        }
+        if (const auto t = prim.attributes.find("TEXCOORD_0"); t != prim.attributes.end()) {
+            const std::vector<double> uv =
+                readAccessor(t->second, 2, at + "/attributes/TEXCOORD_0");
+            if (uv.size() != 2 * vertices)
+                fail(at + "/attributes/TEXCOORD_0", "has another count than POSITION");
+            m.uvs.resize(vertices);
+            for (size_t i = 0; i < vertices; ++i) {
+                // glTF's v runs down the image; Spillway's (OBJ's) up.
+                m.uvs[i] = vec2(float(uv[2 * i]), float(1.0 - uv[2 * i + 1]));
+                if (!std::isfinite(m.uvs[i].x) || !std::isfinite(m.uvs[i].y))
+                    fail("/accessors/" + std::to_string(t->second),
+                         "a texture coordinate is not finite");
+            }
+        }
+        std::vector<uint> indices;
+        if (prim.indices >= 0) {
+            for (double x : readAccessor(prim.indices, 1, at + "/indices", true)) {
+                if (!(x >= 0.0) || x >= double(vertices))
+                    fail("/accessors/" + std::to_string(prim.indices),
+                         "index " + std::to_string(uint64_t(std::max(x, 0.0))) +
+                             " is past the vertex count " + std::to_string(vertices));
+                indices.push_back(uint(x));
+            }
+        } else {
+            for (size_t i = 0; i < vertices; ++i)
+                indices.push_back(uint(i));
+        }
+        // A mirroring transform turns the winding: keep the front faces the file's.
+        const bool mirrored = glm::determinant(glm::dmat3(world)) < 0.0;
+        auto add = [&](uint a, uint b, uint c) {
+            if (mirrored) std::swap(b, c);
+            const vec3 e1 = m.positions[b] - m.positions[a], e2 = m.positions[c] - m.positions[a];
+            if (glm::length(glm::cross(e1, e2)) > 0.0f)
+                m.triangles.push_back(uvec3(a, b, c));
+            else
+                ++m.droppedTriangles;
+        };
+        if (mode == TINYGLTF_MODE_TRIANGLES) {
+            if (indices.size() % 3 != 0) fail(at + "/indices", "a triangle list needs 3n indices");
+            for (size_t i = 0; i + 2 < indices.size(); i += 3)
+                add(indices[i], indices[i + 1], indices[i + 2]);
+        } else if (mode == TINYGLTF_MODE_TRIANGLE_STRIP) {
+            for (size_t i = 0; i + 2 < indices.size(); ++i)
+                i % 2 ? add(indices[i + 1], indices[i], indices[i + 2])
+                      : add(indices[i], indices[i + 1], indices[i + 2]);
+        } else {
+            for (size_t i = 1; i + 1 < indices.size(); ++i)
+                add(indices[0], indices[i], indices[i + 1]);
+        }
+        if (m.triangles.empty()) return;
+        if (scene_.meshes.size() >= size_t(kMaxObjects))
+            fail(at, "more than " + std::to_string(kMaxObjects) + " primitives");
+        scene_.meshes.push_back(std::move(m));
+    }
+
+    // --- materials -------------------------------------------------------------------------
+
+    // glTF's default material: white, metallic 1, roughness 1.
+    static Shader defaultShader() {
+        Shader s;
+        s.typeName = "MetallicRoughness";
+        s.params.model = kModelMetallicRoughness;
+        s.params.colour = vec3(1.0f);
+        s.params.reflectance = 1.0f;
+        s.params.metallic = 1.0f;
+        s.params.alpha = gltfAlpha(1.0f);
+        s.params.ior = 1.5f;
+        return s;
+    }
+
+    int shaderFor(int material, const std::string& at) {
+        if (material >= int(model_.materials.size()))
+            fail(at, "names material " + std::to_string(material) + " of " +
+                         std::to_string(model_.materials.size()));
+        // Materials 0 .. n-1 are shaders 0 .. n-1, made on first use; the default one is n.
+        const size_t count = model_.materials.size();
+        if (shaderOf_.empty()) shaderOf_.assign(count + 1, -1);
+        const size_t key = material < 0 ? count : size_t(material);
+        if (shaderOf_[key] < 0) {
+            if (scene_.shaders.size() >= size_t(kMaxShaders))
+                fail(at, "more than " + std::to_string(kMaxShaders) + " materials");
+            shaderOf_[key] = int(scene_.shaders.size());
+            scene_.shaders.push_back(material < 0 ? defaultShader() : readMaterial(material));
+        }
+        return shaderOf_[key];
+    }
+
+    Shader readMaterial(int index) {
+        const tinygltf::Material& mat = model_.materials[size_t(index)];
+        const std::string at = "/materials/" + std::to_string(index);
+        const std::string name =
+            "material " + std::to_string(index) + (mat.name.empty() ? "" : " (" + mat.name + ")");
+        Shader s = defaultShader();
+        const tinygltf::PbrMetallicRoughness& pbr = mat.pbrMetallicRoughness;
+        if (pbr.baseColorFactor.size() != 4)
+            fail(at + "/pbrMetallicRoughness/baseColorFactor", "needs 4 numbers");
+        for (int k = 0; k < 3; ++k)
+            s.params.colour[k] =
+                unit(pbr.baseColorFactor[size_t(k)], at + "/pbrMetallicRoughness/baseColorFactor");
+        s.params.metallic =
+            float(unit(pbr.metallicFactor, at + "/pbrMetallicRoughness/metallicFactor"));
+        s.params.alpha = gltfAlpha(
+            float(unit(pbr.roughnessFactor, at + "/pbrMetallicRoughness/roughnessFactor")));
+        if (pbr.baseColorTexture.index >= 0)
+            baseColourTexture(pbr.baseColorTexture.index, s, at, name);
+        if (pbr.metallicRoughnessTexture.index >= 0)
+            warn(name + ": its metallicRoughnessTexture is not rendered yet (its factors are)");
+        if (mat.normalTexture.index >= 0)
+            warn(name + ": its normalTexture is not rendered yet (the mesh's normals are)");
+        if (mat.occlusionTexture.index >= 0)
+            warn(name + ": its occlusionTexture is ignored (a path tracer finds occlusion itself)");
+        if (mat.emissiveTexture.index >= 0)
+            warn(name + ": its emissiveTexture is not rendered yet (its emissiveFactor is)");
+        if (mat.alphaMode == "BLEND")
+            warn(name + ": alphaMode BLEND is not rendered (it is drawn opaque)");
+        else if (mat.alphaMode == "MASK")
+            warn(name + ": alphaMode MASK is not rendered yet (it is drawn opaque)");
+        double strength = 1.0;
+        if (const auto e = mat.extensions.find("KHR_materials_emissive_strength");
+            e != mat.extensions.end() && e->second.Has("emissiveStrength")) {
+            const tinygltf::Value& v = e->second.Get("emissiveStrength");
+            strength = v.IsNumber() ? v.GetNumberAsDouble() : -1.0;
+            if (!(strength >= 0.0) || !std::isfinite(strength))
+                fail(at + "/extensions/KHR_materials_emissive_strength/emissiveStrength",
+                     "must be a non-negative number");
+        }
+        if (mat.emissiveFactor.size() != 3) fail(at + "/emissiveFactor", "needs 3 numbers");
+        for (int k = 0; k < 3; ++k) {
+            const double e = unit(mat.emissiveFactor[size_t(k)], at + "/emissiveFactor") * strength;
+            if (!(e <= kMaxRadiance))
+                fail(at + "/extensions/KHR_materials_emissive_strength",
+                     "emission beyond " + std::to_string(kMaxRadiance));
+            s.params.emission[k] = float(e);
+        }
+        if (mat.doubleSided) s.params.flags |= kShaderTwoSided;
+        return s;
+    }
+
+    double unit(double x, const std::string& at) const {
+        if (!(x >= 0.0 && x <= 1.0)) fail(at, "must lie in [0, 1]");
+        return x;
+    }
+
+    // The base colour's image, times the factor: Layered(upper: image, lower: 0, mask: factor).
+    void baseColourTexture(int index, Shader& s, const std::string& at, const std::string& name) {
+        const std::string where = at + "/pbrMetallicRoughness/baseColorTexture";
+        if (index >= int(model_.textures.size()))
+            fail(where, "names texture " + std::to_string(index) + " of " +
+                            std::to_string(model_.textures.size()));
+        const int source = model_.textures[size_t(index)].source;
+        if (source < 0 || source >= int(model_.images.size()))
+            fail("/textures/" + std::to_string(index) + "/source", "names no image");
+        const tinygltf::Image& image = model_.images[size_t(source)];
+        if (image.uri.empty() || image.uri.rfind("data:", 0) == 0) {
+            warn(name + ": its baseColorTexture is embedded in the file, not rendered yet (its "
+                        "baseColorFactor is)");
+            return;
+        }
+        const std::string file =
+            fs::absolute(dir_ / decodeUri(image.uri)).lexically_normal().string();
+        auto in = OIIO::ImageInput::open(file);
+        if (!in)
+            fail("/images/" + std::to_string(source) + "/uri",
+                 "'" + file + "' is not an image OpenImageIO can read");
+        in->close();
+        Texture picture{};
+        picture.type = TextureType::Standard;
+        picture.path = file;
+        Texture zero{};
+        zero.colour = vec3(0.0f);
+        Texture factor{};
+        factor.colour = s.params.colour;
+        const int base = int(scene_.textures.size());
+        scene_.textures.push_back(picture);
+        scene_.textures.push_back(zero);
+        scene_.textures.push_back(factor);
+        Texture layered{};
+        layered.type = TextureType::Layered;
+        layered.upper = base, layered.lower = base + 1, layered.mask = base + 2;
+        scene_.textures.push_back(layered);
+        s.texture = base + 3;
+        s.params.flags |= kShaderTextured;
+    }
+
+    static std::string decodeUri(const std::string& uri) {
+        std::string out;
+        for (size_t i = 0; i < uri.size(); ++i) {
+            if (uri[i] == '%' && i + 2 < uri.size() && std::isxdigit(uri[i + 1]) &&
+                std::isxdigit(uri[i + 2])) {
+                out += char(std::stoi(uri.substr(i + 1, 2), nullptr, 16));
+                i += 2;
+            } else {
+                out += uri[i];
+            }
+        }
+        return out;
+    }
+
+    // --- lights ----------------------------------------------------------------------------
+
+    void readLight(const tinygltf::Node& n, const glm::dmat4& world, const std::string& at) {
+        const auto ext = n.extensions.find("KHR_lights_punctual");
+        if (ext == n.extensions.end()) return;
+        const tinygltf::Value& v = ext->second.Get("light");
+        const std::string where = at + "/extensions/KHR_lights_punctual/light";
+        if (!v.IsInt() || v.GetNumberAsInt() < 0 || v.GetNumberAsInt() >= int(model_.lights.size()))
+            fail(where, "names no light of the file's KHR_lights_punctual lights");
+        const tinygltf::Light& l = model_.lights[size_t(v.GetNumberAsInt())];
+        vec3 colour(1.0f);
+        if (!l.color.empty()) {
+            if (l.color.size() != 3) fail(where, "a light's color has 3 numbers");
+            for (int k = 0; k < 3; ++k)
+                colour[k] = float(unit(l.color[size_t(k)], where + "/color"));
+        }
+        if (!(l.intensity >= 0.0) || !(l.intensity / kLumensPerWatt <= kMaxRadiance))
+            fail(where,
+                 "a light's intensity must lie in [0, " + std::to_string(kMaxRadiance) + "]");
+        PunctualLight p;
+        p.intensity = colour * float(l.intensity / kLumensPerWatt);
+        if (l.type == "point") {
+            p.kind = kEmitterPoint;
+            const glm::dvec3 rel = glm::dvec3(world[3]) - scene_.origin;
+            if (const std::string far = beyondReach(rel, "a point light"); !far.empty())
+                fail(at, far);
+            p.position = vec3(rel);
+            include(glm::dvec3(world[3]));
+        } else if (l.type == "directional") {
+            p.kind = kEmitterDirectional;
+            const glm::dvec3 d = -glm::dvec3(world[2]); // the light shines along its -Z
+            const double len = glm::length(d);
+            if (!(len > 1e-30)) fail(at, "a directional light's node has a zero scale");
+            p.direction = vec3(d / len);
+        } else {
+            warn("has " + l.type + " lights, not rendered yet");
+            return;
+        }
+        if (l.range > 0.0) warn("has lights with a range, rendered without it (as physics has it)");
+        scene_.punctualLights.push_back(p);
+    }
+
+    void warnUnrendered() {
+        if (!model_.animations.empty()) warn("has animations: rendered at rest");
+        if (model_.scenes.size() > 1) warn("has more than one scene: the default one rendered");
+    }
+
+    std::string path_;
+    fs::path dir_;
+    Scene& scene_;
+    tinygltf::Model model_;
+    std::set<std::string> warned_;
+    std::set<int> onPath_;
+    std::vector<int> shaderOf_;
+    glm::dvec3 lo_{0.0}, hi_{0.0}; // the bounds of every position and point light read
+    bool bounded_ = false;
+    bool cameraFound_ = false;
+};
+
+} // namespace
+
+bool isGltfPath(const std::string& path) {
+    const std::string ext = lower(fs::path(path).extension().string());
+    return ext == ".gltf" || ext == ".glb";
+}
+
+Scene loadGltfScene(const std::string& path) {
+    Scene scene;
+    scene.file = path;
+    GltfReader(path, scene).read();
+    return scene;
+}
+
+} // namespace spw

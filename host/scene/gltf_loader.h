@@ -1,0 +1,24 @@
+// glTF 2.0 files as scenes (docs/scene-format.md, "glTF files"): `.gltf` (JSON, with external or
+// embedded buffers) and `.glb` (binary), read with tinygltf. The default scene's meshes become
+// triangle meshes with MetallicRoughness shaders (shared/gltf.h), one per material; its first
+// perspective camera is the camera (else one that frames the scene's bounds); its
+// KHR_lights_punctual point and directional lights and its emissive materials light it (else a
+// uniform environment of radiance 1). What the file holds that Spillway does not render is listed
+// in Scene::warnings, once each; an extension the file requires that Spillway cannot honour is an
+// error.
+#pragma once
+
+#include "host/scene/scene.h"
+
+#include <string>
+
+namespace spw {
+
+// Whether `path` names a glTF file (by its extension: .gltf or .glb, any case).
+bool isGltfPath(const std::string& path);
+
+// Loads a glTF file as a whole scene. Throws SceneError naming the file, and where in it (a JSON
+// pointer such as /meshes/0/primitives/1) the problem is.
+Scene loadGltfScene(const std::string& path);
+
+} // namespace spw

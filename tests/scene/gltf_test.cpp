@@ -1,0 +1,364 @@
+// glTF 2.0 files (host/scene/gltf_loader.h), written by the tests: `.gltf` with embedded and
+// external buffers and `.glb`; every index and accessor component type, strides, normalized
+// texture coordinates; node hierarchies of matrices and TRS; cameras, lights, emissive
+// materials and what is not rendered (warnings, once); malformed files, each a SceneError
+// naming the file and where in it; and rendering on every backend.
+#include "host/scene/gltf_loader.h"
+#include "test_util.h"
+
+#include "shared/gltf.h"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <cstring>
+#include <fstream>
+
+namespace spw::test {
+namespace {
+
+using nlohmann::json;
+
+// A glTF document built in memory: one buffer of bytes, accessors appended to it.
+struct GltfBuilder {
+    json doc = {{"asset", {{"version", "2.0"}}}};
+    std::string bytes;
+
+    // An accessor over `data` (each value written as `componentType`) of glTF type `type`.
+    template <class T>
+    int accessor(const std::vector<T>& data, int componentType, const std::string& type,
+                 bool normalized = false, size_t stride = 0) {
+        while (bytes.size() % 4 != 0)
+            bytes.push_back('\0');
+        const size_t offset = bytes.size();
+        const int components = type == "SCALAR" ? 1 : type == "VEC2" ? 2 : 3;
+        const size_t element = sizeof(T) * size_t(components);
+        const size_t step = stride ? stride : element;
+        const size_t count = data.size() / size_t(components);
+        bytes.resize(offset + step * count, '\x7f'); // the padding between strided elements
+        for (size_t i = 0; i < count; ++i)
+            std::memcpy(&bytes[offset + i * step], &data[i * size_t(components)], element);
+        json view = {{"buffer", 0}, {"byteOffset", offset}, {"byteLength", step * count}};
+        if (stride) view["byteStride"] = stride;
+        doc["bufferViews"].push_back(view);
+        json a = {{"bufferView", doc["bufferViews"].size() - 1},
+                  {"componentType", componentType},
+                  {"count", count},
+                  {"type", type}};
+        if (normalized) a["normalized"] = true;
+        if (type == "VEC3" && componentType == 5126) { // POSITION needs its bounds
+            json lo = json::array(), hi = json::array();
+            for (int k = 0; k < 3; ++k) {
+                float l = 1e30f, h = -1e30f;
+                for (size_t i = 0; i < count; ++i)
+                    l = std::min(l, float(data[3 * i + size_t(k)])),
+                    h = std::max(h, float(data[3 * i + size_t(k)]));
+                lo.push_back(l), hi.push_back(h);
+            }
+            a["min"] = lo, a["max"] = hi;
+        }
+        doc["accessors"].push_back(a);
+        return int(doc["accessors"].size()) - 1;
+    }
+
+    // A unit quad in z = 0 facing +Z (two triangles), with normals and texture coordinates.
+    json quad(int material = -1, int indexType = 5123) {
+        const int pos = accessor<float>({0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0}, 5126, "VEC3");
+        const int nor = accessor<float>({0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1}, 5126, "VEC3");
+        const int uv = accessor<float>({0, 1, 1, 1, 1, 0, 0, 0}, 5126, "VEC2");
+        int idx;
+        if (indexType == 5121)
+            idx = accessor<uint8_t>({0, 1, 2, 0, 2, 3}, 5121, "SCALAR");
+        else if (indexType == 5125)
+            idx = accessor<uint32_t>({0, 1, 2, 0, 2, 3}, 5125, "SCALAR");
+        else
+            idx = accessor<uint16_t>({0, 1, 2, 0, 2, 3}, 5123, "SCALAR");
+        json prim = {{"attributes", {{"POSITION", pos}, {"NORMAL", nor}, {"TEXCOORD_0", uv}}},
+                     {"indices", idx}};
+        if (material >= 0) prim["material"] = material;
+        return prim;
+    }
+    int mesh(const json& primitive) {
+        doc["meshes"].push_back({{"primitives", json::array({primitive})}});
+        return int(doc["meshes"].size()) - 1;
+    }
+    int node(json n) {
+        doc["nodes"].push_back(std::move(n));
+        return int(doc["nodes"].size()) - 1;
+    }
+    void scene(const std::vector<int>& roots) {
+        doc["scenes"] = json::array({{{"nodes", roots}}});
+        doc["scene"] = 0;
+    }
+
+    static std::string base64(const std::string& in) {
+        static const char* k = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+        std::string out;
+        for (size_t i = 0; i < in.size(); i += 3) {
+            const uint32_t b = uint32_t(uint8_t(in[i])) << 16 |
+                               (i + 1 < in.size() ? uint32_t(uint8_t(in[i + 1])) << 8 : 0u) |
+                               (i + 2 < in.size() ? uint32_t(uint8_t(in[i + 2])) : 0u);
+            out += k[b >> 18 & 63];
+            out += k[b >> 12 & 63];
+            out += i + 1 < in.size() ? k[b >> 6 & 63] : '=';
+            out += i + 2 < in.size() ? k[b & 63] : '=';
+        }
+        return out;
+    }
+
+    // The document as a .gltf with its buffer embedded (a data: URI).
+    std::string embedded(const TempDir& dir, const std::string& name) {
+        json d = doc;
+        d["buffers"] =
+            json::array({{{"byteLength", bytes.size()},
+                          {"uri", "data:application/octet-stream;base64," + base64(bytes)}}});
+        return dir.write(name, d.dump());
+    }
+    // As a .gltf beside its buffer file.
+    std::string external(const TempDir& dir, const std::string& name) {
+        json d = doc;
+        d["buffers"] = json::array({{{"byteLength", bytes.size()}, {"uri", name + ".bin"}}});
+        dir.write(name + ".bin", bytes);
+        return dir.write(name, d.dump());
+    }
+    // As a .glb: the JSON chunk and the binary chunk, each padded to 4 bytes.
+    std::string binary(const TempDir& dir, const std::string& name) {
+        json d = doc;
+        d["buffers"] = json::array({{{"byteLength", bytes.size()}}});
+        std::string text = d.dump(), bin = bytes;
+        while (text.size() % 4)
+            text += ' ';
+        while (bin.size() % 4)
+            bin += '\0';
+        std::string out;
+        auto u32 = [&](uint32_t v) { out.append(reinterpret_cast<const char*>(&v), 4); };
+        u32(0x46546C67u), u32(2u), u32(uint32_t(12 + 8 + text.size() + 8 + bin.size()));
+        u32(uint32_t(text.size())), u32(0x4E4F534Au), out += text;
+        u32(uint32_t(bin.size())), u32(0x004E4942u), out += bin;
+        return dir.write(name, out);
+    }
+};
+
+// A material: base colour, metallic, roughness, emission.
+json material(vec3 colour, float metallic, float roughness, vec3 emission = vec3(0.0f)) {
+    return {{"pbrMetallicRoughness",
+             {{"baseColorFactor", {colour.x, colour.y, colour.z, 1.0}},
+              {"metallicFactor", metallic},
+              {"roughnessFactor", roughness}}},
+            {"emissiveFactor", {emission.x, emission.y, emission.z}}};
+}
+
+// A quad 4 units in front of a camera at (0, 0, 5) looking down -Z, scaled 2x by its parent,
+// its child moved by a matrix; a second material on the child.
+GltfBuilder cameraAndQuads() {
+    GltfBuilder b;
+    b.doc["materials"] = json::array(
+        {material(vec3(0.8f, 0.5f, 0.25f), 0.25f, 0.5f), material(vec3(1.0f), 1.0f, 0.0f)});
+    b.doc["cameras"] =
+        json::array({{{"type", "perspective"},
+                      {"perspective", {{"yfov", 0.8}, {"aspectRatio", 2.0}, {"znear", 0.1}}}}});
+    const int quadA = b.mesh(b.quad(0, 5121));
+    const int quadB = b.mesh(b.quad(1, 5125));
+    const int child =
+        b.node({{"mesh", quadB}, {"matrix", {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 3, 0, 0, 1}}});
+    const int parent = b.node(
+        {{"mesh", quadA}, {"scale", {2, 2, 2}}, {"translation", {0, 0, 1}}, {"children", {child}}});
+    const int camera = b.node({{"camera", 0}, {"translation", {0, 0, 5}}});
+    b.scene({parent, camera});
+    return b;
+}
+
+TEST(Gltf, MeshesTransformsCameraAndMaterialsLoad) {
+    TempDir dir;
+    GltfBuilder b = cameraAndQuads();
+    const Scene s = loadScene(b.embedded(dir, "quads.gltf"));
+    EXPECT_EQ(s.origin, glm::dvec3(0, 0, 5));
+    ASSERT_TRUE(s.camera.fovDegrees);
+    EXPECT_NEAR(std::tan(glm::radians(*s.camera.fovDegrees) / 2), std::tan(0.4) * 2.0, 1e-5);
+    EXPECT_EQ(s.image.width, 640);
+    EXPECT_EQ(s.image.height, 320);
+    ASSERT_EQ(s.meshes.size(), 2u);
+    ASSERT_EQ(s.objectCount, 2);
+    // Parent: scale 2, then up 1 in z; camera-relative: z - 5.
+    EXPECT_EQ(s.meshes[0].positions[2], vec3(2, 2, -4));
+    // Child: its matrix moves it 3 along x, inside the parent's scale: x = 2 (1 + 3).
+    EXPECT_EQ(s.meshes[1].positions[1], vec3(8, 0, -4));
+    EXPECT_EQ(s.meshes[0].normals[0], vec3(0, 0, 1));
+    EXPECT_EQ(s.meshes[0].uvs[0], vec2(0, 0)); // glTF's v = 1 is the image's bottom
+    EXPECT_EQ(s.meshes[0].triangles.size(), 2u);
+    ASSERT_EQ(s.shaders.size(), 2u);
+    const ShaderParams& a = s.shaders[size_t(s.meshes[0].shader)].params;
+    EXPECT_EQ(a.model, kModelMetallicRoughness);
+    EXPECT_EQ(a.colour, vec3(0.8f, 0.5f, 0.25f));
+    EXPECT_EQ(a.metallic, 0.25f);
+    EXPECT_EQ(a.alpha, 0.25f);
+    EXPECT_EQ(s.shaders[size_t(s.meshes[1].shader)].params.alpha, kGltfMinAlpha);
+    // No light and no emission: a uniform environment of radiance 1.
+    ASSERT_TRUE(s.environment);
+    EXPECT_EQ(s.environment->radiance, vec3(1.0f));
+    EXPECT_TRUE(s.warnings.empty());
+}
+
+// The same document embedded, beside an external buffer and as a .glb: the same scene.
+TEST(Gltf, EmbeddedExternalAndBinaryFilesAreTheSameScene) {
+    TempDir dir;
+    GltfBuilder b = cameraAndQuads();
+    const Scene e = loadScene(b.embedded(dir, "a.gltf"));
+    for (const std::string& path : {b.external(dir, "b.gltf"), b.binary(dir, "c.glb")}) {
+        const Scene s = loadScene(path);
+        ASSERT_EQ(s.meshes.size(), e.meshes.size()) << path;
+        for (size_t m = 0; m < s.meshes.size(); ++m) {
+            EXPECT_EQ(s.meshes[m].positions, e.meshes[m].positions) << path;
+            EXPECT_EQ(s.meshes[m].triangles, e.meshes[m].triangles) << path;
+        }
+    }
+}
+
+// Every index type, and texture coordinates as normalized integers in an interleaved view.
+TEST(Gltf, EveryIndexAndComponentTypeReads) {
+    TempDir dir;
+    for (int indexType : {5121, 5123, 5125})
+        for (int uvType : {5126, 5121, 5123}) {
+            GltfBuilder b;
+            json prim = b.quad(-1, indexType);
+            if (uvType == 5121)
+                prim["attributes"]["TEXCOORD_0"] =
+                    b.accessor<uint8_t>({0, 255, 255, 255, 255, 0, 0, 0}, 5121, "VEC2", true, 4);
+            if (uvType == 5123)
+                prim["attributes"]["TEXCOORD_0"] = b.accessor<uint16_t>(
+                    {0, 65535, 65535, 65535, 65535, 0, 0, 0}, 5123, "VEC2", true, 8);
+            b.scene({b.node({{"mesh", b.mesh(prim)}})});
+            const Scene s = loadScene(b.embedded(dir, "t.gltf"));
+            ASSERT_EQ(s.meshes.size(), 1u);
+            EXPECT_EQ(s.meshes[0].triangles[1], uvec3(0, 2, 3)) << indexType;
+            EXPECT_EQ(s.meshes[0].uvs[1], vec2(1, 0)) << uvType;
+            EXPECT_EQ(s.meshes[0].uvs[2], vec2(1, 1)) << uvType;
+        }
+}
+
+TEST(Gltf, LightsEmissionAndWhatIsNotRenderedIsWarnedOnce) {
+    TempDir dir;
+    GltfBuilder b;
+    json emissive = material(vec3(0.5f), 0.0f, 1.0f, vec3(1.0f, 0.5f, 0.25f));
+    emissive["extensions"]["KHR_materials_emissive_strength"]["emissiveStrength"] = 4.0;
+    emissive["alphaMode"] = "BLEND";
+    b.doc["materials"] = json::array({emissive});
+    b.doc["extensionsUsed"] = {"KHR_lights_punctual", "KHR_materials_emissive_strength",
+                               "EXT_unknown"};
+    b.doc["extensions"]["KHR_lights_punctual"]["lights"] =
+        json::array({{{"type", "point"}, {"intensity", 683.0}, {"color", {1.0, 0.5, 0.0}}},
+                     {{"type", "directional"}, {"intensity", 1366.0}},
+                     {{"type", "spot"}, {"intensity", 1.0}, {"spot", {{"outerConeAngle", 0.5}}}}});
+    const int mesh = b.mesh(b.quad(0));
+    b.scene({b.node({{"mesh", mesh}}), b.node({{"mesh", mesh}, {"translation", {0, 0, -2}}}),
+             b.node({{"translation", {1, 2, 3}},
+                     {"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}}),
+             b.node({{"rotation", {-0.7071068, 0, 0, 0.7071068}},
+                     {"extensions", {{"KHR_lights_punctual", {{"light", 1}}}}}}),
+             b.node({{"extensions", {{"KHR_lights_punctual", {{"light", 2}}}}}})});
+    b.doc["animations"] = json::array({{{"channels", json::array()}, {"samplers", json::array()}}});
+    const Scene s = loadScene(b.embedded(dir, "lit.gltf"));
+    EXPECT_EQ(s.shaders[0].params.emission, vec3(4.0f, 2.0f, 1.0f));
+    ASSERT_EQ(s.punctualLights.size(), 2u);
+    EXPECT_EQ(s.punctualLights[0].kind, kEmitterPoint);
+    EXPECT_EQ(s.punctualLights[0].intensity, vec3(1.0f, 0.5f, 0.0f)); // 683 cd: 1 W/sr
+    EXPECT_EQ(s.punctualLights[1].kind, kEmitterDirectional);
+    EXPECT_NEAR(s.punctualLights[1].direction.y, -1.0f, 1e-6f); // -Z turned down
+    EXPECT_EQ(s.punctualLights[1].intensity, vec3(2.0f));
+    EXPECT_FALSE(s.environment); // lit by its lights
+    std::string all;
+    for (const std::string& w : s.warnings)
+        all += w + "\n";
+    for (const char* what : {"EXT_unknown", "spot", "BLEND", "animations"})
+        EXPECT_NE(all.find(what), std::string::npos) << what << " not in:\n" << all;
+    EXPECT_EQ(s.warnings.size(), 4u) << all; // the two meshes' material warned once
+}
+
+// Each malformed file: a SceneError naming the file and, where it helps, the JSON pointer.
+TEST(Gltf, MalformedFilesAreErrorsNamingTheFileAndWhere) {
+    TempDir dir;
+    auto expectError = [&](const std::string& path, const std::string& part) {
+        try {
+            loadScene(path);
+            ADD_FAILURE() << path << ": loaded";
+        } catch (const SceneError& e) {
+            const std::string what = e.what();
+            EXPECT_EQ(what.rfind(path + ": ", 0), 0u) << what;
+            EXPECT_NE(what.find(part), std::string::npos) << what;
+        }
+    };
+    expectError(dir.write("bad.gltf", "{\"asset\": {\"version\": \"2.0\"}, \"nodes\": ["),
+                "not a glTF 2.0 file");
+    {
+        GltfBuilder b;
+        json prim = b.quad();
+        b.doc["accessors"][size_t(prim["indices"])]["count"] = 600;
+        b.scene({b.node({{"mesh", b.mesh(prim)}})});
+        expectError(b.embedded(dir, "range.gltf"), "past the end");
+    }
+    {
+        GltfBuilder b;
+        json prim = b.quad();
+        prim["indices"] = b.accessor<uint16_t>({0, 1, 7}, 5123, "SCALAR");
+        b.scene({b.node({{"mesh", b.mesh(prim)}})});
+        expectError(b.embedded(dir, "index.gltf"), "index 7 is past the vertex count 4");
+    }
+    {
+        GltfBuilder b;
+        const int mesh = b.mesh(b.quad());
+        b.node({{"mesh", mesh}, {"children", {1}}});
+        b.node({{"children", {0}}});
+        b.scene({0});
+        expectError(b.embedded(dir, "loop.gltf"), "recursive");
+    }
+    {
+        GltfBuilder b;
+        const float nan = std::numeric_limits<float>::quiet_NaN();
+        json prim = b.quad();
+        prim["attributes"]["POSITION"] = b.accessor<float>(
+            {0, 0, 0, 1, 0, 0, 1, nan, 0, 0, std::numeric_limits<float>::infinity(), 0}, 5126,
+            "VEC3");
+        b.doc["accessors"].back()["min"] = {0, 0, 0};
+        b.doc["accessors"].back()["max"] = {1, 1, 0};
+        b.scene({b.node({{"mesh", b.mesh(prim)}})});
+        expectError(b.embedded(dir, "nan.gltf"), "is not finite");
+    }
+    {
+        GltfBuilder b;
+        b.scene({b.node({{"mesh", b.mesh(b.quad())}})});
+        const std::string path = b.external(dir, "missing.gltf");
+        std::filesystem::remove(path + ".bin");
+        expectError(path, "missing.gltf.bin");
+    }
+    {
+        GltfBuilder b;
+        b.doc["extensionsRequired"] = {"KHR_draco_mesh_compression"};
+        b.doc["extensionsUsed"] = {"KHR_draco_mesh_compression"};
+        b.scene({b.node({{"mesh", b.mesh(b.quad())}})});
+        expectError(b.embedded(dir, "draco.gltf"), "/extensionsRequired");
+    }
+}
+
+// `spillway render model.glb` on every backend: an image, the same on the cpu and reference
+// backends to the bit (full-precision rays), and bad files exit 2 leaving nothing behind.
+TEST(Gltf, EveryBackendRendersAFileDirectly) {
+    TempDir dir;
+    GltfBuilder b = cameraAndQuads();
+    const std::string glb = b.binary(dir, "model.glb");
+    for (const std::string& backend : backendsUnderTest()) {
+        const std::string out = dir.file(backend + ".exr");
+        const CommandResult r =
+            runSpillway("render " + glb + " --backend " + backend +
+                        " --spp 4 --width 32 --height 16 -o " + out + " --quiet");
+        EXPECT_EQ(r.status, 0) << backend << ": " << r.output;
+        EXPECT_TRUE(std::filesystem::exists(out)) << backend;
+    }
+    const std::string bad = dir.write("bad.glb", "glTF nonsense");
+    const CommandResult r = runSpillway("render " + bad + " -o " + dir.file("bad.exr"));
+    EXPECT_EQ(r.status, 2) << r.output;
+    EXPECT_NE(r.output.find(bad + ": "), std::string::npos) << r.output;
+    EXPECT_FALSE(std::filesystem::exists(dir.file("bad.exr")));
+}
+
+} // namespace
+} // namespace spw::test
