@@ -86,7 +86,8 @@ TEST(MetallicRoughness, WhiteFurnaceAndTheNarrowLobeLimits) {
             const SamplingReport r = testSampling(m, lobes(m), 50000, 21);
             EXPECT_LE(r.fcosIntegral, 1.0 + 1e-3)
                 << "metallic " << metallic << ", roughness " << roughness;
-            EXPECT_GT(r.fcosIntegral, 0.3) << "metallic " << metallic << ", roughness " << roughness;
+            EXPECT_GT(r.fcosIntegral, 0.3)
+                << "metallic " << metallic << ", roughness " << roughness;
         }
     BsdfUnderTest metal = metallicRoughness(1.0f, 0.0f, 0.0);
     metal.albedo = vec3(1.0f);
