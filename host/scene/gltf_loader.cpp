@@ -54,7 +54,29 @@ class GltfReader {
     GltfReader(const std::string& path, Scene& scene)
         : path_(path), dir_(fs::path(path).parent_path()), scene_(scene) {}
 
-    void read() {
+    // The whole file as the scene: its camera (or one framing it), its lights (or a uniform
+    // environment).
+    void readScene() {
+        read(glm::dmat4(1.0), true);
+        if (!cameraFound_) frameBounds();
+        scene_.objectCount = int(scene_.meshes.size());
+        bool emissive = !scene_.punctualLights.empty();
+        for (const Mesh& m : scene_.meshes)
+            emissive = emissive || scene_.shaders[size_t(m.shader)].params.emission != vec3(0.0f);
+        if (!emissive) scene_.environment = Environment{}; // radiance 1 from everywhere
+        if (scene_.shaders.empty()) scene_.shaders.push_back(defaultShader());
+    }
+
+    // The file's meshes and lights placed by `transform` into a scene whose camera is set;
+    // every mesh takes `shader` where it is >= 0, else the file's materials, appended.
+    void readObject(const glm::dmat4& transform, int shader) {
+        shaderOverride_ = shader;
+        read(transform, false);
+        if (cameraSeen_) warn("its cameras are not used: the scene has its own");
+    }
+
+  private:
+    void read(const glm::dmat4& transform, bool takesCamera) {
         parse();
         checkExtensions();
         const int sceneIndex = model_.defaultScene >= 0 ? model_.defaultScene : 0;
@@ -65,25 +87,16 @@ class GltfReader {
         const tinygltf::Scene& s = model_.scenes[size_t(sceneIndex)];
         // Two passes over the node graph: the camera first (the world is camera-relative), then
         // the meshes and lights, placed relative to it.
-        for (size_t i = 0; i < s.nodes.size(); ++i)
-            visit(s.nodes[i], glm::dmat4(1.0),
-                  "/scenes/" + std::to_string(sceneIndex) + "/nodes/" + std::to_string(i),
-                  Pass::Camera, 0);
-        for (size_t i = 0; i < s.nodes.size(); ++i)
-            visit(s.nodes[i], glm::dmat4(1.0),
-                  "/scenes/" + std::to_string(sceneIndex) + "/nodes/" + std::to_string(i),
-                  Pass::Geometry, 0);
-        if (!cameraFound_) frameBounds();
+        for (Pass pass : {Pass::Camera, Pass::Geometry}) {
+            if (pass == Pass::Camera && !takesCamera) continue;
+            for (size_t i = 0; i < s.nodes.size(); ++i)
+                visit(s.nodes[i], transform,
+                      "/scenes/" + std::to_string(sceneIndex) + "/nodes/" + std::to_string(i), pass,
+                      0);
+        }
         warnUnrendered();
-        scene_.objectCount = int(scene_.meshes.size());
-        bool emissive = !scene_.punctualLights.empty();
-        for (const Mesh& m : scene_.meshes)
-            emissive = emissive || scene_.shaders[size_t(m.shader)].params.emission != vec3(0.0f);
-        if (!emissive) scene_.environment = Environment{}; // radiance 1 from everywhere
-        if (scene_.shaders.empty()) scene_.shaders.push_back(defaultShader());
     }
 
-  private:
     enum class Pass { Camera, Geometry };
 
     [[noreturn]] void fail(const std::string& pointer, const std::string& message) const {
@@ -172,6 +185,7 @@ class GltfReader {
         if (pass == Pass::Camera) {
             if (n.camera >= 0 && !cameraFound_) readCamera(n.camera, world, self + "/camera");
         } else {
+            cameraSeen_ = cameraSeen_ || n.camera >= 0;
             if (n.mesh >= 0) readMesh(n.mesh, world, self + "/mesh");
             readLight(n, world, self);
             if (n.skin >= 0) warn("has skins: rendered in their bind pose");
@@ -459,6 +473,7 @@ class GltfReader {
     }
 
     int shaderFor(int material, const std::string& at) {
+        if (shaderOverride_ >= 0) return shaderOverride_;
         if (material >= int(model_.materials.size()))
             fail(at, "names material " + std::to_string(material) + " of " +
                          std::to_string(model_.materials.size()));
@@ -642,7 +657,8 @@ class GltfReader {
     std::vector<int> shaderOf_;
     glm::dvec3 lo_{0.0}, hi_{0.0}; // the bounds of every position and point light read
     bool bounded_ = false;
-    bool cameraFound_ = false;
+    bool cameraFound_ = false, cameraSeen_ = false;
+    int shaderOverride_ = -1;
 };
 
 } // namespace
@@ -655,8 +671,13 @@ bool isGltfPath(const std::string& path) {
 Scene loadGltfScene(const std::string& path) {
     Scene scene;
     scene.file = path;
-    GltfReader(path, scene).read();
+    GltfReader(path, scene).readScene();
     return scene;
+}
+
+void appendGltfObject(const std::string& path, const glm::dmat4& transform, int shader,
+                      Scene& scene) {
+    GltfReader(path, scene).readObject(transform, shader);
 }
 
 } // namespace spw

@@ -10,6 +10,8 @@
 
 #include "host/scene/scene.h"
 
+#include <glm/mat4x4.hpp>
+
 #include <string>
 
 namespace spw {
@@ -20,5 +22,12 @@ bool isGltfPath(const std::string& path);
 // Loads a glTF file as a whole scene. Throws SceneError naming the file, and where in it (a JSON
 // pointer such as /meshes/0/primitives/1) the problem is.
 Scene loadGltfScene(const std::string& path);
+
+// A glTF file as an object of a YAML scene (`type: Gltf`): its default scene's meshes and lights
+// placed by `transform` relative to `scene.origin` (the scene's camera), appended to
+// `scene.meshes` and `scene.punctualLights`; every mesh takes shader `shader` where it is >= 0,
+// else the file's materials, appended to `scene.shaders`. The file's cameras are not used.
+void appendGltfObject(const std::string& path, const glm::dmat4& transform, int shader,
+                      Scene& scene);
 
 } // namespace spw

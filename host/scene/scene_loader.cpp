@@ -335,18 +335,36 @@ struct PendingObject {
     int line;
 };
 
+// A glTF file placed as an object: read once every YAML shader is (its materials follow them).
+struct PendingGltf {
+    std::string path;
+    glm::dmat4 transform;
+    int shader; // -1: the file's own materials
+};
+
 void readObject(const Reader& rd, const YAML::Node& n, const fs::path& dir, Scene& scene,
-                std::vector<PendingObject>& pending) {
+                std::vector<PendingObject>& pending, std::vector<PendingGltf>& gltf) {
     if (!n.IsMap()) rd.fail(n, "object must be a map of keys to values");
     rd.checkKeys(n, "object", {"type", "filename", "translation", "rotation", "scale", "shader"});
     std::string t = n["type"] ? rd.string(n["type"], "object type") : "Polygon";
-    if (t != "Polygon") rd.fail(n["type"], "unknown object type '" + t + "' (Polygon)");
-    if (!n["filename"]) rd.fail(n, "object needs a filename (an OBJ file)");
+    if (t != "Polygon" && t != "Gltf")
+        rd.fail(n["type"], "unknown object type '" + t + "' (Polygon, Gltf)");
+    const bool isGltf = t == "Gltf";
+    if (!n["filename"])
+        rd.fail(n, std::string("object needs a filename (") +
+                       (isGltf ? "a .gltf or .glb file)" : "an OBJ file)"));
     fs::path p = dir / rd.string(n["filename"], "object filename");
     if (!fs::is_regular_file(p))
         rd.fail(n["filename"], "object file '" + p.string() + "' does not exist");
+    if (isGltf && !isGltfPath(p.string()))
+        rd.fail(n["filename"], "a Gltf object's file ends in .gltf or .glb");
     int shader = n["shader"] ? int(rd.integer(n["shader"], "object shader", 0, 1 << 30)) : 0;
     const glm::dmat4 xf = readTransform(rd, n, "object", true);
+    if (isGltf) {
+        gltf.push_back({p.string(), xf, n["shader"] ? shader : -1});
+        if (n["shader"]) pending.push_back({n, shader, n["shader"].Mark().line + 1});
+        return;
+    }
     Mesh mesh = loadObjMesh(p.string(), xf, scene.origin, rd.file(), n["filename"].Mark().line + 1);
     mesh.shader = shader;
     scene.meshes.push_back(std::move(mesh));
@@ -481,7 +499,7 @@ class SceneReader {
         else if (key == "object" || key == "objects")
             each("objects", [&](const YAML::Node& e) {
                 roomFor(e, 0, 1);
-                readObject(rd_, e, dir_, scene_, pending_);
+                readObject(rd_, e, dir_, scene_, pending_, gltf_);
             });
         else if (key == "shader" || key == "shaders")
             each("shaders", [&](const YAML::Node& e) {
@@ -530,6 +548,7 @@ class SceneReader {
     Scene& scene_;
     TextureReader textures_;
     std::vector<PendingObject> pending_;
+    std::vector<PendingGltf> gltf_;
     std::vector<Mesh> lightMeshes_;
     std::vector<Shader> lightShaders_;
     std::set<std::string> seenOnce_;
@@ -544,6 +563,13 @@ void SceneReader::finish(const YAML::Node& root) {
             rd_.fail(o.line, "object uses shader " + std::to_string(o.shader) +
                                  " but the scene has " + std::to_string(sceneShaders) + " shader" +
                                  (sceneShaders == 1 ? "" : "s"));
+    for (const PendingGltf& g : gltf_)
+        appendGltfObject(g.path, g.transform, g.shader, scene_);
+    if (scene_.shaders.size() + lightShaders_.size() > size_t(kMaxShaders) ||
+        scene_.meshes.size() + lightMeshes_.size() > size_t(kMaxObjects))
+        rd_.fail(1, "more than " + std::to_string(kMaxShaders) + " shaders or " +
+                        std::to_string(kMaxObjects) +
+                        " objects with the glTF files' materials and meshes");
     scene_.objectCount = int(scene_.meshes.size());
     scene_.quadLightCount = int(lightMeshes_.size());
     for (size_t i = 0; i < lightMeshes_.size(); ++i) {

@@ -360,5 +360,46 @@ TEST(Gltf, EveryBackendRendersAFileDirectly) {
     EXPECT_FALSE(std::filesystem::exists(dir.file("bad.exr")));
 }
 
+// `type: Gltf` places a file in a YAML scene: moved by the object's transform, relative to the
+// scene's camera; its materials follow the scene's shaders, or `shader:` replaces them all.
+TEST(Gltf, AYamlSceneObjectPlacesAFileWithItsMaterialsOrAShader) {
+    TempDir dir;
+    GltfBuilder b = cameraAndQuads();
+    b.embedded(dir, "quads.gltf");
+    const std::string head =
+        "camera: {type: PinHole, look at: {eye: [0, 0, 10], target: [0, 0, 0]}, "
+        "fov: 40}\n"
+        "objects:\n";
+    const std::string tail = "shaders:\n  - {type: Lambert}\n";
+    const Scene own = loadScene(dir.write(
+        "own.yaml",
+        head + "  - {type: Gltf, filename: quads.gltf, translation: [0, 0, 1]}\n" + tail));
+    ASSERT_EQ(own.meshes.size(), 2u);
+    EXPECT_EQ(own.objectCount, 2);
+    // The file's parent node: scale 2, z + 1; the object: z + 1; camera-relative: z - 10.
+    EXPECT_EQ(own.meshes[0].positions[2], vec3(2, 2, -8));
+    ASSERT_EQ(own.shaders.size(), 3u); // the scene's Lambert, then the file's two materials
+    EXPECT_EQ(own.shaders[0].params.model, kModelLambert);
+    EXPECT_EQ(own.shaders[size_t(own.meshes[0].shader)].params.colour, vec3(0.8f, 0.5f, 0.25f));
+    EXPECT_GE(own.meshes[1].shader, 1);
+    EXPECT_FALSE(own.environment);      // a YAML scene lights itself
+    ASSERT_EQ(own.warnings.size(), 1u); // the file's camera, not used
+    EXPECT_NE(own.warnings[0].find("cameras are not used"), std::string::npos);
+
+    const Scene overridden = loadScene(dir.write(
+        "shader.yaml", head + "  - {type: Gltf, filename: quads.gltf, shader: 0}\n" + tail));
+    ASSERT_EQ(overridden.shaders.size(), 1u);
+    for (const Mesh& m : overridden.meshes)
+        EXPECT_EQ(m.shader, 0);
+    EXPECT_THROW(loadScene(dir.write("bad.yaml", head +
+                                                     "  - {type: Gltf, filename: quads.gltf, "
+                                                     "shader: 3}\n" +
+                                                     tail)),
+                 SceneError);
+    EXPECT_THROW(loadScene(dir.write("notgltf.yaml",
+                                     head + "  - {type: Gltf, filename: own.yaml}\n" + tail)),
+                 SceneError);
+}
+
 } // namespace
 } // namespace spw::test
