@@ -130,8 +130,13 @@ std::uint64_t sceneHash(const Scene& scene) {
         f.array(m.uvs);
         f.array(m.triangles);
     }
-    for (const Texture& t : scene.textures)
-        if (t.type == TextureType::Standard) hashFileContents(f, t.path);
+    for (const Texture& t : scene.textures) {
+        if (t.type != TextureType::Standard) continue;
+        if (t.bytes) // embedded in the scene file
+            f.bytes(t.bytes->data(), t.bytes->size());
+        else
+            hashFileContents(f, t.path);
+    }
     return f.h;
 }
 

@@ -5,6 +5,7 @@
 
 #include "shared/gltf.h"
 
+#include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
 #include <glm/gtc/matrix_inverse.hpp>
 #include <glm/gtc/quaternion.hpp>
@@ -16,6 +17,8 @@
 #include <cstring>
 #include <filesystem>
 #include <limits>
+#include <map>
+#include <memory>
 #include <set>
 
 namespace spw {
@@ -37,9 +40,14 @@ constexpr double kDefaultAspect = 4.0 / 3.0;
 constexpr double kLumensPerWatt = 683.0;
 
 // tinygltf reads every image's bytes; the pixels are left to OpenImageIO's texture cache, which
-// reads the file itself (or, for an embedded image, nothing yet: a warning says so).
-bool keepImageUndecoded(tinygltf::Image*, const int, std::string*, std::string*, int, int,
-                        const unsigned char*, int, void*) {
+// reads an image file itself, and an embedded image (a buffer view, a data: URI) from these
+// bytes, kept here per image.
+using ImageBytes = std::map<int, std::shared_ptr<const std::string>>;
+bool keepImageUndecoded(tinygltf::Image* image, const int index, std::string*, std::string*, int,
+                        int, const unsigned char* bytes, int size, void* user) {
+    if (image->uri.empty() || image->uri.rfind("data:", 0) == 0)
+        (*static_cast<ImageBytes*>(user))[index] = std::make_shared<const std::string>(
+            reinterpret_cast<const char*>(bytes), size_t(std::max(size, 0)));
     return true;
 }
 
@@ -111,7 +119,7 @@ class GltfReader {
         if (!fs::is_regular_file(path_, ec))
             throw SceneError(path_, 0, "cannot open the glTF file: not a readable file");
         tinygltf::TinyGLTF loader;
-        loader.SetImageLoader(keepImageUndecoded, nullptr);
+        loader.SetImageLoader(keepImageUndecoded, &embedded_);
         std::string err, warnings;
         const bool binary = lower(fs::path(path_).extension().string()) == ".glb";
         const bool ok = binary ? loader.LoadBinaryFromFile(&model_, &err, &warnings, path_)
@@ -556,21 +564,30 @@ class GltfReader {
         if (source < 0 || source >= int(model_.images.size()))
             fail("/textures/" + std::to_string(index) + "/source", "names no image");
         const tinygltf::Image& image = model_.images[size_t(source)];
-        if (image.uri.empty() || image.uri.rfind("data:", 0) == 0) {
-            warn(name + ": its baseColorTexture is embedded in the file, not rendered yet (its "
-                        "baseColorFactor is)");
-            return;
-        }
-        const std::string file =
-            fs::absolute(dir_ / decodeUri(image.uri)).lexically_normal().string();
-        auto in = OIIO::ImageInput::open(file);
-        if (!in)
-            fail("/images/" + std::to_string(source) + "/uri",
-                 "'" + file + "' is not an image OpenImageIO can read");
-        in->close();
         Texture picture{};
         picture.type = TextureType::Standard;
-        picture.path = file;
+        const std::string imageAt = "/images/" + std::to_string(source);
+        if (const auto e = embedded_.find(source); e != embedded_.end()) {
+            // A name no file has, its extension telling OpenImageIO the format.
+            const std::string ext = image.mimeType == "image/jpeg" ? ".jpg" : ".png";
+            picture.path = fs::absolute(path_).lexically_normal().string() + "#image" +
+                           std::to_string(source) + ext;
+            picture.bytes = e->second;
+            OIIO::Filesystem::IOMemReader proxy(const_cast<char*>(picture.bytes->data()),
+                                                picture.bytes->size());
+            auto in = OIIO::ImageInput::open(picture.path, nullptr, &proxy);
+            if (!in || in->spec().width < 1 || in->spec().height < 1)
+                fail(imageAt, "the embedded image is not one OpenImageIO can read");
+            in->close();
+        } else {
+            if (image.uri.empty()) fail(imageAt, "an image needs a uri or a bufferView");
+            picture.path = fs::absolute(dir_ / decodeUri(image.uri)).lexically_normal().string();
+            auto in = OIIO::ImageInput::open(picture.path);
+            if (!in)
+                fail(imageAt + "/uri",
+                     "'" + picture.path + "' is not an image OpenImageIO can read");
+            in->close();
+        }
         Texture zero{};
         zero.colour = vec3(0.0f);
         Texture factor{};
@@ -652,6 +669,7 @@ class GltfReader {
     fs::path dir_;
     Scene& scene_;
     tinygltf::Model model_;
+    ImageBytes embedded_;
     std::set<std::string> warned_;
     std::set<int> onPath_;
     std::vector<int> shaderOf_;

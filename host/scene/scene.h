@@ -7,6 +7,7 @@
 
 #include <glm/vec3.hpp>
 
+#include <memory>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -106,7 +107,10 @@ enum class TextureType { Constant, Standard, Layered };
 struct Texture {
     TextureType type = TextureType::Constant;
     vec3 colour{1.0f};
-    std::string path;                      // Standard: absolute path of the image
+    std::string path; // Standard: absolute path of the image
+    // Standard, an image embedded in the scene file (a glTF buffer): the encoded file itself,
+    // read from memory under `path`, a name no file has ("model.glb#image0.png").
+    std::shared_ptr<const std::string> bytes;
     int upper = -1, lower = -1, mask = -1; // Layered: indices into Scene::textures
     int line = 0;                          // where the scene file defines it
 };

@@ -3,6 +3,7 @@
 #include "host/image/image_io.h"
 #include "host/scene/wide_texels.h"
 
+#include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/half.h>
 #include <OpenImageIO/imagecache.h>
 
@@ -25,6 +26,8 @@ constexpr size_t kMaxLevels = 32;
 
 struct TextureResolver::Impl {
     OIIO::ImageCache* cache = nullptr;
+    // The readers of embedded images (Texture::bytes), alive as long as the cache.
+    std::vector<std::unique_ptr<OIIO::Filesystem::IOMemReader>> proxies;
     struct Level {
         int x = 0, y = 0, width = 1, height = 1; // the data window
     };
@@ -453,6 +456,15 @@ TextureResolver::TextureResolver(const Scene& scene, double cacheMiB, bool filte
         if (t.type != TextureType::Standard) continue;
         Impl::Image& img = impl_->images[i];
         OIIO::ustring name(t.path);
+        if (t.bytes) { // embedded: read from memory, through a proxy the cache keeps using
+            auto& proxy =
+                impl_->proxies.emplace_back(std::make_unique<OIIO::Filesystem::IOMemReader>(
+                    const_cast<char*>(t.bytes->data()), t.bytes->size()));
+            OIIO::ImageSpec config;
+            void* ptr = proxy.get();
+            config.attribute("oiio:ioproxy", OIIO::TypeDesc::PTR, &ptr);
+            impl_->cache->add_file(name, nullptr, &config);
+        }
         img.handle = impl_->cache->get_image_handle(name);
         const OIIO::ImageSpec* spec =
             img.handle ? impl_->cache->imagespec(img.handle, nullptr, 0, 0) : nullptr;

@@ -8,6 +8,8 @@
 
 #include "shared/gltf.h"
 
+#include <OpenImageIO/imagebuf.h>
+#include <OpenImageIO/imagebufalgo.h>
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
@@ -399,6 +401,67 @@ TEST(Gltf, AYamlSceneObjectPlacesAFileWithItsMaterialsOrAShader) {
     EXPECT_THROW(loadScene(dir.write("notgltf.yaml",
                                      head + "  - {type: Gltf, filename: own.yaml}\n" + tail)),
                  SceneError);
+}
+
+// A base colour image, embedded in a .glb's buffer, as a data: URI, or a file beside the .gltf,
+// read through the same texture cache: a green image under a white factor renders green.
+TEST(Gltf, BaseColourImagesEmbeddedOrBesideTheFileAreRendered) {
+    TempDir dir;
+    const std::string png = dir.file("green.png");
+    {
+        OIIO::ImageBuf green(OIIO::ImageSpec(4, 4, 3, OIIO::TypeDesc::UINT8));
+        const float g[3] = {0.0f, 1.0f, 0.0f};
+        OIIO::ImageBufAlgo::fill(green, g);
+        ASSERT_TRUE(green.write(png));
+    }
+    const std::string pngBytes = readFile(png);
+    auto channelMeans = [](const Scene& scene) {
+        RenderConfig cfg;
+        cfg.backend = BackendKind::Reference;
+        cfg.spp = 4;
+        Scene small = scene;
+        small.image.width = small.image.height = 8;
+        const std::vector<float> img = render(small, cfg)->film->image();
+        vec3 sum(0.0f);
+        for (size_t i = 0; i + 2 < img.size(); i += 3)
+            sum += vec3(img[i], img[i + 1], img[i + 2]);
+        return sum;
+    };
+    for (const char* how : {"glb", "data", "file"}) {
+        GltfBuilder b;
+        json mat = material(vec3(1.0f), 0.0f, 1.0f);
+        mat["pbrMetallicRoughness"]["baseColorTexture"] = {{"index", 0}};
+        b.doc["materials"] = json::array({mat});
+        b.doc["textures"] = json::array({{{"source", 0}}});
+        if (std::string(how) == "file") {
+            b.doc["images"] = json::array({{{"uri", "green.png"}}});
+        } else if (std::string(how) == "data") {
+            b.doc["images"] =
+                json::array({{{"uri", "data:image/png;base64," + GltfBuilder::base64(pngBytes)}}});
+        } else {
+            while (b.bytes.size() % 4 != 0)
+                b.bytes.push_back('\0');
+            b.doc["bufferViews"].push_back(
+                {{"buffer", 0}, {"byteOffset", b.bytes.size()}, {"byteLength", pngBytes.size()}});
+            b.bytes += pngBytes;
+            b.doc["images"] = json::array(
+                {{{"bufferView", b.doc["bufferViews"].size() - 1}, {"mimeType", "image/png"}}});
+        }
+        json prim = b.quad(0);
+        b.doc["cameras"] = json::array(
+            {{{"type", "perspective"},
+              {"perspective", {{"yfov", 0.25}, {"aspectRatio", 1.0}, {"znear", 0.1}}}}});
+        b.scene({b.node({{"mesh", b.mesh(prim)}}),
+                 b.node({{"camera", 0}, {"translation", {0.5, 0.5, 3}}})});
+        const std::string path =
+            std::string(how) == "glb" ? b.binary(dir, "g.glb") : b.embedded(dir, "g.gltf");
+        const Scene scene = loadScene(path);
+        ASSERT_TRUE(scene.usesTextures()) << how;
+        EXPECT_TRUE(scene.warnings.empty()) << how << ": " << scene.warnings.at(0);
+        const vec3 m = channelMeans(scene);
+        EXPECT_GT(m.y, 0.0f) << how;
+        EXPECT_LT(m.x, 0.1f * m.y) << how << ": the image's green, not the white factor";
+    }
 }
 
 } // namespace
