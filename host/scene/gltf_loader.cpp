@@ -646,12 +646,24 @@ class GltfReader {
                 fail(at, far);
             p.position = vec3(rel);
             include(glm::dvec3(world[3]));
-        } else if (l.type == "directional") {
-            p.kind = kEmitterDirectional;
+        } else if (l.type == "directional" || l.type == "spot") {
+            p.kind = l.type == "spot" ? kEmitterSpot : kEmitterDirectional;
             const glm::dvec3 d = -glm::dvec3(world[2]); // the light shines along its -Z
             const double len = glm::length(d);
-            if (!(len > 1e-30)) fail(at, "a directional light's node has a zero scale");
+            if (!(len > 1e-30)) fail(at, "a " + l.type + " light's node has a zero scale");
             p.direction = vec3(d / len);
+            if (l.type == "spot") {
+                const double inner = l.spot.innerConeAngle, outer = l.spot.outerConeAngle;
+                if (!(inner >= 0.0 && inner < outer && outer <= 0.5 * M_PI))
+                    fail(where + "/spot", "needs 0 <= innerConeAngle < outerConeAngle <= pi/2");
+                p.cosInner = float(std::cos(inner));
+                p.cosOuter = float(std::cos(outer));
+                const glm::dvec3 rel = glm::dvec3(world[3]) - scene_.origin;
+                if (const std::string far = beyondReach(rel, "a spot light"); !far.empty())
+                    fail(at, far);
+                p.position = vec3(rel);
+                include(glm::dvec3(world[3]));
+            }
         } else {
             warn("has " + l.type + " lights, not rendered yet");
             return;

@@ -81,6 +81,7 @@ PunctualLight readPunctualLight(const Reader& rd, const YAML::Node& n, const glm
     const bool directed = (kind.flags & kLightTakesDirection) != 0u;
     if (positioned) keys.push_back("position");
     if (directed) keys.push_back("direction");
+    if (kind.kind == kEmitterSpot) keys.insert(keys.end(), {"inner angle", "outer angle"});
     rd.checkKeys(n, what, keys);
     PunctualLight light;
     light.kind = kind.kind;
@@ -97,6 +98,16 @@ PunctualLight readPunctualLight(const Reader& rd, const YAML::Node& n, const glm
         if (!(length > 1e-30) || !std::isfinite(length))
             rd.fail(n["direction"], what + " direction must be a non-zero vector");
         light.direction = vec3(d / length);
+    }
+    if (kind.kind == kEmitterSpot) { // degrees, glTF's defaults
+        const double outer =
+            n["outer angle"] ? rd.number(n["outer angle"], "outer angle", 0.01, 90.0) : 45.0;
+        const double inner =
+            n["inner angle"] ? rd.number(n["inner angle"], "inner angle", 0.0, 90.0) : 0.0;
+        if (!(inner < outer))
+            rd.fail(n["inner angle"], "a spot light's inner angle must be less than its outer one");
+        light.cosInner = float(std::cos(inner * M_PI / 180.0));
+        light.cosOuter = float(std::cos(outer * M_PI / 180.0));
     }
     light.intensity = vec3(lightIntensity(rd, n, true));
     light.line = n.Mark().line + 1;

@@ -105,7 +105,14 @@ void SceneLights::addPunctual(const PunctualLight& p, double radius, std::vector
     if (kind.flags & kLightTakesDirection) e.normal = p.direction;
     e.radiance = p.intensity;
     const double r = std::max(radius, 1e-30);
-    if (kind.flags & kLightTakesPosition) {
+    if (p.kind == kEmitterSpot) {
+        e.e1 = vec3(p.cosOuter, p.cosInner, 0.0f);
+        // 2 pi I (1 - cos) over a cone halfway between the inner and the outer one.
+        const double c = 0.5 * (double(p.cosInner) + double(p.cosOuter));
+        powers.push_back(2.0 * kPi * (1.0 - c) * double(luminance(p.intensity)));
+        brightest_ = std::max(brightest_,
+                              float(std::min(double(maxComponent(p.intensity)) / (r * r), 1e30)));
+    } else if (kind.flags & kLightTakesPosition) {
         powers.push_back(4.0 * kPi * double(luminance(p.intensity)));
         brightest_ = std::max(brightest_,
                               float(std::min(double(maxComponent(p.intensity)) / (r * r), 1e30)));

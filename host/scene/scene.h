@@ -143,6 +143,9 @@ struct PunctualLight {
     vec3 position{0.0f};
     vec3 direction{0.0f, -1.0f, 0.0f};
     vec3 intensity{1.0f};
+    // A spot light's cone (shared/spot_light.h): full intensity within the inner angle, none
+    // beyond the outer one. glTF's defaults: 0 and pi/4.
+    float cosInner = 1.0f, cosOuter = 0.70710678f;
     int line = 0;
 };
 

@@ -29,6 +29,7 @@
     X(Triangle, 0u, triangle_light, Quad, kLightSurface)                                           \
     X(Point, 1u, point_light, Point, kLightDelta | kLightTakesPosition)                            \
     X(Environment, 2u, environment_light, Environment, kLightAtInfinity)                           \
-    X(Directional, 3u, directional_light, Directional, kLightDelta | kLightTakesDirection)
+    X(Directional, 3u, directional_light, Directional, kLightDelta | kLightTakesDirection)         \
+    X(Spot, 4u, spot_light, Spot, kLightDelta | kLightTakesPosition | kLightTakesDirection)
 
 #endif

@@ -51,15 +51,15 @@ const uint kEmitterKindCount = 0u SPW_EMITTER_KINDS(SPW_EMITTER_ONE);
 struct Emitter {
     vec3 p0; // triangle: vertex 0; point: the position
     float area;
-    vec3 e1; // triangle: v1 - v0
+    vec3 e1; // triangle: v1 - v0; spot: (cos outer angle, cos inner angle, 0)
     float pickPdf;
     vec3 e2; // triangle: v2 - v0
     uint twoSided;
-    vec3 normal;   // triangle: unit, cross(e1, e2) direction: the front face; directional: the
-                   // unit direction its light travels
+    vec3 normal;   // triangle: unit, cross(e1, e2) direction: the front face; directional, spot:
+                   // the unit direction its light travels
     uint type;     // kEmitter*
-    vec3 radiance; // triangle: radiance; point: intensity (W/sr); environment: radiance (times
-                   // the map's texel where it has one); directional: irradiance (W/m^2)
+    vec3 radiance; // triangle: radiance; point, spot: intensity (W/sr); environment: radiance
+                   // (times the map's texel where it has one); directional: irradiance (W/m^2)
     float pad1;
 };
 

@@ -250,7 +250,9 @@ TEST(Gltf, LightsEmissionAndWhatIsNotRenderedIsWarnedOnce) {
     b.doc["extensions"]["KHR_lights_punctual"]["lights"] =
         json::array({{{"type", "point"}, {"intensity", 683.0}, {"color", {1.0, 0.5, 0.0}}},
                      {{"type", "directional"}, {"intensity", 1366.0}},
-                     {{"type", "spot"}, {"intensity", 1.0}, {"spot", {{"outerConeAngle", 0.5}}}}});
+                     {{"type", "spot"},
+                      {"intensity", 683.0},
+                      {"spot", {{"innerConeAngle", 0.25}, {"outerConeAngle", 0.5}}}}});
     const int mesh = b.mesh(b.quad(0));
     b.scene({b.node({{"mesh", mesh}}), b.node({{"mesh", mesh}, {"translation", {0, 0, -2}}}),
              b.node({{"translation", {1, 2, 3}},
@@ -261,19 +263,23 @@ TEST(Gltf, LightsEmissionAndWhatIsNotRenderedIsWarnedOnce) {
     b.doc["animations"] = json::array({{{"channels", json::array()}, {"samplers", json::array()}}});
     const Scene s = loadScene(b.embedded(dir, "lit.gltf"));
     EXPECT_EQ(s.shaders[0].params.emission, vec3(4.0f, 2.0f, 1.0f));
-    ASSERT_EQ(s.punctualLights.size(), 2u);
+    ASSERT_EQ(s.punctualLights.size(), 3u);
     EXPECT_EQ(s.punctualLights[0].kind, kEmitterPoint);
     EXPECT_EQ(s.punctualLights[0].intensity, vec3(1.0f, 0.5f, 0.0f)); // 683 cd: 1 W/sr
     EXPECT_EQ(s.punctualLights[1].kind, kEmitterDirectional);
     EXPECT_NEAR(s.punctualLights[1].direction.y, -1.0f, 1e-6f); // -Z turned down
     EXPECT_EQ(s.punctualLights[1].intensity, vec3(2.0f));
+    EXPECT_EQ(s.punctualLights[2].kind, kEmitterSpot);
+    EXPECT_EQ(s.punctualLights[2].direction, vec3(0, 0, -1));
+    EXPECT_EQ(s.punctualLights[2].cosInner, float(std::cos(0.25)));
+    EXPECT_EQ(s.punctualLights[2].cosOuter, float(std::cos(0.5)));
     EXPECT_FALSE(s.environment); // lit by its lights
     std::string all;
     for (const std::string& w : s.warnings)
         all += w + "\n";
-    for (const char* what : {"EXT_unknown", "spot", "BLEND", "animations"})
+    for (const char* what : {"EXT_unknown", "BLEND", "animations"})
         EXPECT_NE(all.find(what), std::string::npos) << what << " not in:\n" << all;
-    EXPECT_EQ(s.warnings.size(), 4u) << all; // the two meshes' material warned once
+    EXPECT_EQ(s.warnings.size(), 3u) << all; // the two meshes' material warned once
 }
 
 // Each malformed file: a SceneError naming the file and, where it helps, the JSON pointer.

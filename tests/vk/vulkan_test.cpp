@@ -278,8 +278,11 @@ TEST(VulkanVsCpu, EveryEmitterKindAgreesUpToFloatRounding) {
                               "colour: [0.2, 0.4, 1]}\n";
     const std::string environment = "  - {type: Environment, string: sky.exr}\n";
     const std::string sun = "  - {type: Directional, direction: [0.4, -1, -0.3], intensity: 1.5}\n";
+    const std::string spot =
+        "  - {type: Spot, position: [0.2, 1.5, 0.4], direction: [0, -1, -0.2], "
+        "intensity: 3, inner angle: 15, outer angle: 40}\n";
     for (const auto& [lights, kinds] :
-         {std::pair{point, nlohmann::json({"point"})},
+         {std::pair{point, nlohmann::json({"point"})}, std::pair{spot, nlohmann::json({"spot"})},
           std::pair{environment, nlohmann::json({"environment"})},
           std::pair{sun, nlohmann::json({"directional"})},
           std::pair{point + environment + sun,
