@@ -21,6 +21,7 @@ packages=(
   clang-format                             # the test that sources are formatted (.clang-format)
   libvulkan-dev mesa-vulkan-drivers vulkan-validationlayers glslc glslang-tools
   python3 python3-numpy python3-matplotlib # convergence plots
+  blender                                  # scripts/cycles_compare.py: glTF files in Cycles
 )
 
 # scripts/fuzz.sh: clang with libFuzzer and the sanitizer runtimes.

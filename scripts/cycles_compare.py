@@ -1,0 +1,293 @@
+#!/usr/bin/env python3
+"""Renders a glTF file with Spillway and with Blender's Cycles (Blender's own glTF importer,
+headless) under matched settings, and reports how far apart the images are.
+
+  scripts/cycles_compare.py FILE.glb [--spp 256] [--width 96] [--out DIR] [--max-relmse X]
+  scripts/cycles_compare.py --make-test-files DIR     writes the files the suite compares
+  scripts/cycles_compare.py --self-test [--spillway BIN]   compares them within the bounds below
+
+Matched: the file's own camera (the test files have one), the image size, samples per pixel,
+a 1-pixel box filter, up to 16 bounces, no denoising, no clamping, linear output (Cycles'
+"Standard" view, no look, exposure 0), and a uniform white environment of radiance 1 where the
+file has no light. Reported: Spillway's `compare` of the two images (relMSE, per-channel means)
+and the per-channel mean ratio Spillway / Cycles. With --max-relmse, exits 1 when relMSE is
+above it or a channel's mean ratio is off by more than --max-ratio-error (default 0.1).
+
+The two renderers' materials are not the same BRDF: Blender 3.4's importer turns a glTF
+material into a Principled BSDF, whose diffuse lobe has Disney's retro-reflection and whose
+specular takes the dielectric F0 from its `specular` input, where glTF's appendix B mixes
+Lambert and GGX by Schlick's Fresnel. docs/scene-format.md ("glTF files") gives the agreement
+measured and the bound the suite asserts.
+"""
+import argparse
+import json
+import math
+import os
+import shutil
+import struct
+import subprocess
+import sys
+import tempfile
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+
+# Run inside Blender (blender -b --python-expr): import, match the settings, render an EXR.
+BLENDER_SCRIPT = r"""
+import sys, json, bpy
+import numpy as np
+if not hasattr(np, "bool"):
+    np.bool = bool  # Blender 3.4's glTF importer on NumPy 1.24 and later
+args = json.loads(sys.argv[sys.argv.index("--") + 1])
+bpy.ops.wm.read_factory_settings(use_empty=True)
+bpy.ops.import_scene.gltf(filepath=args["file"])
+scene = bpy.context.scene
+cameras = [o for o in scene.objects if o.type == "CAMERA"]
+if not cameras:
+    raise SystemExit("the file has no camera")
+scene.camera = cameras[0]
+cam = cameras[0].data
+cam.sensor_fit = "HORIZONTAL"
+cam.angle_x = args["fov_x"]
+scene.render.engine = "CYCLES"
+scene.cycles.device = "CPU"
+scene.cycles.samples = args["spp"]
+scene.cycles.use_adaptive_sampling = False
+scene.cycles.use_denoising = False
+scene.cycles.max_bounces = 16
+for kind in ("diffuse", "glossy", "transmission", "volume", "transparent"):
+    setattr(scene.cycles, kind + "_bounces", 16)
+scene.cycles.sample_clamp_direct = 0.0
+scene.cycles.sample_clamp_indirect = 0.0
+scene.cycles.caustics_reflective = True
+scene.cycles.caustics_refractive = True
+scene.cycles.blur_glossy = 0.0
+scene.cycles.pixel_filter_type = "BOX"
+scene.cycles.filter_width = 1.0
+scene.render.resolution_x = args["width"]
+scene.render.resolution_y = args["height"]
+scene.render.resolution_percentage = 100
+scene.view_settings.view_transform = "Standard"
+scene.view_settings.look = "None"
+scene.view_settings.exposure = 0.0
+scene.view_settings.gamma = 1.0
+if not args["lit"]:
+    world = bpy.data.worlds.new("white")
+    world.use_nodes = True
+    world.node_tree.nodes["Background"].inputs["Color"].default_value = (1, 1, 1, 1)
+    world.node_tree.nodes["Background"].inputs["Strength"].default_value = 1.0
+    scene.world = world
+scene.render.image_settings.file_format = "OPEN_EXR"
+scene.render.image_settings.color_depth = "32"
+scene.render.filepath = args["out"]
+bpy.ops.render.render(write_still=True)
+"""
+
+
+def gltf_json(path):
+    with open(path, "rb") as f:
+        data = f.read()
+    if data[:4] == b"glTF":
+        length = struct.unpack("<I", data[12:16])[0]
+        return json.loads(data[20:20 + length])
+    return json.loads(data)
+
+
+def horizontal_fov(path):
+    """The horizontal field of view Spillway gives the file's first camera (radians)."""
+    cams = [c for c in gltf_json(path).get("cameras", []) if c.get("type") == "perspective"]
+    if not cams:
+        sys.exit("%s has no perspective camera: the comparison takes the file's own" % path)
+    p = cams[0]["perspective"]
+    return 2 * math.atan(math.tan(p["yfov"] / 2) * p.get("aspectRatio", 4 / 3))
+
+
+def lit(path):
+    """Whether the file has a light or an emissive material (else both take a white world)."""
+    doc = gltf_json(path)
+    if doc.get("extensions", {}).get("KHR_lights_punctual", {}).get("lights"):
+        return True
+    return any(any(x > 0 for x in m.get("emissiveFactor", [0, 0, 0]))
+               for m in doc.get("materials", []))
+
+
+def run(cmd, **kw):
+    r = subprocess.run(cmd, capture_output=True, text=True, **kw)
+    if r.returncode != 0:
+        sys.exit("%s failed (%d):\n%s%s" % (cmd[0], r.returncode, r.stdout[-3000:], r.stderr[-3000:]))
+    return r
+
+
+def compare(spillway, file, spp, width, out):
+    os.makedirs(out, exist_ok=True)
+    ours, theirs, stats = (os.path.join(out, n) for n in ("spillway.exr", "cycles.exr", "stats.json"))
+    run([spillway, "render", file, "--width", str(width), "--spp", str(spp), "--sampler", "Sobol",
+         "--quiet", "-o", ours, "--stats", stats])
+    with open(stats) as f:
+        s = json.load(f)
+    fov_x = horizontal_fov(file)
+    args = {"file": os.path.abspath(file), "spp": spp, "width": s["width"], "height": s["height"],
+            "fov_x": fov_x, "out": os.path.abspath(theirs), "lit": lit(file)}
+    blender = shutil.which("blender")
+    if not blender:
+        sys.exit("blender is not installed (Debian: apt-get install blender)")
+    # Blender runs its own Python: none of the caller's (a virtual environment's) paths.
+    env = {k: v for k, v in os.environ.items() if not k.startswith(("PYTHON", "PYENV", "VIRTUAL_ENV"))}
+    env["PATH"] = "/usr/bin:/bin:" + env.get("PATH", "")
+    run([blender, "-b", "--factory-startup", "--python-exit-code", "1", "--python-expr",
+         BLENDER_SCRIPT, "--", json.dumps(args)], env=env)
+    if not os.path.exists(theirs):
+        sys.exit("Blender wrote no image (%s)" % theirs)
+    r = run([spillway, "compare", ours, theirs, "--json"])
+    metrics = json.loads(r.stdout)
+    a, b = metrics["mean_a"], metrics["mean_b"]
+    ratios = [x / y if y > 0 else float("inf") for x, y in zip(a, b)]
+    return metrics, ratios
+
+
+# --- test files: glTF written here, each with a camera ---------------------------------------
+
+def sphere(rings=24, segments=48):
+    pos, nor, idx = [], [], []
+    for r in range(rings + 1):
+        t = math.pi * r / rings
+        for s in range(segments + 1):
+            p = 2 * math.pi * s / segments
+            n = (math.sin(t) * math.cos(p), math.cos(t), math.sin(t) * math.sin(p))
+            pos += n
+            nor += n
+    for r in range(rings):
+        for s in range(segments):
+            a = r * (segments + 1) + s
+            b = a + segments + 1
+            idx += [a, a + 1, b, a + 1, b + 1, b]
+    return pos, nor, idx
+
+
+def floor(size=4.0, y=-1.0):
+    pos = [-size, y, -size, size, y, -size, size, y, size, -size, y, size]
+    return pos, [0, 1, 0] * 4, [0, 2, 1, 0, 3, 2]
+
+
+def write_glb(path, meshes, materials, camera_z=4.5, yfov=0.6):
+    """meshes: (positions, normals, indices, material) each; a perspective camera on +Z."""
+    doc = {"asset": {"version": "2.0"}, "scene": 0, "materials": materials, "meshes": [],
+           "nodes": [], "accessors": [], "bufferViews": []}
+    blob = bytearray()
+
+    def view(data, fmt, count, comps, ctype, extra=None):
+        while len(blob) % 4:
+            blob.append(0)
+        off = len(blob)
+        blob.extend(struct.pack("<%d%s" % (len(data), fmt), *data))
+        doc["bufferViews"].append({"buffer": 0, "byteOffset": off, "byteLength": len(blob) - off})
+        acc = {"bufferView": len(doc["bufferViews"]) - 1, "componentType": ctype, "count": count,
+               "type": {1: "SCALAR", 3: "VEC3"}[comps]}
+        acc.update(extra or {})
+        doc["accessors"].append(acc)
+        return len(doc["accessors"]) - 1
+
+    for pos, nor, idx, mat in meshes:
+        n = len(pos) // 3
+        lo = [min(pos[k::3]) for k in range(3)]
+        hi = [max(pos[k::3]) for k in range(3)]
+        p = view(pos, "f", n, 3, 5126, {"min": lo, "max": hi})
+        q = view(nor, "f", n, 3, 5126)
+        i = view(idx, "I", len(idx), 1, 5125)
+        doc["meshes"].append({"primitives": [{"attributes": {"POSITION": p, "NORMAL": q},
+                                              "indices": i, "material": mat}]})
+        doc["nodes"].append({"mesh": len(doc["meshes"]) - 1})
+    doc["cameras"] = [{"type": "perspective",
+                       "perspective": {"yfov": yfov, "aspectRatio": 4 / 3, "znear": 0.05}}]
+    doc["nodes"].append({"camera": 0, "translation": [0, 0.3, camera_z]})
+    doc["scenes"] = [{"nodes": list(range(len(doc["nodes"])))}]
+    doc["buffers"] = [{"byteLength": len(blob)}]
+    text = json.dumps(doc).encode()
+    text += b" " * (-len(text) % 4)
+    blob += b"\0" * (-len(blob) % 4)
+    with open(path, "wb") as f:
+        f.write(struct.pack("<III", 0x46546C67, 2, 12 + 8 + len(text) + 8 + len(blob)))
+        f.write(struct.pack("<II", len(text), 0x4E4F534A) + text)
+        f.write(struct.pack("<II", len(blob), 0x004E4942) + bytes(blob))
+
+
+def material(colour, metallic, roughness):
+    return {"pbrMetallicRoughness": {"baseColorFactor": list(colour) + [1.0],
+                                     "metallicFactor": metallic, "roughnessFactor": roughness}}
+
+
+def make_test_files(out):
+    os.makedirs(out, exist_ok=True)
+    s, f = sphere(), floor()
+    grey = material((0.5, 0.5, 0.5), 0.0, 1.0)
+    files = {
+        "rough-metal.glb": [material((0.95, 0.64, 0.54), 1.0, 0.5), grey],
+        "rough-plastic.glb": [material((0.8, 0.3, 0.2), 0.0, 0.6), grey],
+    }
+    for name, mats in files.items():
+        write_glb(os.path.join(out, name), [s + (0,), f + (1,)], mats)
+    return sorted(os.path.join(out, n) for n in files)
+
+
+# The suite's bound (docs/scene-format.md, "glTF files", says why): relMSE and each channel's
+# mean ratio, at 128 samples per pixel, 96 x 72 pixels.
+SELF_TEST_MAX_RELMSE = 0.015
+SELF_TEST_MAX_RATIO_ERROR = 0.07
+
+
+def self_test(spillway):
+    work = tempfile.mkdtemp(prefix="cycles-compare-")
+    try:
+        failed = 0
+        for path in make_test_files(work):
+            out = os.path.join(work, os.path.basename(path) + ".out")
+            metrics, ratios = compare(spillway, path, 128, 96, out)
+            ok = metrics["relmse"] <= SELF_TEST_MAX_RELMSE and all(
+                abs(r - 1.0) <= SELF_TEST_MAX_RATIO_ERROR for r in ratios)
+            print("%s %s: relMSE %.4g (bound %g), mean ratio %s (bound 1 +- %g)" % (
+                "ok  " if ok else "FAIL", os.path.basename(path), metrics["relmse"],
+                SELF_TEST_MAX_RELMSE, ["%.3f" % r for r in ratios], SELF_TEST_MAX_RATIO_ERROR))
+            failed += not ok
+        return 1 if failed else 0
+    finally:
+        shutil.rmtree(work)
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("file", nargs="?")
+    ap.add_argument("--spillway", default=os.path.join(ROOT, "build", "spillway"))
+    ap.add_argument("--spp", type=int, default=256)
+    ap.add_argument("--width", type=int, default=96)
+    ap.add_argument("--out", default=None)
+    ap.add_argument("--max-relmse", type=float, default=None)
+    ap.add_argument("--max-ratio-error", type=float, default=0.1)
+    ap.add_argument("--make-test-files", metavar="DIR")
+    ap.add_argument("--self-test", action="store_true")
+    a = ap.parse_args()
+    if a.make_test_files:
+        for p in make_test_files(a.make_test_files):
+            print(p)
+        return 0
+    if a.self_test:
+        return self_test(a.spillway)
+    if not a.file:
+        ap.error("a glTF file, or --make-test-files DIR")
+    out = a.out or tempfile.mkdtemp(prefix="cycles-compare-")
+    metrics, ratios = compare(a.spillway, a.file, a.spp, a.width, out)
+    print("%s: relMSE %.4g, mean Spillway %s, Cycles %s, ratio %s (images in %s)" % (
+        a.file, metrics["relmse"], ["%.4f" % x for x in metrics["mean_a"]],
+        ["%.4f" % x for x in metrics["mean_b"]], ["%.3f" % r for r in ratios], out))
+    if a.max_relmse is not None:
+        bad = metrics["relmse"] > a.max_relmse or any(
+            not abs(r - 1.0) <= a.max_ratio_error for r in ratios)
+        if bad:
+            print("FAIL: beyond relMSE %g or a mean ratio off by more than %g" % (
+                a.max_relmse, a.max_ratio_error))
+            return 1
+    if not a.out:
+        shutil.rmtree(out)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
