@@ -28,7 +28,8 @@ namespace fs = std::filesystem;
 namespace {
 
 // The extensions this loader honours: a file may require them.
-const std::set<std::string> kHonoured = {"KHR_lights_punctual", "KHR_materials_emissive_strength"};
+const std::set<std::string> kHonoured = {"KHR_lights_punctual", "KHR_materials_emissive_strength",
+                                         "KHR_texture_transform"};
 
 // The image of a `spillway render model.glb` without an aspect ratio: 640 pixels wide.
 constexpr int kDefaultWidth = 640;
@@ -514,8 +515,7 @@ class GltfReader {
             float(unit(pbr.metallicFactor, at + "/pbrMetallicRoughness/metallicFactor"));
         s.params.alpha = gltfAlpha(
             float(unit(pbr.roughnessFactor, at + "/pbrMetallicRoughness/roughnessFactor")));
-        if (pbr.baseColorTexture.index >= 0)
-            baseColourTexture(pbr.baseColorTexture.index, s, at, name);
+        if (pbr.baseColorTexture.index >= 0) baseColourTexture(pbr.baseColorTexture, s, at, name);
         if (pbr.metallicRoughnessTexture.index >= 0)
             warn(name + ": its metallicRoughnessTexture is not rendered yet (its factors are)");
         if (mat.normalTexture.index >= 0)
@@ -555,8 +555,13 @@ class GltfReader {
     }
 
     // The base colour's image, times the factor: Layered(upper: image, lower: 0, mask: factor).
-    void baseColourTexture(int index, Shader& s, const std::string& at, const std::string& name) {
+    void baseColourTexture(const tinygltf::TextureInfo& info, Shader& s, const std::string& at,
+                           const std::string& name) {
+        const int index = info.index;
         const std::string where = at + "/pbrMetallicRoughness/baseColorTexture";
+        if (info.texCoord != 0)
+            warn(name + ": its baseColorTexture's texCoord " + std::to_string(info.texCoord) +
+                 " is read as TEXCOORD_0");
         if (index >= int(model_.textures.size()))
             fail(where, "names texture " + std::to_string(index) + " of " +
                             std::to_string(model_.textures.size()));
@@ -592,6 +597,7 @@ class GltfReader {
         zero.colour = vec3(0.0f);
         Texture factor{};
         factor.colour = s.params.colour;
+        readTextureTransform(info, where, picture);
         const int base = int(scene_.textures.size());
         scene_.textures.push_back(picture);
         scene_.textures.push_back(zero);
@@ -602,6 +608,43 @@ class GltfReader {
         scene_.textures.push_back(layered);
         s.texture = base + 3;
         s.params.flags |= kShaderTextured;
+    }
+
+    // KHR_texture_transform on a texture reference: T(offset) R(rotation) S(scale) of glTF's
+    // texture coordinates, written for Spillway's (v = 1 - glTF's v) as F M F, F that flip.
+    void readTextureTransform(const tinygltf::TextureInfo& info, const std::string& where,
+                              Texture& picture) {
+        const auto e = info.extensions.find("KHR_texture_transform");
+        if (e == info.extensions.end()) return;
+        const std::string at = where + "/extensions/KHR_texture_transform";
+        auto numbers = [&](const char* key, std::vector<double> fallback) {
+            if (!e->second.Has(key)) return fallback;
+            const tinygltf::Value& v = e->second.Get(key);
+            std::vector<double> out;
+            if (v.IsNumber()) out.push_back(v.GetNumberAsDouble());
+            for (int i = 0; v.IsArray() && i < int(v.ArrayLen()); ++i)
+                out.push_back(v.Get(i).IsNumber() ? v.Get(i).GetNumberAsDouble() : NAN);
+            for (double x : out)
+                if (!std::isfinite(x) || std::fabs(x) > 1e6)
+                    fail(at + "/" + key, "must be finite numbers of at most 1e6");
+            if (out.size() != fallback.size())
+                fail(at + "/" + key, "needs " + std::to_string(fallback.size()) + " numbers");
+            return out;
+        };
+        const std::vector<double> offset = numbers("offset", {0.0, 0.0});
+        const double rotation = numbers("rotation", {0.0})[0];
+        const std::vector<double> scale = numbers("scale", {1.0, 1.0});
+        if (e->second.Has("texCoord"))
+            warn("KHR_texture_transform's texCoord is read as TEXCOORD_0");
+        const double c = std::cos(rotation), sn = std::sin(rotation);
+        // Column by column, as the extension's GLSL writes them.
+        const glm::dmat3 t(1, 0, 0, 0, 1, 0, offset[0], offset[1], 1);
+        const glm::dmat3 r(c, sn, 0, -sn, c, 0, 0, 0, 1);
+        const glm::dmat3 sc(scale[0], 0, 0, 0, scale[1], 0, 0, 0, 1);
+        const glm::dmat3 flip(1, 0, 0, 0, -1, 0, 0, 1, 1); // (u, v) -> (u, 1 - v)
+        picture.uvTransformed = true;
+        picture.uvTransform = mat3(flip * t * r * sc * flip);
+        picture.footprintScale = float(std::max({std::fabs(scale[0]), std::fabs(scale[1]), 1e-6}));
     }
 
     static std::string decodeUri(const std::string& uri) {

@@ -111,6 +111,11 @@ struct Texture {
     // Standard, an image embedded in the scene file (a glTF buffer): the encoded file itself,
     // read from memory under `path`, a name no file has ("model.glb#image0.png").
     std::shared_ptr<const std::string> bytes;
+    // Standard: an affine map of the texture coordinates before the lookup (glTF's
+    // KHR_texture_transform), and how much it stretches a footprint (its larger scale).
+    bool uvTransformed = false;
+    mat3 uvTransform{1.0f};
+    float footprintScale = 1.0f;
     int upper = -1, lower = -1, mask = -1; // Layered: indices into Scene::textures
     int line = 0;                          // where the scene file defines it
 };

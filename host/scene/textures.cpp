@@ -568,8 +568,22 @@ void TextureResolver::albedos(const Shader& shader, size_t n, const vec2* uv,
         }
         case TextureType::Standard: {
             // OBJ's v grows upwards, image rows downwards. The footprint is isotropic.
+            const Texture& tex = scene_.textures[size_t(op.texture)];
+            const vec2* at = uv;
+            const float* width = footprint;
+            if (tex.uvTransformed) {
+                thread_local std::vector<vec2> moved;
+                thread_local std::vector<float> widths;
+                moved.resize(n), widths.resize(n);
+                for (size_t k = 0; k < n; ++k) {
+                    moved[k] = vec2(tex.uvTransform * vec3(uv[k], 1.0f));
+                    widths[k] = footprint ? footprint[k] * tex.footprintScale : 0.0f;
+                }
+                at = moved.data();
+                width = footprint ? widths.data() : nullptr;
+            }
             TexelReader(*impl_, *thread, op.texture)
-                .lookups(n, uv, impl_->filtered ? footprint : nullptr, v);
+                .lookups(n, at, impl_->filtered ? width : nullptr, v);
             impl_->lookups.fetch_add(n, std::memory_order_relaxed);
             break;
         }

@@ -470,5 +470,58 @@ TEST(Gltf, BaseColourImagesEmbeddedOrBesideTheFileAreRendered) {
     }
 }
 
+// KHR_texture_transform: an image red in its left half, green in its right; offset 0.5 and
+// scale 0.5 in u map the quad onto the green half alone, where without it both halves show.
+TEST(Gltf, TextureTransformMovesTheLookups) {
+    TempDir dir;
+    {
+        OIIO::ImageBuf img(OIIO::ImageSpec(16, 4, 3, OIIO::TypeDesc::UINT8));
+        const float red[3] = {1.0f, 0.0f, 0.0f}, green[3] = {0.0f, 1.0f, 0.0f};
+        OIIO::ImageBufAlgo::fill(img, red, OIIO::ROI(0, 8, 0, 4));
+        OIIO::ImageBufAlgo::fill(img, green, OIIO::ROI(8, 16, 0, 4));
+        ASSERT_TRUE(img.write(dir.file("halves.png")));
+    }
+    // Red over green in image rows [row0, row1) of a 16 x 16 render.
+    auto redOverGreen = [&](const json& transform, int row0 = 0, int row1 = 16) {
+        GltfBuilder b;
+        json mat = material(vec3(1.0f), 0.0f, 1.0f);
+        mat["pbrMetallicRoughness"]["baseColorTexture"] = {{"index", 0}};
+        if (!transform.is_null())
+            mat["pbrMetallicRoughness"]["baseColorTexture"]["extensions"]["KHR_texture_transform"] =
+                transform;
+        b.doc["materials"] = json::array({mat});
+        b.doc["textures"] = json::array({{{"source", 0}}});
+        b.doc["images"] = json::array({{{"uri", "halves.png"}}});
+        b.doc["extensionsUsed"] = {"KHR_texture_transform"};
+        b.doc["cameras"] = json::array(
+            {{{"type", "perspective"},
+              {"perspective", {{"yfov", 0.25}, {"aspectRatio", 1.0}, {"znear", 0.1}}}}});
+        b.scene({b.node({{"mesh", b.mesh(b.quad(0))}}),
+                 b.node({{"camera", 0}, {"translation", {0.5, 0.5, 3}}})});
+        Scene scene = loadScene(b.embedded(dir, "t.gltf"));
+        EXPECT_TRUE(scene.warnings.empty()) << scene.warnings.at(0);
+        scene.image.width = scene.image.height = 16;
+        RenderConfig cfg;
+        cfg.backend = BackendKind::Cpu;
+        cfg.spp = 4;
+        const std::vector<float> img = render(scene, cfg)->film->image();
+        double r = 0, g = 0;
+        for (size_t i = size_t(row0) * 16 * 3; i < size_t(row1) * 16 * 3; i += 3)
+            r += img[i], g += img[i + 1];
+        return r / g;
+    };
+    const double plain = redOverGreen(json());
+    const double moved = redOverGreen({{"offset", {0.5, 0.0}}, {"scale", {0.5, 1.0}}});
+    EXPECT_GT(plain, 0.5);
+    EXPECT_LT(plain, 2.0);
+    EXPECT_LT(moved, 0.1);
+    // Turned a quarter counter-clockwise, then moved by (1, 0): u' = 1 - v (glTF's v, which
+    // runs down the quad), so the image's red half lies along the quad's bottom, its green
+    // along the top; turned the other way, the other way round.
+    const json quarter = {{"offset", {1.0, 0.0}}, {"rotation", M_PI / 2}};
+    EXPECT_LT(redOverGreen(quarter, 0, 6), 0.1);
+    EXPECT_GT(redOverGreen(quarter, 10, 16), 10.0);
+}
+
 } // namespace
 } // namespace spw::test
