@@ -283,9 +283,10 @@ const std::map<Twin, ScalarSide>& scalarSides() {
               in.setAbove(10, 4), in.setUnit(13), in.setUnit(14);
           },
           [](const Inputs& in, size_t k, Expected& e) {
-              vec3 wi, weight;
-              float pdf;
-              bool specular;
+              // Unwritten where the sample fails: putSample reads them only where it does not.
+              vec3 wi(0.0f), weight(0.0f);
+              float pdf = 0.0f;
+              bool specular = false;
               const bool ok = conductorSample(
                   in.get3(0, k), in.f(3, k), in.get3(4, k), in.get3(7, k), in.get3(10, k),
                   vec2(in.f(13, k), in.f(14, k)), wi, weight, pdf, specular);
@@ -315,9 +316,10 @@ const std::map<Twin, ScalarSide>& scalarSides() {
               in.setDirection(8), in.setUnit(11), in.setUnit(12), in.setUnit(13);
           },
           [](const Inputs& in, size_t k, Expected& e) {
-              vec3 wi, weight;
-              float pdf;
-              bool specular;
+              // Unwritten where the sample fails: putSample reads them only where it does not.
+              vec3 wi(0.0f), weight(0.0f);
+              float pdf = 0.0f;
+              bool specular = false;
               const bool ok = dielectricSample(
                   in.f(0, k), in.f(1, k), in.get3(2, k), in.get3(5, k), in.get3(8, k),
                   vec3(in.f(11, k), in.f(12, k), in.f(13, k)), wi, weight, pdf, specular);
