@@ -425,6 +425,17 @@ class GltfReader {
                          "a texture coordinate is not finite");
             }
         }
+        readTriangles(prim, mode, world, vertices, at, m);
+        if (m.triangles.empty()) return;
+        if (scene_.meshes.size() >= size_t(kMaxObjects))
+            fail(at, "more than " + std::to_string(kMaxObjects) + " primitives");
+        scene_.meshes.push_back(std::move(m));
+    }
+
+    // The primitive's triangles (a list, strip or fan; without indices, its vertices in order),
+    // each index checked against the vertex count; zero-area triangles counted, not kept.
+    void readTriangles(const tinygltf::Primitive& prim, int mode, const glm::dmat4& world,
+                       size_t vertices, const std::string& at, Mesh& m) const {
         std::vector<uint> indices;
         if (prim.indices >= 0) {
             for (double x : readAccessor(prim.indices, 1, at + "/indices", true)) {
@@ -460,10 +471,6 @@ class GltfReader {
             for (size_t i = 1; i + 1 < indices.size(); ++i)
                 add(indices[0], indices[i], indices[i + 1]);
         }
-        if (m.triangles.empty()) return;
-        if (scene_.meshes.size() >= size_t(kMaxObjects))
-            fail(at, "more than " + std::to_string(kMaxObjects) + " primitives");
-        scene_.meshes.push_back(std::move(m));
     }
 
     // --- materials -------------------------------------------------------------------------
