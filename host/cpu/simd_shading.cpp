@@ -3,7 +3,7 @@
 // itself through foreach_target.h) and picks the best the processor has at the first call.
 //
 // Each kernel is shadeSurface() (shared/path.h) for one surface model (shared/lambert.h,
-// conductor.h, dielectric.h) and triangle emitters: shadeLanes() is its control flow, and a
+// conductor.h, dielectric.h, gltf.h) and triangle emitters: shadeLanes() is its control flow, and a
 // small struct per model supplies bsdfEval, bsdfSample and bsdfIsDelta as the SIMD twins of the
 // model's shared functions (host/simd/simd_math-inl.h, each checked against its scalar function
 // lane by lane).
@@ -40,9 +40,9 @@ struct RandomLanes {
 struct SurfaceLanes {
     Vec3s p, ng, ns, albedo, wo, beta; // the hit, -rayDir, the path's throughput
     Floats offset;
-    Floats alpha, ior; // the shader's GGX width and index of refraction
-    Uints live;        // bounce < max depth: the path goes on from here
-    Uints roulette;    // bounce >= min depth
+    Floats alpha, ior, metallic; // the shader's GGX width, index of refraction and metalness
+    Uints live;                  // bounce < max depth: the path goes on from here
+    Uints roulette;              // bounce >= min depth
     RandomLanes random;
     Vec3s e0, e1, e2, eNormal, eRadiance; // the picked emitter (a triangle)
     Floats ePickPdf, eArea;
@@ -91,7 +91,7 @@ void MakeRandomNumbers(simd_shading::RandomLanes& lanes, size_t count, uint samp
 // One vector of hits: what every model's eval and sample read.
 struct HitVector {
     V3 ng, albedo, wo;
-    V ngDotWo, alpha, ior;
+    V ngDotWo, alpha, ior, metallic;
     V3 n; // facingShadingNormal
 };
 
@@ -136,6 +136,20 @@ struct DielectricLanesModel {
     }
     BsdfSample sample(const HitVector& h, V ux, V uy, V uz) const {
         return dielectricSample(h.ior, h.alpha, h.ng, h.ngDotWo, frame, h.wo, ux, uy, uz);
+    }
+};
+
+struct MetallicRoughnessLanesModel {
+    Frame frame;
+    V alpha; // max(alpha, kGltfMinAlpha), as gltfBsdfEval and gltfBsdfSample take it
+    explicit MetallicRoughnessLanesModel(const HitVector& h)
+        : frame(shadingFrame(h.n)), alpha(gmax(h.alpha, hn::Set(D(), kGltfMinAlpha))) {}
+    M delta(const HitVector&) const { return hn::FirstN(D(), 0); }
+    V3 eval(const HitVector& h, V3 wi, V& pdf) const {
+        return gltfEval(h.albedo, h.metallic, alpha, h.ng, h.ngDotWo, frame, h.wo, wi, pdf);
+    }
+    BsdfSample sample(const HitVector& h, V ux, V uy, V uz) const {
+        return gltfSample(h.albedo, h.metallic, alpha, h.ng, h.ngDotWo, frame, h.wo, ux, uy, uz);
     }
 };
 
@@ -185,7 +199,7 @@ void shadeLanes(const simd_shading::SurfaceLanes& in, size_t count, bool nee, bo
         HitVector h;
         const V3 p = load(in.p, i), ns = load(in.ns, i), beta = load(in.beta, i);
         h.ng = load(in.ng, i), h.albedo = load(in.albedo, i), h.wo = load(in.wo, i);
-        h.alpha = load(in.alpha, i), h.ior = load(in.ior, i);
+        h.alpha = load(in.alpha, i), h.ior = load(in.ior, i), h.metallic = load(in.metallic, i);
         h.ngDotWo = dot(h.ng, h.wo);
         h.n = facingShadingNormal(ns, h.ng, h.ngDotWo);
         const Model model(h);
@@ -238,6 +252,10 @@ void ShadeDielectricLanes(const simd_shading::SurfaceLanes& in, size_t count, bo
                           float threshold, simd_shading::SurfaceResults& out) {
     shadeLanes<DielectricLanesModel>(in, count, nee, mis, threshold, out);
 }
+void ShadeMetallicRoughnessLanes(const simd_shading::SurfaceLanes& in, size_t count, bool nee,
+                                 bool mis, float threshold, simd_shading::SurfaceResults& out) {
+    shadeLanes<MetallicRoughnessLanesModel>(in, count, nee, mis, threshold, out);
+}
 
 } // namespace spw::HWY_NAMESPACE
 HWY_AFTER_NAMESPACE();
@@ -247,6 +265,7 @@ namespace spw {
 HWY_EXPORT(ShadeLambertLanes);
 HWY_EXPORT(ShadeConductorLanes);
 HWY_EXPORT(ShadeDielectricLanes);
+HWY_EXPORT(ShadeMetallicRoughnessLanes);
 HWY_EXPORT(MakeRandomNumbers);
 
 using simd::kBlock;
@@ -295,6 +314,7 @@ void fillLane(const SceneView& scene, const RenderParams& rp, const ShadeInput& 
     const ShaderParams& sh = scene.shaders[hit.shader];
     lanes.alpha.v[k] = sh.alpha;
     lanes.ior.v[k] = sh.ior;
+    lanes.metallic.v[k] = sh.metallic;
     const bool live = st.bounce < rp.maxDepth;
     lanes.live.v[k] = mask(live);
     lanes.roulette.v[k] = mask(st.bounce >= rp.minDepth);
@@ -358,7 +378,7 @@ const WideTwin kWideTwins[] = {
     {kModelLambert, "ShadeLambertLanes"},
     {kModelConductor, "ShadeConductorLanes"},
     {kModelDielectric, "ShadeDielectricLanes"},
-    {kModelMetallicRoughness, nullptr},
+    {kModelMetallicRoughness, "ShadeMetallicRoughnessLanes"},
 };
 static_assert(sizeof(kWideTwins) / sizeof(kWideTwins[0]) == kModelCount,
               "every registered surface model names its wide twin, or nullptr for none");
@@ -422,6 +442,10 @@ void shadeHits(const SceneView& view, const RenderParams& rp, bool simd, const S
             break;
         case kModelDielectric:
             HWY_DYNAMIC_DISPATCH(ShadeDielectricLanes)
+            (b.lanes, end, nee, mis, rp.threshold, results);
+            break;
+        case kModelMetallicRoughness:
+            HWY_DYNAMIC_DISPATCH(ShadeMetallicRoughnessLanes)
             (b.lanes, end, nee, mis, rp.threshold, results);
             break;
         }

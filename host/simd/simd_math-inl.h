@@ -486,6 +486,83 @@ HWY_INLINE BsdfSample dielectricSample(V ior, V alpha, V3 ng, V go, const Frame&
     return s;
 }
 
+// --- MetallicRoughness (shared/gltf.h) -----------------------------------------------------------
+
+// glm's mix(vec3(a), b, t): a (1 - t) + b t.
+HWY_INLINE V3 mix(V a, V3 b, V t) {
+    const V at = hn::Mul(a, hn::Sub(hn::Set(D(), 1.0f), t));
+    return {hn::Add(at, hn::Mul(b.x, t)), hn::Add(at, hn::Mul(b.y, t)),
+            hn::Add(at, hn::Mul(b.z, t))};
+}
+HWY_INLINE V mean(V3 v) {
+    return hn::Div(hn::Add(hn::Add(v.x, v.y), v.z), hn::Set(D(), 3.0f));
+}
+// Twin of gltfSpecularProbability (shared/gltf.h).
+HWY_INLINE V gltfSpecularProbability(V3 f0, V3 cDiff, V cosO) {
+    const D d;
+    const V one = hn::Set(d, 1.0f);
+    const V3 F = schlickFresnel(f0, cosO);
+    const V fs = mean(F);
+    const V fd = mean(mul(cDiff, sub(V3{one, one, one}, F)));
+    const V p = gmin(gmax(hn::Div(fs, hn::Add(fs, fd)), hn::Set(d, 0.25f)), hn::Set(d, 0.9f));
+    return hn::IfThenElse(hn::Gt(fd, hn::Zero(d)), p, one);
+}
+// Twin of gltfEval (shared/gltf.h), given dot(ng, wo) and shadingFrame's frame.
+HWY_INLINE V3 gltfEval(V3 colour, V metallic, V alpha, V3 ng, V ngDotWo, const Frame& f, V3 wo,
+                       V3 wi, V& pdf) {
+    const D d;
+    const V zero = hn::Zero(d), one = hn::Set(d, 1.0f), two = hn::Set(d, 2.0f);
+    const V invPi = hn::Set(d, kInvPi);
+    const V3 lo = frameToLocal(f, wo), li = frameToLocal(f, wi);
+    V3 h = add(lo, li);
+    const V len2 = dot(h, h);
+    const M evaluated = hn::AndNot(hn::Or(hn::Le(hn::Mul(ngDotWo, dot(ng, wi)), zero),
+                                          hn::Or(hn::Le(lo.z, zero), hn::Le(li.z, zero))),
+                                   hn::Gt(len2, zero));
+    h = mul(h, hn::Div(one, hn::Sqrt(len2)));
+    const V3 f0 = mix(hn::Set(d, kGltfDielectricF0), colour, metallic);
+    const V3 cDiff = mul(colour, hn::Sub(one, metallic));
+    const V3 F = schlickFresnel(f0, dot(lo, h));
+    const V ndf = ggxD(h, alpha);
+    const V denom = ggxG2Denominator(lo, li, alpha);
+    const V3 specular =
+        select(hn::Gt(denom, zero), mul(F, hn::Div(hn::Mul(ndf, li.z), hn::Mul(two, denom))),
+               V3{zero, zero, zero});
+    const V3 diffuse = mul(mul(sub(V3{one, one, one}, F), cDiff), hn::Mul(li.z, invPi));
+    const V pSpecular = gltfSpecularProbability(f0, cDiff, lo.z);
+    const V specularPdf = hn::Div(ndf, hn::Mul(two, hn::Add(lo.z, ggxA(lo, alpha))));
+    pdf = hn::IfThenElseZero(evaluated,
+                             hn::Add(hn::Mul(pSpecular, specularPdf),
+                                     hn::Mul(hn::Sub(one, pSpecular), hn::Mul(li.z, invPi))));
+    return select(evaluated, add(specular, diffuse), V3{zero, zero, zero});
+}
+// Twin of gltfSample (shared/gltf.h), given dot(ng, wo) and shadingFrame's frame.
+HWY_INLINE BsdfSample gltfSample(V3 colour, V metallic, V alpha, V3 ng, V ngDotWo, const Frame& f,
+                                 V3 wo, V ux, V uy, V uz) {
+    const D d;
+    const V zero = hn::Zero(d), one = hn::Set(d, 1.0f), two = hn::Set(d, 2.0f);
+    const V3 lo = frameToLocal(f, wo);
+    const V3 f0 = mix(hn::Set(d, kGltfDielectricF0), colour, metallic);
+    const V3 cDiff = mul(colour, hn::Sub(one, metallic));
+    const M specularLobe = hn::Lt(uz, gltfSpecularProbability(f0, cDiff, lo.z));
+    BsdfSample s;
+    s.ok = hn::Gt(lo.z, zero);
+    V3 li = sampleCosineHemisphere(ux, uy);
+    if (!hn::AllFalse(d, specularLobe)) {
+        const V3 h = ggxSampleVisibleNormal(lo, alpha, ux, uy);
+        const V oh = dot(lo, h);
+        s.ok = hn::AndNot(hn::And(specularLobe, hn::Le(oh, zero)), s.ok);
+        li = select(specularLobe, sub(mul(h, hn::Mul(two, oh)), lo), li);
+    }
+    s.ok = hn::And(s.ok, hn::Gt(li.z, zero));
+    s.wi = frameToWorld(f, li);
+    const V3 fcos = gltfEval(colour, metallic, alpha, ng, ngDotWo, f, wo, s.wi, s.pdf);
+    s.ok = hn::And(s.ok, hn::Gt(s.pdf, zero));
+    s.weight = div(fcos, s.pdf);
+    s.specular = hn::FirstN(d, 0);
+    return s;
+}
+
 // --- rand4 (shared/rng.h) ----------------------------------------------------------------------
 struct U4 {
     VU x, y, z, w;

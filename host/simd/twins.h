@@ -38,6 +38,9 @@
     X(fresnelDielectric, "dielectric.h")                                                           \
     X(dielectricEval, "dielectric.h")                                                              \
     X(dielectricSample, "dielectric.h")                                                            \
+    X(gltfSpecularProbability, "gltf.h")                                                           \
+    X(gltfEval, "gltf.h")                                                                          \
+    X(gltfSample, "gltf.h")                                                                        \
     X(pcg4d, "rng.h")                                                                              \
     X(laineKarrasPermutation, "rng.h")                                                             \
     X(scrambledSobol4, "rng.h")                                                                    \
@@ -69,7 +72,7 @@ inline constexpr TwinInfo kTwins[] = {
 // `specular` as masks u0 and u1, its out-parameters zero where it fails). twins.cpp says per twin
 // which rows it reads; `uniform` holds the arguments that are one value for every lane.
 struct TwinLanes {
-    Floats f[16];
+    Floats f[17];
     Uints u[5];
     std::uint32_t uniform[3];
 };
