@@ -13,9 +13,21 @@ void onEmbreeError(void* user, RTCError code, const char* message) {
     if (error->empty())
         *error = "Embree error " + std::to_string(int(code)) + ": " + (message ? message : "");
 }
+// Embree's filter function for a mesh with holes: candidate hits HitFilter::keeps rejects are
+// marked invalid, so traversal goes on past them.
+void filterHits(const RTCFilterFunctionNArguments* args) {
+    const auto* filter = static_cast<const HitFilter*>(args->geometryUserPtr);
+    for (unsigned i = 0; i < args->N; ++i) {
+        if (args->valid[i] == 0) continue;
+        const uint mesh = RTCHitN_geomID(args->hit, args->N, i);
+        const uint prim = RTCHitN_primID(args->hit, args->N, i);
+        const float u = RTCHitN_u(args->hit, args->N, i), v = RTCHitN_v(args->hit, args->N, i);
+        if (!filter->keeps(mesh, prim, u, v)) args->valid[i] = 0;
+    }
+}
 } // namespace
 
-EmbreeScene::EmbreeScene(const Scene& scene) {
+EmbreeScene::EmbreeScene(const Scene& scene, const HitFilter* filter) {
     device_ = rtcNewDevice(nullptr);
     if (!device_)
         throw std::runtime_error("cannot create the Embree device (error " +
@@ -40,6 +52,11 @@ EmbreeScene::EmbreeScene(const Scene& scene) {
         for (size_t i = 0; i < mesh.triangles.size(); ++i)
             for (int k = 0; k < 3; ++k)
                 ib[3 * i + k] = mesh.triangles[i][k];
+        if (filter && filter->filters(uint(m))) {
+            rtcSetGeometryUserData(g, const_cast<HitFilter*>(filter));
+            rtcSetGeometryIntersectFilterFunction(g, filterHits);
+            rtcSetGeometryOccludedFilterFunction(g, filterHits);
+        }
         rtcCommitGeometry(g);
         rtcAttachGeometryByID(scene_, g, unsigned(m));
         rtcReleaseGeometry(g);

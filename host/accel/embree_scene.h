@@ -14,10 +14,23 @@ struct RTCSceneTy;
 
 namespace spw {
 
+// Which candidate hits count, for meshes with holes in them (an alpha cut-out): Embree asks
+// `keeps` for each hit it finds on a mesh that `filters`, and traversal goes on past those it
+// does not keep, for closest hits and shadow rays alike. Meshes that do not filter get no
+// filter function, and cost nothing.
+class HitFilter {
+  public:
+    virtual ~HitFilter() = default;
+    virtual bool filters(uint mesh) const = 0;
+    // Thread-safe: Embree calls it from every thread that traces.
+    virtual bool keeps(uint mesh, uint prim, float u, float v) const = 0;
+};
+
 class EmbreeScene {
   public:
     // Builds the BVH on Embree's default device. Throws std::runtime_error on a device error.
-    explicit EmbreeScene(const Scene& scene);
+    // `filter` (or none) must outlive the scene.
+    explicit EmbreeScene(const Scene& scene, const HitFilter* filter = nullptr);
     ~EmbreeScene();
     EmbreeScene(const EmbreeScene&) = delete;
     EmbreeScene& operator=(const EmbreeScene&) = delete;

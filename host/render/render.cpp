@@ -9,6 +9,7 @@
 #include "host/render/rank_policy.h"
 #include "host/render/stop_rule.h"
 #include "host/scene/camera.h"
+#include "host/scene/cutouts.h"
 #include "host/scene/textures.h"
 #include "host/vk/context.h"
 #include "host/vk/vulkan_shading.h"
@@ -125,9 +126,10 @@ class RenderSession {
     BackendChoice choice_;
     int threads_ = 0;
     std::optional<SceneLights> lights_;
+    std::optional<TextureResolver> textures_;
+    std::optional<Cutouts> cutouts_; // the BVH's hit filter: built before it, outlives it
     std::unique_ptr<EmbreeScene> embree_;
     std::optional<HitSetup> hitSetup_;
-    std::optional<TextureResolver> textures_;
     std::optional<CameraModel> camera_;
     std::optional<RenderContext> ctx_;
     std::unique_ptr<Backend> backend_;
@@ -221,13 +223,16 @@ void RenderSession::chooseBackend() {
 // backend.
 void RenderSession::build() {
     lights_.emplace(scene_);
-    {
-        StageTimer t(stats_.stages, "build bvh");
-        embree_ = std::make_unique<EmbreeScene>(scene_);
-    }
-    hitSetup_.emplace(scene_, *lights_);
     textures_.emplace(scene_, scene_.settings.textureCacheMiB,
                       config_.textureFilter == TextureFilter::Cone, config_.pipeline.simdShading);
+    cutouts_.emplace(scene_, *textures_);
+    if (cutouts_->meshes() > 0) stats_.extra["cutout_meshes"] = cutouts_->meshes();
+    {
+        StageTimer t(stats_.stages, "build bvh");
+        embree_ =
+            std::make_unique<EmbreeScene>(scene_, cutouts_->meshes() > 0 ? &*cutouts_ : nullptr);
+    }
+    hitSetup_.emplace(scene_, *lights_);
     camera_.emplace(scene_, plan_.sampleBase);
 
     RenderParams params{};

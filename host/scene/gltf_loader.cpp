@@ -523,6 +523,7 @@ class GltfReader {
         s.params.alpha = gltfAlpha(
             float(unit(pbr.roughnessFactor, at + "/pbrMetallicRoughness/roughnessFactor")));
         if (pbr.baseColorTexture.index >= 0) baseColourTexture(pbr.baseColorTexture, s, at, name);
+        if (mat.alphaMode == "MASK") readCutout(mat, s, at, name);
         if (pbr.metallicRoughnessTexture.index >= 0)
             warn(name + ": its metallicRoughnessTexture is not rendered yet (its factors are)");
         if (mat.normalTexture.index >= 0)
@@ -533,8 +534,8 @@ class GltfReader {
             warn(name + ": its emissiveTexture is not rendered yet (its emissiveFactor is)");
         if (mat.alphaMode == "BLEND")
             warn(name + ": alphaMode BLEND is not rendered (it is drawn opaque)");
-        else if (mat.alphaMode == "MASK")
-            warn(name + ": alphaMode MASK is not rendered yet (it is drawn opaque)");
+        else if (mat.alphaMode != "OPAQUE" && mat.alphaMode != "MASK")
+            fail(at + "/alphaMode", "must be OPAQUE, MASK or BLEND");
         double strength = 1.0;
         if (const auto e = mat.extensions.find("KHR_materials_emissive_strength");
             e != mat.extensions.end() && e->second.Has("emissiveStrength")) {
@@ -564,11 +565,54 @@ class GltfReader {
     // The base colour's image, times the factor: Layered(upper: image, lower: 0, mask: factor).
     void baseColourTexture(const tinygltf::TextureInfo& info, Shader& s, const std::string& at,
                            const std::string& name) {
+        Texture picture = imageTexture(info, at + "/pbrMetallicRoughness/baseColorTexture",
+                                       name + ": its baseColorTexture");
+        Texture zero{};
+        zero.colour = vec3(0.0f);
+        Texture factor{};
+        factor.colour = s.params.colour;
+        const int base = int(scene_.textures.size());
+        scene_.textures.push_back(picture);
+        scene_.textures.push_back(zero);
+        scene_.textures.push_back(factor);
+        Texture layered{};
+        layered.type = TextureType::Layered;
+        layered.upper = base, layered.lower = base + 1, layered.mask = base + 2;
+        scene_.textures.push_back(layered);
+        s.texture = base + 3;
+        s.params.flags |= kShaderTextured;
+    }
+
+    // alphaMode MASK: a cut-out where baseColorFactor's alpha times the base colour image's
+    // alpha channel (1 where it has none) is below alphaCutoff. A factor that decides alone is
+    // no cut-out at all (at least the cutoff) or hides the whole surface.
+    void readCutout(const tinygltf::Material& mat, Shader& s, const std::string& at,
+                    const std::string& name) {
+        const tinygltf::PbrMetallicRoughness& pbr = mat.pbrMetallicRoughness;
+        Cutout& c = s.cutout;
+        c.alpha = float(unit(pbr.baseColorFactor[3], at + "/pbrMetallicRoughness/baseColorFactor"));
+        c.cutoff = float(mat.alphaCutoff);
+        if (!(c.cutoff >= 0.0f) || !std::isfinite(mat.alphaCutoff))
+            fail(at + "/alphaCutoff", "must be a non-negative number");
+        if (pbr.baseColorTexture.index >= 0) {
+            Texture alpha =
+                imageTexture(pbr.baseColorTexture, at + "/pbrMetallicRoughness/baseColorTexture",
+                             name + ": its baseColorTexture");
+            alpha.channel = 3;
+            alpha.linear = true;
+            c.texture = int(scene_.textures.size());
+            scene_.textures.push_back(alpha);
+        }
+        c.enabled = c.texture >= 0 || c.alpha < c.cutoff;
+    }
+
+    // A texture reference's image, as a Standard texture with its KHR_texture_transform: read
+    // from memory where the file embeds it (checked readable now), else from beside the file.
+    Texture imageTexture(const tinygltf::TextureInfo& info, const std::string& where,
+                         const std::string& what) {
         const int index = info.index;
-        const std::string where = at + "/pbrMetallicRoughness/baseColorTexture";
         if (info.texCoord != 0)
-            warn(name + ": its baseColorTexture's texCoord " + std::to_string(info.texCoord) +
-                 " is read as TEXCOORD_0");
+            warn(what + "'s texCoord " + std::to_string(info.texCoord) + " is read as TEXCOORD_0");
         if (index >= int(model_.textures.size()))
             fail(where, "names texture " + std::to_string(index) + " of " +
                             std::to_string(model_.textures.size()));
@@ -600,21 +644,8 @@ class GltfReader {
                      "'" + picture.path + "' is not an image OpenImageIO can read");
             in->close();
         }
-        Texture zero{};
-        zero.colour = vec3(0.0f);
-        Texture factor{};
-        factor.colour = s.params.colour;
         readTextureTransform(info, where, picture);
-        const int base = int(scene_.textures.size());
-        scene_.textures.push_back(picture);
-        scene_.textures.push_back(zero);
-        scene_.textures.push_back(factor);
-        Texture layered{};
-        layered.type = TextureType::Layered;
-        layered.upper = base, layered.lower = base + 1, layered.mask = base + 2;
-        scene_.textures.push_back(layered);
-        s.texture = base + 3;
-        s.params.flags |= kShaderTextured;
+        return picture;
     }
 
     // KHR_texture_transform on a texture reference: T(offset) R(rotation) S(scale) of glTF's

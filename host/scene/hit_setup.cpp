@@ -66,14 +66,7 @@ void HitSetup::textureQuery(const HitRecord& h, vec3 dir, uint cone, const Surfa
         if (worldArea > 0.0f)
             footprint = coneWidthAt(cone, h.t) / cosine * std::sqrt(uvArea / worldArea);
     }
-    uv = uvAt(h.mesh, h.prim, h.u, h.v);
-}
-
-vec2 HitSetup::uvAt(uint meshIndex, uint prim, float u, float v) const {
-    const Mesh& mesh = src_.meshes[meshIndex];
-    if (mesh.uvs.empty()) return vec2(0.0f);
-    const uvec3 tri = mesh.triangles[prim];
-    return (1.0f - u - v) * mesh.uvs[tri.x] + u * mesh.uvs[tri.y] + v * mesh.uvs[tri.z];
+    uv = mesh.uvAt(h.prim, h.u, h.v);
 }
 
 } // namespace spw

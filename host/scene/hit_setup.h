@@ -58,8 +58,6 @@ class HitSetup {
   private:
     // World-space hit for (mesh, triangle, Embree's u, v) at distance t; albedo left at 0.
     void surfaceHit(uint meshIndex, uint prim, float u, float v, float t, SurfaceHit& hit) const;
-    // Interpolated texture coordinates (0, 0 when the mesh has none).
-    vec2 uvAt(uint meshIndex, uint prim, float u, float v) const;
 
     const Scene& src_;
     const SceneLights& lights_;

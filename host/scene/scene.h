@@ -116,13 +116,31 @@ struct Texture {
     bool uvTransformed = false;
     mat3 uvTransform{1.0f};
     float footprintScale = 1.0f;
+    // Standard: the image's channels read, from `channel` on (3: alpha alone); where the image
+    // has no such channel, the value is 1 (glTF: an image without alpha is opaque).
+    int channel = 0;
+    // Standard: the values as stored, never sRGB-decoded (glTF's alpha, normal and
+    // metallic-roughness images); otherwise 8-bit images are taken to be sRGB.
+    bool linear = false;
     int upper = -1, lower = -1, mask = -1; // Layered: indices into Scene::textures
     int line = 0;                          // where the scene file defines it
+};
+
+// An alpha cut-out (glTF's alphaMode MASK): the surface is there only where its alpha, `alpha`
+// times the first channel of the texture tree `texture` (or alone, -1), is at least `cutoff`.
+// Elsewhere rays pass through it, camera, bounce and shadow rays alike (the BVH's hit filter,
+// host/scene/cutouts.h).
+struct Cutout {
+    bool enabled = false;
+    float alpha = 1.0f;
+    int texture = -1;
+    float cutoff = 0.5f;
 };
 
 struct Shader {
     ShaderParams params{};
     int texture = -1; // root of the texture tree, or -1
+    Cutout cutout;
     std::string typeName;
     int line = 0;
 };
@@ -137,6 +155,14 @@ struct Mesh {
     int shader = 0;
     std::string name;         // the file, or "quad light N"
     int droppedTriangles = 0; // zero-area triangles left out when loading
+
+    // Texture coordinates interpolated at Embree's barycentrics (u, v) of triangle `prim`;
+    // (0, 0) where the mesh has none.
+    vec2 uvAt(uint prim, float u, float v) const {
+        if (uvs.empty()) return vec2(0.0f);
+        const uvec3 tri = triangles[prim];
+        return (1.0f - u - v) * uvs[tri.x] + u * uvs[tri.y] + v * uvs[tri.z];
+    }
 };
 
 // A punctual light of an emitter kind that takes a position or a direction

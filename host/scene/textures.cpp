@@ -34,8 +34,10 @@ struct TextureResolver::Impl {
     struct Image {
         OIIO::ImageCache::ImageHandle* handle = nullptr;
         bool srgb = false;
-        bool eightBit = false; // its texels are 8-bit integers (the wide filter reads those)
-        int channels = 3;
+        bool eightBit = false;     // its texels are 8-bit integers (the wide filter reads those)
+        int channels = 3;          // from Texture::channel on
+        int firstChannel = 0;      // Texture::channel
+        bool absent = false;       // the image has no channel Texture::channel: every value is 1
         float finest = 1.0f;       // the finest level's larger side, texels
         std::vector<Level> levels; // finest first
         size_t firstHeld = 0;      // its levels' slots in ThreadState::held
@@ -250,10 +252,12 @@ class TexelReader {
         const Held& h = held_[size_t(levelIndex)];
         TexelTile tile;
         if (!h.tile || h.type != OIIO::TypeDesc::UINT8) return tile;
-        tile.pixels = h.pixels;
+        // The channels read start Texture::channel bytes into each texel.
+        tile.pixels = h.pixels + image_.firstChannel;
         tile.x0 = h.x0, tile.y0 = h.y0, tile.x1 = h.x1, tile.y1 = h.y1;
         tile.pixelBytes = int(h.pixelBytes), tile.rowBytes = int(h.rowBytes);
-        tile.bytes = int(h.bytes()), tile.channels = std::min(image_.channels, 3);
+        tile.bytes = int(h.bytes()) - image_.firstChannel;
+        tile.channels = std::min(image_.channels, 3);
         tile.decode = image_.srgb ? srgbTable().data() : linearTable().data();
         return tile;
     }
@@ -333,11 +337,13 @@ class TexelReader {
         return decode(h, h.at(x, y));
     }
 
-    // The pixel at p as linear values: its first three channels (a one-channel image's value
-    // in all three), 8- and 16-bit integers in [0, 1], sRGB-encoded images linearised per texel,
-    // before filtering (8-bit ones through a table). The cache keeps 8- and 16-bit integers,
-    // half and float as they are in the file, and anything else as float.
-    vec3 decode(const Held& h, const unsigned char* p) const {
+    // The pixel at p as linear values: its channels from Texture::channel on, up to three (a
+    // one-channel image's value in all three), 8- and 16-bit integers in [0, 1], sRGB-encoded
+    // images linearised per texel, before filtering (8-bit ones through a table). The cache
+    // keeps 8- and 16-bit integers, half and float as they are in the file, and anything else as
+    // float.
+    vec3 decode(const Held& h, const unsigned char* texel) const {
+        const unsigned char* p = texel + size_t(image_.firstChannel) * channelBytes(h.type);
         float v[3] = {0.0f, 0.0f, 0.0f};
         const int nc = std::min(image_.channels, 3);
         if (h.type == OIIO::TypeDesc::UINT8) {
@@ -369,6 +375,12 @@ class TexelReader {
             return t;
         }();
         return table;
+    }
+
+    static size_t channelBytes(OIIO::TypeDesc::BASETYPE type) {
+        return type == OIIO::TypeDesc::UINT8                                    ? 1
+               : type == OIIO::TypeDesc::UINT16 || type == OIIO::TypeDesc::HALF ? 2
+                                                                                : 4;
     }
 
     // Channel c of a pixel of a format other than 8-bit.
@@ -419,12 +431,12 @@ void visit(const Scene& scene, int t, std::vector<int>& slotOf, std::vector<int>
 TextureResolver::TextureResolver(const Scene& scene, double cacheMiB, bool filtered, bool wide)
     : scene_(scene) {
     programs_.resize(scene.textures.size());
-    for (const Shader& sh : scene.shaders) {
-        if (sh.texture < 0 || !programs_[size_t(sh.texture)].empty()) continue;
+    auto compile = [&](int root) {
+        if (root < 0 || !programs_[size_t(root)].empty()) return;
         // The loader bounds the depth (kMaxTextureDepth), so this recursion is bounded too.
         std::vector<int> slotOf(scene.textures.size(), -1), order;
-        visit(scene, sh.texture, slotOf, order);
-        std::vector<Op>& program = programs_[size_t(sh.texture)];
+        visit(scene, root, slotOf, order);
+        std::vector<Op>& program = programs_[size_t(root)];
         for (int t : order) {
             const Texture& tex = scene.textures[size_t(t)];
             Op op{tex.type, t, -1, -1, -1};
@@ -433,6 +445,10 @@ TextureResolver::TextureResolver(const Scene& scene, double cacheMiB, bool filte
                 op.mask = slotOf[size_t(tex.mask)];
             program.push_back(op);
         }
+    };
+    for (const Shader& sh : scene.shaders) {
+        compile(sh.texture);
+        if (sh.cutout.enabled) compile(sh.cutout.texture);
     }
     int standard = 0;
     for (const Texture& t : scene.textures)
@@ -471,10 +487,13 @@ TextureResolver::TextureResolver(const Scene& scene, double cacheMiB, bool filte
         if (!spec || spec->width < 1 || spec->height < 1)
             throw std::runtime_error("cannot read texture '" + t.path +
                                      "': " + impl_->cache->geterror());
-        img.channels = spec->nchannels;
+        img.firstChannel = std::max(t.channel, 0);
+        img.absent = img.firstChannel >= spec->nchannels;
+        img.channels = img.absent ? 1 : spec->nchannels - img.firstChannel;
         img.eightBit = spec->format == OIIO::TypeDesc::UINT8;
         std::string cs = spec->get_string_attribute("oiio:ColorSpace");
-        img.srgb = cs == "sRGB" || (cs.empty() && spec->format == OIIO::TypeDesc::UINT8);
+        img.srgb =
+            !t.linear && (cs == "sRGB" || (cs.empty() && spec->format == OIIO::TypeDesc::UINT8));
         img.finest = float(std::max(spec->width, spec->height));
         // Its MIP levels, as many as the file has (an image without them is its own only level).
         for (int level = 0; level < int(kMaxLevels); ++level) {
@@ -551,7 +570,20 @@ void TextureResolver::albedos(const Shader& shader, size_t n, const vec2* uv,
             out[k] = p.colour * p.reflectance;
         return;
     }
-    const std::vector<Op>& program = programs_[size_t(shader.texture)];
+    const vec3* root = evaluate(shader.texture, n, uv, footprint);
+    for (size_t k = 0; k < n; ++k)
+        out[k] = root[k] * p.reflectance;
+}
+
+void TextureResolver::values(int tree, size_t n, const vec2* uv, const float* footprint,
+                             vec3* out) const {
+    const vec3* root = evaluate(tree, n, uv, footprint);
+    std::copy(root, root + n, out);
+}
+
+const vec3* TextureResolver::evaluate(int tree, size_t n, const vec2* uv,
+                                      const float* footprint) const {
+    const std::vector<Op>& program = programs_[size_t(tree)];
     Impl::ThreadState* thread = impl_ ? &impl_->thread() : nullptr;
     // Every node's values for every hit: nodes x hits, in a per-thread buffer.
     thread_local std::vector<vec3> values;
@@ -569,6 +601,10 @@ void TextureResolver::albedos(const Shader& shader, size_t n, const vec2* uv,
         case TextureType::Standard: {
             // OBJ's v grows upwards, image rows downwards. The footprint is isotropic.
             const Texture& tex = scene_.textures[size_t(op.texture)];
+            if (impl_->images[size_t(op.texture)].absent) {
+                std::fill(v, v + n, vec3(1.0f));
+                break;
+            }
             const vec2* at = uv;
             const float* width = footprint;
             if (tex.uvTransformed) {
@@ -596,9 +632,7 @@ void TextureResolver::albedos(const Shader& shader, size_t n, const vec2* uv,
         }
         }
     }
-    const vec3* root = &values[(program.size() - 1) * n];
-    for (size_t k = 0; k < n; ++k)
-        out[k] = root[k] * p.reflectance;
+    return &values[(program.size() - 1) * n];
 }
 
 } // namespace spw

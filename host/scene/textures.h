@@ -54,6 +54,10 @@ class TextureResolver {
     // would switch file every time.
     void albedos(const Shader& shader, size_t n, const vec2* uv, const float* footprint,
                  vec3* out) const;
+    // The values of the texture tree rooted at Scene::textures[tree] (one a shader uses: its
+    // colour's or its cut-out's) for n lookups, as albedos() evaluates them; footprint null:
+    // the finest level. Thread-safe.
+    void values(int tree, size_t n, const vec2* uv, const float* footprint, vec3* out) const;
     // True when the scene has image textures (OpenImageIO is in use).
     bool active() const { return impl_ != nullptr; }
     // Throws SceneError (the texture's file and scene line) if an image lookup failed since the
@@ -73,6 +77,9 @@ class TextureResolver {
         int texture;            // index into Scene::textures
         int upper, lower, mask; // Layered: operand slots
     };
+    // The tree's values for n lookups, in a per-thread buffer that the next call reuses.
+    const vec3* evaluate(int tree, size_t n, const vec2* uv, const float* footprint) const;
+
     const Scene& scene_;
     std::vector<std::vector<Op>> programs_; // per Scene::textures root used by a shader
     std::unique_ptr<Impl> impl_;

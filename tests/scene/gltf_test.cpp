@@ -525,3 +525,125 @@ TEST(Gltf, TextureTransformMovesTheLookups) {
 
 } // namespace
 } // namespace spw::test
+
+namespace spw::test {
+namespace {
+
+// A white floor (4 x 4) lit by a directional light slanting down, seen from above; and, unless
+// `veil` is null, a unit quad of material `veil` between them (z = 1), which hides part of the
+// floor from the camera and shadows another part. `image`: the veil's base colour image.
+struct Veiled {
+    std::vector<float> image;
+    nlohmann::json stats;
+};
+Veiled renderVeiled(const TempDir& dir, const json& veil, BackendKind backend,
+                    const std::string& image = "") {
+    GltfBuilder b;
+    b.doc["materials"] = json::array({material(vec3(0.8f), 0.0f, 1.0f)});
+    b.doc["extensionsUsed"] = {"KHR_lights_punctual"};
+    b.doc["extensions"]["KHR_lights_punctual"]["lights"] =
+        json::array({{{"type", "directional"}, {"intensity", 2000.0}}});
+    b.doc["cameras"] =
+        json::array({{{"type", "perspective"},
+                      {"perspective", {{"yfov", 0.6}, {"aspectRatio", 1.0}, {"znear", 0.1}}}}});
+    std::vector<int> nodes = {
+        b.node(
+            {{"mesh", b.mesh(b.quad(0))}, {"scale", {4, 4, 4}}, {"translation", {-1.5, -1.5, 0}}}),
+        b.node({{"camera", 0}, {"translation", {0.5, 0.5, 5}}}),
+        // Down, slanting toward +x: the veil's shadow lies half a unit aside, partly in view.
+        b.node({{"rotation", {0, -0.2297529, 0, 0.9732489}},
+                {"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}})};
+    if (!veil.is_null()) {
+        b.doc["materials"].push_back(veil);
+        if (!image.empty()) {
+            b.doc["textures"] = json::array({{{"source", 0}}});
+            b.doc["images"] = json::array({{{"uri", image}}});
+        }
+        nodes.push_back(b.node({{"mesh", b.mesh(b.quad(1))}, {"translation", {0, 0, 1}}}));
+    }
+    b.scene(nodes);
+    Scene scene = loadScene(b.embedded(dir, "veiled.gltf"));
+    scene.image.width = scene.image.height = 24;
+    RenderConfig cfg;
+    cfg.backend = backend;
+    cfg.spp = 4;
+    const std::unique_ptr<RenderResult> r = render(scene, cfg);
+    return {r->film->image(), r->stats.extra};
+}
+
+// The veil's material: blue, its alpha mode, base colour alpha and image.
+json veilMaterial(const char* mode, float alpha = 1.0f, bool textured = false) {
+    json m = material(vec3(0.2f, 0.4f, 0.8f), 0.0f, 0.5f);
+    m["alphaMode"] = mode;
+    m["pbrMetallicRoughness"]["baseColorFactor"][3] = alpha;
+    if (textured) m["pbrMetallicRoughness"]["baseColorTexture"] = {{"index", 0}};
+    return m;
+}
+
+// An RGBA image: white, its alpha `left` in the left half and `right` in the right half.
+void writeAlphaImage(const std::string& path, float left, float right, int channels = 4) {
+    OIIO::ImageBuf img(OIIO::ImageSpec(16, 4, channels, OIIO::TypeDesc::UINT8));
+    const float a[4] = {1.0f, 1.0f, 1.0f, left}, c[4] = {1.0f, 1.0f, 1.0f, right};
+    OIIO::ImageBufAlgo::fill(img, a, OIIO::ROI(0, 8, 0, 4, 0, 1, 0, channels));
+    OIIO::ImageBufAlgo::fill(img, c, OIIO::ROI(8, 16, 0, 4, 0, 1, 0, channels));
+    ASSERT_TRUE(img.write(path));
+}
+
+// The mean of columns [x0, x1) of a 24 x 24 image.
+double columnsMean(const std::vector<float>& img, int x0, int x1) {
+    double sum = 0;
+    for (int y = 0; y < 24; ++y)
+        for (int x = x0; x < x1; ++x)
+            for (int c = 0; c < 3; ++c)
+                sum += img[size_t(y * 24 + x) * 3 + size_t(c)];
+    return sum / (24.0 * (x1 - x0) * 3.0);
+}
+
+// alphaMode MASK: where the base colour's alpha (factor times image) is below alphaCutoff, the
+// surface is not there, for camera, bounce and shadow rays alike, on every backend. A veil that
+// is all hole renders bit for bit the scene without it, its shadow gone too; one with no hole,
+// the opaque veil; an image without alpha is opaque; an image half hole shows the floor in that
+// half. Meshes without a cut-out get no filter.
+TEST(Gltf, AlphaMaskCutsHolesForCameraBounceAndShadowRays) {
+    TempDir dir;
+    writeAlphaImage(dir.file("holes.png"), 0.0f, 0.0f);
+    writeAlphaImage(dir.file("solid.png"), 1.0f, 1.0f);
+    writeAlphaImage(dir.file("rgb.png"), 1.0f, 1.0f, 3);
+    writeAlphaImage(dir.file("half.png"), 0.0f, 1.0f);
+    for (BackendKind backend : {BackendKind::Reference, BackendKind::Cpu, BackendKind::Vulkan}) {
+        SCOPED_TRACE(backendName(backend));
+        const Veiled bare = renderVeiled(dir, json(), backend);
+        const Veiled opaque = renderVeiled(dir, veilMaterial("OPAQUE"), backend);
+        const Veiled opaqueImage =
+            renderVeiled(dir, veilMaterial("OPAQUE", 1.0f, true), backend, "solid.png");
+        EXPECT_FALSE(opaque.stats.contains("cutout_meshes"));
+        EXPECT_NE(bare.image, opaque.image); // the veil and its shadow are seen
+        // The factor alone: at least the cutoff is no cut-out; below it, no veil.
+        const Veiled kept = renderVeiled(dir, veilMaterial("MASK", 0.5f), backend);
+        EXPECT_EQ(kept.image, opaque.image);
+        EXPECT_FALSE(kept.stats.contains("cutout_meshes"));
+        const Veiled gone = renderVeiled(dir, veilMaterial("MASK", 0.3f), backend);
+        EXPECT_EQ(gone.image, bare.image);
+        EXPECT_EQ(gone.stats.value("cutout_meshes", 0), 1);
+        // The image's alpha: all hole, none, or no alpha channel at all (opaque).
+        EXPECT_EQ(renderVeiled(dir, veilMaterial("MASK", 1.0f, true), backend, "holes.png").image,
+                  bare.image);
+        EXPECT_EQ(renderVeiled(dir, veilMaterial("MASK", 1.0f, true), backend, "solid.png").image,
+                  opaqueImage.image);
+        EXPECT_EQ(renderVeiled(dir, veilMaterial("MASK", 1.0f, true), backend, "rgb.png").image,
+                  opaqueImage.image);
+        // Half a hole: the veil's left half (image columns 7-10) shows the floor as the bare
+        // scene does, its right half (14-17) is the opaque veil.
+        const Veiled half =
+            renderVeiled(dir, veilMaterial("MASK", 1.0f, true), backend, "half.png");
+        EXPECT_NEAR(columnsMean(half.image, 7, 11), columnsMean(bare.image, 7, 11),
+                    0.02 * columnsMean(bare.image, 7, 11));
+        EXPECT_NEAR(columnsMean(half.image, 14, 18), columnsMean(opaqueImage.image, 14, 18),
+                    0.02 * columnsMean(opaqueImage.image, 14, 18));
+        EXPECT_GT(std::fabs(columnsMean(bare.image, 7, 11) - columnsMean(opaque.image, 7, 11)),
+                  0.1 * columnsMean(bare.image, 7, 11));
+    }
+}
+
+} // namespace
+} // namespace spw::test
