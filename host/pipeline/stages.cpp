@@ -198,9 +198,9 @@ constexpr size_t kChunk = 128;
 static_assert(kChunk <= 256, "chunk indices are bytes");
 
 // Hit setup of the sorted hits order[0, n), n <= kChunk, into in[0, n): each hit's geometry and
-// path, then the albedos, a run of hits of one shader at a time, texture by texture
-// (TextureResolver::albedos: the same values as one hit at a time, bit for bit). Hits that end
-// their path (max depth) get no albedo: shading never reads it there.
+// path, then the albedos (and normal maps), a run of hits of one shader at a time, texture by
+// texture (TextureResolver::albedos: the same values as one hit at a time, bit for bit). Hits that
+// end their path (max depth) get no albedo: shading never reads it there.
 void setUpChunk(const RenderContext& ctx, const std::vector<RayState>& rays,
                 const std::vector<HitRecord>& hits, const SortedHit* order, size_t n,
                 ShadeInput* in) {
@@ -223,7 +223,7 @@ void setUpChunk(const RenderContext& ctx, const std::vector<RayState>& rays,
         x.pad0 = 0.0f;
         if (ray.path.bounce >= ctx.params.maxDepth) continue;
         const Shader& shader = ctx.scene.shaders[x.hit.shader];
-        if (shader.texture < 0) {
+        if (shader.texture < 0 && shader.normalTexture < 0) {
             x.hit.albedo = ctx.textures.albedo(shader, vec2(0.0f), 0.0f);
             continue;
         }
@@ -235,9 +235,16 @@ void setUpChunk(const RenderContext& ctx, const std::vector<RayState>& rays,
         size_t b = a + 1;
         while (b < m && in[slot[b]].hit.shader == shader)
             ++b;
-        ctx.textures.albedos(ctx.scene.shaders[shader], b - a, uv + a, footprint + a, albedo + a);
+        const Shader& sh = ctx.scene.shaders[shader];
+        ctx.textures.albedos(sh, b - a, uv + a, footprint + a, albedo + a);
         for (size_t j = a; j < b; ++j)
             in[slot[j]].hit.albedo = albedo[j];
+        if (sh.normalTexture >= 0) {
+            ctx.textures.values(sh.normalTexture, b - a, uv + a, footprint + a, albedo + a);
+            for (size_t j = a; j < b; ++j)
+                ctx.hitSetup.tiltNormal(hits[order[slot[j]].index], albedo[j], sh.normalScale,
+                                        in[slot[j]].hit);
+        }
         a = b;
     }
 }

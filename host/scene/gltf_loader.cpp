@@ -411,6 +411,9 @@ class GltfReader {
                 }
             }
         }
+        if (prim.attributes.count("TANGENT"))
+            warn("TANGENT attributes are not read: normal maps take tangents made from the "
+                 "texture coordinates, triangle by triangle");
         if (const auto t = prim.attributes.find("TEXCOORD_0"); t != prim.attributes.end()) {
             const std::vector<double> uv =
                 readAccessor(t->second, 2, at + "/attributes/TEXCOORD_0");
@@ -526,8 +529,16 @@ class GltfReader {
         if (mat.alphaMode == "MASK") readCutout(mat, s, at, name);
         if (pbr.metallicRoughnessTexture.index >= 0)
             warn(name + ": its metallicRoughnessTexture is not rendered yet (its factors are)");
-        if (mat.normalTexture.index >= 0)
-            warn(name + ": its normalTexture is not rendered yet (the mesh's normals are)");
+        if (mat.normalTexture.index >= 0) {
+            Texture normals = imageTexture(mat.normalTexture, at + "/normalTexture",
+                                           name + ": its normalTexture");
+            normals.linear = true;
+            s.normalTexture = int(scene_.textures.size());
+            scene_.textures.push_back(normals);
+            s.normalScale = float(mat.normalTexture.scale);
+            if (!std::isfinite(s.normalScale) || std::fabs(s.normalScale) > 1e3f)
+                fail(at + "/normalTexture/scale", "must be a finite number of at most 1000");
+        }
         if (mat.occlusionTexture.index >= 0)
             warn(name + ": its occlusionTexture is ignored (a path tracer finds occlusion itself)");
         if (mat.emissiveTexture.index >= 0)
@@ -608,8 +619,8 @@ class GltfReader {
 
     // A texture reference's image, as a Standard texture with its KHR_texture_transform: read
     // from memory where the file embeds it (checked readable now), else from beside the file.
-    Texture imageTexture(const tinygltf::TextureInfo& info, const std::string& where,
-                         const std::string& what) {
+    template <class Info> // tinygltf::TextureInfo, NormalTextureInfo
+    Texture imageTexture(const Info& info, const std::string& where, const std::string& what) {
         const int index = info.index;
         if (info.texCoord != 0)
             warn(what + "'s texCoord " + std::to_string(info.texCoord) + " is read as TEXCOORD_0");
@@ -650,8 +661,8 @@ class GltfReader {
 
     // KHR_texture_transform on a texture reference: T(offset) R(rotation) S(scale) of glTF's
     // texture coordinates, written for Spillway's (v = 1 - glTF's v) as F M F, F that flip.
-    void readTextureTransform(const tinygltf::TextureInfo& info, const std::string& where,
-                              Texture& picture) {
+    template <class Info>
+    void readTextureTransform(const Info& info, const std::string& where, Texture& picture) {
         const auto e = info.extensions.find("KHR_texture_transform");
         if (e == info.extensions.end()) return;
         const std::string at = where + "/extensions/KHR_texture_transform";

@@ -37,7 +37,7 @@ void HitSetup::setUpHit(const HitRecord& h, vec3 dir, uint cone, const TextureRe
     surfaceHit(h.mesh, h.prim, h.u, h.v, h.t, hit);
     if (!albedo) return;
     const Shader& shader = src_.shaders[hit.shader];
-    if (shader.texture < 0) {
+    if (shader.texture < 0 && shader.normalTexture < 0) {
         hit.albedo = textures.albedo(shader, vec2(0.0f), 0.0f);
         return;
     }
@@ -45,6 +45,35 @@ void HitSetup::setUpHit(const HitRecord& h, vec3 dir, uint cone, const TextureRe
     float footprint;
     textureQuery(h, dir, cone, hit, uv, footprint);
     hit.albedo = textures.albedo(shader, uv, footprint);
+    if (shader.normalTexture >= 0) {
+        vec3 texel;
+        textures.values(shader.normalTexture, 1, &uv, &footprint, &texel);
+        tiltNormal(h, texel, shader.normalScale, hit);
+    }
+}
+
+void HitSetup::tiltNormal(const HitRecord& h, vec3 texel, float scale, SurfaceHit& hit) const {
+    const Mesh& mesh = src_.meshes[h.mesh];
+    if (mesh.uvs.empty()) return;
+    const uvec3 tri = mesh.triangles[h.prim];
+    const vec3 e1 = mesh.positions[tri.y] - mesh.positions[tri.x],
+               e2 = mesh.positions[tri.z] - mesh.positions[tri.x];
+    const vec2 d1 = mesh.uvs[tri.y] - mesh.uvs[tri.x], d2 = mesh.uvs[tri.z] - mesh.uvs[tri.x];
+    const float det = d1.x * d2.y - d2.x * d1.y;
+    if (!(std::fabs(det) > 0.0f)) return;
+    // dp/du and dp/dv of the triangle's texture mapping.
+    const vec3 dpdu = (e1 * d2.y - e2 * d1.y) / det, dpdv = (e2 * d1.x - e1 * d2.x) / det;
+    const vec3 n = hit.ns;
+    const vec3 t = dpdu - n * glm::dot(n, dpdu);
+    const float tLength = glm::length(t);
+    if (!(tLength > 0.0f) || !std::isfinite(tLength)) return;
+    const vec3 tangent = t / tLength;
+    vec3 bitangent = glm::cross(n, tangent);
+    if (glm::dot(bitangent, dpdv) < 0.0f) bitangent = -bitangent; // a mirrored mapping
+    const vec3 local = (2.0f * texel - 1.0f) * vec3(scale, scale, 1.0f);
+    const vec3 tilted = tangent * local.x + bitangent * local.y + n * local.z;
+    const float length = glm::length(tilted);
+    if (length > 0.0f && std::isfinite(length)) hit.ns = tilted / length;
 }
 
 void HitSetup::textureQuery(const HitRecord& h, vec3 dir, uint cone, const SurfaceHit& hit,

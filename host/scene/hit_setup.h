@@ -39,6 +39,12 @@ class HitSetup {
     }
     void textureQuery(const HitRecord& h, vec3 dir, uint cone, const SurfaceHit& hit, vec2& uv,
                       float& footprint) const;
+    // The shading normal tilted by a tangent-space normal map's value `texel` (linear, [0, 1]
+    // per channel): to (2 texel - 1), its x and y times `scale`, in the frame the triangle's
+    // texture coordinates make (x: growing u, y: growing v), made orthonormal about the
+    // interpolated normal (Gram-Schmidt), z along it. Left as it was where the triangle has no
+    // texture frame or the tilted normal is degenerate.
+    void tiltNormal(const HitRecord& h, vec3 texel, float scale, SurfaceHit& hit) const;
     // What setUpGeometry will read, asked for ahead by a caller that knows many hits before it
     // sets them up: first the triangle's vertex indices, then (reading those) its vertices and
     // vertex normals. On a mesh larger than the caches each is a miss that the depth-first

@@ -141,6 +141,11 @@ struct Shader {
     ShaderParams params{};
     int texture = -1; // root of the texture tree, or -1
     Cutout cutout;
+    // A tangent-space normal map (glTF's normalTexture), or -1: its texel t tilts the shading
+    // normal to (2 t - 1) (x and y times normalScale) in the frame of the triangle's texture
+    // coordinates (HitSetup::tiltNormal).
+    int normalTexture = -1;
+    float normalScale = 1.0f;
     std::string typeName;
     int line = 0;
 };

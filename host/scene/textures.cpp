@@ -448,6 +448,7 @@ TextureResolver::TextureResolver(const Scene& scene, double cacheMiB, bool filte
     };
     for (const Shader& sh : scene.shaders) {
         compile(sh.texture);
+        compile(sh.normalTexture);
         if (sh.cutout.enabled) compile(sh.cutout.texture);
     }
     int standard = 0;

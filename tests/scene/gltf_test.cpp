@@ -647,3 +647,100 @@ TEST(Gltf, AlphaMaskCutsHolesForCameraBounceAndShadowRays) {
 
 } // namespace
 } // namespace spw::test
+
+namespace spw::test {
+namespace {
+
+// A unit quad in z = 0 under a slanting directional light, filling the view: with normals
+// `normal` everywhere, and a normal map of one texel value `image` unless it is empty. `turned`:
+// its texture coordinates a quarter turn round (u along +y, v along -x), so the generated
+// tangent frame turns with them. The image's mean.
+double tiltedQuadMean(const TempDir& dir, vec3 normal, const std::string& image, float scale,
+                      bool turned, BackendKind backend) {
+    GltfBuilder b;
+    json mat = material(vec3(0.8f), 0.0f, 0.5f);
+    if (!image.empty()) {
+        mat["normalTexture"] = {{"index", 0}, {"scale", scale}};
+        b.doc["textures"] = json::array({{{"source", 0}}});
+        b.doc["images"] = json::array({{{"uri", image}}});
+    }
+    b.doc["materials"] = json::array({mat});
+    const int pos = b.accessor<float>({0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0}, 5126, "VEC3");
+    std::vector<float> normals;
+    for (int i = 0; i < 4; ++i)
+        normals.insert(normals.end(), {normal.x, normal.y, normal.z});
+    const int nor = b.accessor<float>(normals, 5126, "VEC3");
+    // glTF's v runs down: (u, 1 - v) is Spillway's.
+    const int uv = b.accessor<float>(turned ? std::vector<float>{0, 0, 0, 1, 1, 1, 1, 0}
+                                            : std::vector<float>{0, 1, 1, 1, 1, 0, 0, 0},
+                                     5126, "VEC2");
+    const int idx = b.accessor<uint16_t>({0, 1, 2, 0, 2, 3}, 5123, "SCALAR");
+    const json prim = {{"attributes", {{"POSITION", pos}, {"NORMAL", nor}, {"TEXCOORD_0", uv}}},
+                       {"indices", idx},
+                       {"material", 0}};
+    b.doc["extensionsUsed"] = {"KHR_lights_punctual"};
+    b.doc["extensions"]["KHR_lights_punctual"]["lights"] =
+        json::array({{{"type", "directional"}, {"intensity", 2000.0}}});
+    b.doc["cameras"] =
+        json::array({{{"type", "perspective"},
+                      {"perspective", {{"yfov", 0.25}, {"aspectRatio", 1.0}, {"znear", 0.1}}}}});
+    // The light turned from -Z to travel along (0.6, 0.3, -1).
+    const vec3 from(0, 0, -1), to = glm::normalize(vec3(0.6f, 0.3f, -1.0f));
+    const vec3 axis = glm::cross(from, to);
+    const vec4 q = glm::normalize(vec4(axis, 1.0f + glm::dot(from, to)));
+    b.scene({b.node({{"mesh", b.mesh(prim)}}),
+             b.node({{"camera", 0}, {"translation", {0.5, 0.5, 3}}}),
+             b.node({{"rotation", {q.x, q.y, q.z, q.w}},
+                     {"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}})});
+    Scene scene = loadScene(b.embedded(dir, "tilted.gltf"));
+    scene.image.width = scene.image.height = 16;
+    RenderConfig cfg;
+    cfg.backend = backend;
+    cfg.spp = 4;
+    const std::vector<float> img = render(scene, cfg)->film->image();
+    double sum = 0;
+    for (float x : img)
+        sum += x;
+    return sum / double(img.size());
+}
+
+// normalTexture: a map of one texel value tilts the shading normal as a mesh whose normals
+// are that tilt does, in the frame of the texture coordinates (turned with them), with its
+// scale, on every backend; the tilts mirrored (a flipped tangent or bitangent) do not.
+TEST(Gltf, NormalTexturesTiltTheShadingNormalInTheTextureFrame) {
+    TempDir dir;
+    const int texel[3] = {200, 90, 220};
+    {
+        OIIO::ImageBuf img(OIIO::ImageSpec(4, 4, 3, OIIO::TypeDesc::UINT8));
+        const float v[3] = {texel[0] / 255.0f, texel[1] / 255.0f, texel[2] / 255.0f};
+        OIIO::ImageBufAlgo::fill(img, v);
+        ASSERT_TRUE(img.write(dir.file("tilt.png")));
+    }
+    const vec3 local(2.0f * texel[0] / 255.0f - 1.0f, 2.0f * texel[1] / 255.0f - 1.0f,
+                     2.0f * texel[2] / 255.0f - 1.0f);
+    for (BackendKind backend : {BackendKind::Reference, BackendKind::Cpu, BackendKind::Vulkan}) {
+        SCOPED_TRACE(backendName(backend));
+        const double flat = tiltedQuadMean(dir, vec3(0, 0, 1), "", 1.0f, false, backend);
+        for (float scale : {1.0f, 0.6f})
+            for (bool turned : {false, true}) {
+                SCOPED_TRACE("scale " + std::to_string(scale) + (turned ? ", turned" : ""));
+                const vec3 n(local.x * scale, local.y * scale, local.z);
+                // Tangent and bitangent: +x and +y; turned, +y and -x.
+                const vec3 world = turned ? vec3(-n.y, n.x, n.z) : n;
+                const double mapped =
+                    tiltedQuadMean(dir, vec3(0, 0, 1), "tilt.png", scale, turned, backend);
+                const double meshed =
+                    tiltedQuadMean(dir, glm::normalize(world), "", 1.0f, turned, backend);
+                EXPECT_NEAR(mapped, meshed, 2e-3 * meshed);
+                EXPECT_GT(std::fabs(mapped - flat), 0.05 * flat);
+                for (const vec3 mirrored :
+                     {vec3(-world.x, world.y, world.z), vec3(world.x, -world.y, world.z)})
+                    EXPECT_GT(std::fabs(mapped - tiltedQuadMean(dir, glm::normalize(mirrored), "",
+                                                                1.0f, turned, backend)),
+                              0.02 * meshed);
+            }
+    }
+}
+
+} // namespace
+} // namespace spw::test
