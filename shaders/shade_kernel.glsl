@@ -123,14 +123,14 @@ ShadeInput loadInput(uint i) {
     r.hit.emitter = w[2].w;
     r.hit.albedo = uintBitsToFloat(w[3].xyz);
     r.hit.offset = uintBitsToFloat(w[3].w);
-    r.path.beta = uintBitsToFloat(w[4].xyz);
-    r.path.prevPdf = uintBitsToFloat(w[4].w);
-    r.path.pathId = w[5].x;
-    r.path.bounce = w[5].y;
-    r.path.flags = w[5].z;
-    r.path.cone = w[5].w;
-    r.rayDir = uintBitsToFloat(w[6].xyz);
-    r.pad0 = uintBitsToFloat(w[6].w);
+    r.hit.material = w[4].x;
+    r.path.beta = uintBitsToFloat(w[4].yzw);
+    r.path.prevPdf = uintBitsToFloat(w[5].x);
+    r.path.pathId = w[5].y;
+    r.path.bounce = w[5].z;
+    r.path.flags = w[5].w;
+    r.path.cone = w[6].x;
+    r.rayDir = uintBitsToFloat(w[6].yzw);
     return r;
 }
 

@@ -311,7 +311,7 @@ void fillLane(const SceneView& scene, const RenderParams& rp, const ShadeInput& 
     set(lanes.wo, k, wo);
     set(lanes.beta, k, st.beta);
     lanes.offset.v[k] = hit.offset;
-    const ShaderParams& sh = scene.shaders[hit.shader];
+    const ShaderParams sh = shaderAtHit(scene.shaders[hit.shader], hit);
     lanes.alpha.v[k] = sh.alpha;
     lanes.ior.v[k] = sh.ior;
     lanes.metallic.v[k] = sh.metallic;
@@ -451,7 +451,8 @@ void shadeHits(const SceneView& view, const RenderParams& rp, bool simd, const S
         }
         for (size_t k = 0; k < b.count; ++k) {
             const ShadeInput& hit = in[b.hitOf[k]];
-            takeLane(view.shaders[hit.hit.shader], results, k, hit, out[b.hitOf[k]]);
+            takeLane(shaderAtHit(view.shaders[hit.hit.shader], hit.hit), results, k, hit,
+                     out[b.hitOf[k]]);
         }
         b.count = 0;
     };

@@ -208,6 +208,8 @@ void setUpChunk(const RenderContext& ctx, const std::vector<RayState>& rays,
     vec2 uv[kChunk];
     float footprint[kChunk];
     vec3 albedo[kChunk];
+    const HitRecord* record[kChunk]; // the hits that look textures up, and their setups
+    SurfaceHit* hit[kChunk];
     size_t m = 0;
     for (size_t i = 0; i < n; ++i)
         ctx.hitSetup.prefetchTriangle(hits[order[i].index]);
@@ -220,10 +222,9 @@ void setUpChunk(const RenderContext& ctx, const std::vector<RayState>& rays,
         ctx.hitSetup.setUpGeometry(hits[k], x.hit);
         x.path = ray.path;
         x.rayDir = ray.dir;
-        x.pad0 = 0.0f;
         if (ray.path.bounce >= ctx.params.maxDepth) continue;
         const Shader& shader = ctx.scene.shaders[x.hit.shader];
-        if (shader.texture < 0 && shader.normalTexture < 0) {
+        if (shader.texture < 0 && shader.normalTexture < 0 && shader.metallicRoughnessTexture < 0) {
             x.hit.albedo = ctx.textures.albedo(shader, vec2(0.0f), 0.0f);
             continue;
         }
@@ -237,14 +238,12 @@ void setUpChunk(const RenderContext& ctx, const std::vector<RayState>& rays,
             ++b;
         const Shader& sh = ctx.scene.shaders[shader];
         ctx.textures.albedos(sh, b - a, uv + a, footprint + a, albedo + a);
-        for (size_t j = a; j < b; ++j)
+        for (size_t j = a; j < b; ++j) {
             in[slot[j]].hit.albedo = albedo[j];
-        if (sh.normalTexture >= 0) {
-            ctx.textures.values(sh.normalTexture, b - a, uv + a, footprint + a, albedo + a);
-            for (size_t j = a; j < b; ++j)
-                ctx.hitSetup.tiltNormal(hits[order[slot[j]].index], albedo[j], sh.normalScale,
-                                        in[slot[j]].hit);
+            record[j] = &hits[order[slot[j]].index];
+            hit[j] = &in[slot[j]].hit;
         }
+        ctx.hitSetup.applyMaps(sh, ctx.textures, b - a, uv + a, footprint + a, record + a, hit + a);
         a = b;
     }
 }

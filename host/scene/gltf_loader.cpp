@@ -523,12 +523,20 @@ class GltfReader {
                 unit(pbr.baseColorFactor[size_t(k)], at + "/pbrMetallicRoughness/baseColorFactor");
         s.params.metallic =
             float(unit(pbr.metallicFactor, at + "/pbrMetallicRoughness/metallicFactor"));
-        s.params.alpha = gltfAlpha(
-            float(unit(pbr.roughnessFactor, at + "/pbrMetallicRoughness/roughnessFactor")));
+        s.roughness =
+            float(unit(pbr.roughnessFactor, at + "/pbrMetallicRoughness/roughnessFactor"));
+        s.params.alpha = gltfAlpha(s.roughness);
         if (pbr.baseColorTexture.index >= 0) baseColourTexture(pbr.baseColorTexture, s, at, name);
         if (mat.alphaMode == "MASK") readCutout(mat, s, at, name);
-        if (pbr.metallicRoughnessTexture.index >= 0)
-            warn(name + ": its metallicRoughnessTexture is not rendered yet (its factors are)");
+        if (pbr.metallicRoughnessTexture.index >= 0) {
+            Texture mr = imageTexture(pbr.metallicRoughnessTexture,
+                                      at + "/pbrMetallicRoughness/metallicRoughnessTexture",
+                                      name + ": its metallicRoughnessTexture");
+            mr.linear = true;
+            s.metallicRoughnessTexture = int(scene_.textures.size());
+            scene_.textures.push_back(mr);
+            s.params.flags |= kShaderHitParams;
+        }
         if (mat.normalTexture.index >= 0) {
             Texture normals = imageTexture(mat.normalTexture, at + "/normalTexture",
                                            name + ": its normalTexture");

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <vector>
 
 namespace spw {
 
@@ -30,6 +31,7 @@ void HitSetup::surfaceHit(uint meshIndex, uint prim, float u, float v, float t,
     hit.emitter = lights_.emitterOf(meshIndex, prim);
     hit.albedo = vec3(0.0f);
     hit.offset = surfaceOffset(hit.p, p0, p1, p2, hit.ng);
+    hit.material = 0u;
 }
 
 void HitSetup::setUpHit(const HitRecord& h, vec3 dir, uint cone, const TextureResolver& textures,
@@ -37,7 +39,7 @@ void HitSetup::setUpHit(const HitRecord& h, vec3 dir, uint cone, const TextureRe
     surfaceHit(h.mesh, h.prim, h.u, h.v, h.t, hit);
     if (!albedo) return;
     const Shader& shader = src_.shaders[hit.shader];
-    if (shader.texture < 0 && shader.normalTexture < 0) {
+    if (shader.texture < 0 && shader.normalTexture < 0 && shader.metallicRoughnessTexture < 0) {
         hit.albedo = textures.albedo(shader, vec2(0.0f), 0.0f);
         return;
     }
@@ -45,10 +47,34 @@ void HitSetup::setUpHit(const HitRecord& h, vec3 dir, uint cone, const TextureRe
     float footprint;
     textureQuery(h, dir, cone, hit, uv, footprint);
     hit.albedo = textures.albedo(shader, uv, footprint);
+    const HitRecord* record = &h;
+    SurfaceHit* out = &hit;
+    applyMaps(shader, textures, 1, &uv, &footprint, &record, &out);
+}
+
+namespace {
+// x in [0, 1] as a 16-bit unsigned normalized integer (shared/bsdf.h's shaderAtHit reads it).
+uint unorm16(float x) {
+    return uint(std::lround(std::clamp(x, 0.0f, 1.0f) * 65535.0f));
+}
+} // namespace
+
+void HitSetup::applyMaps(const Shader& shader, const TextureResolver& textures, size_t n,
+                         const vec2* uv, const float* footprint, const HitRecord* const* hits,
+                         SurfaceHit* const* hit) const {
+    if (shader.normalTexture < 0 && shader.metallicRoughnessTexture < 0) return;
+    thread_local std::vector<vec3> texels;
+    texels.resize(n);
     if (shader.normalTexture >= 0) {
-        vec3 texel;
-        textures.values(shader.normalTexture, 1, &uv, &footprint, &texel);
-        tiltNormal(h, texel, shader.normalScale, hit);
+        textures.values(shader.normalTexture, n, uv, footprint, texels.data());
+        for (size_t k = 0; k < n; ++k)
+            tiltNormal(*hits[k], texels[k], shader.normalScale, *hit[k]);
+    }
+    if (shader.metallicRoughnessTexture >= 0) {
+        textures.values(shader.metallicRoughnessTexture, n, uv, footprint, texels.data());
+        for (size_t k = 0; k < n; ++k)
+            hit[k]->material = unorm16(shader.params.metallic * texels[k].z) |
+                               unorm16(shader.roughness * texels[k].y) << 16u;
     }
 }
 

@@ -45,6 +45,12 @@ class HitSetup {
     // interpolated normal (Gram-Schmidt), z along it. Left as it was where the triangle has no
     // texture frame or the tilted normal is degenerate.
     void tiltNormal(const HitRecord& h, vec3 texel, float scale, SurfaceHit& hit) const;
+    // What a shader's maps beyond its colour give n hits of it at uv[k] (footprints as
+    // albedos()): its normal map's tilt and its metallic-roughness image's SurfaceHit::material.
+    // hits[k] is the closest hit hit[k] was set up from.
+    void applyMaps(const Shader& shader, const TextureResolver& textures, size_t n, const vec2* uv,
+                   const float* footprint, const HitRecord* const* hits,
+                   SurfaceHit* const* hit) const;
     // What setUpGeometry will read, asked for ahead by a caller that knows many hits before it
     // sets them up: first the triangle's vertex indices, then (reading those) its vertices and
     // vertex normals. On a mesh larger than the caches each is a miss that the depth-first

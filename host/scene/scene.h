@@ -146,6 +146,11 @@ struct Shader {
     // coordinates (HitSetup::tiltNormal).
     int normalTexture = -1;
     float normalScale = 1.0f;
+    // MetallicRoughness: glTF's metallicRoughnessTexture, or -1: its texel's blue channel times
+    // params.metallic is the hit's metallic, its green times `roughness` (the factor alpha was
+    // made from) the hit's roughness, carried in SurfaceHit::material (kShaderHitParams).
+    int metallicRoughnessTexture = -1;
+    float roughness = 1.0f;
     std::string typeName;
     int line = 0;
 };

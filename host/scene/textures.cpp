@@ -449,6 +449,7 @@ TextureResolver::TextureResolver(const Scene& scene, double cacheMiB, bool filte
     for (const Shader& sh : scene.shaders) {
         compile(sh.texture);
         compile(sh.normalTexture);
+        compile(sh.metallicRoughnessTexture);
         if (sh.cutout.enabled) compile(sh.cutout.texture);
     }
     int standard = 0;

@@ -55,8 +55,8 @@ class TextureResolver {
     void albedos(const Shader& shader, size_t n, const vec2* uv, const float* footprint,
                  vec3* out) const;
     // The values of the texture tree rooted at Scene::textures[tree] (one a shader uses: its
-    // colour's, its normal map's or its cut-out's) for n lookups, as albedos() evaluates them;
-    // footprint null: the finest level. Thread-safe.
+    // colour's, normal map's, metallic-roughness image's or cut-out's) for n lookups, as albedos()
+    // evaluates them; footprint null: the finest level. Thread-safe.
     void values(int tree, size_t n, const vec2* uv, const float* footprint, vec3* out) const;
     // True when the scene has image textures (OpenImageIO is in use).
     bool active() const { return impl_ != nullptr; }

@@ -22,6 +22,16 @@
 
 SHARED_BEGIN
 
+// The shader's parameters at a hit: with kShaderHitParams (a MetallicRoughness shader with a
+// metallic-roughness image), the metallic and the GGX alpha of the roughness the hit carries.
+SHARED_FN ShaderParams shaderAtHit(ShaderParams sh, SurfaceHit hit) {
+    if ((sh.flags & kShaderHitParams) != 0u) {
+        sh.metallic = float(hit.material & 0xFFFFu) * (1.0f / 65535.0f);
+        sh.alpha = gltfAlpha(float(hit.material >> 16u) * (1.0f / 65535.0f));
+    }
+    return sh;
+}
+
 // True when the shader's BSDF is nothing but delta lobes: light sampling can never hit them,
 // so next-event estimation is skipped.
 SHARED_FN bool bsdfIsDelta(ShaderParams sh) {

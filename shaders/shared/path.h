@@ -88,7 +88,7 @@ SHARED_FN void shadeSurfaceWith(SCENE_PARAM RenderParams rp, SurfaceHit hit, vec
     r.nextDir = vec3(0.0f);
     r.next = st;
 
-    ShaderParams sh = SHADER(hit.shader);
+    ShaderParams sh = shaderAtHit(SHADER(hit.shader), hit);
     vec3 wo = -rayDir;
 
     // 1. Emission seen by this ray, weighted against having sampled it from the previous vertex.

@@ -16,7 +16,6 @@ struct ShadeInput {
     SurfaceHit hit;
     PathState path;
     vec3 rayDir;
-    float pad0;
 };
 
 // Threads per workgroup of every shading kernel.

@@ -18,8 +18,9 @@ SPW_SURFACE_MODELS(SPW_MODEL_CONSTANT)
 const uint kModelCount = 0u SPW_SURFACE_MODELS(SPW_MODEL_ONE);
 #undef SPW_MODEL_ONE
 
-const uint kShaderTwoSided = 1u; // emits from both faces
-const uint kShaderTextured = 2u; // albedo comes from a texture tree, resolved on the host
+const uint kShaderTwoSided = 1u;  // emits from both faces
+const uint kShaderTextured = 2u;  // albedo comes from a texture tree, resolved on the host
+const uint kShaderHitParams = 4u; // metallic and roughness come from the hit (SurfaceHit.material)
 
 struct ShaderParams {
     vec3 emission;     // radiance leaving the front face (both with kShaderTwoSided)
@@ -65,14 +66,17 @@ struct Emitter {
 
 // What the shading step needs to know about a hit, already in world space.
 struct SurfaceHit {
-    vec3 p;       // position, interpolated from the triangle's vertices (not o + t d)
-    float t;      // distance along the unit ray direction
-    vec3 ng;      // unit geometric normal, cross(v1 - v0, v2 - v0)
-    uint shader;  // index into the scene's shaders
-    vec3 ns;      // unit shading normal (interpolated vertex normals, or ng)
-    uint emitter; // index of the emitting triangle hit, or kNoEmitter
-    vec3 albedo;  // reflectance x texture, resolved on the host in hit-sorted order
-    float offset; // how far rays leaving p start off the surface (shared/offset.h), set with p
+    vec3 p;        // position, interpolated from the triangle's vertices (not o + t d)
+    float t;       // distance along the unit ray direction
+    vec3 ng;       // unit geometric normal, cross(v1 - v0, v2 - v0)
+    uint shader;   // index into the scene's shaders
+    vec3 ns;       // unit shading normal (interpolated vertex normals, or ng)
+    uint emitter;  // index of the emitting triangle hit, or kNoEmitter
+    vec3 albedo;   // reflectance x texture, resolved on the host in hit-sorted order
+    float offset;  // how far rays leaving p start off the surface (shared/offset.h), set with p
+    uint material; // with kShaderHitParams: the metallic (low 16 bits) and perceptual roughness
+                   // (high) that the host's texture lookup gave the hit, as unorm16 (bsdf.h's
+                   // shaderAtHit); 0 otherwise
 };
 const uint kNoEmitter = 0xFFFFFFFFu;
 

@@ -3,7 +3,7 @@
 // wrong side, emitters seen from behind and one- and two-sided, every strategy and sampler,
 // paths before min depth, past it and at max depth, rough and smooth Conductors and Dielectrics
 // (reflection, refraction, total internal reflection), MetallicRoughness from dielectric to
-// metal, and every model's hits mixed in runs
+// metal (and with metallic and roughness per hit), and every model's hits mixed in runs
 // that are not a multiple of the vector width.
 #include "host/cpu/simd_shading.h"
 #include "host/render/render.h"
@@ -54,6 +54,7 @@ Fixture makeFixture(std::mt19937& rng, int emitters) {
         uint model;
         float alpha, ior;
         float metallic = 1.0f;
+        uint flags = 0u;
     };
     for (Model m :
          {Model{kModelLambert, 0.0f, 1.5f}, Model{kModelLambert, 0.0f, 1.5f},
@@ -62,7 +63,8 @@ Fixture makeFixture(std::mt19937& rng, int emitters) {
           Model{kModelDielectric, 0.2f, 1.5f}, Model{kModelConductor, 1e-3f, 1.5f},
           Model{kModelDielectric, 0.0f, 1.33f}, Model{kModelMetallicRoughness, 0.3f, 1.5f, 0.5f},
           Model{kModelMetallicRoughness, 0.0f, 1.5f, 0.0f},
-          Model{kModelMetallicRoughness, 0.6f, 1.5f, 1.0f}}) {
+          Model{kModelMetallicRoughness, 0.6f, 1.5f, 1.0f},
+          Model{kModelMetallicRoughness, 0.6f, 1.5f, 1.0f, kShaderHitParams}}) {
         ShaderParams sh{};
         sh.model = m.model;
         sh.colour = vec3(0.8f);
@@ -70,6 +72,7 @@ Fixture makeFixture(std::mt19937& rng, int emitters) {
         sh.alpha = m.alpha;
         sh.ior = m.ior;
         sh.metallic = m.metallic;
+        sh.flags = m.flags;
         f.shaders.push_back(sh);
     }
     float total = 0.0f;
@@ -113,6 +116,7 @@ std::vector<ShadeInput> randomHits(std::mt19937& rng, const Fixture& f, size_t n
         h.emitter = !f.emitters.empty() && u(rng) < 0.1f ? uint(i % f.emitters.size()) : kNoEmitter;
         h.albedo = vec3(u(rng), u(rng), u(rng));
         h.offset = 1e-6f * (1.0f + u(rng));
+        h.material = uint(rng()); // metallic and roughness, where the shader takes them per hit
         in.rayDir = unitVector(rng);
         PathState& st = in.path;
         st.beta = u(rng) < 0.05f ? vec3(0.0f) : vec3(u(rng), u(rng), u(rng)) * 2.0f;

@@ -744,3 +744,71 @@ TEST(Gltf, NormalTexturesTiltTheShadingNormalInTheTextureFrame) {
 
 } // namespace
 } // namespace spw::test
+
+namespace spw::test {
+namespace {
+
+// The view-filling quad of tiltedQuadMean under the same light, of base colour `colour`,
+// metallic and roughness factors, and a metallicRoughnessTexture `image` unless it is empty.
+double metalRoughQuadMean(const TempDir& dir, float metallic, float roughness,
+                          const std::string& image, BackendKind backend) {
+    GltfBuilder b;
+    json mat = material(vec3(0.9f, 0.6f, 0.3f), metallic, roughness);
+    if (!image.empty()) {
+        mat["pbrMetallicRoughness"]["metallicRoughnessTexture"] = {{"index", 0}};
+        b.doc["textures"] = json::array({{{"source", 0}}});
+        b.doc["images"] = json::array({{{"uri", image}}});
+    }
+    b.doc["materials"] = json::array({mat});
+    b.doc["extensionsUsed"] = {"KHR_lights_punctual"};
+    b.doc["extensions"]["KHR_lights_punctual"]["lights"] =
+        json::array({{{"type", "point"}, {"intensity", 3000.0}}});
+    b.doc["cameras"] =
+        json::array({{{"type", "perspective"},
+                      {"perspective", {{"yfov", 0.25}, {"aspectRatio", 1.0}, {"znear", 0.1}}}}});
+    b.scene({b.node({{"mesh", b.mesh(b.quad(0))}}),
+             b.node({{"camera", 0}, {"translation", {0.5, 0.5, 3}}}),
+             b.node({{"translation", {0.2, 0.7, 1.0}},
+                     {"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}})});
+    Scene scene = loadScene(b.embedded(dir, "metal-rough.gltf"));
+    EXPECT_TRUE(scene.warnings.empty()) << scene.warnings.at(0);
+    scene.image.width = scene.image.height = 16;
+    RenderConfig cfg;
+    cfg.backend = backend;
+    cfg.spp = 4;
+    const std::vector<float> img = render(scene, cfg)->film->image();
+    double sum = 0;
+    for (float x : img)
+        sum += x;
+    return sum / double(img.size());
+}
+
+// metallicRoughnessTexture: its blue channel scales the metallic factor, its green the
+// roughness factor, read linearly; an image of one texel value renders as the factors times
+// that value do, on every backend, and not as the channels swapped.
+TEST(Gltf, MetallicRoughnessTexturesScaleTheFactorsPerHit) {
+    TempDir dir;
+    const float green = 0.4f, blue = 0.8f; // as 8-bit: 102 / 255 and 204 / 255 exactly
+    {
+        OIIO::ImageBuf img(OIIO::ImageSpec(4, 4, 3, OIIO::TypeDesc::UINT8));
+        const float v[3] = {0.1f, green, blue};
+        OIIO::ImageBufAlgo::fill(img, v);
+        ASSERT_TRUE(img.write(dir.file("mr.png")));
+    }
+    const float metallic = 0.75f, roughness = 0.5f;
+    for (BackendKind backend : {BackendKind::Reference, BackendKind::Cpu, BackendKind::Vulkan}) {
+        SCOPED_TRACE(backendName(backend));
+        const double mapped = metalRoughQuadMean(dir, metallic, roughness, "mr.png", backend);
+        const double factors =
+            metalRoughQuadMean(dir, metallic * blue, roughness * green, "", backend);
+        const double swapped =
+            metalRoughQuadMean(dir, metallic * green, roughness * blue, "", backend);
+        const double plain = metalRoughQuadMean(dir, metallic, roughness, "", backend);
+        EXPECT_NEAR(mapped, factors, 1e-3 * factors);
+        EXPECT_GT(std::fabs(mapped - swapped), 0.05 * factors);
+        EXPECT_GT(std::fabs(mapped - plain), 0.05 * factors);
+    }
+}
+
+} // namespace
+} // namespace spw::test
