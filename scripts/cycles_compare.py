@@ -28,6 +28,7 @@ import struct
 import subprocess
 import sys
 import tempfile
+import zlib
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
@@ -147,55 +148,94 @@ def compare(spillway, file, spp, width, out):
 # --- test files: glTF written here, each with a camera ---------------------------------------
 
 def sphere(rings=24, segments=48):
-    pos, nor, idx = [], [], []
+    """A unit sphere: positions, normals, indices and texture coordinates (u round the equator
+    from +X toward -Z, v from the north pole down)."""
+    pos, nor, idx, uv = [], [], [], []
     for r in range(rings + 1):
         t = math.pi * r / rings
         for s in range(segments + 1):
             p = 2 * math.pi * s / segments
-            n = (math.sin(t) * math.cos(p), math.cos(t), math.sin(t) * math.sin(p))
+            n = (math.sin(t) * math.cos(p), math.cos(t), -math.sin(t) * math.sin(p))
             pos += n
             nor += n
+            uv += [s / segments, r / rings]
     for r in range(rings):
         for s in range(segments):
             a = r * (segments + 1) + s
             b = a + segments + 1
-            idx += [a, a + 1, b, a + 1, b + 1, b]
-    return pos, nor, idx
+            idx += [a, b, a + 1, a + 1, b, b + 1]
+    return pos, nor, idx, uv
 
 
 def floor(size=4.0, y=-1.0):
     pos = [-size, y, -size, size, y, -size, size, y, size, -size, y, size]
-    return pos, [0, 1, 0] * 4, [0, 2, 1, 0, 3, 2]
+    return pos, [0, 1, 0] * 4, [0, 2, 1, 0, 3, 2], None
 
 
-def write_glb(path, meshes, materials, camera_z=4.5, yfov=0.6):
-    """meshes: (positions, normals, indices, material) each; a perspective camera on +Z."""
+def png(width, height, channels, pixel):
+    """A PNG of 8-bit channels (3: RGB, 4: RGBA); pixel(x, y) gives each texel's bytes."""
+    rows = b"".join(b"\0" + bytes(c for x in range(width) for c in pixel(x, y))
+                    for y in range(height))
+
+    def chunk(kind, data):
+        return (struct.pack(">I", len(data)) + kind + data +
+                struct.pack(">I", zlib.crc32(kind + data) & 0xFFFFFFFF))
+    header = struct.pack(">IIBBBBB", width, height, 8, {3: 2, 4: 6}[channels], 0, 0, 0)
+    return (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", header) + chunk(b"IDAT", zlib.compress(rows)) +
+            chunk(b"IEND", b""))
+
+
+def write_glb(path, meshes, materials, camera_z=4.5, yfov=0.6, images=(), sun=None):
+    """meshes: (positions, normals, indices, uvs or None, material) each; a perspective camera
+    on +Z; images: PNG files' bytes, texture i reading image i; sun: a directional light's
+    direction of travel and illuminance (lux), or none."""
     doc = {"asset": {"version": "2.0"}, "scene": 0, "materials": materials, "meshes": [],
            "nodes": [], "accessors": [], "bufferViews": []}
     blob = bytearray()
 
-    def view(data, fmt, count, comps, ctype, extra=None):
+    def raw(data):
         while len(blob) % 4:
             blob.append(0)
         off = len(blob)
-        blob.extend(struct.pack("<%d%s" % (len(data), fmt), *data))
-        doc["bufferViews"].append({"buffer": 0, "byteOffset": off, "byteLength": len(blob) - off})
-        acc = {"bufferView": len(doc["bufferViews"]) - 1, "componentType": ctype, "count": count,
-               "type": {1: "SCALAR", 3: "VEC3"}[comps]}
+        blob.extend(data)
+        doc["bufferViews"].append({"buffer": 0, "byteOffset": off, "byteLength": len(data)})
+        return len(doc["bufferViews"]) - 1
+
+    def view(data, fmt, count, comps, ctype, extra=None):
+        acc = {"bufferView": raw(struct.pack("<%d%s" % (len(data), fmt), *data)),
+               "componentType": ctype, "count": count,
+               "type": {1: "SCALAR", 2: "VEC2", 3: "VEC3"}[comps]}
         acc.update(extra or {})
         doc["accessors"].append(acc)
         return len(doc["accessors"]) - 1
 
-    for pos, nor, idx, mat in meshes:
+    for pos, nor, idx, uv, mat in meshes:
         n = len(pos) // 3
         lo = [min(pos[k::3]) for k in range(3)]
         hi = [max(pos[k::3]) for k in range(3)]
-        p = view(pos, "f", n, 3, 5126, {"min": lo, "max": hi})
-        q = view(nor, "f", n, 3, 5126)
+        attributes = {"POSITION": view(pos, "f", n, 3, 5126, {"min": lo, "max": hi}),
+                      "NORMAL": view(nor, "f", n, 3, 5126)}
+        if uv:
+            attributes["TEXCOORD_0"] = view(uv, "f", n, 2, 5126)
         i = view(idx, "I", len(idx), 1, 5125)
-        doc["meshes"].append({"primitives": [{"attributes": {"POSITION": p, "NORMAL": q},
-                                              "indices": i, "material": mat}]})
+        doc["meshes"].append({"primitives": [{"attributes": attributes, "indices": i,
+                                              "material": mat}]})
         doc["nodes"].append({"mesh": len(doc["meshes"]) - 1})
+    if images:
+        doc["images"] = [{"bufferView": raw(b), "mimeType": "image/png"} for b in images]
+        doc["textures"] = [{"source": i} for i in range(len(images))]
+    if sun:
+        direction, lux = sun
+        # The rotation taking -Z (a light's direction) to `direction`: axis -Z x d, angle.
+        d = [x / math.sqrt(sum(y * y for y in direction)) for x in direction]
+        axis = (d[1], -d[0], 0.0)
+        w = 1.0 - d[2]
+        norm = math.sqrt(sum(x * x for x in axis) + w * w)
+        doc["extensionsUsed"] = ["KHR_lights_punctual"]
+        doc["extensions"] = {"KHR_lights_punctual": {"lights": [
+            {"type": "directional", "intensity": lux}]}}
+        doc["nodes"].append({"rotation": [axis[0] / norm, axis[1] / norm, 0.0, w / norm],
+                             "extensions": {"KHR_lights_punctual": {"light": 0}}})
     doc["cameras"] = [{"type": "perspective",
                        "perspective": {"yfov": yfov, "aspectRatio": 4 / 3, "znear": 0.05}}]
     doc["nodes"].append({"camera": 0, "translation": [0, 0.3, camera_z]})
@@ -215,6 +255,23 @@ def material(colour, metallic, roughness):
                                      "metallicFactor": metallic, "roughnessFactor": roughness}}
 
 
+def textured_images(size=64):
+    """A base colour checker, a metallic-roughness image (metal and smooth in its top half,
+    plastic and rough in its bottom half) and a normal map of ridges across u."""
+    def colour(x, y):
+        return (220, 90, 50) if (x // 8 + y // 8) % 2 else (225, 225, 215)
+
+    def metal_rough(x, y):
+        return (0, 90, 255) if y < size // 2 else (0, 190, 0)
+
+    def normal(x, y):
+        tilt = 0.45 * math.sin(2 * math.pi * 6 * (x + 0.5) / size)
+        n = (tilt, 0.0, math.sqrt(1 - tilt * tilt))
+        return tuple(int(round((c + 1) * 127.5)) for c in n)
+    return [png(size, size, 3, colour), png(size, size, 3, metal_rough),
+            png(size, size, 3, normal)]
+
+
 def make_test_files(out):
     os.makedirs(out, exist_ok=True)
     s, f = sphere(), floor()
@@ -225,7 +282,17 @@ def make_test_files(out):
     }
     for name, mats in files.items():
         write_glb(os.path.join(out, name), [s + (0,), f + (1,)], mats)
-    return sorted(os.path.join(out, n) for n in files)
+    # Every image a material takes, under a sun slanting from the upper left, without the
+    # floor: lit by a sun from the camera's side, a rough grey floor seen at grazing angles is
+    # the two BRDFs' largest difference (Principled's Disney diffuse retro-reflects: 23-34 %
+    # brighter there, where the sphere agrees within 2 %).
+    textured = material((1.0, 1.0, 1.0), 1.0, 1.0)
+    textured["pbrMetallicRoughness"]["baseColorTexture"] = {"index": 0}
+    textured["pbrMetallicRoughness"]["metallicRoughnessTexture"] = {"index": 1}
+    textured["normalTexture"] = {"index": 2}
+    write_glb(os.path.join(out, "textured.glb"), [s + (0,)], [textured],
+              images=textured_images(), sun=((0.5, -0.7, -0.5), 2.0 * 683))
+    return sorted(os.path.join(out, n) for n in list(files) + ["textured.glb"])
 
 
 # The suite's bound (docs/scene-format.md, "glTF files", says why): relMSE and each channel's
