@@ -526,6 +526,21 @@ class GltfReader {
         s.roughness =
             float(unit(pbr.roughnessFactor, at + "/pbrMetallicRoughness/roughnessFactor"));
         s.params.alpha = gltfAlpha(s.roughness);
+        readImages(mat, s, at, name);
+        if (mat.alphaMode == "BLEND")
+            warn(name + ": alphaMode BLEND is not rendered (it is drawn opaque)");
+        else if (mat.alphaMode != "OPAQUE" && mat.alphaMode != "MASK")
+            fail(at + "/alphaMode", "must be OPAQUE, MASK or BLEND");
+        readEmission(mat, s, at);
+        if (mat.doubleSided) s.params.flags |= kShaderTwoSided;
+        return s;
+    }
+
+    // The material's images: base colour (and its alpha, for MASK), metallic-roughness and
+    // normal map, and what is not rendered of the rest.
+    void readImages(const tinygltf::Material& mat, Shader& s, const std::string& at,
+                    const std::string& name) {
+        const tinygltf::PbrMetallicRoughness& pbr = mat.pbrMetallicRoughness;
         if (pbr.baseColorTexture.index >= 0) baseColourTexture(pbr.baseColorTexture, s, at, name);
         if (mat.alphaMode == "MASK") readCutout(mat, s, at, name);
         if (pbr.metallicRoughnessTexture.index >= 0) {
@@ -551,10 +566,10 @@ class GltfReader {
             warn(name + ": its occlusionTexture is ignored (a path tracer finds occlusion itself)");
         if (mat.emissiveTexture.index >= 0)
             warn(name + ": its emissiveTexture is not rendered yet (its emissiveFactor is)");
-        if (mat.alphaMode == "BLEND")
-            warn(name + ": alphaMode BLEND is not rendered (it is drawn opaque)");
-        else if (mat.alphaMode != "OPAQUE" && mat.alphaMode != "MASK")
-            fail(at + "/alphaMode", "must be OPAQUE, MASK or BLEND");
+    }
+
+    // emissiveFactor times KHR_materials_emissive_strength's strength.
+    void readEmission(const tinygltf::Material& mat, Shader& s, const std::string& at) {
         double strength = 1.0;
         if (const auto e = mat.extensions.find("KHR_materials_emissive_strength");
             e != mat.extensions.end() && e->second.Has("emissiveStrength")) {
@@ -572,8 +587,6 @@ class GltfReader {
                      "emission beyond " + std::to_string(kMaxRadiance));
             s.params.emission[k] = float(e);
         }
-        if (mat.doubleSided) s.params.flags |= kShaderTwoSided;
-        return s;
     }
 
     double unit(double x, const std::string& at) const {

@@ -426,6 +426,39 @@ void visit(const Scene& scene, int t, std::vector<int>& slotOf, std::vector<int>
     order.push_back(t);
 }
 
+// Opens a Standard texture's image in the cache (an embedded one through a proxy it keeps):
+// its channels, encoding and MIP levels. Throws where the image cannot be read.
+void openImage(TextureResolver::Impl& impl, const Texture& t, TextureResolver::Impl::Image& img) {
+    OIIO::ustring name(t.path);
+    if (t.bytes) { // embedded: read from memory, through a proxy the cache keeps using
+        auto& proxy = impl.proxies.emplace_back(std::make_unique<OIIO::Filesystem::IOMemReader>(
+            const_cast<char*>(t.bytes->data()), t.bytes->size()));
+        OIIO::ImageSpec config;
+        void* ptr = proxy.get();
+        config.attribute("oiio:ioproxy", OIIO::TypeDesc::PTR, &ptr);
+        impl.cache->add_file(name, nullptr, &config);
+    }
+    img.handle = impl.cache->get_image_handle(name);
+    const OIIO::ImageSpec* spec =
+        img.handle ? impl.cache->imagespec(img.handle, nullptr, 0, 0) : nullptr;
+    if (!spec || spec->width < 1 || spec->height < 1)
+        throw std::runtime_error("cannot read texture '" + t.path + "': " + impl.cache->geterror());
+    img.firstChannel = std::max(t.channel, 0);
+    img.absent = img.firstChannel >= spec->nchannels;
+    img.channels = img.absent ? 1 : spec->nchannels - img.firstChannel;
+    img.eightBit = spec->format == OIIO::TypeDesc::UINT8;
+    std::string cs = spec->get_string_attribute("oiio:ColorSpace");
+    img.srgb = !t.linear && (cs == "sRGB" || (cs.empty() && spec->format == OIIO::TypeDesc::UINT8));
+    img.finest = float(std::max(spec->width, spec->height));
+    // Its MIP levels, as many as the file has (an image without them is its own only level).
+    for (int level = 0; level < int(kMaxLevels); ++level) {
+        const OIIO::ImageSpec* ls =
+            level == 0 ? spec : impl.cache->imagespec(img.handle, nullptr, 0, level);
+        if (!ls || ls->width < 1 || ls->height < 1) break;
+        img.levels.push_back({ls->x, ls->y, ls->width, ls->height});
+    }
+}
+
 } // namespace
 
 TextureResolver::TextureResolver(const Scene& scene, double cacheMiB, bool filtered, bool wide)
@@ -473,37 +506,7 @@ TextureResolver::TextureResolver(const Scene& scene, double cacheMiB, bool filte
         const Texture& t = scene.textures[i];
         if (t.type != TextureType::Standard) continue;
         Impl::Image& img = impl_->images[i];
-        OIIO::ustring name(t.path);
-        if (t.bytes) { // embedded: read from memory, through a proxy the cache keeps using
-            auto& proxy =
-                impl_->proxies.emplace_back(std::make_unique<OIIO::Filesystem::IOMemReader>(
-                    const_cast<char*>(t.bytes->data()), t.bytes->size()));
-            OIIO::ImageSpec config;
-            void* ptr = proxy.get();
-            config.attribute("oiio:ioproxy", OIIO::TypeDesc::PTR, &ptr);
-            impl_->cache->add_file(name, nullptr, &config);
-        }
-        img.handle = impl_->cache->get_image_handle(name);
-        const OIIO::ImageSpec* spec =
-            img.handle ? impl_->cache->imagespec(img.handle, nullptr, 0, 0) : nullptr;
-        if (!spec || spec->width < 1 || spec->height < 1)
-            throw std::runtime_error("cannot read texture '" + t.path +
-                                     "': " + impl_->cache->geterror());
-        img.firstChannel = std::max(t.channel, 0);
-        img.absent = img.firstChannel >= spec->nchannels;
-        img.channels = img.absent ? 1 : spec->nchannels - img.firstChannel;
-        img.eightBit = spec->format == OIIO::TypeDesc::UINT8;
-        std::string cs = spec->get_string_attribute("oiio:ColorSpace");
-        img.srgb =
-            !t.linear && (cs == "sRGB" || (cs.empty() && spec->format == OIIO::TypeDesc::UINT8));
-        img.finest = float(std::max(spec->width, spec->height));
-        // Its MIP levels, as many as the file has (an image without them is its own only level).
-        for (int level = 0; level < int(kMaxLevels); ++level) {
-            const OIIO::ImageSpec* ls =
-                level == 0 ? spec : impl_->cache->imagespec(img.handle, nullptr, 0, level);
-            if (!ls || ls->width < 1 || ls->height < 1) break;
-            img.levels.push_back({ls->x, ls->y, ls->width, ls->height});
-        }
+        openImage(*impl_, t, img);
         img.firstHeld = impl_->heldSlots;
         impl_->heldSlots += img.levels.size();
     }

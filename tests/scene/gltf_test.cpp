@@ -628,6 +628,11 @@ TEST(Gltf, AlphaMaskCutsHolesForCameraBounceAndShadowRays) {
         // The image's alpha: all hole, none, or no alpha channel at all (opaque).
         EXPECT_EQ(renderVeiled(dir, veilMaterial("MASK", 1.0f, true), backend, "holes.png").image,
                   bare.image);
+        // Embedded in the file: the colour and the alpha read from one image in memory.
+        const std::string embedded =
+            "data:image/png;base64," + GltfBuilder::base64(readFile(dir.file("holes.png")));
+        EXPECT_EQ(renderVeiled(dir, veilMaterial("MASK", 1.0f, true), backend, embedded).image,
+                  bare.image);
         EXPECT_EQ(renderVeiled(dir, veilMaterial("MASK", 1.0f, true), backend, "solid.png").image,
                   opaqueImage.image);
         EXPECT_EQ(renderVeiled(dir, veilMaterial("MASK", 1.0f, true), backend, "rgb.png").image,
