@@ -1,5 +1,6 @@
 #include "host/render/render.h"
 
+#include "host/accel/cutouts.h"
 #include "host/accel/embree_scene.h"
 #include "host/backend/backend.h"
 #include "host/cpu/cpu_shading.h"
@@ -9,7 +10,6 @@
 #include "host/render/rank_policy.h"
 #include "host/render/stop_rule.h"
 #include "host/scene/camera.h"
-#include "host/scene/cutouts.h"
 #include "host/scene/textures.h"
 #include "host/vk/context.h"
 #include "host/vk/vulkan_shading.h"

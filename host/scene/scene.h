@@ -129,7 +129,7 @@ struct Texture {
 // An alpha cut-out (glTF's alphaMode MASK): the surface is there only where its alpha, `alpha`
 // times the first channel of the texture tree `texture` (or alone, -1), is at least `cutoff`.
 // Elsewhere rays pass through it, camera, bounce and shadow rays alike (the BVH's hit filter,
-// host/scene/cutouts.h).
+// host/accel/cutouts.h).
 struct Cutout {
     bool enabled = false;
     float alpha = 1.0f;

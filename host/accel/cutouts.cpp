@@ -1,4 +1,4 @@
-#include "host/scene/cutouts.h"
+#include "host/accel/cutouts.h"
 
 namespace spw {
 
