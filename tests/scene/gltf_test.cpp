@@ -253,7 +253,9 @@ TEST(Gltf, LightsEmissionAndWhatIsNotRenderedIsWarnedOnce) {
                      {{"type", "spot"},
                       {"intensity", 683.0},
                       {"spot", {{"innerConeAngle", 0.25}, {"outerConeAngle", 0.5}}}}});
-    const int mesh = b.mesh(b.quad(0));
+    json prim = b.quad(0);
+    prim["attributes"]["TANGENT"] = prim["attributes"]["NORMAL"]; // read as nothing: warned
+    const int mesh = b.mesh(prim);
     b.scene({b.node({{"mesh", mesh}}), b.node({{"mesh", mesh}, {"translation", {0, 0, -2}}}),
              b.node({{"translation", {1, 2, 3}},
                      {"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}}),
@@ -277,9 +279,9 @@ TEST(Gltf, LightsEmissionAndWhatIsNotRenderedIsWarnedOnce) {
     std::string all;
     for (const std::string& w : s.warnings)
         all += w + "\n";
-    for (const char* what : {"EXT_unknown", "BLEND", "animations"})
+    for (const char* what : {"EXT_unknown", "BLEND", "animations", "TANGENT"})
         EXPECT_NE(all.find(what), std::string::npos) << what << " not in:\n" << all;
-    EXPECT_EQ(s.warnings.size(), 3u) << all; // the two meshes' material warned once
+    EXPECT_EQ(s.warnings.size(), 4u) << all; // the two meshes' material and tangents warned once
 }
 
 // Each malformed file: a SceneError naming the file and, where it helps, the JSON pointer.
