@@ -582,6 +582,27 @@ json veilMaterial(const char* mode, float alpha = 1.0f, bool textured = false) {
     return m;
 }
 
+// The mean of `scene` rendered at 16 x 16 and 4 spp on `backend`.
+double meanAt16(Scene scene, BackendKind backend) {
+    scene.image.width = scene.image.height = 16;
+    RenderConfig cfg;
+    cfg.backend = backend;
+    cfg.spp = 4;
+    const std::vector<float> img = render(scene, cfg)->film->image();
+    double sum = 0;
+    for (float x : img)
+        sum += x;
+    return sum / double(img.size());
+}
+
+// A 4 x 4 8-bit RGB image of one value.
+void writeConstantImage(const std::string& path, vec3 value) {
+    OIIO::ImageBuf img(OIIO::ImageSpec(4, 4, 3, OIIO::TypeDesc::UINT8));
+    const float v[3] = {value.x, value.y, value.z};
+    OIIO::ImageBufAlgo::fill(img, v);
+    ASSERT_TRUE(img.write(path));
+}
+
 // An RGBA image: white, its alpha `left` in the left half and `right` in the right half.
 void writeAlphaImage(const std::string& path, float left, float right, int channels = 4) {
     OIIO::ImageBuf img(OIIO::ImageSpec(16, 4, channels, OIIO::TypeDesc::UINT8));
@@ -700,15 +721,7 @@ double tiltedQuadMean(const TempDir& dir, vec3 normal, const std::string& image,
              b.node({{"rotation", {q.x, q.y, q.z, q.w}},
                      {"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}})});
     Scene scene = loadScene(b.embedded(dir, "tilted.gltf"));
-    scene.image.width = scene.image.height = 16;
-    RenderConfig cfg;
-    cfg.backend = backend;
-    cfg.spp = 4;
-    const std::vector<float> img = render(scene, cfg)->film->image();
-    double sum = 0;
-    for (float x : img)
-        sum += x;
-    return sum / double(img.size());
+    return meanAt16(scene, backend);
 }
 
 // normalTexture: a map of one texel value tilts the shading normal as a mesh whose normals
@@ -717,12 +730,8 @@ double tiltedQuadMean(const TempDir& dir, vec3 normal, const std::string& image,
 TEST(Gltf, NormalTexturesTiltTheShadingNormalInTheTextureFrame) {
     TempDir dir;
     const int texel[3] = {200, 90, 220};
-    {
-        OIIO::ImageBuf img(OIIO::ImageSpec(4, 4, 3, OIIO::TypeDesc::UINT8));
-        const float v[3] = {texel[0] / 255.0f, texel[1] / 255.0f, texel[2] / 255.0f};
-        OIIO::ImageBufAlgo::fill(img, v);
-        ASSERT_TRUE(img.write(dir.file("tilt.png")));
-    }
+    writeConstantImage(dir.file("tilt.png"),
+                       vec3(texel[0] / 255.0f, texel[1] / 255.0f, texel[2] / 255.0f));
     const vec3 local(2.0f * texel[0] / 255.0f - 1.0f, 2.0f * texel[1] / 255.0f - 1.0f,
                      2.0f * texel[2] / 255.0f - 1.0f);
     for (BackendKind backend : {BackendKind::Reference, BackendKind::Cpu, BackendKind::Vulkan}) {
@@ -779,15 +788,7 @@ double metalRoughQuadMean(const TempDir& dir, float metallic, float roughness,
                      {"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}})});
     Scene scene = loadScene(b.embedded(dir, "metal-rough.gltf"));
     EXPECT_TRUE(scene.warnings.empty()) << scene.warnings.at(0);
-    scene.image.width = scene.image.height = 16;
-    RenderConfig cfg;
-    cfg.backend = backend;
-    cfg.spp = 4;
-    const std::vector<float> img = render(scene, cfg)->film->image();
-    double sum = 0;
-    for (float x : img)
-        sum += x;
-    return sum / double(img.size());
+    return meanAt16(scene, backend);
 }
 
 // metallicRoughnessTexture: its blue channel scales the metallic factor, its green the
@@ -796,12 +797,7 @@ double metalRoughQuadMean(const TempDir& dir, float metallic, float roughness,
 TEST(Gltf, MetallicRoughnessTexturesScaleTheFactorsPerHit) {
     TempDir dir;
     const float green = 0.4f, blue = 0.8f; // as 8-bit: 102 / 255 and 204 / 255 exactly
-    {
-        OIIO::ImageBuf img(OIIO::ImageSpec(4, 4, 3, OIIO::TypeDesc::UINT8));
-        const float v[3] = {0.1f, green, blue};
-        OIIO::ImageBufAlgo::fill(img, v);
-        ASSERT_TRUE(img.write(dir.file("mr.png")));
-    }
+    writeConstantImage(dir.file("mr.png"), vec3(0.1f, green, blue));
     const float metallic = 0.75f, roughness = 0.5f;
     for (BackendKind backend : {BackendKind::Reference, BackendKind::Cpu, BackendKind::Vulkan}) {
         SCOPED_TRACE(backendName(backend));
