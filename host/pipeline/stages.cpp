@@ -224,7 +224,7 @@ void setUpChunk(const RenderContext& ctx, const std::vector<RayState>& rays,
         x.rayDir = ray.dir;
         if (ray.path.bounce >= ctx.params.maxDepth) continue;
         const Shader& shader = ctx.scene.shaders[x.hit.shader];
-        if (shader.texture < 0 && shader.normalTexture < 0 && shader.metallicRoughnessTexture < 0) {
+        if (!shader.looksUpTextures()) {
             x.hit.albedo = ctx.textures.albedo(shader, vec2(0.0f), 0.0f);
             continue;
         }
@@ -238,12 +238,16 @@ void setUpChunk(const RenderContext& ctx, const std::vector<RayState>& rays,
             ++b;
         const Shader& sh = ctx.scene.shaders[shader];
         ctx.textures.albedos(sh, b - a, uv + a, footprint + a, albedo + a);
-        for (size_t j = a; j < b; ++j) {
+        for (size_t j = a; j < b; ++j)
             in[slot[j]].hit.albedo = albedo[j];
-            record[j] = &hits[order[slot[j]].index];
-            hit[j] = &in[slot[j]].hit;
+        if (sh.hasMaps()) {
+            for (size_t j = a; j < b; ++j) {
+                record[j] = &hits[order[slot[j]].index];
+                hit[j] = &in[slot[j]].hit;
+            }
+            ctx.hitSetup.applyMaps(sh, ctx.textures, b - a, uv + a, footprint + a, record + a,
+                                   hit + a);
         }
-        ctx.hitSetup.applyMaps(sh, ctx.textures, b - a, uv + a, footprint + a, record + a, hit + a);
         a = b;
     }
 }

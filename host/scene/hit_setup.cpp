@@ -39,7 +39,7 @@ void HitSetup::setUpHit(const HitRecord& h, vec3 dir, uint cone, const TextureRe
     surfaceHit(h.mesh, h.prim, h.u, h.v, h.t, hit);
     if (!albedo) return;
     const Shader& shader = src_.shaders[hit.shader];
-    if (shader.texture < 0 && shader.normalTexture < 0 && shader.metallicRoughnessTexture < 0) {
+    if (!shader.looksUpTextures()) {
         hit.albedo = textures.albedo(shader, vec2(0.0f), 0.0f);
         return;
     }
@@ -62,7 +62,7 @@ uint unorm16(float x) {
 void HitSetup::applyMaps(const Shader& shader, const TextureResolver& textures, size_t n,
                          const vec2* uv, const float* footprint, const HitRecord* const* hits,
                          SurfaceHit* const* hit) const {
-    if (shader.normalTexture < 0 && shader.metallicRoughnessTexture < 0) return;
+    if (!shader.hasMaps()) return;
     thread_local std::vector<vec3> texels;
     texels.resize(n);
     if (shader.normalTexture >= 0) {

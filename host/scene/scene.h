@@ -151,6 +151,11 @@ struct Shader {
     // made from) the hit's roughness, carried in SurfaceHit::material (kShaderHitParams).
     int metallicRoughnessTexture = -1;
     float roughness = 1.0f;
+
+    // Maps beyond the colour, looked up in hit setup after it (HitSetup::applyMaps).
+    bool hasMaps() const { return normalTexture >= 0 || metallicRoughnessTexture >= 0; }
+    // Whether hit setup looks anything up at a hit's texture coordinates.
+    bool looksUpTextures() const { return texture >= 0 || hasMaps(); }
     std::string typeName;
     int line = 0;
 };
