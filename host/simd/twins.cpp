@@ -65,54 +65,35 @@ FrameArgs frameArgs(const TwinLanes& in, int ngRow, int nsRow, int woRow, size_t
     return a;
 }
 
-// The twin on the vector of lanes starting at i.
-void runVector(Twin twin, const TwinLanes& in, size_t i, TwinResults& out) {
+// The random-number twins (shared/rng.h) on the vector of lanes starting at i.
+void runRandomTwin(Twin twin, const TwinLanes& in, size_t i, TwinResults& out) {
+    switch (twin) {
+    case Twin::pcg4d: // v u0-3 -> u0-3
+        return storeU4(pcg4d(loadU4(in, 0, i)), out, i);
+    case Twin::laineKarrasPermutation: // x u0, seed u1 -> u0
+        return storeU(laineKarrasPermutation(loadU(in.u[0], i), loadU(in.u[1], i)), out, 0, i);
+    case Twin::scrambledSobol4: // sampleIndex u0, key u1-4 -> u0-3
+        return storeU4(scrambledSobol4(loadU(in.u[0], i), loadU4(in, 1, i)), out, i);
+    case Twin::uintToUnit: // x u0 -> f0
+        return store(uintToUnit(loadU(in.u[0], i)), out.f[0], i);
+    case Twin::rand4: { // pixel u0, sampleIndex u1, bounce u2; sampling, seed, group uniform
+        const U4 r = rand4(in.uniform[0], in.uniform[1], loadU(in.u[0], i), loadU(in.u[1], i),
+                           loadU(in.u[2], i), in.uniform[2]);
+        store(uintToUnit(r.x), out.f[0], i);
+        store(uintToUnit(r.y), out.f[1], i);
+        store(uintToUnit(r.z), out.f[2], i);
+        return store(uintToUnit(r.w), out.f[3], i);
+    }
+    default:
+        return;
+    }
+}
+
+// The BSDF twins (shared/ggx.h, conductor.h, dielectric.h, gltf.h) on the vector of lanes
+// starting at i; the others to runRandomTwin.
+void runBsdfTwin(Twin twin, const TwinLanes& in, size_t i, TwinResults& out) {
     auto f = [&](int row) { return load(in.f[row], i); };
     switch (twin) {
-    case Twin::maxComponent: // v f0-2 -> f0
-        return store(maxComponent(load3(in, 0, i)), out.f[0], i);
-    case Twin::quantizePdf: // pdf f0 -> f0
-        return store(quantizePdf(f(0)), out.f[0], i);
-    case Twin::powerHeuristic: // pdfThis f0, pdfOther f1 -> f0
-        return store(powerHeuristic(f(0), f(1)), out.f[0], i);
-    case Twin::facingShadingNormal: { // ns f0-2, ng f3-5, wo f6-8 -> f0-2
-        const V3 ng = load3(in, 3, i);
-        return store3(facingShadingNormal(load3(in, 0, i), ng, dot(ng, load3(in, 6, i))), out, 0,
-                      i);
-    }
-    case Twin::sinQuarterPi: // x f0 -> f0
-        return store(sinQuarterPi(f(0)), out.f[0], i);
-    case Twin::cosQuarterPi: // x f0 -> f0
-        return store(cosQuarterPi(f(0)), out.f[0], i);
-    case Twin::sampleCosineHemisphere: // u f0-1 -> f0-2
-        return store3(sampleCosineHemisphere(f(0), f(1)), out, 0, i);
-    case Twin::toWorld: // local f0-2, n f3-5 -> f0-2
-        return store3(toWorld(load3(in, 0, i), load3(in, 3, i)), out, 0, i);
-    case Twin::surfaceOffset: // p f0-2, v0 f3-5, v1 f6-8, v2 f9-11, n f12-14 -> f0
-        return store(surfaceOffset(load3(in, 0, i), load3(in, 3, i), load3(in, 6, i),
-                                   load3(in, 9, i), load3(in, 12, i)),
-                     out.f[0], i);
-    case Twin::offsetOrigin: // p f0-2, ng f3-5, offset f6, dir f7-9 -> f0-2
-        return store3(offsetOrigin(load3(in, 0, i), load3(in, 3, i), f(6), load3(in, 7, i)), out, 0,
-                      i);
-    case Twin::shadowRayTmax: // dist f0, offsetP f1, offsetQ f2, cosQ f3 -> f0
-        return store(shadowRayTmax(f(0), f(1), f(2), f(3)), out.f[0], i);
-    case Twin::emitterPoint: // p0 f0-2, e1 f3-5, e2 f6-8, u f9-10 -> f0-2
-        return store3(emitterPoint(load3(in, 0, i), load3(in, 3, i), load3(in, 6, i), f(9), f(10)),
-                      out, 0, i);
-    case Twin::emitterCosine: // normal f0-2, twoSided u0 (mask), towardReceiver f3-5 -> f0
-        return store(emitterCosine(load3(in, 0, i), loadMask(in.u[0], i), load3(in, 3, i)),
-                     out.f[0], i);
-    case Twin::emitterSolidAnglePdf: // pickPdf f0, area f1, dist f2, cosLight f3 -> f0
-        return store(emitterSolidAnglePdf(f(0), f(1), f(2), f(3)), out.f[0], i);
-    case Twin::lambertEval: { // albedo f0-2, ng f3-5, ns f6-8, wo f9-11, wi f12-14 -> f0-2, pdf f3
-        const V3 ng = load3(in, 3, i);
-        const V ngDotWo = dot(ng, load3(in, 9, i));
-        const V3 n = facingShadingNormal(load3(in, 6, i), ng, ngDotWo);
-        V pdf;
-        store3(lambertEval(load3(in, 0, i), ng, ngDotWo, n, load3(in, 12, i), pdf), out, 0, i);
-        return store(pdf, out.f[3], i);
-    }
     case Twin::ggxD: // h f0-2, alpha f3 -> f0
         return store(ggxD(load3(in, 0, i), f(3)), out.f[0], i);
     case Twin::ggxA: // w f0-2, alpha f3 -> f0
@@ -173,22 +154,61 @@ void runVector(Twin twin, const TwinLanes& in, size_t i, TwinResults& out) {
                                       f(14), f(15), f(16)),
                            out, i);
     }
-    case Twin::pcg4d: // v u0-3 -> u0-3
-        return storeU4(pcg4d(loadU4(in, 0, i)), out, i);
-    case Twin::laineKarrasPermutation: // x u0, seed u1 -> u0
-        return storeU(laineKarrasPermutation(loadU(in.u[0], i), loadU(in.u[1], i)), out, 0, i);
-    case Twin::scrambledSobol4: // sampleIndex u0, key u1-4 -> u0-3
-        return storeU4(scrambledSobol4(loadU(in.u[0], i), loadU4(in, 1, i)), out, i);
-    case Twin::uintToUnit: // x u0 -> f0
-        return store(uintToUnit(loadU(in.u[0], i)), out.f[0], i);
-    case Twin::rand4: { // pixel u0, sampleIndex u1, bounce u2; sampling, seed, group uniform
-        const U4 r = rand4(in.uniform[0], in.uniform[1], loadU(in.u[0], i), loadU(in.u[1], i),
-                           loadU(in.u[2], i), in.uniform[2]);
-        store(uintToUnit(r.x), out.f[0], i);
-        store(uintToUnit(r.y), out.f[1], i);
-        store(uintToUnit(r.z), out.f[2], i);
-        return store(uintToUnit(r.w), out.f[3], i);
+    default:
+        return runRandomTwin(twin, in, i, out);
     }
+}
+
+// The twin on the vector of lanes starting at i.
+void runVector(Twin twin, const TwinLanes& in, size_t i, TwinResults& out) {
+    auto f = [&](int row) { return load(in.f[row], i); };
+    switch (twin) {
+    case Twin::maxComponent: // v f0-2 -> f0
+        return store(maxComponent(load3(in, 0, i)), out.f[0], i);
+    case Twin::quantizePdf: // pdf f0 -> f0
+        return store(quantizePdf(f(0)), out.f[0], i);
+    case Twin::powerHeuristic: // pdfThis f0, pdfOther f1 -> f0
+        return store(powerHeuristic(f(0), f(1)), out.f[0], i);
+    case Twin::facingShadingNormal: { // ns f0-2, ng f3-5, wo f6-8 -> f0-2
+        const V3 ng = load3(in, 3, i);
+        return store3(facingShadingNormal(load3(in, 0, i), ng, dot(ng, load3(in, 6, i))), out, 0,
+                      i);
+    }
+    case Twin::sinQuarterPi: // x f0 -> f0
+        return store(sinQuarterPi(f(0)), out.f[0], i);
+    case Twin::cosQuarterPi: // x f0 -> f0
+        return store(cosQuarterPi(f(0)), out.f[0], i);
+    case Twin::sampleCosineHemisphere: // u f0-1 -> f0-2
+        return store3(sampleCosineHemisphere(f(0), f(1)), out, 0, i);
+    case Twin::toWorld: // local f0-2, n f3-5 -> f0-2
+        return store3(toWorld(load3(in, 0, i), load3(in, 3, i)), out, 0, i);
+    case Twin::surfaceOffset: // p f0-2, v0 f3-5, v1 f6-8, v2 f9-11, n f12-14 -> f0
+        return store(surfaceOffset(load3(in, 0, i), load3(in, 3, i), load3(in, 6, i),
+                                   load3(in, 9, i), load3(in, 12, i)),
+                     out.f[0], i);
+    case Twin::offsetOrigin: // p f0-2, ng f3-5, offset f6, dir f7-9 -> f0-2
+        return store3(offsetOrigin(load3(in, 0, i), load3(in, 3, i), f(6), load3(in, 7, i)), out, 0,
+                      i);
+    case Twin::shadowRayTmax: // dist f0, offsetP f1, offsetQ f2, cosQ f3 -> f0
+        return store(shadowRayTmax(f(0), f(1), f(2), f(3)), out.f[0], i);
+    case Twin::emitterPoint: // p0 f0-2, e1 f3-5, e2 f6-8, u f9-10 -> f0-2
+        return store3(emitterPoint(load3(in, 0, i), load3(in, 3, i), load3(in, 6, i), f(9), f(10)),
+                      out, 0, i);
+    case Twin::emitterCosine: // normal f0-2, twoSided u0 (mask), towardReceiver f3-5 -> f0
+        return store(emitterCosine(load3(in, 0, i), loadMask(in.u[0], i), load3(in, 3, i)),
+                     out.f[0], i);
+    case Twin::emitterSolidAnglePdf: // pickPdf f0, area f1, dist f2, cosLight f3 -> f0
+        return store(emitterSolidAnglePdf(f(0), f(1), f(2), f(3)), out.f[0], i);
+    case Twin::lambertEval: { // albedo f0-2, ng f3-5, ns f6-8, wo f9-11, wi f12-14 -> f0-2, pdf f3
+        const V3 ng = load3(in, 3, i);
+        const V ngDotWo = dot(ng, load3(in, 9, i));
+        const V3 n = facingShadingNormal(load3(in, 6, i), ng, ngDotWo);
+        V pdf;
+        store3(lambertEval(load3(in, 0, i), ng, ngDotWo, n, load3(in, 12, i), pdf), out, 0, i);
+        return store(pdf, out.f[3], i);
+    }
+    default:
+        return runBsdfTwin(twin, in, i, out);
     }
 }
 
