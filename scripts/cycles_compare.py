@@ -185,12 +185,15 @@ def png(width, height, channels, pixel):
             chunk(b"IEND", b""))
 
 
-def write_glb(path, meshes, materials, camera_z=4.5, yfov=0.6, images=(), sun=None):
+def write_glb(path, meshes, materials, camera_z=4.5, yfov=0.6, images=(), sun=None,
+              extensions=()):
     """meshes: (positions, normals, indices, uvs or None, material) each; a perspective camera
     on +Z; images: PNG files' bytes, texture i reading image i; sun: a directional light's
-    direction of travel and illuminance (lux), or none."""
+    direction of travel and illuminance (lux), or none; extensions: names the materials use."""
     doc = {"asset": {"version": "2.0"}, "scene": 0, "materials": materials, "meshes": [],
            "nodes": [], "accessors": [], "bufferViews": []}
+    if extensions:
+        doc["extensionsUsed"] = list(extensions)
     blob = bytearray()
 
     def raw(data):
@@ -231,7 +234,7 @@ def write_glb(path, meshes, materials, camera_z=4.5, yfov=0.6, images=(), sun=No
         axis = (d[1], -d[0], 0.0)
         w = 1.0 - d[2]
         norm = math.sqrt(sum(x * x for x in axis) + w * w)
-        doc["extensionsUsed"] = ["KHR_lights_punctual"]
+        doc["extensionsUsed"] = doc.get("extensionsUsed", []) + ["KHR_lights_punctual"]
         doc["extensions"] = {"KHR_lights_punctual": {"lights": [
             {"type": "directional", "intensity": lux}]}}
         doc["nodes"].append({"rotation": [axis[0] / norm, axis[1] / norm, 0.0, w / norm],
@@ -272,6 +275,21 @@ def textured_images(size=64):
             png(size, size, 3, normal)]
 
 
+def panel(x0=-2.5, x1=2.5, y0=-1.0, y1=2.0, z=-2.5):
+    """A quad facing +Z, its image upright (texture coordinate (0, 0) at the top left)."""
+    pos = [x0, y0, z, x1, y0, z, x1, y1, z, x0, y1, z]
+    return pos, [0, 0, 1] * 4, [0, 1, 2, 0, 2, 3], [0, 1, 1, 1, 1, 0, 0, 0]
+
+
+def emission_image(width=240, height=144):
+    """Warm, cool and white stripes across, a dark band along the bottom."""
+    def texel(x, y):
+        if y >= height * 3 // 4:
+            return (20, 20, 20)
+        return [(255, 170, 60), (70, 150, 255), (235, 235, 235)][x * 3 // width]
+    return png(width, height, 3, texel)
+
+
 def make_test_files(out):
     os.makedirs(out, exist_ok=True)
     s, f = sphere(), floor()
@@ -292,7 +310,16 @@ def make_test_files(out):
     textured["normalTexture"] = {"index": 2}
     write_glb(os.path.join(out, "textured.glb"), [s + (0,)], [textured],
               images=textured_images(), sun=((0.5, -0.7, -0.5), 2.0 * 683))
-    return sorted(os.path.join(out, n) for n in list(files) + ["textured.glb"])
+    # An emissive panel behind the sphere, its emission an image (emissiveTexture), the only
+    # light: seen directly, and lighting the sphere's rim and the floor.
+    glowing = material((0.0, 0.0, 0.0), 0.0, 1.0)
+    glowing["emissiveFactor"] = [1.0, 1.0, 1.0]
+    glowing["emissiveTexture"] = {"index": 0}
+    glowing["extensions"] = {"KHR_materials_emissive_strength": {"emissiveStrength": 3.0}}
+    write_glb(os.path.join(out, "emissive.glb"),
+              [s + (0,), f + (1,), panel() + (2,)], list(files["rough-plastic.glb"]) + [glowing],
+              images=[emission_image()], extensions=["KHR_materials_emissive_strength"])
+    return sorted(os.path.join(out, n) for n in list(files) + ["textured.glb", "emissive.glb"])
 
 
 # The suite's bound (docs/scene-format.md, "glTF files", says why): relMSE and each channel's

@@ -25,13 +25,15 @@
 //                   other samplers' and strategies' code is dropped;
 //   4 kEmitterKinds bit 1 << kEmitter* for each kind of emitter in the scene (every kind of the
 //                   registry, shared/emitter_kinds.h): with one kind, the others' light
-//                   sampling (the environment's CDF searches, point lights) is dropped.
+//                   sampling (the environment's CDF searches, point lights) is dropped;
+//   5 kEmissionMaps false: no emitter has an emission map (glTF's emissiveTexture), so the
+//                   lookups of shared/emission_map.h are dropped.
 // Why it matters on lavapipe: it runs 8 invocations as the lanes of one vector and executes both
 // sides of every if, masked, whatever the lanes decide; code a uniform condition switches off
 // still costs its full time there. Constants make the condition known to the compiler instead.
 //
-// Bindings (set 0): 0 shader table, 1 emitters, 2 emitter CDF, 3 the environment's map and
-// CDFs (shared/lights.h; 4 unread bytes without a map), 4 inputs, 5 results. 0-4 are uniform
+// Bindings (set 0): 0 shader table, 1 emitters, 2 emitter CDF, 3 the light data: the
+// environment's map and CDFs and the emission maps (4 unread bytes without any), 4 inputs, 5 results. 0-4 are uniform
 // texel buffers of 32-bit unsigned words (R32G32B32A32_UINT, or R32_UINT for 2 and 3), read with
 // texelFetch and turned back into the shared structs field by field; 5 is a storage buffer written
 // as whole uvec4s. Why not storage buffers throughout: on lavapipe (Mesa 22.3) every storage
@@ -55,11 +57,12 @@ layout(constant_id = 1) const bool kTextured = true;
 layout(constant_id = 2) const uint kSampling = kSamplerIndependent;
 layout(constant_id = 3) const uint kStrategy = kStrategyMis;
 layout(constant_id = 4) const uint kEmitterKinds = 0xFFFFFFFFu; // every kind
+layout(constant_id = 5) const bool kEmissionMaps = true;
 
 layout(set = 0, binding = 0) uniform usamplerBuffer shaderTable; // 3 texels per ShaderParams
 layout(set = 0, binding = 1) uniform usamplerBuffer emitterTable; // 5 texels per Emitter
 layout(set = 0, binding = 2) uniform usamplerBuffer emitterCdf;
-layout(set = 0, binding = 3) uniform usamplerBuffer environmentData;
+layout(set = 0, binding = 3) uniform usamplerBuffer lightData;
 layout(set = 0, binding = 4) uniform usamplerBuffer inputs; // 7 texels per ShadeInput
 layout(std430, set = 0, binding = 5) writeonly buffer Results { uvec4 results[]; }; // 7 per ShadeResult
 layout(scalar, push_constant) uniform Push { ShadePush pc; };
@@ -100,7 +103,8 @@ Emitter kernelEmitter(uint i) {
     e.normal = uintBitsToFloat(w3.xyz);
     e.type = w3.w;
     e.radiance = uintBitsToFloat(w4.xyz);
-    e.pad1 = uintBitsToFloat(w4.w);
+    e.map = w4.w;
+    if (!kEmissionMaps) e.map = kNoEmissionMap;
 #define SPW_ONLY_KIND(Name, id, stem, Scene, flags)                                                \
     if (kEmitterKinds == (1u << kEmitter##Name)) e.type = kEmitter##Name;
     SPW_EMITTER_KINDS(SPW_ONLY_KIND)
@@ -150,7 +154,7 @@ void storeResult(uint i, ShadeResult r) {
 #define SHADER(i) kernelShader(i)
 #define EMITTER(i) kernelEmitter(i)
 #define EMITTER_CDF(i) uintBitsToFloat(fetch(emitterCdf, i).x)
-#define ENVIRONMENT_DATA(i) uintBitsToFloat(fetch(environmentData, i).x)
+#define LIGHT_DATA(i) uintBitsToFloat(fetch(lightData, i).x)
 #include "shared/path.h"
 
 void main() {

@@ -385,7 +385,8 @@ static_assert(sizeof(kWideTwins) / sizeof(kWideTwins[0]) == kModelCount,
 
 bool simdShadingApplies(const SceneView& view) {
     for (uint i = 0; i < view.emitterCount; ++i)
-        if (view.emitters[i].type != kEmitterTriangle) return false;
+        if (view.emitters[i].type != kEmitterTriangle || view.emitters[i].map != kNoEmissionMap)
+            return false;
     return true;
 }
 

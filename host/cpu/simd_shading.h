@@ -35,7 +35,8 @@ struct WideTwin {
 extern const WideTwin kWideTwins[kModelCount];
 
 // Whether the kernels can shade this scene's hits: every emitter next-event estimation picks is
-// a triangle (point lights and the environment take shadeSurface()).
+// a triangle without an emission map (point lights, the environment and emission maps take
+// shadeSurface()).
 bool simdShadingApplies(const SceneView& view);
 
 // out[i] = shadeSurface(view, rp, in[i]) for i in [0, n); `simd` false shades every hit with

@@ -222,9 +222,10 @@ void RenderSession::chooseBackend() {
 // What the scene needs (BVH, textures, camera), the render-wide parameters, the film and the
 // backend.
 void RenderSession::build() {
-    lights_.emplace(scene_);
     textures_.emplace(scene_, scene_.settings.textureCacheMiB,
                       config_.textureFilter == TextureFilter::Cone, config_.pipeline.simdShading);
+    lights_.emplace(scene_, &*textures_);
+    if (lights_->emissionImages() > 0) stats_.extra["emission_maps"] = lights_->emissionImages();
     cutouts_.emplace(scene_, *textures_);
     if (cutouts_->meshes() > 0) stats_.extra["cutout_meshes"] = cutouts_->meshes();
     {

@@ -531,7 +531,7 @@ class GltfReader {
             warn(name + ": alphaMode BLEND is not rendered (it is drawn opaque)");
         else if (mat.alphaMode != "OPAQUE" && mat.alphaMode != "MASK")
             fail(at + "/alphaMode", "must be OPAQUE, MASK or BLEND");
-        readEmission(mat, s, at);
+        readEmission(mat, s, at, name);
         if (mat.doubleSided) s.params.flags |= kShaderTwoSided;
         return s;
     }
@@ -564,12 +564,12 @@ class GltfReader {
         }
         if (mat.occlusionTexture.index >= 0)
             warn(name + ": its occlusionTexture is ignored (a path tracer finds occlusion itself)");
-        if (mat.emissiveTexture.index >= 0)
-            warn(name + ": its emissiveTexture is not rendered yet (its emissiveFactor is)");
     }
 
-    // emissiveFactor times KHR_materials_emissive_strength's strength.
-    void readEmission(const tinygltf::Material& mat, Shader& s, const std::string& at) {
+    // emissiveFactor times KHR_materials_emissive_strength's strength, times emissiveTexture's
+    // image (sRGB) where the material has one and the factor is not black.
+    void readEmission(const tinygltf::Material& mat, Shader& s, const std::string& at,
+                      const std::string& name) {
         double strength = 1.0;
         if (const auto e = mat.extensions.find("KHR_materials_emissive_strength");
             e != mat.extensions.end() && e->second.Has("emissiveStrength")) {
@@ -586,6 +586,11 @@ class GltfReader {
                 fail(at + "/extensions/KHR_materials_emissive_strength",
                      "emission beyond " + std::to_string(kMaxRadiance));
             s.params.emission[k] = float(e);
+        }
+        if (mat.emissiveTexture.index >= 0 && maxComponent(s.params.emission) > 0.0f) {
+            s.emissionTexture = int(scene_.textures.size());
+            scene_.textures.push_back(imageTexture(mat.emissiveTexture, at + "/emissiveTexture",
+                                                   name + ": its emissiveTexture"));
         }
     }
 

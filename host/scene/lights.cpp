@@ -1,14 +1,38 @@
 #include "host/scene/lights.h"
 
 #include "host/scene/emitter_kinds.h"
+#include "host/scene/textures.h"
 
+#include "shared/emission_map.h"
 #include "shared/sampling.h"
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 
 namespace spw {
 namespace {
+
+// The most texels an emission map's image keeps (2048 x 2048: 48 MB of floats; the kernels'
+// light data is one texel buffer, which Vulkan devices bound at 2^27 elements and up).
+constexpr size_t kMaxEmissionTexels = size_t(1) << 22;
+
+// The next coarser MIP level of a w x h image: each texel the mean of up to 2 x 2 (an odd
+// side's last texel averaged with itself).
+std::vector<vec3> halved(const std::vector<vec3>& in, int& w, int& h) {
+    const int hw = (w + 1) / 2, hh = (h + 1) / 2;
+    std::vector<vec3> out(size_t(hw) * size_t(hh));
+    auto at = [&](int x, int y) {
+        return in[size_t(std::min(y, h - 1)) * size_t(w) + size_t(std::min(x, w - 1))];
+    };
+    for (int y = 0; y < hh; ++y)
+        for (int x = 0; x < hw; ++x)
+            out[size_t(y) * size_t(hw) + size_t(x)] =
+                0.25f * (at(2 * x, 2 * y) + at(2 * x + 1, 2 * y) + at(2 * x, 2 * y + 1) +
+                         at(2 * x + 1, 2 * y + 1));
+    w = hw, h = hh;
+    return out;
+}
 
 // The radius of a sphere around every vertex of the scene (centred on their bounding box): the
 // scale an environment's power is measured at.
@@ -24,7 +48,7 @@ double sceneRadius(const Scene& scene) {
 
 } // namespace
 
-SceneLights::SceneLights(const Scene& scene) {
+SceneLights::SceneLights(const Scene& scene, const TextureResolver* textures) {
     for (const Shader& s : scene.shaders)
         shaders_.push_back(s.params);
 
@@ -32,36 +56,27 @@ SceneLights::SceneLights(const Scene& scene) {
     // range), normalised into pickPdf below.
     std::vector<double> powers;
     emitterBase_.assign(scene.meshes.size(), -1);
-    for (size_t m = 0; m < scene.meshes.size(); ++m) {
-        const Mesh& mesh = scene.meshes[m];
-        const ShaderParams& sp = shaders_[size_t(mesh.shader)];
-        if (maxComponent(sp.emission) <= 0.0f) continue;
-        brightest_ = std::max(brightest_, maxComponent(sp.emission));
-        emitterBase_[m] = int(emitters_.size());
-        bool twoSided = (sp.flags & kShaderTwoSided) != 0;
-        for (const uvec3& t : mesh.triangles) {
-            Emitter e{};
-            e.type = kEmitterTriangle;
-            e.p0 = mesh.positions[t.x];
-            e.e1 = mesh.positions[t.y] - e.p0;
-            e.e2 = mesh.positions[t.z] - e.p0;
-            vec3 c = glm::cross(e.e1, e.e2);
-            e.area = 0.5f * glm::length(c);
-            e.normal = glm::normalize(c);
-            e.twoSided = twoSided ? 1u : 0u;
-            e.radiance = sp.emission;
-            // Power = L * area * pi per emitting side.
-            powers.push_back(double(luminance(sp.emission)) * double(e.area) * kPi *
-                             (twoSided ? 2.0 : 1.0));
-            emitters_.push_back(e);
-        }
-    }
+    for (size_t m = 0; m < scene.meshes.size(); ++m)
+        addTriangles(scene, m, textures, powers);
 
     const double radius = sceneRadius(scene);
     for (const PunctualLight& p : scene.punctualLights)
         addPunctual(p, radius, powers);
 
     if (scene.environment) buildEnvironment(*scene.environment, radius, powers);
+
+    // The emission maps go behind the environment's data, which starts at 0.
+    if (!maps_.empty()) {
+        const uint base = uint(lightData_.size());
+        for (Emitter& e : emitters_)
+            if (e.map != kNoEmissionMap) {
+                float& image = maps_[e.map + 6]; // the record's image offset (emission_map.h)
+                image = glm::uintBitsToFloat(glm::floatBitsToUint(image) + base);
+                e.map += base;
+            }
+        lightData_.insert(lightData_.end(), maps_.begin(), maps_.end());
+        maps_.clear();
+    }
 
     double totalPower = 0.0;
     for (double p : powers)
@@ -90,6 +105,99 @@ SceneLights::SceneLights(const Scene& scene) {
         environment_ = uint(emitters_.size());
         emitters_.push_back(e); // pickPdf 0, after the CDF: never picked
     }
+}
+
+// Every triangle of mesh m, if its shader emits: an emitter each, with its power.
+void SceneLights::addTriangles(const Scene& scene, size_t m, const TextureResolver* textures,
+                               std::vector<double>& powers) {
+    const Mesh& mesh = scene.meshes[m];
+    const Shader& shader = scene.shaders[size_t(mesh.shader)];
+    const ShaderParams& sp = shader.params;
+    if (maxComponent(sp.emission) <= 0.0f) return;
+    const EmissionImage* image = nullptr;
+    if (shader.emissionTexture >= 0) {
+        if (!textures || !textures->active())
+            throw std::logic_error("an emission map's image needs the scene's texture resolver");
+        image = &emissionImage(shader.emissionTexture, *textures);
+    }
+    brightest_ =
+        std::max(brightest_, maxComponent(sp.emission) * (image ? image->brightest : 1.0f));
+    emitterBase_[m] = int(emitters_.size());
+    bool twoSided = (sp.flags & kShaderTwoSided) != 0;
+    for (const uvec3& t : mesh.triangles) {
+        Emitter e{};
+        e.type = kEmitterTriangle;
+        e.p0 = mesh.positions[t.x];
+        e.e1 = mesh.positions[t.y] - e.p0;
+        e.e2 = mesh.positions[t.z] - e.p0;
+        vec3 c = glm::cross(e.e1, e.e2);
+        e.area = 0.5f * glm::length(c);
+        e.normal = glm::normalize(c);
+        e.twoSided = twoSided ? 1u : 0u;
+        e.radiance = sp.emission;
+        // Power = L * area * pi per emitting side, L the map's mean over the triangle.
+        double mapped = 1.0;
+        if (image)
+            mapped =
+                addEmissionMap(mesh, t, scene.textures[size_t(shader.emissionTexture)], *image, e);
+        powers.push_back(double(luminance(sp.emission)) * mapped * double(e.area) * kPi *
+                         (twoSided ? 2.0 : 1.0));
+        emitters_.push_back(e);
+    }
+}
+
+// An emission map's image, read once into maps_ (linear RGB, row by row); one larger than
+// kMaxEmissionTexels is averaged down to a coarser level until it fits.
+const SceneLights::EmissionImage& SceneLights::emissionImage(int texture,
+                                                             const TextureResolver& textures) {
+    if (const auto found = emissionImages_.find(texture); found != emissionImages_.end())
+        return found->second;
+    EmissionImage image;
+    std::vector<vec3> texels = textures.finestLevel(texture, image.width, image.height);
+    while (size_t(image.width) * size_t(image.height) > kMaxEmissionTexels)
+        texels = halved(texels, image.width, image.height);
+    image.offset = uint(maps_.size());
+    double sum = 0.0;
+    for (const vec3& t : texels) {
+        maps_.insert(maps_.end(), {t.x, t.y, t.z});
+        sum += double(luminance(t));
+        image.brightest = std::max(image.brightest, maxComponent(t));
+    }
+    image.meanLuminance = sum / double(texels.size());
+    return emissionImages_[texture] = image;
+}
+
+double SceneLights::addEmissionMap(const Mesh& mesh, const uvec3& t, const Texture& texture,
+                                   const EmissionImage& image, Emitter& e) {
+    // Image coordinates (s, t) = (u, 1 - v) of the vertices, after the texture transform.
+    vec2 st[3];
+    for (int k = 0; k < 3; ++k) {
+        vec2 uv = mesh.uvs.empty() ? vec2(0.0f) : mesh.uvs[t[k]];
+        if (texture.uvTransformed) uv = vec2(texture.uvTransform * vec3(uv, 1.0f));
+        st[k] = vec2(uv.x, 1.0f - uv.y);
+    }
+    const vec2 d1 = st[1] - st[0], d2 = st[2] - st[0];
+    e.map = uint(maps_.size());
+    maps_.insert(maps_.end(),
+                 {st[0].x, st[0].y, d1.x, d1.y, d2.x, d2.y, glm::uintBitsToFloat(image.offset),
+                  glm::uintBitsToFloat(uint(image.width)),
+                  glm::uintBitsToFloat(uint(image.height))});
+    // The map's mean over the triangle, from an n x n grid of stratified points, n growing with
+    // the texels the triangle covers (at most 32). Where the grid misses the triangle's bright
+    // texels, the pick probability is only less apt: the floor, 1 % of the image's mean, keeps
+    // every triangle of a lit image pickable.
+    const float texels =
+        0.5f * std::fabs(d1.x * d2.y - d1.y * d2.x) * float(image.width) * float(image.height);
+    const int n = std::clamp(int(std::ceil(std::sqrt(texels))), 4, 32);
+    SceneView view;
+    view.lightData = maps_.data();
+    double sum = 0.0;
+    for (int i = 0; i < n; ++i)
+        for (int j = 0; j < n; ++j) {
+            const vec2 u((float(i) + 0.5f) / float(n), (float(j) + 0.5f) / float(n));
+            sum += double(luminance(emissionMapValue(view, e.map, sampleTriangle(u))));
+        }
+    return std::max(sum / double(n * n), 0.01 * image.meanLuminance);
 }
 
 // A punctual light's emitter and its power, by what its kind takes (emitter_kinds.h):
@@ -137,8 +245,8 @@ void SceneLights::buildEnvironment(const Environment& env, double radius,
         const size_t w = size_t(env.width), h = size_t(env.height);
         envWidth_ = uint(w);
         envHeight_ = uint(h);
-        environmentData_.assign(3 * w * h + h + w * h + (h - 1) + (w - 1), 0.0f);
-        float* texels = environmentData_.data();
+        lightData_.assign(3 * w * h + h + w * h + (h - 1) + (w - 1), 0.0f);
+        float* texels = lightData_.data();
         float* marginal = texels + 3 * w * h;
         float* conditional = marginal + h;
         std::vector<double> rowWeight(h, 0.0);
@@ -195,7 +303,7 @@ SceneView SceneLights::view() const {
     v.emitters = emitters_.data();
     v.emitterCdf = cdf_.data();
     v.emitterCount = uint(cdf_.size());
-    v.environmentData = environmentData_.empty() ? nullptr : environmentData_.data();
+    v.lightData = lightData_.empty() ? nullptr : lightData_.data();
     return v;
 }
 

@@ -9,13 +9,18 @@
 #include "host/scene/scene.h"
 #include "shared/scene_access.h"
 
+#include <map>
 #include <vector>
 
 namespace spw {
 
+class TextureResolver;
+
 class SceneLights {
   public:
-    explicit SceneLights(const Scene& scene);
+    // `textures` reads the images of emission maps (Shader::emissionTexture); a scene with one
+    // needs it.
+    explicit SceneLights(const Scene& scene, const TextureResolver* textures = nullptr);
 
     // The shading view: shaders, emitters and their CDF.
     SceneView view() const;
@@ -27,8 +32,10 @@ class SceneLights {
     uint environment() const { return environment_; }
     uint environmentWidth() const { return envWidth_; }
     uint environmentHeight() const { return envHeight_; }
-    const std::vector<float>& environmentData() const { return environmentData_; }
+    const std::vector<float>& lightData() const { return lightData_; }
     float brightestEmission() const { return brightest_; }
+    // How many images the emission maps read (each baked once, however many meshes use it).
+    size_t emissionImages() const { return emissionImages_.size(); }
     // The emitter index of a mesh's triangle, or kNoEmitter.
     uint emitterOf(uint mesh, uint triangle) const {
         const int base = emitterBase_[mesh];
@@ -36,6 +43,21 @@ class SceneLights {
     }
 
   private:
+    // An emission map's image in the maps' data: where it starts, its size, its mean luminance
+    // and its largest channel.
+    struct EmissionImage {
+        uint offset = 0;
+        int width = 1, height = 1;
+        double meanLuminance = 0.0;
+        float brightest = 0.0f;
+    };
+    void addTriangles(const Scene& scene, size_t m, const TextureResolver* textures,
+                      std::vector<double>& powers);
+    const EmissionImage& emissionImage(int texture, const TextureResolver& textures);
+    // Appends triangle t's record (shared/emission_map.h) to maps_ for Emitter::map; returns
+    // the map's mean luminance over the triangle, as the power estimate weighs it.
+    double addEmissionMap(const Mesh& mesh, const uvec3& t, const Texture& texture,
+                          const EmissionImage& image, Emitter& e);
     void addPunctual(const PunctualLight& p, double radius, std::vector<double>& powers);
     void buildEnvironment(const Environment& env, double radius, std::vector<double>& powers);
 
@@ -46,7 +68,12 @@ class SceneLights {
     float brightest_ = 0.0f;
     uint environment_ = kNoEmitter;
     uint envWidth_ = 0, envHeight_ = 0;
-    std::vector<float> environmentData_; // texels, then CDFs (shared/lights.h)
+    // The environment map's texels and CDFs, then the emission maps (SceneView::lightData).
+    std::vector<float> lightData_;
+    // The emission maps' images and records, offsets relative to their start until the
+    // constructor moves them behind the environment's data.
+    std::vector<float> maps_;
+    std::map<int, EmissionImage> emissionImages_; // by Scene::textures index
 };
 
 } // namespace spw

@@ -151,6 +151,10 @@ struct Shader {
     // made from) the hit's roughness, carried in SurfaceHit::material (kShaderHitParams).
     int metallicRoughnessTexture = -1;
     float roughness = 1.0f;
+    // An emission map (glTF's emissiveTexture), or -1: a Standard texture whose image times
+    // params.emission is the radiance at each point of the mesh's triangles. The kernels read it
+    // from the light data (shared/emission_map.h), not hit setup: light sampling needs it too.
+    int emissionTexture = -1;
 
     // Maps beyond the colour, looked up in hit setup after it (HitSetup::applyMaps).
     bool hasMaps() const { return normalTexture >= 0 || metallicRoughnessTexture >= 0; }

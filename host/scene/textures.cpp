@@ -169,6 +169,16 @@ class TexelReader {
         }
     }
 
+    // Every texel of the finest level, row by row.
+    void finestLevel(std::vector<vec3>& out) {
+        const Impl::Level& level = image_.levels[0];
+        out.resize(size_t(level.width) * size_t(level.height));
+        for (int y = 0; y < level.height; ++y)
+            for (int x = 0; x < level.width; ++x)
+                out[size_t(y) * size_t(level.width) + size_t(x)] =
+                    image_.absent ? vec3(1.0f) : texel(0, level.x + x, level.y + y);
+    }
+
   private:
     struct LevelQuery {
         float s, t;  // image space
@@ -559,6 +569,16 @@ TextureStatistics TextureResolver::statistics() const {
     s.cacheMisses = count("stat:find_tile_cache_misses");
     s.peakCacheBytes = impl_->peakCacheBytes.load();
     return s;
+}
+
+std::vector<vec3> TextureResolver::finestLevel(int texture, int& width, int& height) const {
+    const Impl::Image& image = impl_->images[size_t(texture)];
+    width = image.levels[0].width;
+    height = image.levels[0].height;
+    std::vector<vec3> out;
+    TexelReader(*impl_, impl_->thread(), texture).finestLevel(out);
+    checkErrors();
+    return out;
 }
 
 vec3 TextureResolver::albedo(const Shader& shader, vec2 uv, float footprint) const {

@@ -58,6 +58,10 @@ class TextureResolver {
     // colour's, normal map's, metallic-roughness image's or cut-out's) for n lookups, as albedos()
     // evaluates them; footprint null: the finest level. Thread-safe.
     void values(int tree, size_t n, const vec2* uv, const float* footprint, vec3* out) const;
+    // The finest MIP level of the image of Standard texture Scene::textures[texture], as lookups
+    // read it (linear, its channels from Texture::channel on), row by row from the top, and its
+    // size. Throws SceneError where its pixels cannot be read.
+    std::vector<vec3> finestLevel(int texture, int& width, int& height) const;
     // True when the scene has image textures (OpenImageIO is in use).
     bool active() const { return impl_ != nullptr; }
     // Throws SceneError (the texture's file and scene line) if an image lookup failed since the

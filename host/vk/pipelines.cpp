@@ -37,8 +37,11 @@ ShadingPipelines::ShadingPipelines(const Context& context, const std::vector<std
 
         // Every constant is 32 bits wide (VkBool32 or uint).
         const uint32_t values[] = {spec.hasEmitters ? VK_TRUE : VK_FALSE,
-                                   spec.textured ? VK_TRUE : VK_FALSE, spec.sampling, spec.strategy,
-                                   spec.emitterKinds};
+                                   spec.textured ? VK_TRUE : VK_FALSE,
+                                   spec.sampling,
+                                   spec.strategy,
+                                   spec.emitterKinds,
+                                   spec.emissionMaps ? VK_TRUE : VK_FALSE};
         constexpr uint32_t kConstants = uint32_t(std::size(values));
         VkSpecializationMapEntry entries[kConstants];
         for (uint32_t i = 0; i < kConstants; ++i)

@@ -23,6 +23,7 @@ struct KernelSpecialization {
     uint32_t sampling = 0;       // constant_id 2: RenderParams::sampling
     uint32_t strategy = 0;       // constant_id 3: RenderParams::strategy
     uint32_t emitterKinds = ~0u; // constant_id 4: bit 1 << kEmitter* for each kind in the scene
+    bool emissionMaps = true;    // constant_id 5: an emitter has an emission map
 };
 
 class ShadingPipelines {

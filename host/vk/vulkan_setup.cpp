@@ -39,8 +39,11 @@ std::vector<std::string> VulkanShading::chooseKernels(const RenderContext& ctx,
     spec_.sampling = ctx.params.sampling;
     spec_.strategy = ctx.params.strategy;
     spec_.emitterKinds = 0;
-    for (const Emitter& e : ctx.lights.emitters())
+    spec_.emissionMaps = false;
+    for (const Emitter& e : ctx.lights.emitters()) {
         spec_.emitterKinds |= 1u << e.type;
+        spec_.emissionMaps = spec_.emissionMaps || e.map != kNoEmissionMap;
+    }
     std::vector<std::string> kernels;
     if (pipeline.sortsHits()) {
         for (const SurfaceModelInfo& m : kSurfaceModels)
@@ -135,10 +138,9 @@ void VulkanShading::uploadTables(const RenderContext& ctx) {
                                 kTexelBytes, "emitter");
     emitterCdf_ = uploadTable(view.emitterCdf, view.emitterCount * sizeof(float), sizeof(float),
                               "emitter CDF");
-    // The environment's map and CDFs; a constant environment (or none) binds 16 bytes.
-    environment_ =
-        uploadTable(lights.environmentData().data(),
-                    lights.environmentData().size() * sizeof(float), sizeof(float), "environment");
+    // The environment's map and CDFs and the emission maps; without them, 16 bytes are bound.
+    environment_ = uploadTable(lights.lightData().data(), lights.lightData().size() * sizeof(float),
+                               sizeof(float), "light data");
     const HostArray* tables[4] = {shaderTable_.get(), emitterTable_.get(), emitterCdf_.get(),
                                   environment_.get()};
     const VkFormat formats[4] = {VK_FORMAT_R32G32B32A32_UINT, VK_FORMAT_R32G32B32A32_UINT,

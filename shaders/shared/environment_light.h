@@ -10,7 +10,7 @@ SHARED_BEGIN
 // theta = acos(d.y) (row 0 is straight up, +Y). Its radiance is constant over each texel, and so
 // is the sampling density in (u, v): texels are picked in proportion to luminance x sin(theta)
 // (the solid angle a texel spans), a row from the marginal CDF, then a column from that row's
-// conditional CDF (Pharr et al., pbrt 3rd ed., 14.2.4). ENVIRONMENT_DATA holds, as floats:
+// conditional CDF (Pharr et al., pbrt 3rd ed., 14.2.4). LIGHT_DATA holds, as floats from 0:
 //   3WH   the texels' RGB radiance, row by row
 //   H     the rows' CDF (inclusive prefix sums, the last exactly 1)
 //   WH    each row's CDF over its columns
@@ -32,7 +32,7 @@ SHARED_FN vec3 environmentDirection(vec2 uv) {
 // from cos(phi) = -d.z / rho on either half of the circle, without dividing.
 SHARED_FN bool environmentPastColumn(SCENE_PARAM RenderParams rp, vec3 d, float rho, uint k) {
     uint w = rp.envWidth;
-    float c = ENVIRONMENT_DATA(4u * w * rp.envHeight + 2u * rp.envHeight - 1u + k - 1u);
+    float c = LIGHT_DATA(4u * w * rp.envHeight + 2u * rp.envHeight - 1u + k - 1u);
     if (2u * k <= w) return d.x < 0.0f ? -d.z >= c * rho : true; // boundary phi <= 0
     return d.x >= 0.0f && -d.z <= c * rho;                       // boundary phi > 0
 }
@@ -44,7 +44,7 @@ SHARED_FN uvec2 environmentTexel(SCENE_PARAM RenderParams rp, vec3 d) {
     uint hi = rp.envHeight - 1u;
     while (lo < hi) { // the first boundary below d: cos falls as theta grows
         uint mid = (lo + hi) >> 1u;
-        if (d.y > ENVIRONMENT_DATA(rowCos + mid))
+        if (d.y > LIGHT_DATA(rowCos + mid))
             hi = mid;
         else
             lo = mid + 1u;
@@ -64,7 +64,7 @@ SHARED_FN uvec2 environmentTexel(SCENE_PARAM RenderParams rp, vec3 d) {
 }
 
 SHARED_FN float environmentCdfInterval(SCENE_PARAM uint base, uint i) {
-    return ENVIRONMENT_DATA(base + i) - (i > 0u ? ENVIRONMENT_DATA(base + i - 1u) : 0.0f);
+    return LIGHT_DATA(base + i) - (i > 0u ? LIGHT_DATA(base + i - 1u) : 0.0f);
 }
 
 // Radiance arriving from direction d (unit) out of environment e.
@@ -72,7 +72,7 @@ SHARED_FN vec3 environmentRadiance(SCENE_PARAM RenderParams rp, Emitter e, vec3 
     if (rp.envWidth == 0u) return e.radiance;
     uvec2 t = environmentTexel(SCENE_ARG rp, d);
     uint i = 3u * (t.y * rp.envWidth + t.x);
-    return vec3(ENVIRONMENT_DATA(i), ENVIRONMENT_DATA(i + 1u), ENVIRONMENT_DATA(i + 2u));
+    return vec3(LIGHT_DATA(i), LIGHT_DATA(i + 1u), LIGHT_DATA(i + 2u));
 }
 
 // Solid-angle density of environmentSample() choosing d, before the pick probability.
@@ -95,13 +95,13 @@ SHARED_FN uint environmentSearch(SCENE_PARAM uint base, uint n, INOUT(float) u) 
     uint hi = n - 1u;
     while (lo < hi) {
         uint mid = (lo + hi) >> 1u;
-        if (ENVIRONMENT_DATA(base + mid) > u)
+        if (LIGHT_DATA(base + mid) > u)
             hi = mid;
         else
             lo = mid + 1u;
     }
-    float below = lo > 0u ? ENVIRONMENT_DATA(base + lo - 1u) : 0.0f;
-    float width = ENVIRONMENT_DATA(base + lo) - below;
+    float below = lo > 0u ? LIGHT_DATA(base + lo - 1u) : 0.0f;
+    float width = LIGHT_DATA(base + lo) - below;
     u = width > 0.0f ? min((u - below) / width, kOneMinusEpsilon) : 0.5f;
     return lo;
 }

@@ -2,6 +2,7 @@
 // returns, and the geometry of triangle emitters that MIS also reads when a ray hits one.
 #ifndef SPILLWAY_SHARED_LIGHT_SAMPLE_H
 #define SPILLWAY_SHARED_LIGHT_SAMPLE_H
+#include "emission_map.h"
 #include "offset.h"
 #include "sampling.h"
 #include "scene_access.h"

@@ -1,5 +1,5 @@
-// How shared code reads scene-wide arrays (shaders, emitters, the emitter CDF, the environment
-// map). In C++ they are
+// How shared code reads scene-wide arrays (shaders, emitters, the emitter CDF, the light data:
+// the environment's and emitters' maps). In C++ they are
 // spans passed as the first argument of every function that needs them; in GLSL they are
 // storage buffers declared by the kernel before it includes the shared headers, and the
 // SCENE_PARAM / SCENE_ARG macros vanish.
@@ -14,9 +14,10 @@ struct SceneView {
     const Emitter* emitters = nullptr;
     const float* emitterCdf = nullptr; // inclusive prefix sums of pickPdf, last entry 1
     uint emitterCount = 0;
-    // The environment's lat-long map and its sampling CDFs (shared/lights.h: environment*), or
-    // nothing for a constant environment or none.
-    const float* environmentData = nullptr;
+    // The light data, as floats: the environment's lat-long map and its sampling CDFs
+    // (shared/environment_light.h) from 0, then the emission maps (shared/emission_map.h); or
+    // nothing where there is neither.
+    const float* lightData = nullptr;
 };
 } // namespace spw
 #define SCENE_PARAM const SceneView &scene,
@@ -24,7 +25,7 @@ struct SceneView {
 #define SHADER(i) scene.shaders[i]
 #define EMITTER(i) scene.emitters[i]
 #define EMITTER_CDF(i) scene.emitterCdf[i]
-#define ENVIRONMENT_DATA(i) scene.environmentData[i]
+#define LIGHT_DATA(i) scene.lightData[i]
 #else
 #define SCENE_PARAM
 #define SCENE_ARG

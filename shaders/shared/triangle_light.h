@@ -16,7 +16,7 @@ SHARED_FN LightSample triangle_lightSample(SCENE_PARAM RenderParams rp, Emitter 
     ls.wi = d / dist;
     float cosLight = emitterCosine(e, -ls.wi);
     ls.pdf = emitterSolidAnglePdf(e, dist, cosLight);
-    ls.radiance = e.radiance;
+    ls.radiance = emitterRadiance(SCENE_ARG e, sampleTriangle(u));
     // Stop short of the emitter's own surface, whatever the scene's scale.
     float offsetQ = surfaceOffset(q, e.p0, e.p0 + e.e1, e.p0 + e.e2, e.normal);
     ls.tmax = shadowRayTmax(dist, hit.offset, offsetQ, cosLight);

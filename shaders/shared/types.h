@@ -61,8 +61,12 @@ struct Emitter {
     uint type;     // kEmitter*
     vec3 radiance; // triangle: radiance; point, spot: intensity (W/sr); environment: radiance
                    // (times the map's texel where it has one); directional: irradiance (W/m^2)
-    float pad1;
+    uint map;      // triangle: its emission map's record in the light data (shared/emission_map.h),
+                   // which the radiance is multiplied by; kNoEmissionMap (0) otherwise
 };
+// No record starts at 0 (the maps' first image is ahead of every record), so a zeroed Emitter has
+// no map.
+const uint kNoEmissionMap = 0u;
 
 // What the shading step needs to know about a hit, already in world space.
 struct SurfaceHit {

@@ -3,6 +3,7 @@
 // texture coordinates; node hierarchies of matrices and TRS; cameras, lights, emissive
 // materials and what is not rendered (warnings, once); malformed files, each a SceneError
 // naming the file and where in it; and rendering on every backend.
+#include "host/image/image_io.h"
 #include "host/scene/gltf_loader.h"
 #include "test_util.h"
 
@@ -810,6 +811,118 @@ TEST(Gltf, MetallicRoughnessTexturesScaleTheFactorsPerHit) {
         EXPECT_NEAR(mapped, factors, 1e-3 * factors);
         EXPECT_GT(std::fabs(mapped - swapped), 0.05 * factors);
         EXPECT_GT(std::fabs(mapped - plain), 0.05 * factors);
+    }
+}
+
+} // namespace
+} // namespace spw::test
+
+namespace spw::test {
+namespace {
+
+// A white floor (4 x 4, z = 0) under a two-sided emitting unit quad at z = 1 whose emission is
+// emissiveFactor 1 x strength 4 x the image `image` (none: the factor alone, times `scale`),
+// seen from above; 24 x 24 pixels, the quad in columns and rows 7.2-16.8, the image's left half
+// on the left.
+std::vector<float> renderEmissiveQuad(const TempDir& dir, const std::string& image, float scale,
+                                      BackendKind backend, uint strategy = kStrategyMis,
+                                      int spp = 16) {
+    GltfBuilder b;
+    json light = material(vec3(0.0f), 0.0f, 1.0f, vec3(scale));
+    light["doubleSided"] = true;
+    light["extensions"]["KHR_materials_emissive_strength"]["emissiveStrength"] = 4.0;
+    if (!image.empty()) {
+        light["emissiveTexture"] = {{"index", 0}};
+        b.doc["textures"] = json::array({{{"source", 0}}});
+        b.doc["images"] = json::array({{{"uri", image}}});
+    }
+    b.doc["materials"] = json::array({material(vec3(0.8f), 0.0f, 1.0f), light});
+    b.doc["extensionsUsed"] = {"KHR_materials_emissive_strength"};
+    b.doc["cameras"] =
+        json::array({{{"type", "perspective"},
+                      {"perspective", {{"yfov", 0.6}, {"aspectRatio", 1.0}, {"znear", 0.1}}}}});
+    b.scene(
+        {b.node(
+             {{"mesh", b.mesh(b.quad(0))}, {"scale", {4, 4, 4}}, {"translation", {-1.5, -1.5, 0}}}),
+         b.node({{"mesh", b.mesh(b.quad(1))}, {"translation", {0, 0, 1}}}),
+         b.node({{"camera", 0}, {"translation", {0.5, 0.5, 5}}})});
+    Scene scene = loadScene(b.embedded(dir, "emissive.gltf"));
+    EXPECT_TRUE(scene.warnings.empty()) << scene.warnings.at(0);
+    scene.image.width = scene.image.height = 24;
+    RenderConfig cfg;
+    cfg.backend = backend;
+    cfg.spp = spp;
+    cfg.strategy = strategy;
+    return render(scene, cfg)->film->image();
+}
+
+// The mean of pixels [x0, x1) x [y0, y1) of a 24 x 24 image.
+double rectMean(const std::vector<float>& img, int x0, int x1, int y0, int y1) {
+    double sum = 0;
+    for (int y = y0; y < y1; ++y)
+        for (int x = x0; x < x1; ++x)
+            for (int c = 0; c < 3; ++c)
+                sum += img[size_t(y * 24 + x) * 3 + size_t(c)];
+    return sum / (double(y1 - y0) * double(x1 - x0) * 3.0);
+}
+
+// The whole image's mean.
+double imageMean(const std::vector<float>& img) {
+    return rectMean(img, 0, 24, 0, 24);
+}
+
+// emissiveTexture: the image times the factor is the radiance at each point of the emitter, seen
+// by rays that hit it and by next-event estimation alike, on every backend. An image of one value
+// renders as the factor times that value does; an image half black is black where the camera
+// sees that half (and so is one beyond 2048 x 2048 texels, averaged down first), and light
+// sampling and BSDF sampling alone agree on the floor it lights.
+TEST(Gltf, EmissiveTexturesScaleTheEmissionWhereverItIsSampled) {
+    TempDir dir;
+    const float grey = 0.4f; // as 8-bit sRGB: 102 / 255, linearised
+    writeConstantImage(dir.file("grey.png"), vec3(grey));
+    const float linear = srgbToLinear(102.0f / 255.0f);
+    OIIO::ImageBuf half(OIIO::ImageSpec(64, 4, 3, OIIO::TypeDesc::UINT8));
+    const float white[3] = {1.0f, 1.0f, 1.0f};
+    OIIO::ImageBufAlgo::fill(half, white, OIIO::ROI(0, 32, 0, 4, 0, 1, 0, 3));
+    ASSERT_TRUE(half.write(dir.file("half.png")));
+    // Beyond 2048 x 2048 texels, averaged down 2 x 2 (to 1025 x 1025) before baking.
+    OIIO::ImageBuf large(OIIO::ImageSpec(2050, 2050, 3, OIIO::TypeDesc::UINT8));
+    OIIO::ImageBufAlgo::fill(large, white, OIIO::ROI(0, 1025, 0, 2050, 0, 1, 0, 3));
+    ASSERT_TRUE(large.write(dir.file("large.png")));
+    for (BackendKind backend : {BackendKind::Reference, BackendKind::Cpu, BackendKind::Vulkan}) {
+        SCOPED_TRACE(backendName(backend));
+        const double mapped = imageMean(renderEmissiveQuad(dir, "grey.png", 1.0f, backend));
+        const double factor = imageMean(renderEmissiveQuad(dir, "", linear, backend));
+        const double plain = imageMean(renderEmissiveQuad(dir, "", 1.0f, backend));
+        EXPECT_NEAR(mapped, factor, 1e-4 * factor);
+        EXPECT_GT(plain, 1.5 * mapped);
+
+        // The camera sees the image's white half at 4 (and no MIS weight at the first hit), its
+        // black half at 0.
+        const std::vector<float> halved = renderEmissiveQuad(dir, "half.png", 1.0f, backend);
+        EXPECT_NEAR(rectMean(halved, 8, 11, 8, 16), 4.0, 1e-3);
+        EXPECT_NEAR(rectMean(halved, 13, 16, 8, 16), 0.0, 1e-3);
+        const std::vector<float> large = renderEmissiveQuad(dir, "large.png", 1.0f, backend);
+        EXPECT_NEAR(rectMean(large, 8, 11, 8, 16), 4.0, 1e-3);
+        EXPECT_NEAR(rectMean(large, 13, 16, 8, 16), 0.0, 1e-3);
+        // The floor around the quad, lit by its underside: what light sampling alone finds
+        // agrees with what BSDF sampling alone finds (at 256 spp; at 16, BSDF sampling alone is
+        // 11 % off, with or without the map), and with both, and is half what the whole quad
+        // gives.
+        const auto floorMean = [](const std::vector<float>& img) {
+            return (rectMean(img, 0, 24, 0, 6) + rectMean(img, 0, 24, 19, 24)) / 2.0;
+        };
+        const double byLight =
+            floorMean(renderEmissiveQuad(dir, "half.png", 1.0f, backend, kStrategyLight, 256));
+        const double byBsdf =
+            floorMean(renderEmissiveQuad(dir, "half.png", 1.0f, backend, kStrategyBsdf, 256));
+        const double byBoth =
+            floorMean(renderEmissiveQuad(dir, "half.png", 1.0f, backend, kStrategyMis, 256));
+        const double whole =
+            floorMean(renderEmissiveQuad(dir, "", 1.0f, backend, kStrategyMis, 256));
+        EXPECT_NEAR(byLight, byBsdf, 0.02 * byBsdf);
+        EXPECT_NEAR(byBoth, byLight, 0.02 * byLight);
+        EXPECT_NEAR(byBoth, 0.5 * whole, 0.03 * byBoth);
     }
 }
 

@@ -42,7 +42,7 @@ const Fields kEmitter = {SPW_FIELD(Emitter, p0),       SPW_FIELD(Emitter, area),
                          SPW_FIELD(Emitter, e1),       SPW_FIELD(Emitter, pickPdf),
                          SPW_FIELD(Emitter, e2),       SPW_FIELD(Emitter, twoSided),
                          SPW_FIELD(Emitter, normal),   SPW_FIELD(Emitter, type),
-                         SPW_FIELD(Emitter, radiance), SPW_FIELD(Emitter, pad1)};
+                         SPW_FIELD(Emitter, radiance), SPW_FIELD(Emitter, map)};
 // Nested structs: "hit.p" is ShadeInput::hit's p.
 Fields nested(const std::string& prefix, size_t base, const Fields& inner) {
     Fields out;
