@@ -64,20 +64,39 @@ SceneLights::SceneLights(const Scene& scene, const TextureResolver* textures) {
         addPunctual(p, radius, powers);
 
     if (scene.environment) buildEnvironment(*scene.environment, radius, powers);
+    placeEmissionMaps();
+    buildCdf(powers, scene.meshes.size());
 
-    // The emission maps go behind the environment's data, which starts at 0.
-    if (!maps_.empty()) {
-        const uint base = uint(lightData_.size());
-        for (Emitter& e : emitters_)
-            if (e.map != kNoEmissionMap) {
-                float& image = maps_[e.map + 6]; // the record's image offset (emission_map.h)
-                image = glm::uintBitsToFloat(glm::floatBitsToUint(image) + base);
-                e.map += base;
-            }
-        lightData_.insert(lightData_.end(), maps_.begin(), maps_.end());
-        maps_.clear();
+    // An environment stays visible to escaping rays even where next-event estimation never
+    // picks it (a scene with no geometry has no power to give it).
+    for (size_t i = 0; i < emitters_.size(); ++i)
+        if (emitters_[i].type == kEmitterEnvironment) environment_ = uint(i);
+    if (scene.environment && environment_ == kNoEmitter &&
+        maxComponent(scene.environment->radiance) > 0.0f) {
+        Emitter e{};
+        e.type = kEmitterEnvironment;
+        e.radiance = scene.environment->radiance;
+        environment_ = uint(emitters_.size());
+        emitters_.push_back(e); // pickPdf 0, after the CDF: never picked
     }
+}
 
+// The emission maps go behind the environment's data, which starts at 0.
+void SceneLights::placeEmissionMaps() {
+    if (maps_.empty()) return;
+    const uint base = uint(lightData_.size());
+    for (Emitter& e : emitters_)
+        if (e.map != kNoEmissionMap) {
+            float& image = maps_[e.map + 6]; // the record's image offset (emission_map.h)
+            image = glm::uintBitsToFloat(glm::floatBitsToUint(image) + base);
+            e.map += base;
+        }
+    lightData_.insert(lightData_.end(), maps_.begin(), maps_.end());
+    maps_.clear();
+}
+
+// Every emitter's pickPdf and the CDF, from their powers; without any power, no emitter.
+void SceneLights::buildCdf(const std::vector<double>& powers, size_t meshes) {
     double totalPower = 0.0;
     for (double p : powers)
         totalPower += p;
@@ -91,19 +110,7 @@ SceneLights::SceneLights(const Scene& scene, const TextureResolver* textures) {
         cdf_.back() = 1.0f;
     } else {
         emitters_.clear(); // nothing emits: nothing to sample
-        emitterBase_.assign(scene.meshes.size(), -1);
-    }
-    // An environment stays visible to escaping rays even where next-event estimation never
-    // picks it (a scene with no geometry has no power to give it).
-    for (size_t i = 0; i < emitters_.size(); ++i)
-        if (emitters_[i].type == kEmitterEnvironment) environment_ = uint(i);
-    if (scene.environment && environment_ == kNoEmitter &&
-        maxComponent(scene.environment->radiance) > 0.0f) {
-        Emitter e{};
-        e.type = kEmitterEnvironment;
-        e.radiance = scene.environment->radiance;
-        environment_ = uint(emitters_.size());
-        emitters_.push_back(e); // pickPdf 0, after the CDF: never picked
+        emitterBase_.assign(meshes, -1);
     }
 }
 
@@ -241,60 +248,64 @@ void SceneLights::buildEnvironment(const Environment& env, double radius,
     e.radiance = env.radiance;
     double integral = 4.0 * kPi * double(luminance(env.radiance)); // over the sphere
     float brightest = maxComponent(env.radiance);
-    if (!env.path.empty()) {
-        const size_t w = size_t(env.width), h = size_t(env.height);
-        envWidth_ = uint(w);
-        envHeight_ = uint(h);
-        lightData_.assign(3 * w * h + h + w * h + (h - 1) + (w - 1), 0.0f);
-        float* texels = lightData_.data();
-        float* marginal = texels + 3 * w * h;
-        float* conditional = marginal + h;
-        std::vector<double> rowWeight(h, 0.0);
-        integral = 0.0;
-        brightest = 0.0f;
-        for (size_t y = 0; y < h; ++y) {
-            const double sinTheta = std::sin(kPi * (double(y) + 0.5) / double(h));
-            double running = 0.0;
-            std::vector<double> weights(w);
-            for (size_t x = 0; x < w; ++x) {
-                vec3 L;
-                for (int c = 0; c < 3; ++c)
-                    L[c] = env.rgb[(y * w + x) * 3 + size_t(c)] * env.radiance[c];
-                for (int c = 0; c < 3; ++c)
-                    texels[(y * w + x) * 3 + size_t(c)] = L[c];
-                brightest = std::max(brightest, maxComponent(L));
-                weights[x] = double(luminance(L)) * sinTheta;
-                running += weights[x];
-            }
-            // A black row is sampled uniformly across (it is never picked: its weight is 0).
-            double partial = 0.0;
-            for (size_t x = 0; x < w; ++x) {
-                partial += running > 0.0 ? weights[x] : 1.0;
-                conditional[y * w + x] = float(partial / (running > 0.0 ? running : double(w)));
-            }
-            conditional[y * w + w - 1] = 1.0f;
-            rowWeight[y] = running;
-            integral += running;
-        }
-        double total = integral, partial = 0.0;
-        for (size_t y = 0; y < h; ++y) {
-            partial += rowWeight[y];
-            marginal[y] = total > 0.0 ? float(partial / total) : float(y + 1) / float(h);
-        }
-        marginal[h - 1] = 1.0f;
-        float* rowCos = conditional + w * h;
-        for (size_t k = 1; k < h; ++k)
-            rowCos[k - 1] = float(std::cos(kPi * double(k) / double(h)));
-        float* columnCos = rowCos + (h - 1);
-        for (size_t k = 1; k < w; ++k)
-            columnCos[k - 1] = float(std::cos(-kPi + 2.0 * kPi * double(k) / double(w)));
-        // Each texel spans (2 pi / w) x (pi / h) in (phi, theta): its solid angle is that times
-        // sin(theta).
-        integral *= 2.0 * kPi * kPi / double(w * h);
-    }
+    if (!env.path.empty()) integral = buildEnvironmentMap(env, brightest);
     brightest_ = std::max(brightest_, brightest);
     powers.push_back(kPi * radius * radius * integral);
     emitters_.push_back(e);
+}
+
+// The map's texels and sampling tables, from 0 in lightData_ (shared/environment_light.h);
+// returns its luminance integrated over the sphere, and its brightest channel in `brightest`.
+double SceneLights::buildEnvironmentMap(const Environment& env, float& brightest) {
+    const size_t w = size_t(env.width), h = size_t(env.height);
+    envWidth_ = uint(w);
+    envHeight_ = uint(h);
+    lightData_.assign(3 * w * h + h + w * h + (h - 1) + (w - 1), 0.0f);
+    float* texels = lightData_.data();
+    float* marginal = texels + 3 * w * h;
+    float* conditional = marginal + h;
+    std::vector<double> rowWeight(h, 0.0);
+    double integral = 0.0;
+    brightest = 0.0f;
+    std::vector<double> weights(w);
+    for (size_t y = 0; y < h; ++y) {
+        const double sinTheta = std::sin(kPi * (double(y) + 0.5) / double(h));
+        double running = 0.0;
+        for (size_t x = 0; x < w; ++x) {
+            vec3 L;
+            for (int c = 0; c < 3; ++c)
+                L[c] = env.rgb[(y * w + x) * 3 + size_t(c)] * env.radiance[c];
+            for (int c = 0; c < 3; ++c)
+                texels[(y * w + x) * 3 + size_t(c)] = L[c];
+            brightest = std::max(brightest, maxComponent(L));
+            weights[x] = double(luminance(L)) * sinTheta;
+            running += weights[x];
+        }
+        // A black row is sampled uniformly across (it is never picked: its weight is 0).
+        double partial = 0.0;
+        for (size_t x = 0; x < w; ++x) {
+            partial += running > 0.0 ? weights[x] : 1.0;
+            conditional[y * w + x] = float(partial / (running > 0.0 ? running : double(w)));
+        }
+        conditional[y * w + w - 1] = 1.0f;
+        rowWeight[y] = running;
+        integral += running;
+    }
+    double partial = 0.0;
+    for (size_t y = 0; y < h; ++y) {
+        partial += rowWeight[y];
+        marginal[y] = integral > 0.0 ? float(partial / integral) : float(y + 1) / float(h);
+    }
+    marginal[h - 1] = 1.0f;
+    float* rowCos = conditional + w * h;
+    for (size_t k = 1; k < h; ++k)
+        rowCos[k - 1] = float(std::cos(kPi * double(k) / double(h)));
+    float* columnCos = rowCos + (h - 1);
+    for (size_t k = 1; k < w; ++k)
+        columnCos[k - 1] = float(std::cos(-kPi + 2.0 * kPi * double(k) / double(w)));
+    // Each texel spans (2 pi / w) x (pi / h) in (phi, theta): its solid angle is that times
+    // sin(theta).
+    return integral * 2.0 * kPi * kPi / double(w * h);
 }
 
 SceneView SceneLights::view() const {

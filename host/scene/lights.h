@@ -58,8 +58,11 @@ class SceneLights {
     // the map's mean luminance over the triangle, as the power estimate weighs it.
     double addEmissionMap(const Mesh& mesh, const uvec3& t, const Texture& texture,
                           const EmissionImage& image, Emitter& e);
+    void placeEmissionMaps();
+    void buildCdf(const std::vector<double>& powers, size_t meshes);
     void addPunctual(const PunctualLight& p, double radius, std::vector<double>& powers);
     void buildEnvironment(const Environment& env, double radius, std::vector<double>& powers);
+    double buildEnvironmentMap(const Environment& env, float& brightest);
 
     std::vector<ShaderParams> shaders_;
     std::vector<Emitter> emitters_;
