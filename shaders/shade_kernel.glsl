@@ -18,9 +18,10 @@
 // Specialisation constants drop what the scene does not need:
 //   0 kHasEmitters  false: no emitter anywhere, so no emission weighting and no next-event
 //                   estimation (the shadow-ray code is removed);
-//   1 kTextured     false: no shader is textured, so the albedo is the shader's constant
-//                   colour x reflectance (the same product the host's TextureResolver computes)
-//                   and the host-resolved per-hit albedo is not read;
+//   1 kTextured     false: no shader is textured and no mesh has vertex colours, so the
+//                   albedo is the shader's constant colour x reflectance (the same product the
+//                   host's TextureResolver computes) and the host-resolved per-hit albedo is
+//                   not read;
 //   2 kSampling, 3 kStrategy  RenderParams' sampler and MIS strategy, fixed for the render: the
 //                   other samplers' and strategies' code is dropped;
 //   4 kEmitterKinds bit 1 << kEmitter* for each kind of emitter in the scene (every kind of the

@@ -226,6 +226,7 @@ void setUpChunk(const RenderContext& ctx, const std::vector<RayState>& rays,
         const Shader& shader = ctx.scene.shaders[x.hit.shader];
         if (!shader.looksUpTextures()) {
             x.hit.albedo = ctx.textures.albedo(shader, vec2(0.0f), 0.0f);
+            ctx.hitSetup.applyVertexColour(hits[k], x.hit);
             continue;
         }
         ctx.hitSetup.textureQuery(hits[k], ray.dir, ray.path.cone, x.hit, uv[m], footprint[m]);
@@ -238,8 +239,10 @@ void setUpChunk(const RenderContext& ctx, const std::vector<RayState>& rays,
             ++b;
         const Shader& sh = ctx.scene.shaders[shader];
         ctx.textures.albedos(sh, b - a, uv + a, footprint + a, albedo + a);
-        for (size_t j = a; j < b; ++j)
+        for (size_t j = a; j < b; ++j) {
             in[slot[j]].hit.albedo = albedo[j];
+            ctx.hitSetup.applyVertexColour(hits[order[slot[j]].index], in[slot[j]].hit);
+        }
         if (sh.hasMaps()) {
             for (size_t j = a; j < b; ++j) {
                 record[j] = &hits[order[slot[j]].index];

@@ -128,6 +128,7 @@ std::uint64_t sceneHash(const Scene& scene) {
         f.array(m.positions);
         f.array(m.normals);
         f.array(m.uvs);
+        if (!m.colours.empty()) f.array(m.colours);
         f.array(m.triangles);
     }
     for (const Texture& t : scene.textures) {

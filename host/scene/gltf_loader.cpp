@@ -277,7 +277,8 @@ class GltfReader {
     // --- accessors -------------------------------------------------------------------------
 
     // Accessor `index` as `count` elements of `components` doubles each (normalized integers
-    // mapped to [0, 1] or [-1, 1]); every byte it reads checked to lie inside its buffer.
+    // mapped to [0, 1] or [-1, 1]), its sparse substitutions applied; every byte it reads checked
+    // to lie inside its buffer.
     std::vector<double> readAccessor(int index, int components, const std::string& at,
                                      bool integersOnly = false) const {
         if (index < 0 || index >= int(model_.accessors.size()))
@@ -285,7 +286,6 @@ class GltfReader {
                          std::to_string(model_.accessors.size()));
         const std::string self = "/accessors/" + std::to_string(index);
         const tinygltf::Accessor& a = model_.accessors[size_t(index)];
-        if (a.sparse.isSparse) fail(self + "/sparse", "sparse accessors are not supported");
         const int have = tinygltf::GetNumComponentsInType(uint32_t(a.type));
         if (have != components)
             fail(self + "/type", "has " + std::to_string(have) + " components where " +
@@ -294,42 +294,85 @@ class GltfReader {
         if (size <= 0) fail(self + "/componentType", "unknown component type");
         const bool isFloat = a.componentType == TINYGLTF_COMPONENT_TYPE_FLOAT;
         if (integersOnly && isFloat) fail(self + "/componentType", "indices must be integers");
-        std::vector<double> out(a.count * size_t(components), 0.0);
-        if (a.bufferView < 0) return out; // all zeros (the specification's rule)
-        if (a.bufferView >= int(model_.bufferViews.size()))
-            fail(self + "/bufferView", "names buffer view " + std::to_string(a.bufferView) +
-                                           " of " + std::to_string(model_.bufferViews.size()));
-        const tinygltf::BufferView& v = model_.bufferViews[size_t(a.bufferView)];
-        if (v.buffer < 0 || v.buffer >= int(model_.buffers.size()))
-            fail("/bufferViews/" + std::to_string(a.bufferView) + "/buffer", "names no buffer");
-        const std::vector<unsigned char>& data = model_.buffers[size_t(v.buffer)].data;
         const size_t element = size_t(size) * size_t(components);
-        const size_t stride = v.byteStride ? v.byteStride : element;
-        if (stride < element)
-            fail("/bufferViews/" + std::to_string(a.bufferView) + "/byteStride",
-                 "is smaller than an element");
-        if (v.byteOffset > data.size() || v.byteLength > data.size() - v.byteOffset)
-            fail("/bufferViews/" + std::to_string(a.bufferView),
-                 "reaches past the end of its buffer");
-        const size_t room = a.byteOffset <= v.byteLength ? v.byteLength - a.byteOffset : 0;
-        if (a.byteOffset > v.byteLength ||
-            (a.count > 0 && (room < element || (a.count - 1) > (room - element) / stride)))
-            fail(self, "reaches past the end of its buffer view");
-        const unsigned char* base = data.data() + v.byteOffset + a.byteOffset;
-        for (size_t i = 0; i < a.count; ++i)
-            for (int k = 0; k < components; ++k)
-                out[i * size_t(components) + size_t(k)] =
-                    component(base + i * stride + size_t(k) * size_t(size), a);
+        std::vector<double> out(a.count * size_t(components), 0.0);
+        if (a.bufferView >= 0) { // without one, all zeros (the specification's rule)
+            size_t stride = 0;
+            const unsigned char* base =
+                viewBytes(a.bufferView, a.byteOffset, a.count, element, self, stride);
+            for (size_t i = 0; i < a.count; ++i)
+                for (int k = 0; k < components; ++k)
+                    out[i * size_t(components) + size_t(k)] =
+                        component(base + i * stride + size_t(k) * size_t(size), a.componentType,
+                                  a.normalized);
+        }
+        if (a.sparse.isSparse) applySparse(a, components, self, out);
         return out;
     }
-    static double component(const unsigned char* p, const tinygltf::Accessor& a) {
+
+    // A sparse accessor's substitutions: element indices[j] of `out` becomes values[j].
+    void applySparse(const tinygltf::Accessor& a, int components, const std::string& self,
+                     std::vector<double>& out) const {
+        const std::string at = self + "/sparse";
+        const auto& s = a.sparse;
+        if (s.count < 0 || size_t(s.count) > a.count)
+            fail(at + "/count", "must lie between 0 and the accessor's count");
+        const int indexType = s.indices.componentType;
+        if (indexType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE &&
+            indexType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
+            indexType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT)
+            fail(at + "/indices/componentType", "must be an unsigned integer type");
+        const size_t indexSize = size_t(tinygltf::GetComponentSizeInBytes(uint32_t(indexType)));
+        const size_t size = size_t(tinygltf::GetComponentSizeInBytes(uint32_t(a.componentType)));
+        size_t indexStride = 0, valueStride = 0;
+        const unsigned char* indices =
+            viewBytes(s.indices.bufferView, size_t(s.indices.byteOffset), size_t(s.count),
+                      indexSize, at + "/indices", indexStride);
+        const unsigned char* values =
+            viewBytes(s.values.bufferView, size_t(s.values.byteOffset), size_t(s.count),
+                      size * size_t(components), at + "/values", valueStride);
+        for (size_t j = 0; j < size_t(s.count); ++j) {
+            const double i = component(indices + j * indexStride, indexType, false);
+            if (!(i < double(a.count)))
+                fail(at + "/indices", "index " + std::to_string(uint64_t(i)) +
+                                          " is past the accessor's count " +
+                                          std::to_string(a.count));
+            for (int k = 0; k < components; ++k)
+                out[size_t(i) * size_t(components) + size_t(k)] = component(
+                    values + j * valueStride + size_t(k) * size, a.componentType, a.normalized);
+        }
+    }
+
+    // The first of `count` elements of `element` bytes at `byteOffset` in buffer view `view`,
+    // and their stride; `at` (what reads them) names the error when any would lie outside.
+    const unsigned char* viewBytes(int view, size_t byteOffset, size_t count, size_t element,
+                                   const std::string& at, size_t& stride) const {
+        const std::string viewAt = "/bufferViews/" + std::to_string(view);
+        if (view < 0 || view >= int(model_.bufferViews.size()))
+            fail(at + "/bufferView", "names buffer view " + std::to_string(view) + " of " +
+                                         std::to_string(model_.bufferViews.size()));
+        const tinygltf::BufferView& v = model_.bufferViews[size_t(view)];
+        if (v.buffer < 0 || v.buffer >= int(model_.buffers.size()))
+            fail(viewAt + "/buffer", "names no buffer");
+        const std::vector<unsigned char>& data = model_.buffers[size_t(v.buffer)].data;
+        stride = v.byteStride ? v.byteStride : element;
+        if (stride < element) fail(viewAt + "/byteStride", "is smaller than an element");
+        if (v.byteOffset > data.size() || v.byteLength > data.size() - v.byteOffset)
+            fail(viewAt, "reaches past the end of its buffer");
+        const size_t room = byteOffset <= v.byteLength ? v.byteLength - byteOffset : 0;
+        if (byteOffset > v.byteLength ||
+            (count > 0 && (room < element || (count - 1) > (room - element) / stride)))
+            fail(at, "reaches past the end of its buffer view");
+        return data.data() + v.byteOffset + byteOffset;
+    }
+
+    static double component(const unsigned char* p, int componentType, bool norm) {
         auto get = [&](auto type) {
             decltype(type) x;
             std::memcpy(&x, p, sizeof x);
             return x;
         };
-        const bool norm = a.normalized;
-        switch (a.componentType) {
+        switch (componentType) {
         case TINYGLTF_COMPONENT_TYPE_FLOAT:
             return get(float{});
         case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE:
@@ -428,11 +471,39 @@ class GltfReader {
                          "a texture coordinate is not finite");
             }
         }
+        readColours(prim, vertices, at, m);
         readTriangles(prim, mode, world, vertices, at, m);
         if (m.triangles.empty()) return;
         if (scene_.meshes.size() >= size_t(kMaxObjects))
             fail(at, "more than " + std::to_string(kMaxObjects) + " primitives");
         scene_.meshes.push_back(std::move(m));
+    }
+
+    // COLOR_0 (RGB, or RGBA whose alpha is not read): per-vertex factors of the base colour,
+    // clamped to [0, 1]. Not read where a YAML shader overrides the file's materials.
+    void readColours(const tinygltf::Primitive& prim, size_t vertices, const std::string& at,
+                     Mesh& m) const {
+        const auto c = prim.attributes.find("COLOR_0");
+        if (c == prim.attributes.end() || shaderOverride_ >= 0) return;
+        const std::string where = at + "/attributes/COLOR_0";
+        const int index = c->second;
+        const std::string self = "/accessors/" + std::to_string(index);
+        const int components =
+            index >= 0 && index < int(model_.accessors.size())
+                ? tinygltf::GetNumComponentsInType(uint32_t(model_.accessors[size_t(index)].type))
+                : 3; // readAccessor names the bad index
+        if (components != 3 && components != 4)
+            fail(self + "/type", "COLOR_0 must be VEC3 or VEC4");
+        const std::vector<double> rgba = readAccessor(index, components, where);
+        if (rgba.size() != size_t(components) * vertices)
+            fail(where, "has another count than POSITION");
+        m.colours.resize(vertices);
+        for (size_t i = 0; i < vertices; ++i)
+            for (int k = 0; k < 3; ++k) {
+                const double x = rgba[i * size_t(components) + size_t(k)];
+                if (!std::isfinite(x)) fail(self, "a colour is not finite");
+                m.colours[i][k] = float(std::clamp(x, 0.0, 1.0));
+            }
     }
 
     // The primitive's triangles (a list, strip or fan; without indices, its vertices in order),

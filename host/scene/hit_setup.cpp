@@ -41,12 +41,14 @@ void HitSetup::setUpHit(const HitRecord& h, vec3 dir, uint cone, const TextureRe
     const Shader& shader = src_.shaders[hit.shader];
     if (!shader.looksUpTextures()) {
         hit.albedo = textures.albedo(shader, vec2(0.0f), 0.0f);
+        applyVertexColour(h, hit);
         return;
     }
     vec2 uv;
     float footprint;
     textureQuery(h, dir, cone, hit, uv, footprint);
     hit.albedo = textures.albedo(shader, uv, footprint);
+    applyVertexColour(h, hit);
     const HitRecord* record = &h;
     SurfaceHit* out = &hit;
     applyMaps(shader, textures, 1, &uv, &footprint, &record, &out);

@@ -51,6 +51,15 @@ class HitSetup {
     void applyMaps(const Shader& shader, const TextureResolver& textures, size_t n, const vec2* uv,
                    const float* footprint, const HitRecord* const* hits,
                    SurfaceHit* const* hit) const;
+    // The albedo times the hit's interpolated vertex colour, where its mesh has them
+    // (Mesh::colours). After the albedo is set.
+    void applyVertexColour(const HitRecord& h, SurfaceHit& hit) const {
+        const Mesh& mesh = src_.meshes[h.mesh];
+        if (mesh.colours.empty()) return;
+        const uvec3 tri = mesh.triangles[h.prim];
+        hit.albedo *= (1.0f - h.u - h.v) * mesh.colours[tri.x] + h.u * mesh.colours[tri.y] +
+                      h.v * mesh.colours[tri.z];
+    }
     // What setUpGeometry will read, asked for ahead by a caller that knows many hits before it
     // sets them up: first the triangle's vertex indices, then (reading those) its vertices and
     // vertex normals. On a mesh larger than the caches each is a miss that the depth-first

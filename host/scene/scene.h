@@ -170,6 +170,9 @@ struct Mesh {
     std::vector<vec3> positions;
     std::vector<vec3> normals;
     std::vector<vec2> uvs;
+    // Per vertex, a factor of the albedo (glTF's COLOR_0, HitSetup::applyVertexColour); empty
+    // when the mesh has none.
+    std::vector<vec3> colours;
     std::vector<uvec3> triangles;
     int shader = 0;
     std::string name;         // the file, or "quad light N"

@@ -32,7 +32,7 @@ std::vector<std::string> VulkanShading::chooseKernels(const RenderContext& ctx,
             throw std::runtime_error("shader '" + sh.typeName + "' has surface model " +
                                      std::to_string(sh.params.model) + ", which has no kernel");
         used[sh.params.model] = true;
-        textured = textured || sh.texture >= 0;
+        textured = textured || sh.texture >= 0 || !m.colours.empty();
     }
     spec_.hasEmitters = ctx.lights.view().emitterCount > 0;
     spec_.textured = textured;

@@ -16,6 +16,7 @@
 
 #include <cstring>
 #include <fstream>
+#include <functional>
 
 namespace spw::test {
 namespace {
@@ -34,7 +35,7 @@ struct GltfBuilder {
         while (bytes.size() % 4 != 0)
             bytes.push_back('\0');
         const size_t offset = bytes.size();
-        const int components = type == "SCALAR" ? 1 : type == "VEC2" ? 2 : 3;
+        const int components = type == "SCALAR" ? 1 : type == "VEC2" ? 2 : type == "VEC3" ? 3 : 4;
         const size_t element = sizeof(T) * size_t(components);
         const size_t step = stride ? stride : element;
         const size_t count = data.size() / size_t(components);
@@ -62,6 +63,17 @@ struct GltfBuilder {
         }
         doc["accessors"].push_back(a);
         return int(doc["accessors"].size()) - 1;
+    }
+
+    // A tightly packed buffer view of `data` (for a sparse accessor's indices and values).
+    template <class T> int view(const std::vector<T>& data) {
+        while (bytes.size() % 4 != 0)
+            bytes.push_back('\0');
+        const size_t offset = bytes.size();
+        bytes.append(reinterpret_cast<const char*>(data.data()), data.size() * sizeof(T));
+        doc["bufferViews"].push_back(
+            {{"buffer", 0}, {"byteOffset", offset}, {"byteLength", data.size() * sizeof(T)}});
+        return int(doc["bufferViews"].size()) - 1;
     }
 
     // A unit quad in z = 0 facing +Z (two triangles), with normals and texture coordinates.
@@ -923,6 +935,139 @@ TEST(Gltf, EmissiveTexturesScaleTheEmissionWhereverItIsSampled) {
         EXPECT_NEAR(byLight, byBsdf, 0.02 * byBsdf);
         EXPECT_NEAR(byBoth, byLight, 0.02 * byLight);
         EXPECT_NEAR(byBoth, 0.5 * whole, 0.03 * byBoth);
+    }
+}
+
+} // namespace
+} // namespace spw::test
+
+namespace spw::test {
+namespace {
+
+// A view-filling quad of base colour `factor` (metallic 0, roughness 1) under a point light,
+// its primitive changed by `edit` (vertex colours, say) first; its mean at 16 x 16.
+double quadUnderPointLight(const TempDir& dir, vec3 factor,
+                           const std::function<void(GltfBuilder&, json&)>& edit,
+                           BackendKind backend) {
+    GltfBuilder b;
+    b.doc["materials"] = json::array({material(factor, 0.0f, 1.0f)});
+    b.doc["extensionsUsed"] = {"KHR_lights_punctual"};
+    b.doc["extensions"]["KHR_lights_punctual"]["lights"] =
+        json::array({{{"type", "point"}, {"intensity", 3000.0}}});
+    b.doc["cameras"] =
+        json::array({{{"type", "perspective"},
+                      {"perspective", {{"yfov", 0.25}, {"aspectRatio", 1.0}, {"znear", 0.1}}}}});
+    json prim = b.quad(0);
+    edit(b, prim);
+    b.scene({b.node({{"mesh", b.mesh(prim)}}),
+             b.node({{"camera", 0}, {"translation", {0.5, 0.5, 3}}}),
+             b.node({{"translation", {0.2, 0.7, 1.0}},
+                     {"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}})});
+    Scene scene = loadScene(b.embedded(dir, "coloured.gltf"));
+    EXPECT_TRUE(scene.warnings.empty()) << scene.warnings.at(0);
+    return meanAt16(scene, backend);
+}
+
+// COLOR_0 multiplies the base colour, per vertex, interpolated across the triangles, on every
+// backend: a quad whose four vertices carry one colour renders as its base colour times that
+// colour does, whether the colours are floats (RGB) or normalized bytes or shorts (RGBA, the
+// alpha not read); and not as the colours' channels reversed.
+TEST(Gltf, VertexColoursScaleTheBaseColour) {
+    TempDir dir;
+    const vec3 factor(0.9f, 0.6f, 0.3f), colour(0.4f, 0.8f, 0.2f);
+    const auto floats = [&](GltfBuilder& b, json& prim) {
+        std::vector<float> c;
+        for (int i = 0; i < 4; ++i)
+            c.insert(c.end(), {colour.x, colour.y, colour.z});
+        prim["attributes"]["COLOR_0"] = b.accessor<float>(c, 5126, "VEC3");
+    };
+    const auto bytes = [&](GltfBuilder& b, json& prim) { // 102, 204, 51: exactly the colour
+        std::vector<uint8_t> c;
+        for (int i = 0; i < 4; ++i)
+            c.insert(c.end(), {102, 204, 51, 7});
+        prim["attributes"]["COLOR_0"] = b.accessor<uint8_t>(c, 5121, "VEC4", true);
+    };
+    const auto shorts = [&](GltfBuilder& b, json& prim) { // 0.4, 0.8, 0.2 of 65535
+        std::vector<uint16_t> c;
+        for (int i = 0; i < 4; ++i)
+            c.insert(c.end(), {26214, 52428, 13107, 0});
+        prim["attributes"]["COLOR_0"] = b.accessor<uint16_t>(c, 5123, "VEC4", true);
+    };
+    const auto none = [](GltfBuilder&, json&) {};
+    for (BackendKind backend : {BackendKind::Reference, BackendKind::Cpu, BackendKind::Vulkan}) {
+        SCOPED_TRACE(backendName(backend));
+        const double product = quadUnderPointLight(dir, factor * colour, none, backend);
+        const double reversed =
+            quadUnderPointLight(dir, factor * vec3(colour.z, colour.y, colour.x), none, backend);
+        using Edit = std::function<void(GltfBuilder&, json&)>;
+        for (const Edit& edit : {Edit(floats), Edit(bytes), Edit(shorts)})
+            EXPECT_NEAR(quadUnderPointLight(dir, factor, edit, backend), product, 1e-4 * product);
+        EXPECT_GT(std::fabs(reversed - product), 0.05 * product);
+    }
+}
+
+// A sparse accessor: its indices' elements replaced by its values, over a buffer view or over
+// zeros; the quad it makes renders as the plain quad, to the bit. An index past the count is
+// an error naming the accessor's sparse indices.
+TEST(Gltf, SparseAccessorsSubstituteTheirValues) {
+    TempDir dir;
+    const auto plainQuad = [&](const std::string& name,
+                               const std::function<void(GltfBuilder&, json&)>& edit) {
+        GltfBuilder b;
+        b.doc["materials"] = json::array({material(vec3(0.8f), 0.0f, 1.0f)});
+        json prim = b.quad(0);
+        edit(b, prim);
+        b.doc["cameras"] =
+            json::array({{{"type", "perspective"},
+                          {"perspective", {{"yfov", 0.6}, {"aspectRatio", 1.0}, {"znear", 0.1}}}}});
+        b.scene({b.node({{"mesh", b.mesh(prim)}}),
+                 b.node({{"camera", 0}, {"translation", {0.5, 0.5, 3}}})});
+        return b.embedded(dir, name);
+    };
+    // Vertex 2 stored at (5, 5, 0), put back at (1, 1, 0) by the sparse part.
+    const auto overView = [](GltfBuilder& b, json& prim) {
+        const int pos = b.accessor<float>({0, 0, 0, 1, 0, 0, 5, 5, 0, 0, 1, 0}, 5126, "VEC3");
+        b.doc["accessors"][size_t(pos)]["sparse"] = {
+            {"count", 1},
+            {"indices", {{"bufferView", b.view<uint16_t>({2})}, {"componentType", 5123}}},
+            {"values", {{"bufferView", b.view<float>({1, 1, 0})}}}};
+        prim["attributes"]["POSITION"] = pos;
+    };
+    // No buffer view: zeros, the three vertices off the origin substituted.
+    const auto overZeros = [](GltfBuilder& b, json& prim) {
+        const int pos = b.accessor<float>({0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0}, 5126, "VEC3");
+        b.doc["accessors"][size_t(pos)].erase("bufferView");
+        b.doc["accessors"][size_t(pos)]["sparse"] = {
+            {"count", 3},
+            {"indices", {{"bufferView", b.view<uint8_t>({1, 2, 3, 0})}, {"componentType", 5121}}},
+            {"values", {{"bufferView", b.view<float>({1, 0, 0, 1, 1, 0, 0, 1, 0})}}}};
+        prim["attributes"]["POSITION"] = pos;
+    };
+    const auto pastTheEnd = [](GltfBuilder& b, json& prim) {
+        const int pos = b.accessor<float>({0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0}, 5126, "VEC3");
+        b.doc["accessors"][size_t(pos)]["sparse"] = {
+            {"count", 1},
+            {"indices", {{"bufferView", b.view<uint32_t>({4})}, {"componentType", 5125}}},
+            {"values", {{"bufferView", b.view<float>({1, 1, 0})}}}};
+        prim["attributes"]["POSITION"] = pos;
+    };
+    const std::string plain = plainQuad("plain.gltf", [](GltfBuilder&, json&) {});
+    Scene reference = loadScene(plain);
+    using Edit = std::function<void(GltfBuilder&, json&)>;
+    for (const Edit& edit : {Edit(overView), Edit(overZeros)}) {
+        Scene sparse = loadScene(plainQuad("sparse.gltf", edit));
+        EXPECT_EQ(sparse.meshes.at(0).positions, reference.meshes.at(0).positions);
+        EXPECT_EQ(meanAt16(sparse, BackendKind::Cpu), meanAt16(reference, BackendKind::Cpu));
+    }
+    const std::string bad = plainQuad("bad-sparse.gltf", pastTheEnd);
+    try {
+        loadScene(bad);
+        ADD_FAILURE() << "loaded";
+    } catch (const SceneError& e) {
+        EXPECT_NE(
+            std::string(e.what()).find("/sparse/indices: index 4 is past the accessor's count 4"),
+            std::string::npos)
+            << e.what();
     }
 }
 
