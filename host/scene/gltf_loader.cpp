@@ -659,9 +659,12 @@ class GltfReader {
             s.params.emission[k] = float(e);
         }
         if (mat.emissiveTexture.index >= 0 && maxComponent(s.params.emission) > 0.0f) {
+            const std::string what = name + ": its emissiveTexture";
             s.emissionTexture = int(scene_.textures.size());
-            scene_.textures.push_back(imageTexture(mat.emissiveTexture, at + "/emissiveTexture",
-                                                   name + ": its emissiveTexture"));
+            scene_.textures.push_back(
+                imageTexture(mat.emissiveTexture, at + "/emissiveTexture", what));
+            if (scene_.textures.back().wraps())
+                warn(what + "'s sampler wraps other than REPEAT: rendered repeating");
         }
     }
 
@@ -753,7 +756,40 @@ class GltfReader {
             in->close();
         }
         readTextureTransform(info, where, picture);
+        if (const int sampler = model_.textures[size_t(index)].sampler; sampler >= 0) {
+            if (sampler >= int(model_.samplers.size()))
+                fail("/textures/" + std::to_string(index) + "/sampler",
+                     "names sampler " + std::to_string(sampler) + " of " +
+                         std::to_string(model_.samplers.size()));
+            readSampler(model_.samplers[size_t(sampler)], "/samplers/" + std::to_string(sampler),
+                        what, picture);
+        }
         return picture;
+    }
+
+    // A sampler's wrap modes; its filters are always bilinear and trilinear across MIP levels,
+    // and a NEAREST one is warned about.
+    void readSampler(const tinygltf::Sampler& s, const std::string& at, const std::string& what,
+                     Texture& picture) {
+        auto wrap = [&](int mode, const char* field) {
+            switch (mode) {
+            case TINYGLTF_TEXTURE_WRAP_REPEAT:
+                return Texture::Wrap::Repeat;
+            case TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE:
+                return Texture::Wrap::Clamp;
+            case TINYGLTF_TEXTURE_WRAP_MIRRORED_REPEAT:
+                return Texture::Wrap::Mirror;
+            default:
+                fail(at + "/" + field, "must be 33071, 33648 or 10497");
+            }
+        };
+        picture.wrapU = wrap(s.wrapS, "wrapS");
+        picture.wrapV = wrap(s.wrapT, "wrapT");
+        if (s.magFilter == TINYGLTF_TEXTURE_FILTER_NEAREST ||
+            s.minFilter == TINYGLTF_TEXTURE_FILTER_NEAREST ||
+            s.minFilter == TINYGLTF_TEXTURE_FILTER_NEAREST_MIPMAP_NEAREST ||
+            s.minFilter == TINYGLTF_TEXTURE_FILTER_NEAREST_MIPMAP_LINEAR)
+            warn(what + "'s sampler asks for NEAREST filtering: rendered bilinear");
     }
 
     // KHR_texture_transform on a texture reference: T(offset) R(rotation) S(scale) of glTF's

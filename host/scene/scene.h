@@ -116,6 +116,11 @@ struct Texture {
     bool uvTransformed = false;
     mat3 uvTransform{1.0f};
     float footprintScale = 1.0f;
+    // Standard: what a lookup outside [0, 1] reads along u and along v (glTF's sampler wrapS,
+    // wrapT): the image repeated, its edge texels (clamped) or the image mirrored.
+    enum class Wrap : std::uint8_t { Repeat, Clamp, Mirror };
+    Wrap wrapU = Wrap::Repeat, wrapV = Wrap::Repeat;
+    bool wraps() const { return wrapU != Wrap::Repeat || wrapV != Wrap::Repeat; }
     // Standard: the image's channels read, from `channel` on (3: alpha alone); where the image
     // has no such channel, the value is 1 (glTF: an image without alpha is opaque).
     int channel = 0;

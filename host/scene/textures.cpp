@@ -425,6 +425,26 @@ class TexelReader {
 
 namespace {
 
+// A coordinate on a periodic axis of n texels that reads what `wrap` asks of x: x itself
+// (repeat), or x mirrored about the integers and, for both mirror and clamp, kept within half a
+// texel of the edges, where the periodic bilinear filter reads the edge texel alone. Exact at
+// the finest MIP level; a coarser level's wider texels still blend the far edge in a little.
+float wrapAxis(Texture::Wrap wrap, int n, float x) {
+    if (wrap == Texture::Wrap::Repeat || !std::isfinite(x)) return x;
+    if (wrap == Texture::Wrap::Mirror) {
+        x -= 2.0f * std::floor(0.5f * x); // [0, 2)
+        if (x > 1.0f) x = 2.0f - x;
+    }
+    const float half = 0.5f / float(n);
+    return std::clamp(x, half, 1.0f - half);
+}
+
+// Texture coordinates (OBJ's: v up) wrapped as a w x h image's texture asks. The clamp interval
+// is symmetric, so v's wrap is the same about glTF's v (down) as about OBJ's.
+vec2 wrapped(const Texture& t, int w, int h, vec2 uv) {
+    return vec2(wrapAxis(t.wrapU, w, uv.x), wrapAxis(t.wrapV, h, uv.y));
+}
+
 // Children-first order of the nodes reachable from `root`, each once.
 void visit(const Scene& scene, int t, std::vector<int>& slotOf, std::vector<int>& order) {
     if (slotOf[size_t(t)] >= 0) return;
@@ -632,12 +652,15 @@ const vec3* TextureResolver::evaluate(int tree, size_t n, const vec2* uv,
             }
             const vec2* at = uv;
             const float* width = footprint;
-            if (tex.uvTransformed) {
+            if (tex.uvTransformed || tex.wraps()) {
                 thread_local std::vector<vec2> moved;
                 thread_local std::vector<float> widths;
                 moved.resize(n), widths.resize(n);
+                const Impl::Level& finest = impl_->images[size_t(op.texture)].levels[0];
                 for (size_t k = 0; k < n; ++k) {
-                    moved[k] = vec2(tex.uvTransform * vec3(uv[k], 1.0f));
+                    moved[k] =
+                        tex.uvTransformed ? vec2(tex.uvTransform * vec3(uv[k], 1.0f)) : uv[k];
+                    if (tex.wraps()) moved[k] = wrapped(tex, finest.width, finest.height, moved[k]);
                     widths[k] = footprint ? footprint[k] * tex.footprintScale : 0.0f;
                 }
                 at = moved.data();

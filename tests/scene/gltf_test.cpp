@@ -538,6 +538,81 @@ TEST(Gltf, TextureTransformMovesTheLookups) {
     EXPECT_GT(redOverGreen(quarter, 10, 16), 10.0);
 }
 
+// The red-left, green-right image on the view-filling quad, u stretched to 3u - 1 (the quad's
+// visible u, 0.12-0.88, reads the image from -0.63 to 1.63) under the sampler `sampler` (none:
+// glTF's default, repeat); red over green in each of the 16 columns of a 16 x 16 render.
+std::vector<double> wrappedColumns(const TempDir& dir, const json& sampler) {
+    GltfBuilder b;
+    json mat = material(vec3(1.0f), 0.0f, 1.0f);
+    mat["pbrMetallicRoughness"]["baseColorTexture"] = {
+        {"index", 0},
+        {"extensions",
+         {{"KHR_texture_transform", {{"offset", {-1.0, 0.0}}, {"scale", {3.0, 1.0}}}}}}};
+    b.doc["materials"] = json::array({mat});
+    b.doc["textures"] = json::array({{{"source", 0}}});
+    if (!sampler.is_null()) {
+        b.doc["samplers"] = json::array({sampler});
+        b.doc["textures"][0]["sampler"] = 0;
+    }
+    b.doc["images"] = json::array({{{"uri", "halves.png"}}});
+    b.doc["extensionsUsed"] = {"KHR_texture_transform"};
+    b.doc["cameras"] =
+        json::array({{{"type", "perspective"},
+                      {"perspective", {{"yfov", 0.25}, {"aspectRatio", 1.0}, {"znear", 0.1}}}}});
+    b.scene({b.node({{"mesh", b.mesh(b.quad(0))}}),
+             b.node({{"camera", 0}, {"translation", {0.5, 0.5, 3}}})});
+    Scene scene = loadScene(b.embedded(dir, "wrapped.gltf"));
+    EXPECT_TRUE(scene.warnings.empty()) << scene.warnings.at(0);
+    scene.image.width = scene.image.height = 16;
+    RenderConfig cfg;
+    cfg.backend = BackendKind::Cpu;
+    cfg.spp = 4;
+    const std::vector<float> img = render(scene, cfg)->film->image();
+    std::vector<double> ratio;
+    for (int x = 0; x < 16; ++x) {
+        double r = 0, g = 0;
+        for (int y = 0; y < 16; ++y)
+            r += img[size_t(y * 16 + x) * 3], g += img[size_t(y * 16 + x) * 3 + 1];
+        ratio.push_back(r / g);
+    }
+    return ratio;
+}
+
+// A sampler's wrap modes: repeat (the default, and 10497) alternates the halves along the quad;
+// clamp to edge (33071) stretches the edge texels, red all the way left and green right;
+// mirrored repeat (33648) folds the image back at its edges, green again at the far left and
+// red at the far right. Columns 1-3 read u' from -0.49 to -0.07, 12-14 from 1.07 to 1.49,
+// column 0 from -0.63 to -0.49.
+TEST(Gltf, SamplerWrapModesRepeatClampOrMirror) {
+    TempDir dir;
+    {
+        OIIO::ImageBuf img(OIIO::ImageSpec(16, 4, 3, OIIO::TypeDesc::UINT8));
+        const float red[3] = {1.0f, 0.0f, 0.0f}, green[3] = {0.0f, 1.0f, 0.0f};
+        OIIO::ImageBufAlgo::fill(img, red, OIIO::ROI(0, 8, 0, 4));
+        OIIO::ImageBufAlgo::fill(img, green, OIIO::ROI(8, 16, 0, 4));
+        ASSERT_TRUE(img.write(dir.file("halves.png")));
+    }
+    const auto columns = [](const std::vector<double>& r, int x0, int x1) {
+        double lo = 1e30, hi = 0;
+        for (int x = x0; x < x1; ++x)
+            lo = std::min(lo, r[size_t(x)]), hi = std::max(hi, r[size_t(x)]);
+        return std::make_pair(lo, hi);
+    };
+    for (const json& sampler : {json(), json{{"wrapS", 10497}, {"wrapT", 10497}}}) {
+        const std::vector<double> repeat = wrappedColumns(dir, sampler);
+        EXPECT_LT(columns(repeat, 1, 4).second, 0.1);   // u' -0.49 .. -0.07: the green half
+        EXPECT_GT(columns(repeat, 12, 15).first, 10.0); // 1.07 .. 1.49: the red half
+    }
+    const std::vector<double> clamp = wrappedColumns(dir, {{"wrapS", 33071}, {"wrapT", 10497}});
+    EXPECT_GT(columns(clamp, 0, 4).first, 10.0);
+    EXPECT_LT(columns(clamp, 12, 16).second, 0.1);
+    const std::vector<double> mirror = wrappedColumns(dir, {{"wrapS", 33648}, {"wrapT", 33071}});
+    EXPECT_GT(columns(mirror, 1, 4).first, 10.0);
+    EXPECT_LT(columns(mirror, 12, 15).second, 0.1);
+    EXPECT_LT(mirror[0], 0.5);  // mostly beyond -0.5: green, folded back
+    EXPECT_GT(mirror[15], 2.0); // mostly beyond 1.5: red
+}
+
 } // namespace
 } // namespace spw::test
 
