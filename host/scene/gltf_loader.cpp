@@ -436,47 +436,58 @@ class GltfReader {
                 fail("/accessors/" + std::to_string(position->second), far);
             m.positions[i] = vec3(rel);
         }
-        const glm::dmat3 normalMatrix = glm::inverseTranspose(glm::dmat3(world));
-        if (const auto n = prim.attributes.find("NORMAL"); n != prim.attributes.end()) {
-            const std::vector<double> nor = readAccessor(n->second, 3, at + "/attributes/NORMAL");
-            if (nor.size() != pos.size())
-                fail(at + "/attributes/NORMAL", "has another count than POSITION");
-            m.normals.resize(vertices);
-            for (size_t i = 0; i < vertices && !m.normals.empty(); ++i) {
-                const glm::dvec3 w =
-                    normalMatrix * glm::dvec3(nor[3 * i], nor[3 * i + 1], nor[3 * i + 2]);
-                const double len = glm::length(w);
-                if (!(len > 1e-30) || !std::isfinite(len)) {
-                    warn("has zero or non-finite normals: its faces' own normals used there");
-                    m.normals.clear();
-                } else {
-                    m.normals[i] = vec3(w / len);
-                }
-            }
-        }
+        readNormals(prim, world, vertices, at, m);
         if (prim.attributes.count("TANGENT"))
             warn("TANGENT attributes are not read: normal maps take tangents made from the "
                  "texture coordinates, triangle by triangle");
-        if (const auto t = prim.attributes.find("TEXCOORD_0"); t != prim.attributes.end()) {
-            const std::vector<double> uv =
-                readAccessor(t->second, 2, at + "/attributes/TEXCOORD_0");
-            if (uv.size() != 2 * vertices)
-                fail(at + "/attributes/TEXCOORD_0", "has another count than POSITION");
-            m.uvs.resize(vertices);
-            for (size_t i = 0; i < vertices; ++i) {
-                // glTF's v runs down the image; Spillway's (OBJ's) up.
-                m.uvs[i] = vec2(float(uv[2 * i]), float(1.0 - uv[2 * i + 1]));
-                if (!std::isfinite(m.uvs[i].x) || !std::isfinite(m.uvs[i].y))
-                    fail("/accessors/" + std::to_string(t->second),
-                         "a texture coordinate is not finite");
-            }
-        }
+        readTextureCoordinates(prim, vertices, at, m);
         readColours(prim, vertices, at, m);
         readTriangles(prim, mode, world, vertices, at, m);
         if (m.triangles.empty()) return;
         if (scene_.meshes.size() >= size_t(kMaxObjects))
             fail(at, "more than " + std::to_string(kMaxObjects) + " primitives");
         scene_.meshes.push_back(std::move(m));
+    }
+
+    // NORMAL, turned into world space (the inverse transpose); where one is zero or not finite,
+    // none (the faces' own normals).
+    void readNormals(const tinygltf::Primitive& prim, const glm::dmat4& world, size_t vertices,
+                     const std::string& at, Mesh& m) {
+        const auto n = prim.attributes.find("NORMAL");
+        if (n == prim.attributes.end()) return;
+        const glm::dmat3 normalMatrix = glm::inverseTranspose(glm::dmat3(world));
+        const std::vector<double> nor = readAccessor(n->second, 3, at + "/attributes/NORMAL");
+        if (nor.size() != 3 * vertices)
+            fail(at + "/attributes/NORMAL", "has another count than POSITION");
+        m.normals.resize(vertices);
+        for (size_t i = 0; i < vertices && !m.normals.empty(); ++i) {
+            const glm::dvec3 w =
+                normalMatrix * glm::dvec3(nor[3 * i], nor[3 * i + 1], nor[3 * i + 2]);
+            const double len = glm::length(w);
+            if (!(len > 1e-30) || !std::isfinite(len)) {
+                warn("has zero or non-finite normals: its faces' own normals used there");
+                m.normals.clear();
+            } else {
+                m.normals[i] = vec3(w / len);
+            }
+        }
+    }
+
+    // TEXCOORD_0, its v turned to run up: glTF's v runs down the image, Spillway's (OBJ's) up.
+    void readTextureCoordinates(const tinygltf::Primitive& prim, size_t vertices,
+                                const std::string& at, Mesh& m) const {
+        const auto t = prim.attributes.find("TEXCOORD_0");
+        if (t == prim.attributes.end()) return;
+        const std::vector<double> uv = readAccessor(t->second, 2, at + "/attributes/TEXCOORD_0");
+        if (uv.size() != 2 * vertices)
+            fail(at + "/attributes/TEXCOORD_0", "has another count than POSITION");
+        m.uvs.resize(vertices);
+        for (size_t i = 0; i < vertices; ++i) {
+            m.uvs[i] = vec2(float(uv[2 * i]), float(1.0 - uv[2 * i + 1]));
+            if (!std::isfinite(m.uvs[i].x) || !std::isfinite(m.uvs[i].y))
+                fail("/accessors/" + std::to_string(t->second),
+                     "a texture coordinate is not finite");
+        }
     }
 
     // COLOR_0 (RGB, or RGBA whose alpha is not read): per-vertex factors of the base colour,
@@ -744,7 +755,7 @@ class GltfReader {
                                                 picture.bytes->size());
             auto in = OIIO::ImageInput::open(picture.path, nullptr, &proxy);
             if (!in || in->spec().width < 1 || in->spec().height < 1)
-                fail(imageAt, "the embedded image is not one OpenImageIO can read");
+                fail(imageAt, "the embedded image is not one OpenImageIO can read" + imageError());
             in->close();
         } else {
             if (image.uri.empty()) fail(imageAt, "an image needs a uri or a bufferView");
@@ -752,7 +763,7 @@ class GltfReader {
             auto in = OIIO::ImageInput::open(picture.path);
             if (!in)
                 fail(imageAt + "/uri",
-                     "'" + picture.path + "' is not an image OpenImageIO can read");
+                     "'" + picture.path + "' is not an image OpenImageIO can read" + imageError());
             in->close();
         }
         readTextureTransform(info, where, picture);
@@ -765,6 +776,15 @@ class GltfReader {
                         what, picture);
         }
         return picture;
+    }
+
+    // OpenImageIO's error after a failed open, as ": why" (or nothing). Asking also clears it:
+    // OpenImageIO keeps it per thread until asked, and reports it at exit otherwise.
+    static std::string imageError() {
+        std::string why = OIIO::geterror();
+        while (!why.empty() && (why.back() == '\n' || why.back() == '\r'))
+            why.pop_back();
+        return why.empty() ? "" : ": " + why;
     }
 
     // A sampler's wrap modes; its filters are always bilinear and trilinear across MIP levels,

@@ -852,17 +852,13 @@ TEST(Gltf, NormalTexturesTiltTheShadingNormalInTheTextureFrame) {
 namespace spw::test {
 namespace {
 
-// The view-filling quad of tiltedQuadMean under the same light, of base colour `colour`,
-// metallic and roughness factors, and a metallicRoughnessTexture `image` unless it is empty.
-double metalRoughQuadMean(const TempDir& dir, float metallic, float roughness,
-                          const std::string& image, BackendKind backend) {
+// A view-filling quad of material `mat` under a point light (tiltedQuadMean's view and light),
+// the document and its primitive changed by `edit` first (images, vertex colours); its mean at
+// 16 x 16 on `backend`.
+double quadUnderPointLight(const TempDir& dir, const json& mat,
+                           const std::function<void(GltfBuilder&, json&)>& edit,
+                           BackendKind backend) {
     GltfBuilder b;
-    json mat = material(vec3(0.9f, 0.6f, 0.3f), metallic, roughness);
-    if (!image.empty()) {
-        mat["pbrMetallicRoughness"]["metallicRoughnessTexture"] = {{"index", 0}};
-        b.doc["textures"] = json::array({{{"source", 0}}});
-        b.doc["images"] = json::array({{{"uri", image}}});
-    }
     b.doc["materials"] = json::array({mat});
     b.doc["extensionsUsed"] = {"KHR_lights_punctual"};
     b.doc["extensions"]["KHR_lights_punctual"]["lights"] =
@@ -870,13 +866,31 @@ double metalRoughQuadMean(const TempDir& dir, float metallic, float roughness,
     b.doc["cameras"] =
         json::array({{{"type", "perspective"},
                       {"perspective", {{"yfov", 0.25}, {"aspectRatio", 1.0}, {"znear", 0.1}}}}});
-    b.scene({b.node({{"mesh", b.mesh(b.quad(0))}}),
+    json prim = b.quad(0);
+    edit(b, prim);
+    b.scene({b.node({{"mesh", b.mesh(prim)}}),
              b.node({{"camera", 0}, {"translation", {0.5, 0.5, 3}}}),
              b.node({{"translation", {0.2, 0.7, 1.0}},
                      {"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}})});
-    Scene scene = loadScene(b.embedded(dir, "metal-rough.gltf"));
+    Scene scene = loadScene(b.embedded(dir, "lit-quad.gltf"));
     EXPECT_TRUE(scene.warnings.empty()) << scene.warnings.at(0);
     return meanAt16(scene, backend);
+}
+
+// That quad of base colour (0.9, 0.6, 0.3), metallic and roughness factors, and a
+// metallicRoughnessTexture `image` unless it is empty.
+double metalRoughQuadMean(const TempDir& dir, float metallic, float roughness,
+                          const std::string& image, BackendKind backend) {
+    json mat = material(vec3(0.9f, 0.6f, 0.3f), metallic, roughness);
+    if (!image.empty()) mat["pbrMetallicRoughness"]["metallicRoughnessTexture"] = {{"index", 0}};
+    return quadUnderPointLight(
+        dir, mat,
+        [&](GltfBuilder& b, json&) {
+            if (image.empty()) return;
+            b.doc["textures"] = json::array({{{"source", 0}}});
+            b.doc["images"] = json::array({{{"uri", image}}});
+        },
+        backend);
 }
 
 // metallicRoughnessTexture: its blue channel scales the metallic factor, its green the
@@ -1019,30 +1033,6 @@ TEST(Gltf, EmissiveTexturesScaleTheEmissionWhereverItIsSampled) {
 namespace spw::test {
 namespace {
 
-// A view-filling quad of base colour `factor` (metallic 0, roughness 1) under a point light,
-// its primitive changed by `edit` (vertex colours, say) first; its mean at 16 x 16.
-double quadUnderPointLight(const TempDir& dir, vec3 factor,
-                           const std::function<void(GltfBuilder&, json&)>& edit,
-                           BackendKind backend) {
-    GltfBuilder b;
-    b.doc["materials"] = json::array({material(factor, 0.0f, 1.0f)});
-    b.doc["extensionsUsed"] = {"KHR_lights_punctual"};
-    b.doc["extensions"]["KHR_lights_punctual"]["lights"] =
-        json::array({{{"type", "point"}, {"intensity", 3000.0}}});
-    b.doc["cameras"] =
-        json::array({{{"type", "perspective"},
-                      {"perspective", {{"yfov", 0.25}, {"aspectRatio", 1.0}, {"znear", 0.1}}}}});
-    json prim = b.quad(0);
-    edit(b, prim);
-    b.scene({b.node({{"mesh", b.mesh(prim)}}),
-             b.node({{"camera", 0}, {"translation", {0.5, 0.5, 3}}}),
-             b.node({{"translation", {0.2, 0.7, 1.0}},
-                     {"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}})});
-    Scene scene = loadScene(b.embedded(dir, "coloured.gltf"));
-    EXPECT_TRUE(scene.warnings.empty()) << scene.warnings.at(0);
-    return meanAt16(scene, backend);
-}
-
 // COLOR_0 multiplies the base colour, per vertex, interpolated across the triangles, on every
 // backend: a quad whose four vertices carry one colour renders as its base colour times that
 // colour does, whether the colours are floats (RGB) or normalized bytes or shorts (RGBA, the
@@ -1071,12 +1061,14 @@ TEST(Gltf, VertexColoursScaleTheBaseColour) {
     const auto none = [](GltfBuilder&, json&) {};
     for (BackendKind backend : {BackendKind::Reference, BackendKind::Cpu, BackendKind::Vulkan}) {
         SCOPED_TRACE(backendName(backend));
-        const double product = quadUnderPointLight(dir, factor * colour, none, backend);
-        const double reversed =
-            quadUnderPointLight(dir, factor * vec3(colour.z, colour.y, colour.x), none, backend);
+        const double product =
+            quadUnderPointLight(dir, material(factor * colour, 0.0f, 1.0f), none, backend);
+        const double reversed = quadUnderPointLight(
+            dir, material(factor * vec3(colour.z, colour.y, colour.x), 0.0f, 1.0f), none, backend);
         using Edit = std::function<void(GltfBuilder&, json&)>;
         for (const Edit& edit : {Edit(floats), Edit(bytes), Edit(shorts)})
-            EXPECT_NEAR(quadUnderPointLight(dir, factor, edit, backend), product, 1e-4 * product);
+            EXPECT_NEAR(quadUnderPointLight(dir, material(factor, 0.0f, 1.0f), edit, backend),
+                        product, 1e-4 * product);
         EXPECT_GT(std::fabs(reversed - product), 0.05 * product);
     }
 }
