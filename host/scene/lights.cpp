@@ -195,7 +195,8 @@ double SceneLights::addEmissionMap(const Mesh& mesh, const uvec3& t, const Textu
     // every triangle of a lit image pickable.
     const float texels =
         0.5f * std::fabs(d1.x * d2.y - d1.y * d2.x) * float(image.width) * float(image.height);
-    const int n = std::clamp(int(std::ceil(std::sqrt(texels))), 4, 32);
+    const float side = std::sqrt(texels); // huge, infinite or NaN for far-flung coordinates
+    const int n = side < 32.0f ? std::max(4, int(std::ceil(side))) : 32;
     SceneView view;
     view.lightData = maps_.data();
     double sum = 0.0;
