@@ -34,10 +34,10 @@
 // still costs its full time there. Constants make the condition known to the compiler instead.
 //
 // Bindings (set 0): 0 shader table, 1 emitters, 2 emitter CDF, 3 the light data: the
-// environment's map and CDFs and the emission maps (4 unread bytes without any), 4 inputs, 5 results. 0-4 are uniform
-// texel buffers of 32-bit unsigned words (R32G32B32A32_UINT, or R32_UINT for 2 and 3), read with
-// texelFetch and turned back into the shared structs field by field; 5 is a storage buffer written
-// as whole uvec4s. Why not storage buffers throughout: on lavapipe (Mesa 22.3) every storage
+// environment's map and CDFs and the emission maps (4 unread bytes without any), 4 inputs,
+// 5 results. 0-4 are uniform texel buffers of 32-bit unsigned words (R32G32B32A32_UINT, or
+// R32_UINT for 2 and 3), read with texelFetch and turned back into the shared structs field by
+// field; 5 is a storage buffer written as whole uvec4s. Why not storage buffers throughout: on lavapipe (Mesa 22.3) every storage
 // buffer access whose address differs between lanes is a loop over the 8 lanes with a branch per
 // lane and one scalar load per component, while a texel fetch is a vector gather; the stores are
 // fewest as 7 whole uvec4s per record. (Measured: docs/performance-log.md, "Fifth round".) The unpacking below
