@@ -485,41 +485,55 @@ TEST(Gltf, BaseColourImagesEmbeddedOrBesideTheFileAreRendered) {
     }
 }
 
+// An image red in its left half, green in its right (16 x 4), as halves.png in `dir`.
+void writeHalves(const TempDir& dir) {
+    OIIO::ImageBuf img(OIIO::ImageSpec(16, 4, 3, OIIO::TypeDesc::UINT8));
+    const float red[3] = {1.0f, 0.0f, 0.0f}, green[3] = {0.0f, 1.0f, 0.0f};
+    OIIO::ImageBufAlgo::fill(img, red, OIIO::ROI(0, 8, 0, 4));
+    OIIO::ImageBufAlgo::fill(img, green, OIIO::ROI(8, 16, 0, 4));
+    ASSERT_TRUE(img.write(dir.file("halves.png")));
+}
+
+// halves.png as the base colour of a view-filling quad: `info` is the texture reference (its
+// index set here; its extensions kept), `sampler` the texture's sampler (none: glTF's default).
+// The 16 x 16 image, 4 spp, cpu backend.
+std::vector<float> halvesQuad(const TempDir& dir, json info, const json& sampler = json()) {
+    GltfBuilder b;
+    json mat = material(vec3(1.0f), 0.0f, 1.0f);
+    info["index"] = 0;
+    mat["pbrMetallicRoughness"]["baseColorTexture"] = info;
+    b.doc["materials"] = json::array({mat});
+    b.doc["textures"] = json::array({{{"source", 0}}});
+    if (!sampler.is_null()) {
+        b.doc["samplers"] = json::array({sampler});
+        b.doc["textures"][0]["sampler"] = 0;
+    }
+    b.doc["images"] = json::array({{{"uri", "halves.png"}}});
+    b.doc["extensionsUsed"] = {"KHR_texture_transform"};
+    b.doc["cameras"] =
+        json::array({{{"type", "perspective"},
+                      {"perspective", {{"yfov", 0.25}, {"aspectRatio", 1.0}, {"znear", 0.1}}}}});
+    b.scene({b.node({{"mesh", b.mesh(b.quad(0))}}),
+             b.node({{"camera", 0}, {"translation", {0.5, 0.5, 3}}})});
+    Scene scene = loadScene(b.embedded(dir, "halves.gltf"));
+    EXPECT_TRUE(scene.warnings.empty()) << scene.warnings.at(0);
+    scene.image.width = scene.image.height = 16;
+    RenderConfig cfg;
+    cfg.backend = BackendKind::Cpu;
+    cfg.spp = 4;
+    return render(scene, cfg)->film->image();
+}
+
 // KHR_texture_transform: an image red in its left half, green in its right; offset 0.5 and
 // scale 0.5 in u map the quad onto the green half alone, where without it both halves show.
 TEST(Gltf, TextureTransformMovesTheLookups) {
     TempDir dir;
-    {
-        OIIO::ImageBuf img(OIIO::ImageSpec(16, 4, 3, OIIO::TypeDesc::UINT8));
-        const float red[3] = {1.0f, 0.0f, 0.0f}, green[3] = {0.0f, 1.0f, 0.0f};
-        OIIO::ImageBufAlgo::fill(img, red, OIIO::ROI(0, 8, 0, 4));
-        OIIO::ImageBufAlgo::fill(img, green, OIIO::ROI(8, 16, 0, 4));
-        ASSERT_TRUE(img.write(dir.file("halves.png")));
-    }
+    writeHalves(dir);
     // Red over green in image rows [row0, row1) of a 16 x 16 render.
     auto redOverGreen = [&](const json& transform, int row0 = 0, int row1 = 16) {
-        GltfBuilder b;
-        json mat = material(vec3(1.0f), 0.0f, 1.0f);
-        mat["pbrMetallicRoughness"]["baseColorTexture"] = {{"index", 0}};
-        if (!transform.is_null())
-            mat["pbrMetallicRoughness"]["baseColorTexture"]["extensions"]["KHR_texture_transform"] =
-                transform;
-        b.doc["materials"] = json::array({mat});
-        b.doc["textures"] = json::array({{{"source", 0}}});
-        b.doc["images"] = json::array({{{"uri", "halves.png"}}});
-        b.doc["extensionsUsed"] = {"KHR_texture_transform"};
-        b.doc["cameras"] = json::array(
-            {{{"type", "perspective"},
-              {"perspective", {{"yfov", 0.25}, {"aspectRatio", 1.0}, {"znear", 0.1}}}}});
-        b.scene({b.node({{"mesh", b.mesh(b.quad(0))}}),
-                 b.node({{"camera", 0}, {"translation", {0.5, 0.5, 3}}})});
-        Scene scene = loadScene(b.embedded(dir, "t.gltf"));
-        EXPECT_TRUE(scene.warnings.empty()) << scene.warnings.at(0);
-        scene.image.width = scene.image.height = 16;
-        RenderConfig cfg;
-        cfg.backend = BackendKind::Cpu;
-        cfg.spp = 4;
-        const std::vector<float> img = render(scene, cfg)->film->image();
+        json info = json::object();
+        if (!transform.is_null()) info["extensions"]["KHR_texture_transform"] = transform;
+        const std::vector<float> img = halvesQuad(dir, info);
         double r = 0, g = 0;
         for (size_t i = size_t(row0) * 16 * 3; i < size_t(row1) * 16 * 3; i += 3)
             r += img[i], g += img[i + 1];
@@ -542,32 +556,9 @@ TEST(Gltf, TextureTransformMovesTheLookups) {
 // visible u, 0.12-0.88, reads the image from -0.63 to 1.63) under the sampler `sampler` (none:
 // glTF's default, repeat); red over green in each of the 16 columns of a 16 x 16 render.
 std::vector<double> wrappedColumns(const TempDir& dir, const json& sampler) {
-    GltfBuilder b;
-    json mat = material(vec3(1.0f), 0.0f, 1.0f);
-    mat["pbrMetallicRoughness"]["baseColorTexture"] = {
-        {"index", 0},
-        {"extensions",
-         {{"KHR_texture_transform", {{"offset", {-1.0, 0.0}}, {"scale", {3.0, 1.0}}}}}}};
-    b.doc["materials"] = json::array({mat});
-    b.doc["textures"] = json::array({{{"source", 0}}});
-    if (!sampler.is_null()) {
-        b.doc["samplers"] = json::array({sampler});
-        b.doc["textures"][0]["sampler"] = 0;
-    }
-    b.doc["images"] = json::array({{{"uri", "halves.png"}}});
-    b.doc["extensionsUsed"] = {"KHR_texture_transform"};
-    b.doc["cameras"] =
-        json::array({{{"type", "perspective"},
-                      {"perspective", {{"yfov", 0.25}, {"aspectRatio", 1.0}, {"znear", 0.1}}}}});
-    b.scene({b.node({{"mesh", b.mesh(b.quad(0))}}),
-             b.node({{"camera", 0}, {"translation", {0.5, 0.5, 3}}})});
-    Scene scene = loadScene(b.embedded(dir, "wrapped.gltf"));
-    EXPECT_TRUE(scene.warnings.empty()) << scene.warnings.at(0);
-    scene.image.width = scene.image.height = 16;
-    RenderConfig cfg;
-    cfg.backend = BackendKind::Cpu;
-    cfg.spp = 4;
-    const std::vector<float> img = render(scene, cfg)->film->image();
+    const json stretch = {{"offset", {-1.0, 0.0}}, {"scale", {3.0, 1.0}}};
+    const std::vector<float> img =
+        halvesQuad(dir, {{"extensions", {{"KHR_texture_transform", stretch}}}}, sampler);
     std::vector<double> ratio;
     for (int x = 0; x < 16; ++x) {
         double r = 0, g = 0;
@@ -585,13 +576,7 @@ std::vector<double> wrappedColumns(const TempDir& dir, const json& sampler) {
 // column 0 from -0.63 to -0.49.
 TEST(Gltf, SamplerWrapModesRepeatClampOrMirror) {
     TempDir dir;
-    {
-        OIIO::ImageBuf img(OIIO::ImageSpec(16, 4, 3, OIIO::TypeDesc::UINT8));
-        const float red[3] = {1.0f, 0.0f, 0.0f}, green[3] = {0.0f, 1.0f, 0.0f};
-        OIIO::ImageBufAlgo::fill(img, red, OIIO::ROI(0, 8, 0, 4));
-        OIIO::ImageBufAlgo::fill(img, green, OIIO::ROI(8, 16, 0, 4));
-        ASSERT_TRUE(img.write(dir.file("halves.png")));
-    }
+    writeHalves(dir);
     const auto columns = [](const std::vector<double>& r, int x0, int x1) {
         double lo = 1e30, hi = 0;
         for (int x = x0; x < x1; ++x)
