@@ -670,12 +670,9 @@ class GltfReader {
             s.params.emission[k] = float(e);
         }
         if (mat.emissiveTexture.index >= 0 && maxComponent(s.params.emission) > 0.0f) {
-            const std::string what = name + ": its emissiveTexture";
             s.emissionTexture = int(scene_.textures.size());
-            scene_.textures.push_back(
-                imageTexture(mat.emissiveTexture, at + "/emissiveTexture", what));
-            if (scene_.textures.back().wraps())
-                warn(what + "'s sampler wraps other than REPEAT: rendered repeating");
+            scene_.textures.push_back(imageTexture(mat.emissiveTexture, at + "/emissiveTexture",
+                                                   name + ": its emissiveTexture"));
         }
     }
 

@@ -185,10 +185,15 @@ double SceneLights::addEmissionMap(const Mesh& mesh, const uvec3& t, const Textu
     }
     const vec2 d1 = st[1] - st[0], d2 = st[2] - st[0];
     e.map = uint(maps_.size());
+    auto sized = [](int texels, Texture::Wrap wrap) { // a side and its wrap mode, in one word
+        const uint mode = wrap == Texture::Wrap::Clamp    ? kEmissionWrapClamp
+                          : wrap == Texture::Wrap::Mirror ? kEmissionWrapMirror
+                                                          : kEmissionWrapRepeat;
+        return glm::uintBitsToFloat(uint(texels) | mode << 30u);
+    };
     maps_.insert(maps_.end(),
                  {st[0].x, st[0].y, d1.x, d1.y, d2.x, d2.y, glm::uintBitsToFloat(image.offset),
-                  glm::uintBitsToFloat(uint(image.width)),
-                  glm::uintBitsToFloat(uint(image.height))});
+                  sized(image.width, texture.wrapU), sized(image.height, texture.wrapV)});
     // The map's mean over the triangle, from an n x n grid of stratified points, n growing with
     // the texels the triangle covers (at most 32). Where the grid misses the triangle's bright
     // texels, the pick probability is only less apt: the floor, 1 % of the image's mean, keeps

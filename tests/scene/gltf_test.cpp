@@ -912,7 +912,7 @@ namespace {
 // on the left.
 std::vector<float> renderEmissiveQuad(const TempDir& dir, const std::string& image, float scale,
                                       BackendKind backend, uint strategy = kStrategyMis,
-                                      int spp = 16) {
+                                      int spp = 16, const json& sampler = json()) {
     GltfBuilder b;
     json light = material(vec3(0.0f), 0.0f, 1.0f, vec3(scale));
     light["doubleSided"] = true;
@@ -922,8 +922,15 @@ std::vector<float> renderEmissiveQuad(const TempDir& dir, const std::string& ima
         b.doc["textures"] = json::array({{{"source", 0}}});
         b.doc["images"] = json::array({{{"uri", image}}});
     }
+    if (!sampler.is_null()) { // and u stretched to 3u - 1, so that it reads beyond the image
+        light["emissiveTexture"]["extensions"]["KHR_texture_transform"] = {{"offset", {-1.0, 0.0}},
+                                                                           {"scale", {3.0, 1.0}}};
+        b.doc["samplers"] = json::array({sampler});
+        b.doc["textures"][0]["sampler"] = 0;
+        b.doc["extensionsUsed"].push_back("KHR_texture_transform");
+    }
     b.doc["materials"] = json::array({material(vec3(0.8f), 0.0f, 1.0f), light});
-    b.doc["extensionsUsed"] = {"KHR_materials_emissive_strength"};
+    b.doc["extensionsUsed"].push_back("KHR_materials_emissive_strength");
     b.doc["cameras"] =
         json::array({{{"type", "perspective"},
                       {"perspective", {{"yfov", 0.6}, {"aspectRatio", 1.0}, {"znear", 0.1}}}}});
@@ -991,6 +998,14 @@ TEST(Gltf, EmissiveTexturesScaleTheEmissionWhereverItIsSampled) {
         const std::vector<float> large = renderEmissiveQuad(dir, "large.png", 1.0f, backend);
         EXPECT_NEAR(rectMean(large, 8, 11, 8, 16), 4.0, 1e-3);
         EXPECT_NEAR(rectMean(large, 13, 16, 8, 16), 0.0, 1e-3);
+        // u read from 3u - 1 under a clamping sampler: the white edge texel left of the image
+        // (columns 8-10: u' -0.7 .. 0.2), the black one right of it (13-15: 0.8 .. 1.7); and
+        // light sampling finds the same clamped panel as BSDF sampling.
+        const json clamping = {{"wrapS", 33071}, {"wrapT", 33071}};
+        const std::vector<float> clamped =
+            renderEmissiveQuad(dir, "half.png", 1.0f, backend, kStrategyMis, 16, clamping);
+        EXPECT_NEAR(rectMean(clamped, 8, 11, 8, 16), 4.0, 1e-3);
+        EXPECT_NEAR(rectMean(clamped, 13, 16, 8, 16), 0.0, 1e-3);
         // The floor around the quad, lit by its underside: what light sampling alone finds
         // agrees with what BSDF sampling alone finds (at 256 spp; at 16, BSDF sampling alone is
         // 11 % off, with or without the map), and with both, and is half what the whole quad
@@ -1007,6 +1022,11 @@ TEST(Gltf, EmissiveTexturesScaleTheEmissionWhereverItIsSampled) {
         const double whole =
             floorMean(renderEmissiveQuad(dir, "", 1.0f, backend, kStrategyMis, 256));
         EXPECT_NEAR(byLight, byBsdf, 0.02 * byBsdf);
+        const auto floorOf = [&](uint strategy) {
+            return floorMean(
+                renderEmissiveQuad(dir, "half.png", 1.0f, backend, strategy, 256, clamping));
+        };
+        EXPECT_NEAR(floorOf(kStrategyLight), floorOf(kStrategyBsdf), 0.02 * floorOf(kStrategyBsdf));
         EXPECT_NEAR(byBoth, byLight, 0.02 * byLight);
         EXPECT_NEAR(byBoth, 0.5 * whole, 0.03 * byBoth);
     }
