@@ -186,10 +186,7 @@ double SceneLights::addEmissionMap(const Mesh& mesh, const uvec3& t, const Textu
     const vec2 d1 = st[1] - st[0], d2 = st[2] - st[0];
     e.map = uint(maps_.size());
     auto sized = [](int texels, Texture::Wrap wrap) { // a side and its wrap mode, in one word
-        const uint mode = wrap == Texture::Wrap::Clamp    ? kEmissionWrapClamp
-                          : wrap == Texture::Wrap::Mirror ? kEmissionWrapMirror
-                                                          : kEmissionWrapRepeat;
-        return glm::uintBitsToFloat(uint(texels) | mode << 30u);
+        return glm::uintBitsToFloat(uint(texels) | wrapMode(wrap) << 30u);
     };
     maps_.insert(maps_.end(),
                  {st[0].x, st[0].y, d1.x, d1.y, d2.x, d2.y, glm::uintBitsToFloat(image.offset),

@@ -3,6 +3,7 @@
 #pragma once
 
 #include "host/image/filter.h"
+#include "shared/texture_wrap.h"
 #include "shared/types.h"
 
 #include <glm/vec3.hpp>
@@ -117,8 +118,13 @@ struct Texture {
     mat3 uvTransform{1.0f};
     float footprintScale = 1.0f;
     // Standard: what a lookup outside [0, 1] reads along u and along v (glTF's sampler wrapS,
-    // wrapT): the image repeated, its edge texels (clamped) or the image mirrored.
-    enum class Wrap : std::uint8_t { Repeat, Clamp, Mirror };
+    // wrapT): the image repeated, its edge texels (clamped) or the image mirrored; the values
+    // are shared/texture_wrap.h's modes (wrapMode).
+    enum class Wrap : std::uint8_t {
+        Repeat = kWrapRepeat,
+        Clamp = kWrapClamp,
+        Mirror = kWrapMirror
+    };
     Wrap wrapU = Wrap::Repeat, wrapV = Wrap::Repeat;
     bool wraps() const { return wrapU != Wrap::Repeat || wrapV != Wrap::Repeat; }
     // Standard: the image's channels read, from `channel` on (3: alpha alone); where the image
@@ -130,6 +136,11 @@ struct Texture {
     int upper = -1, lower = -1, mask = -1; // Layered: indices into Scene::textures
     int line = 0;                          // where the scene file defines it
 };
+
+// A wrap mode as the shared wrapCoordinate() takes it.
+inline uint wrapMode(Texture::Wrap wrap) {
+    return uint(wrap);
+}
 
 // An alpha cut-out (glTF's alphaMode MASK): the surface is there only where its alpha, `alpha`
 // times the first channel of the texture tree `texture` (or alone, -1), is at least `cutoff`.

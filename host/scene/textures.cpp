@@ -3,6 +3,8 @@
 #include "host/image/image_io.h"
 #include "host/scene/wide_texels.h"
 
+#include "shared/texture_wrap.h"
+
 #include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/half.h>
 #include <OpenImageIO/imagecache.h>
@@ -425,18 +427,10 @@ class TexelReader {
 
 namespace {
 
-// A coordinate on a periodic axis of n texels that reads what `wrap` asks of x: x itself
-// (repeat), or x mirrored about the integers and, for both mirror and clamp, kept within half a
-// texel of the edges, where the periodic bilinear filter reads the edge texel alone. Exact at
-// the finest MIP level; a coarser level's wider texels still blend the far edge in a little.
+// x wrapped as `wrap` asks along an axis of n texels (shared/texture_wrap.h); a coordinate that
+// is not finite is left for the filter, which reads texel 0 for it.
 float wrapAxis(Texture::Wrap wrap, int n, float x) {
-    if (wrap == Texture::Wrap::Repeat || !std::isfinite(x)) return x;
-    if (wrap == Texture::Wrap::Mirror) {
-        x -= 2.0f * std::floor(0.5f * x); // [0, 2)
-        if (x > 1.0f) x = 2.0f - x;
-    }
-    const float half = 0.5f / float(n);
-    return std::clamp(x, half, 1.0f - half);
+    return std::isfinite(x) ? wrapCoordinate(x, wrapMode(wrap), uint(n)) : x;
 }
 
 // Texture coordinates (OBJ's: v up) wrapped as a w x h image's texture asks. The clamp interval

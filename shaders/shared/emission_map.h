@@ -13,34 +13,16 @@
 //   4-5  (s, t) of vertex 2 minus vertex 0's
 //   6    where the image's texels start in LIGHT_DATA (the bits of a uint)
 //   7-8  its width and height (the bits of uints, below 2^30), each with the wrap mode along
-//        it (kEmissionWrap*: glTF's sampler wrapS, wrapT) in the top two bits
+//        it (kWrap*, shared/texture_wrap.h: glTF's sampler wrapS, wrapT) in the top two bits
 // and each image, 3 w h floats: RGB, row by row from the top.
 #ifndef SPILLWAY_SHARED_EMISSION_MAP_H
 #define SPILLWAY_SHARED_EMISSION_MAP_H
 #include "scene_access.h"
+#include "texture_wrap.h"
 
 SHARED_BEGIN
 
 const uint kEmissionMapRecord = 9u;
-
-// How a coordinate outside [0, 1] reads the image: repeated, its edge texels, or mirrored.
-const uint kEmissionWrapRepeat = 0u;
-const uint kEmissionWrapClamp = 1u;
-const uint kEmissionWrapMirror = 2u;
-
-// Coordinate x on an axis of n texels as `mode` reads it, for the periodic filter below:
-// mirror folds it about the integers, and mirror and clamp keep it within half a texel of the
-// edges, where the filter reads the edge texel alone (the host's texture lookups do the same,
-// host/scene/textures.cpp: wrapAxis).
-SHARED_FN float emissionMapWrap(float x, uint mode, uint n) {
-    if (mode == kEmissionWrapRepeat) return x;
-    if (mode == kEmissionWrapMirror) {
-        x -= 2.0f * floor(0.5f * x);
-        if (x > 1.0f) x = 2.0f - x;
-    }
-    float halfTexel = 0.5f / float(n);
-    return clamp(x, halfTexel, 1.0f - halfTexel);
-}
 
 SHARED_FN vec3 emissionMapTexel(SCENE_PARAM uint image, uint width, uint x, uint y) {
     uint i = image + 3u * (y * width + x);
@@ -58,8 +40,8 @@ SHARED_FN vec3 emissionMapValue(SCENE_PARAM uint record, vec2 b) {
     uint hBits = floatBitsToUint(LIGHT_DATA(record + 8u));
     uint w = wBits & 0x3FFFFFFFu;
     uint h = hBits & 0x3FFFFFFFu;
-    s = emissionMapWrap(s, wBits >> 30u, w);
-    t = emissionMapWrap(t, hBits >> 30u, h);
+    s = wrapCoordinate(s, wBits >> 30u, w);
+    t = wrapCoordinate(t, hBits >> 30u, h);
     // Periodic: only the fraction matters. A NaN coordinate reads the first texel.
     s -= floor(s);
     t -= floor(t);
@@ -98,6 +80,13 @@ SHARED_FN vec2 emitterBarycentrics(Emitter e, vec3 p) {
 SHARED_FN vec3 emitterRadiance(SCENE_PARAM Emitter e, vec2 b) {
     if (e.map == kNoEmissionMap) return e.radiance;
     return e.radiance * emissionMapValue(SCENE_ARG e.map, b);
+}
+
+// The same at a point p on the emitter (a ray's hit): its barycentric coordinates are found
+// only where there is a map to read.
+SHARED_FN vec3 emitterRadianceAt(SCENE_PARAM Emitter e, vec3 p) {
+    if (e.map == kNoEmissionMap) return e.radiance;
+    return e.radiance * emissionMapValue(SCENE_ARG e.map, emitterBarycentrics(e, p));
 }
 
 SHARED_END

@@ -64,7 +64,7 @@ SHARED_FN void addEmission(SCENE_PARAM RenderParams rp, SurfaceHit hit, vec3 wo,
         float lightPdf = emitterSolidAnglePdf(e, hit.t, cosLight);
         w = powerHeuristic(st.prevPdf, lightPdf);
     }
-    r.emitted = st.beta * emitterRadiance(SCENE_ARG e, emitterBarycentrics(e, hit.p)) * w;
+    r.emitted = st.beta * emitterRadianceAt(SCENE_ARG e, hit.p) * w;
     if (w > 0.0f) r.flags |= kShadeEmitted;
 }
 
