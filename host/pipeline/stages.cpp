@@ -192,9 +192,10 @@ size_t sortHits(const Scene& scene, const ShaderOrder& shaders, const std::vecto
 }
 
 namespace {
-// Hits are set up a chunk at a time: a chunk's inputs and results (28 KiB) stay in L1/L2
-// between the fused stages, and its texture lookups go texture by texture.
-constexpr size_t kChunk = 128;
+// Hits are set up a chunk at a time: a chunk's inputs and results (56 KiB) stay in L2 between
+// the fused stages, and its texture lookups go texture by texture. (256 hits measured 2-4 %
+// faster than 128 on the Cornell box and the textured scenes: longer runs of one texture.)
+constexpr size_t kChunk = 256;
 static_assert(kChunk <= 256, "chunk indices are bytes");
 
 // Hit setup of the sorted hits order[0, n), n <= kChunk, into in[0, n): each hit's geometry and
@@ -211,8 +212,13 @@ void setUpChunk(const RenderContext& ctx, const std::vector<RayState>& rays,
     const HitRecord* record[kChunk]; // the hits that look textures up, and their setups
     SurfaceHit* hit[kChunk];
     size_t m = 0;
-    for (size_t i = 0; i < n; ++i)
+    for (size_t i = 0; i < n; ++i) {
+        // The rays are in traversal order, the hits in shader order: each ray read is a miss.
+        const auto* ray = reinterpret_cast<const char*>(&rays[order[i].index]);
+        __builtin_prefetch(ray);
+        __builtin_prefetch(ray + sizeof(RayState) - 1);
         ctx.hitSetup.prefetchTriangle(hits[order[i].index]);
+    }
     for (size_t i = 0; i < n; ++i)
         ctx.hitSetup.prefetchVertices(hits[order[i].index]);
     for (size_t i = 0; i < n; ++i) {

@@ -73,6 +73,7 @@ class HitSetup {
         for (uint i : {tri.x, tri.y, tri.z}) {
             __builtin_prefetch(&mesh.positions[i]);
             if (!mesh.normals.empty()) __builtin_prefetch(&mesh.normals[i]);
+            if (!mesh.uvs.empty()) __builtin_prefetch(&mesh.uvs[i]);
         }
     }
 
