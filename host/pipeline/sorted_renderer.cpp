@@ -112,8 +112,11 @@ size_t SortedRenderer::traceBatch(bool camera) {
             sortRaysMedian(s.rays);
     }
     {
+        // Only camera batches take Embree's packet traversal (the coherent flag): a sorted
+        // bounce batch's rays share a region and a direction, not a path through the BVH, and
+        // traced as packets they took 25-30 % longer than one at a time (3.2 M triangles).
         StageTimer t(times, "traverse");
-        traverse(ctx_.embree, s.rays, camera || mode != RaySortMode::Off, s.hits);
+        traverse(ctx_.embree, s.rays, camera, s.hits);
     }
     if (!camera) {
         policy_.record(mode != RaySortMode::Off, since(sortStart), n);
