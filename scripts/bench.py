@@ -17,9 +17,10 @@ are noisy; ratios travel, absolute seconds do not).
                                finest level) and cone (the default). Writes
                                out/production/bench.json.
   scripts/bench.py incore      in-core speed: the Cornell box at 64 and 256 spp, and at 64 spp
-                               with a Gaussian filter; the 1M-triangle scene; 64 shaders over
-                               layered image textures (the production generator at an in-core
-                               size, out/incore-textured) and its Constant-colour control; reference, cpu (fused stages, SIMD shading),
+                               with a Tent and a Gaussian filter; the 1M-triangle scene; 64
+                               shaders over layered image textures (the production generator at
+                               an in-core size, out/incore-textured) and its Constant-colour
+                               control; reference, cpu (fused stages, SIMD shading),
                                cpu with separate stages, cpu with scalar shading
                                (--simd-shading off), vulkan; runs alternate between configurations and
                                the best of N is kept. Per configuration: render seconds, ratio to
@@ -152,14 +153,17 @@ def bench_incore(spillway, repeat, baseline):
                              textured_dir, "--models", "64", "--triangles", "400000",
                              "--texture-res", "256", "--width", "320", "--height", "180",
                              "--spp", "16", "--max-depth", "2"], text=True)
-    gaussian = os.path.join(ROOT, "out", "bench", "cornell-gaussian.yaml")
-    os.makedirs(os.path.dirname(gaussian), exist_ok=True)
-    with open(gaussian, "w") as f:
-        f.write(open(box).read().replace("filter: {type: Box}", "filter: {type: Gaussian}")
-                .replace("filename: cornell-box/", "filename: %s/" % os.path.join(ROOT, "scenes", "cornell-box")))
+    def with_filter(kind):
+        path = os.path.join(ROOT, "out", "bench", "cornell-%s.yaml" % kind.lower())
+        os.makedirs(os.path.dirname(path), exist_ok=True)
+        with open(path, "w") as f:
+            f.write(open(box).read().replace("filter: {type: Box}", "filter: {type: %s}" % kind)
+                    .replace("filename: cornell-box/", "filename: %s/" % os.path.join(ROOT, "scenes", "cornell-box")))
+        return path
     scenes = [("Cornell box 256x256, 64 spp", box, ["--spp", "64"]),
               ("Cornell box 256x256, 256 spp", box, ["--spp", "256"]),
-              ("Cornell box 256x256, 64 spp, Gaussian filter", gaussian, ["--spp", "64"]),
+              ("Cornell box 256x256, 64 spp, Tent filter", with_filter("Tent"), ["--spp", "64"]),
+              ("Cornell box 256x256, 64 spp, Gaussian filter", with_filter("Gaussian"), ["--spp", "64"]),
               ("1M triangles, 17 shaders, 640x480, 16 spp", heavy, []),
               ("64 textured shaders (7 images each, 256^2), 320x180, 16 spp, depth 2",
                os.path.join(textured_dir, "scene.yaml"), []),
