@@ -198,6 +198,21 @@ namespace {
 constexpr size_t kChunk = 256;
 static_assert(kChunk <= 256, "chunk indices are bytes");
 
+// What setUpChunk reads that is likely a miss, asked for a whole chunk ahead (measured faster
+// than a fixed distance ahead within the loop): first the hits' rays (in traversal order while
+// the hits are in shader order) and triangles, then the triangles' vertices.
+void prefetchChunk(const RenderContext& ctx, const std::vector<RayState>& rays,
+                   const std::vector<HitRecord>& hits, const SortedHit* order, size_t n) {
+    for (size_t i = 0; i < n; ++i) {
+        const auto* ray = reinterpret_cast<const char*>(&rays[order[i].index]);
+        __builtin_prefetch(ray);
+        __builtin_prefetch(ray + sizeof(RayState) - 1);
+        ctx.hitSetup.prefetchTriangle(hits[order[i].index]);
+    }
+    for (size_t i = 0; i < n; ++i)
+        ctx.hitSetup.prefetchVertices(hits[order[i].index]);
+}
+
 // Hit setup of the sorted hits order[0, n), n <= kChunk, into in[0, n): each hit's geometry and
 // path, then the albedos (and normal maps), a run of hits of one shader at a time, texture by
 // texture (TextureResolver::albedos: the same values as one hit at a time, bit for bit). Hits that
@@ -212,15 +227,7 @@ void setUpChunk(const RenderContext& ctx, const std::vector<RayState>& rays,
     const HitRecord* record[kChunk]; // the hits that look textures up, and their setups
     SurfaceHit* hit[kChunk];
     size_t m = 0;
-    for (size_t i = 0; i < n; ++i) {
-        // The rays are in traversal order, the hits in shader order: each ray read is a miss.
-        const auto* ray = reinterpret_cast<const char*>(&rays[order[i].index]);
-        __builtin_prefetch(ray);
-        __builtin_prefetch(ray + sizeof(RayState) - 1);
-        ctx.hitSetup.prefetchTriangle(hits[order[i].index]);
-    }
-    for (size_t i = 0; i < n; ++i)
-        ctx.hitSetup.prefetchVertices(hits[order[i].index]);
+    prefetchChunk(ctx, rays, hits, order, n);
     for (size_t i = 0; i < n; ++i) {
         const std::uint32_t k = order[i].index;
         const RayState& ray = rays[k];
