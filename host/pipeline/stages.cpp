@@ -2,6 +2,7 @@
 
 #include "host/pipeline/parallel.h"
 #include "host/pipeline/radix_sort.h"
+#include "host/simd/lanes.h"
 #include "host/simd/simd_random.h"
 #include "shared/path.h"
 
@@ -213,6 +214,30 @@ void prefetchChunk(const RenderContext& ctx, const std::vector<RayState>& rays,
         ctx.hitSetup.prefetchVertices(hits[order[i].index]);
 }
 
+// The geometry of the sorted hits order[0, n), n <= kChunk, into in[0, n) (albedo 0), with their
+// paths and ray directions, and each hit's texture coordinates and footprint: SIMD-wide, a block
+// of hits at a time (HitSetup::setUpHits).
+void setUpGeometry(const RenderContext& ctx, const std::vector<RayState>& rays,
+                   const std::vector<HitRecord>& hits, const SortedHit* order, size_t n,
+                   ShadeInput* in, vec2* uv, float* footprint) {
+    const HitRecord* record[simd::kBlock];
+    vec3 dir[simd::kBlock];
+    uint cone[simd::kBlock];
+    SurfaceHit* out[simd::kBlock];
+    for (size_t begin = 0; begin < n; begin += simd::kBlock) {
+        const size_t count = std::min(simd::kBlock, n - begin);
+        for (size_t j = 0; j < count; ++j) {
+            const std::uint32_t k = order[begin + j].index;
+            const RayState& ray = rays[k];
+            ShadeInput& x = in[begin + j];
+            x.path = ray.path;
+            x.rayDir = ray.dir;
+            record[j] = &hits[k], dir[j] = ray.dir, cone[j] = ray.path.cone, out[j] = &x.hit;
+        }
+        ctx.hitSetup.setUpHits(count, record, dir, cone, out, uv + begin, footprint + begin);
+    }
+}
+
 // Hit setup of the sorted hits order[0, n), n <= kChunk, into in[0, n): each hit's geometry and
 // path, then the albedos (and normal maps), a run of hits of one shader at a time, texture by
 // texture (TextureResolver::albedos: the same values as one hit at a time, bit for bit). Hits that
@@ -226,23 +251,19 @@ void setUpChunk(const RenderContext& ctx, const std::vector<RayState>& rays,
     vec3 albedo[kChunk];
     const HitRecord* record[kChunk]; // the hits that look textures up, and their setups
     SurfaceHit* hit[kChunk];
-    size_t m = 0;
     prefetchChunk(ctx, rays, hits, order, n);
+    setUpGeometry(ctx, rays, hits, order, n, in, uv, footprint);
+    size_t m = 0;
     for (size_t i = 0; i < n; ++i) {
-        const std::uint32_t k = order[i].index;
-        const RayState& ray = rays[k];
         ShadeInput& x = in[i];
-        ctx.hitSetup.setUpGeometry(hits[k], x.hit);
-        x.path = ray.path;
-        x.rayDir = ray.dir;
-        if (ray.path.bounce >= ctx.params.maxDepth) continue;
+        if (x.path.bounce >= ctx.params.maxDepth) continue;
         const Shader& shader = ctx.scene.shaders[x.hit.shader];
         if (!shader.looksUpTextures()) {
             x.hit.albedo = ctx.textures.albedo(shader, vec2(0.0f), 0.0f);
-            ctx.hitSetup.applyVertexColour(hits[k], x.hit);
+            ctx.hitSetup.applyVertexColour(hits[order[i].index], x.hit);
             continue;
         }
-        ctx.hitSetup.textureQuery(hits[k], ray.dir, ray.path.cone, x.hit, uv[m], footprint[m]);
+        uv[m] = uv[i], footprint[m] = footprint[i]; // m <= i
         slot[m++] = std::uint8_t(i);
     }
     for (size_t a = 0; a < m;) {

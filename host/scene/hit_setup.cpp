@@ -1,5 +1,7 @@
 #include "host/scene/hit_setup.h"
 
+#include "host/scene/wide_hits.h"
+
 #include "shared/cone.h"
 #include "shared/offset.h"
 
@@ -9,6 +11,7 @@
 
 namespace spw {
 
+// Wide twin: setUpHitLanes (host/scene/wide_hits.cpp), with textureQuery.
 void HitSetup::surfaceHit(uint meshIndex, uint prim, float u, float v, float t,
                           SurfaceHit& hit) const {
     const Mesh& mesh = src_.meshes[meshIndex];
@@ -104,6 +107,7 @@ void HitSetup::tiltNormal(const HitRecord& h, vec3 texel, float scale, SurfaceHi
     if (length > 0.0f && std::isfinite(length)) hit.ns = tilted / length;
 }
 
+// Wide twin: setUpHitLanes (host/scene/wide_hits.cpp), with surfaceHit.
 void HitSetup::textureQuery(const HitRecord& h, vec3 dir, uint cone, const SurfaceHit& hit,
                             vec2& uv, float& footprint) const {
     // The filter width in texture space: the cone's width at the hit, stretched by the
@@ -124,6 +128,65 @@ void HitSetup::textureQuery(const HitRecord& h, vec3 dir, uint cone, const Surfa
             footprint = coneWidthAt(cone, h.t) / cosine * std::sqrt(uvArea / worldArea);
     }
     uv = mesh.uvAt(h.prim, h.u, h.v);
+}
+
+namespace {
+void setLane(simd::Vec3s& lanes, size_t j, vec3 v) {
+    lanes.x.v[j] = v.x, lanes.y.v[j] = v.y, lanes.z.v[j] = v.z;
+}
+void setLane(Vec2s& lanes, size_t j, vec2 v) {
+    lanes.x.v[j] = v.x, lanes.y.v[j] = v.y;
+}
+vec3 lane(const simd::Vec3s& lanes, size_t j) {
+    return vec3(lanes.x.v[j], lanes.y.v[j], lanes.z.v[j]);
+}
+
+// Hit j's triangle, ray and barycentrics into lane `to` of `l` (a mesh without vertex normals
+// or texture coordinates gets zeros and a mask of 0).
+void gatherLane(const Mesh& mesh, const HitRecord& h, vec3 dir, uint cone, HitLanes& l, size_t to) {
+    const uvec3 tri = mesh.triangles[h.prim];
+    l.u.v[to] = h.u, l.v.v[to] = h.v, l.t.v[to] = h.t;
+    setLane(l.p0, to, mesh.positions[tri.x]);
+    setLane(l.p1, to, mesh.positions[tri.y]);
+    setLane(l.p2, to, mesh.positions[tri.z]);
+    const bool normals = !mesh.normals.empty(), uvs = !mesh.uvs.empty();
+    l.hasNormals.v[to] = normals ? ~0u : 0u;
+    setLane(l.n0, to, normals ? mesh.normals[tri.x] : vec3(0.0f));
+    setLane(l.n1, to, normals ? mesh.normals[tri.y] : vec3(0.0f));
+    setLane(l.n2, to, normals ? mesh.normals[tri.z] : vec3(0.0f));
+    l.hasUvs.v[to] = uvs ? ~0u : 0u;
+    setLane(l.t0, to, uvs ? mesh.uvs[tri.x] : vec2(0.0f));
+    setLane(l.t1, to, uvs ? mesh.uvs[tri.y] : vec2(0.0f));
+    setLane(l.t2, to, uvs ? mesh.uvs[tri.z] : vec2(0.0f));
+    setLane(l.dir, to, dir);
+    l.coneWidth.v[to] = coneWidth(cone), l.coneSpread.v[to] = coneSpread(cone);
+}
+} // namespace
+
+void HitSetup::setUpHits(size_t n, const HitRecord* const* hits, const vec3* dir, const uint* cone,
+                         SurfaceHit* const* out, vec2* uv, float* footprint) const {
+    HitLanes l;
+    const size_t count = simd::wholeVectors(n);
+    for (size_t j = 0; j < count; ++j) { // padding repeats the last hit
+        const size_t from = std::min(j, n - 1);
+        gatherLane(src_.meshes[hits[from]->mesh], *hits[from], dir[from], cone[from], l, j);
+    }
+    setUpHitLanes(count, l);
+    for (size_t j = 0; j < n; ++j) {
+        const HitRecord& h = *hits[j];
+        SurfaceHit& hit = *out[j];
+        hit.p = lane(l.p, j);
+        hit.t = h.t;
+        hit.ng = lane(l.ng, j);
+        hit.shader = uint(src_.meshes[h.mesh].shader);
+        hit.ns = lane(l.ns, j);
+        hit.emitter = lights_.emitterOf(h.mesh, h.prim);
+        hit.albedo = vec3(0.0f);
+        hit.offset = l.offset.v[j];
+        hit.material = 0u;
+        uv[j] = vec2(l.uv.x.v[j], l.uv.y.v[j]);
+        footprint[j] = l.footprint.v[j];
+    }
 }
 
 } // namespace spw

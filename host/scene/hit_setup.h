@@ -39,6 +39,12 @@ class HitSetup {
     }
     void textureQuery(const HitRecord& h, vec3 dir, uint cone, const SurfaceHit& hit, vec2& uv,
                       float& footprint) const;
+    // setUpGeometry and textureQuery for n <= simd::kBlock hits at once, the arithmetic SIMD-wide
+    // (wide_hits.h), the same bits: *hits[j], reached along a ray of unit direction dir[j] and
+    // packed cone cone[j], into *out[j] (albedo 0), its texture coordinates and footprint into
+    // uv[j] and footprint[j].
+    void setUpHits(size_t n, const HitRecord* const* hits, const vec3* dir, const uint* cone,
+                   SurfaceHit* const* out, vec2* uv, float* footprint) const;
     // The shading normal tilted by a tangent-space normal map's value `texel` (linear, [0, 1]
     // per channel): to (2 texel - 1), its x and y times `scale`, in the frame the triangle's
     // texture coordinates make (x: growing u, y: growing v), made orthonormal about the
