@@ -11,6 +11,13 @@
 
 namespace spw {
 
+HitSetup::HitSetup(const Scene& scene, const SceneLights& lights) : src_(scene), lights_(lights) {
+    for (const Mesh& mesh : scene.meshes) {
+        anyNormals_ = anyNormals_ || !mesh.normals.empty();
+        anyUvs_ = anyUvs_ || !mesh.uvs.empty();
+    }
+}
+
 // Wide twin: setUpHitLanes (host/scene/wide_hits.cpp), with textureQuery.
 void HitSetup::surfaceHit(uint meshIndex, uint prim, float u, float v, float t,
                           SurfaceHit& hit) const {
@@ -141,23 +148,29 @@ vec3 lane(const simd::Vec3s& lanes, size_t j) {
     return vec3(lanes.x.v[j], lanes.y.v[j], lanes.z.v[j]);
 }
 
-// Hit j's triangle, ray and barycentrics into lane `to` of `l` (a mesh without vertex normals
-// or texture coordinates gets zeros and a mask of 0).
+// A hit's triangle, ray and barycentrics into lane `to` of `l`: vertex normals and texture
+// coordinates where the block has any (l.anyNormals, l.anyUvs), zeros and a mask of 0 in the
+// lanes of a mesh without them.
 void gatherLane(const Mesh& mesh, const HitRecord& h, vec3 dir, uint cone, HitLanes& l, size_t to) {
     const uvec3 tri = mesh.triangles[h.prim];
     l.u.v[to] = h.u, l.v.v[to] = h.v, l.t.v[to] = h.t;
     setLane(l.p0, to, mesh.positions[tri.x]);
     setLane(l.p1, to, mesh.positions[tri.y]);
     setLane(l.p2, to, mesh.positions[tri.z]);
-    const bool normals = !mesh.normals.empty(), uvs = !mesh.uvs.empty();
-    l.hasNormals.v[to] = normals ? ~0u : 0u;
-    setLane(l.n0, to, normals ? mesh.normals[tri.x] : vec3(0.0f));
-    setLane(l.n1, to, normals ? mesh.normals[tri.y] : vec3(0.0f));
-    setLane(l.n2, to, normals ? mesh.normals[tri.z] : vec3(0.0f));
-    l.hasUvs.v[to] = uvs ? ~0u : 0u;
-    setLane(l.t0, to, uvs ? mesh.uvs[tri.x] : vec2(0.0f));
-    setLane(l.t1, to, uvs ? mesh.uvs[tri.y] : vec2(0.0f));
-    setLane(l.t2, to, uvs ? mesh.uvs[tri.z] : vec2(0.0f));
+    if (l.anyNormals) {
+        const bool normals = !mesh.normals.empty();
+        l.hasNormals.v[to] = normals ? ~0u : 0u;
+        setLane(l.n0, to, normals ? mesh.normals[tri.x] : vec3(0.0f));
+        setLane(l.n1, to, normals ? mesh.normals[tri.y] : vec3(0.0f));
+        setLane(l.n2, to, normals ? mesh.normals[tri.z] : vec3(0.0f));
+    }
+    if (l.anyUvs) {
+        const bool uvs = !mesh.uvs.empty();
+        l.hasUvs.v[to] = uvs ? ~0u : 0u;
+        setLane(l.t0, to, uvs ? mesh.uvs[tri.x] : vec2(0.0f));
+        setLane(l.t1, to, uvs ? mesh.uvs[tri.y] : vec2(0.0f));
+        setLane(l.t2, to, uvs ? mesh.uvs[tri.z] : vec2(0.0f));
+    }
     setLane(l.dir, to, dir);
     l.coneWidth.v[to] = coneWidth(cone), l.coneSpread.v[to] = coneSpread(cone);
 }
@@ -166,6 +179,7 @@ void gatherLane(const Mesh& mesh, const HitRecord& h, vec3 dir, uint cone, HitLa
 void HitSetup::setUpHits(size_t n, const HitRecord* const* hits, const vec3* dir, const uint* cone,
                          SurfaceHit* const* out, vec2* uv, float* footprint) const {
     HitLanes l;
+    l.anyNormals = anyNormals_, l.anyUvs = anyUvs_;
     const size_t count = simd::wholeVectors(n);
     for (size_t j = 0; j < count; ++j) { // padding repeats the last hit
         const size_t from = std::min(j, n - 1);

@@ -22,7 +22,7 @@ struct HitRecord {
 class HitSetup {
   public:
     // `lights` gives each hit its emitter index; both must outlive this.
-    HitSetup(const Scene& scene, const SceneLights& lights) : src_(scene), lights_(lights) {}
+    HitSetup(const Scene& scene, const SceneLights& lights);
 
     // The whole hit. `dir` and `cone`: the ray's unit direction and packed cone
     // (shared/cone.h), for the texture filter width. `albedo` false: the hit ends its path (max
@@ -89,6 +89,8 @@ class HitSetup {
 
     const Scene& src_;
     const SceneLights& lights_;
+    // Whether any mesh has vertex normals, texture coordinates: setUpHits skips what none has.
+    bool anyNormals_ = false, anyUvs_ = false;
 };
 
 } // namespace spw

@@ -41,14 +41,21 @@ void SetUpHitLanes(size_t count, spw::HitLanes& l) {
         const V3 normal = cross(sub(p1, p0), sub(p2, p0));
         const V3 ng = normalize(normal);
         // The shading normal: the interpolated vertex normals, where they have a length.
-        const V3 n = interpolate(w, u, v, load(l.n0, i), load(l.n1, i), load(l.n2, i));
-        const V length = hn::Sqrt(dot(n, n));
-        const M normals = hn::And(loadMask(l.hasNormals, i), hn::Gt(length, zero));
-        const V3 ns = select(normals, div(n, length), ng);
+        V3 ns = ng;
+        if (l.anyNormals) {
+            const V3 n = interpolate(w, u, v, load(l.n0, i), load(l.n1, i), load(l.n2, i));
+            const V length = hn::Sqrt(dot(n, n));
+            const M normals = hn::And(loadMask(l.hasNormals, i), hn::Gt(length, zero));
+            ns = select(normals, div(n, length), ng);
+        }
         store(p.x, l.p.x, i), store(p.y, l.p.y, i), store(p.z, l.p.z, i);
         store(ng.x, l.ng.x, i), store(ng.y, l.ng.y, i), store(ng.z, l.ng.z, i);
         store(ns.x, l.ns.x, i), store(ns.y, l.ns.y, i), store(ns.z, l.ns.z, i);
         store(surfaceOffset(p, p0, p1, p2, ng), l.offset, i);
+        if (!l.anyUvs) {
+            store(zero, l.footprint, i), store(zero, l.uv.x, i), store(zero, l.uv.y, i);
+            continue;
+        }
         // The cone's width at the hit, stretched by the incidence and scaled by the triangle's
         // texture area over its world area.
         const V2 t0 = load(l.t0, i), t1 = load(l.t1, i), t2 = load(l.t2, i);

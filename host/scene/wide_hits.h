@@ -26,7 +26,8 @@ struct HitLanes {
     simd::Floats u, v, t;
     simd::Vec3s p0, p1, p2, n0, n1, n2, dir;
     Vec2s t0, t1, t2;
-    simd::Uints hasNormals, hasUvs; // all ones where the mesh has them
+    simd::Uints hasNormals, hasUvs;          // all ones where the mesh has them
+    bool anyNormals = false, anyUvs = false; // false: those rows and masks are not read
     simd::Floats coneWidth, coneSpread;
     // Out: what SurfaceHit takes (p, ng, ns, offset), and the texture lookup's coordinates and
     // filter footprint (HitSetup::textureQuery).
