@@ -486,7 +486,7 @@ void openImage(TextureResolver::Impl& impl, const Texture& t, TextureResolver::I
 } // namespace
 
 TextureResolver::TextureResolver(const Scene& scene, double cacheMiB, bool filtered, bool wide)
-    : scene_(scene) {
+    : scene_(scene), wide_(wide) {
     programs_.resize(scene.textures.size());
     auto compile = [&](int root) {
         if (root < 0 || !programs_[size_t(root)].empty()) return;
@@ -625,6 +625,7 @@ const vec3* TextureResolver::evaluate(int tree, size_t n, const vec2* uv,
     const std::vector<Op>& program = programs_[size_t(tree)];
     Impl::ThreadState* thread = impl_ ? &impl_->thread() : nullptr;
     // Every node's values for every hit: nodes x hits, in a per-thread buffer.
+    static_assert(sizeof(vec3) == 3 * sizeof(float), "a run's vec3s are rows of floats");
     thread_local std::vector<vec3> values;
     if (values.size() < program.size() * n) values.resize(program.size() * n);
     for (size_t i = 0; i < program.size(); ++i) {
@@ -666,8 +667,14 @@ const vec3* TextureResolver::evaluate(int tree, size_t n, const vec2* uv,
             break;
         }
         case TextureType::Layered: {
+            // m upper + (1 - m) lower per channel, SIMD-wide over the run's 3 n channels (with
+            // `wide` false, one lookup at a time: the oracle).
             const vec3 *m = &values[size_t(op.mask) * n], *upper = &values[size_t(op.upper) * n],
                        *lower = &values[size_t(op.lower) * n];
+            if (wide_) {
+                blendLayers(3 * n, &m->x, &upper->x, &lower->x, &v->x);
+                break;
+            }
             for (size_t k = 0; k < n; ++k)
                 v[k] = m[k] * upper[k] + (vec3(1.0f) - m[k]) * lower[k];
             break;

@@ -35,8 +35,9 @@ class TextureResolver {
   public:
     // cacheMiB: the tile cache's size (settings: texture cache, or --texture-cache). filtered:
     // lookups take their footprint (MIP levels, trilinear); otherwise the finest level always.
-    // wide: albedos() filters runs of lookups in 8-bit images SIMD-wide (wide_texels.h); false
-    // filters one at a time. The values are the same to the bit.
+    // wide: albedos() filters runs of lookups in 8-bit images and blends Layered textures
+    // SIMD-wide (wide_texels.h); false, one lookup at a time. The values are the same to the
+    // bit.
     TextureResolver(const Scene& scene, double cacheMiB, bool filtered = true, bool wide = true);
     ~TextureResolver();
     TextureResolver(const TextureResolver&) = delete;
@@ -87,6 +88,7 @@ class TextureResolver {
     const Scene& scene_;
     std::vector<std::vector<Op>> programs_; // per Scene::textures root used by a shader
     std::unique_ptr<Impl> impl_;
+    bool wide_ = true;
 };
 
 } // namespace spw

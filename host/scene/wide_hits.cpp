@@ -30,11 +30,32 @@ HWY_INLINE V2 interpolate(V w, V u, V v, V2 a, V2 b, V2 c) {
             hn::Add(hn::Add(hn::Mul(a.y, w), hn::Mul(b.y, u)), hn::Mul(c.y, v))};
 }
 
+// Lanes [i, i + Lanes) of the texture lookup's coordinates and the cone's footprint: its width
+// at the hit, stretched by the incidence and scaled by the triangle's texture area over its world
+// area. `normal`: the triangle's unnormalised normal, ng its unit one.
+HWY_INLINE void textureQuery(spw::HitLanes& l, size_t i, V w, V u, V v, V3 normal, V3 ng) {
+    const D d;
+    const V zero = hn::Zero(d);
+    const V2 t0 = load(l.t0, i), t1 = load(l.t1, i), t2 = load(l.t2, i);
+    const V worldArea = hn::Sqrt(dot(normal, normal));
+    const V ax = hn::Sub(t1.x, t0.x), ay = hn::Sub(t1.y, t0.y);
+    const V bx = hn::Sub(t2.x, t0.x), by = hn::Sub(t2.y, t0.y);
+    const V uvArea = hn::Abs(hn::Sub(hn::Mul(ax, by), hn::Mul(ay, bx)));
+    const V cosine = gmax(hn::Abs(dot(load(l.dir, i), ng)), hn::Set(d, 1e-3f));
+    const V width = hn::Add(load(l.coneWidth, i), hn::Mul(load(l.coneSpread, i), load(l.t, i)));
+    const V footprint = hn::Mul(hn::Div(width, cosine), hn::Sqrt(hn::Div(uvArea, worldArea)));
+    const M uvs = loadMask(l.hasUvs, i);
+    store(hn::IfThenElseZero(hn::And(uvs, hn::Gt(worldArea, zero)), footprint), l.footprint, i);
+    const V2 uv = interpolate(w, u, v, t0, t1, t2);
+    store(hn::IfThenElseZero(uvs, uv.x), l.uv.x, i);
+    store(hn::IfThenElseZero(uvs, uv.y), l.uv.y, i);
+}
+
 void SetUpHitLanes(size_t count, spw::HitLanes& l) {
     const D d;
     const V zero = hn::Zero(d);
     for (size_t i = 0; i < count; i += hn::Lanes(d)) {
-        const V u = load(l.u, i), v = load(l.v, i), t = load(l.t, i);
+        const V u = load(l.u, i), v = load(l.v, i);
         const V w = hn::Sub(hn::Sub(hn::Set(d, 1.0f), u), v);
         const V3 p0 = load(l.p0, i), p1 = load(l.p1, i), p2 = load(l.p2, i);
         const V3 p = interpolate(w, u, v, p0, p1, p2);
@@ -52,25 +73,11 @@ void SetUpHitLanes(size_t count, spw::HitLanes& l) {
         store(ng.x, l.ng.x, i), store(ng.y, l.ng.y, i), store(ng.z, l.ng.z, i);
         store(ns.x, l.ns.x, i), store(ns.y, l.ns.y, i), store(ns.z, l.ns.z, i);
         store(surfaceOffset(p, p0, p1, p2, ng), l.offset, i);
-        if (!l.anyUvs) {
+        if (l.anyUvs) {
+            textureQuery(l, i, w, u, v, normal, ng);
+        } else {
             store(zero, l.footprint, i), store(zero, l.uv.x, i), store(zero, l.uv.y, i);
-            continue;
         }
-        // The cone's width at the hit, stretched by the incidence and scaled by the triangle's
-        // texture area over its world area.
-        const V2 t0 = load(l.t0, i), t1 = load(l.t1, i), t2 = load(l.t2, i);
-        const V worldArea = hn::Sqrt(dot(normal, normal));
-        const V ax = hn::Sub(t1.x, t0.x), ay = hn::Sub(t1.y, t0.y);
-        const V bx = hn::Sub(t2.x, t0.x), by = hn::Sub(t2.y, t0.y);
-        const V uvArea = hn::Abs(hn::Sub(hn::Mul(ax, by), hn::Mul(ay, bx)));
-        const V cosine = gmax(hn::Abs(dot(load(l.dir, i), ng)), hn::Set(d, 1e-3f));
-        const V width = hn::Add(load(l.coneWidth, i), hn::Mul(load(l.coneSpread, i), t));
-        const V footprint = hn::Mul(hn::Div(width, cosine), hn::Sqrt(hn::Div(uvArea, worldArea)));
-        const M uvs = loadMask(l.hasUvs, i);
-        store(hn::IfThenElseZero(hn::And(uvs, hn::Gt(worldArea, zero)), footprint), l.footprint, i);
-        const V2 uv = interpolate(w, u, v, t0, t1, t2);
-        store(hn::IfThenElseZero(uvs, uv.x), l.uv.x, i);
-        store(hn::IfThenElseZero(uvs, uv.y), l.uv.y, i);
     }
 }
 

@@ -1,6 +1,7 @@
-// bilinearInTile (wide_texels.h), compiled once per instruction set through foreach_target.h.
-// It is TexelReader::bilinear (textures.cpp) and TexelReader::decode for 8-bit texels, lane by
-// lane, in the same operations.
+// bilinearInTile and blendLayers (wide_texels.h), compiled once per instruction set through
+// foreach_target.h. They are TexelReader::bilinear (textures.cpp) and TexelReader::decode for
+// 8-bit texels, and the Layered blend of TextureResolver::evaluate, lane by lane, in the same
+// operations.
 #include "host/scene/wide_texels.h"
 
 #undef HWY_TARGET_INCLUDE
@@ -110,16 +111,37 @@ void BilinearInTile(const spw::TexelTile& tile, const spw::TexelLevel& level, si
     }
 }
 
+void BlendLayers(size_t count, const float* mask, const float* upper, const float* lower,
+                 float* out) {
+    const D d;
+    const V one = hn::Set(d, 1.0f);
+    size_t i = 0;
+    for (; i + hn::Lanes(d) <= count; i += hn::Lanes(d)) {
+        const V m = hn::LoadU(d, mask + i);
+        hn::StoreU(hn::Add(hn::Mul(m, hn::LoadU(d, upper + i)),
+                           hn::Mul(hn::Sub(one, m), hn::LoadU(d, lower + i))),
+                   d, out + i);
+    }
+    for (; i < count; ++i)
+        out[i] = mask[i] * upper[i] + (1.0f - mask[i]) * lower[i];
+}
+
 } // namespace spw::HWY_NAMESPACE
 HWY_AFTER_NAMESPACE();
 
 #if HWY_ONCE
 namespace spw {
 HWY_EXPORT(BilinearInTile);
+HWY_EXPORT(BlendLayers);
 
 void bilinearInTile(const TexelTile& tile, const TexelLevel& level, size_t count,
                     TexelLanes& lanes) {
     HWY_DYNAMIC_DISPATCH(BilinearInTile)(tile, level, count, lanes);
+}
+
+void blendLayers(size_t count, const float* mask, const float* upper, const float* lower,
+                 float* out) {
+    HWY_DYNAMIC_DISPATCH(BlendLayers)(count, mask, upper, lower, out);
 }
 
 } // namespace spw

@@ -41,4 +41,10 @@ struct TexelLanes {
 void bilinearInTile(const TexelTile& tile, const TexelLevel& level, size_t count,
                     TexelLanes& lanes);
 
+// A Layered texture's values for a run of lookups, SIMD-wide: out[i] = mask[i] upper[i] +
+// (1 - mask[i]) lower[i] for i in [0, count), each operation rounded once, as the scalar blend
+// of one channel (a run's vec3 values are rows of 3 n floats). `out` may be any of the inputs.
+void blendLayers(size_t count, const float* mask, const float* upper, const float* lower,
+                 float* out);
+
 } // namespace spw

@@ -144,8 +144,9 @@ void writeTexture8(const std::string& path, int w, int h, int channels, int tile
         << OIIO::geterror();
 }
 
-// Runs of lookups in 8-bit images are filtered SIMD-wide (wide_texels.h); one lookup at a
-// time is the oracle. They agree to the bit for grey, RGB and RGBA images, sRGB and linear,
+// Runs of lookups in 8-bit images are filtered, and Layered textures blended, SIMD-wide
+// (wide_texels.h); one lookup at a time is the oracle. They agree to the bit for grey, RGB and
+// RGBA images, sRGB and linear, a Layered texture,
 // tiled with edge tiles or untiled, MIP-mapped, in every instruction set this machine has, at
 // coordinates in runs (as sorted hits come), far, negative, infinite and NaN, and footprints
 // from none through every level to infinite; and so with a cache small enough that a thread
@@ -157,11 +158,16 @@ TEST(TextureLookup, WideFilteringIsTheScalarLookupBitForBit) {
         int width, height, channels, tile;
         const char* colourSpace;
         double cacheMiB;
+        bool layered; // the image as a Layered texture's upper layer and mask over a Constant
     };
     const Case cases[] = {
-        {"rgb.tif", 100, 60, 3, 16, "", 4.0},   {"grey.tif", 64, 64, 1, 16, "", 4.0},
-        {"rgba.tif", 37, 53, 4, 16, "", 4.0},   {"linear.png", 64, 32, 3, 0, "Linear", 4.0},
-        {"untiled.tif", 29, 31, 3, 0, "", 4.0}, {"small-cache.tif", 256, 256, 3, 16, "", 0.02},
+        {"rgb.tif", 100, 60, 3, 16, "", 4.0, false},
+        {"grey.tif", 64, 64, 1, 16, "", 4.0, false},
+        {"rgba.tif", 37, 53, 4, 16, "", 4.0, false},
+        {"linear.png", 64, 32, 3, 0, "Linear", 4.0, false},
+        {"untiled.tif", 29, 31, 3, 0, "", 4.0, false},
+        {"small-cache.tif", 256, 256, 3, 16, "", 0.02, false},
+        {"layered.tif", 100, 60, 3, 16, "", 4.0, true},
     };
     std::mt19937 rng(11);
     std::uniform_real_distribution<float> centre(-2.0f, 3.0f), near(-0.02f, 0.02f),
@@ -172,7 +178,14 @@ TEST(TextureLookup, WideFilteringIsTheScalarLookupBitForBit) {
     ASSERT_FALSE(targets.empty());
     for (const Case& c : cases) {
         writeTexture8(dir.file(c.file), c.width, c.height, c.channels, c.tile, c.colourSpace);
-        const Scene scene = texturedScene(dir, c.file);
+        const std::string image = "{type: Standard, string: " + std::string(c.file) + "}";
+        const Scene scene =
+            c.layered ? loadScene(dir.write("l.yaml", "shader:\n  type: Lambert\n  texture: "
+                                                      "{type: Layered, upper: " +
+                                                          image + ", mask: " + image +
+                                                          ", lower: {type: Constant, colour: "
+                                                          "[0.2, 0.5, 0.9]}}\n"))
+                      : texturedScene(dir, c.file);
         const TextureResolver wide(scene, c.cacheMiB, true, true),
             scalar(scene, c.cacheMiB, true, false);
         size_t compared = 0, differing = 0;
