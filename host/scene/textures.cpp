@@ -620,6 +620,12 @@ void TextureResolver::values(int tree, size_t n, const vec2* uv, const float* fo
     std::copy(root, root + n, out);
 }
 
+namespace {
+// Fewer lookups than this are blended one at a time (the reference backend's single lookups
+// among them): their 3 n channels fill no vector.
+constexpr size_t kWideBlendFrom = 8;
+} // namespace
+
 const vec3* TextureResolver::evaluate(int tree, size_t n, const vec2* uv,
                                       const float* footprint) const {
     const std::vector<Op>& program = programs_[size_t(tree)];
@@ -667,11 +673,11 @@ const vec3* TextureResolver::evaluate(int tree, size_t n, const vec2* uv,
             break;
         }
         case TextureType::Layered: {
-            // m upper + (1 - m) lower per channel, SIMD-wide over the run's 3 n channels (with
-            // `wide` false, one lookup at a time: the oracle).
+            // m upper + (1 - m) lower per channel, SIMD-wide over the run's 3 n channels where
+            // they fill a vector (with `wide` false, one lookup at a time: the oracle).
             const vec3 *m = &values[size_t(op.mask) * n], *upper = &values[size_t(op.upper) * n],
                        *lower = &values[size_t(op.lower) * n];
-            if (wide_) {
+            if (wide_ && n >= kWideBlendFrom) {
                 blendLayers(3 * n, &m->x, &upper->x, &lower->x, &v->x);
                 break;
             }
