@@ -148,6 +148,18 @@ vec3 lane(const simd::Vec3s& lanes, size_t j) {
     return vec3(lanes.x.v[j], lanes.y.v[j], lanes.z.v[j]);
 }
 
+// A triangle's corners' values (vertex normals, texture coordinates) into lane `to` of rows a, b
+// and c, and `has` all ones; zeros and 0 where the mesh has none.
+template <class T, class Rows>
+void setCorners(const std::vector<T>& values, uvec3 tri, Rows& a, Rows& b, Rows& c,
+                simd::Uints& has, size_t to) {
+    const bool any = !values.empty();
+    has.v[to] = any ? ~0u : 0u;
+    setLane(a, to, any ? values[tri.x] : T(0.0f));
+    setLane(b, to, any ? values[tri.y] : T(0.0f));
+    setLane(c, to, any ? values[tri.z] : T(0.0f));
+}
+
 // A hit's triangle, ray and barycentrics into lane `to` of `l`: vertex normals and texture
 // coordinates where the block has any (l.anyNormals, l.anyUvs), zeros and a mask of 0 in the
 // lanes of a mesh without them.
@@ -157,20 +169,8 @@ void gatherLane(const Mesh& mesh, const HitRecord& h, vec3 dir, uint cone, HitLa
     setLane(l.p0, to, mesh.positions[tri.x]);
     setLane(l.p1, to, mesh.positions[tri.y]);
     setLane(l.p2, to, mesh.positions[tri.z]);
-    if (l.anyNormals) {
-        const bool normals = !mesh.normals.empty();
-        l.hasNormals.v[to] = normals ? ~0u : 0u;
-        setLane(l.n0, to, normals ? mesh.normals[tri.x] : vec3(0.0f));
-        setLane(l.n1, to, normals ? mesh.normals[tri.y] : vec3(0.0f));
-        setLane(l.n2, to, normals ? mesh.normals[tri.z] : vec3(0.0f));
-    }
-    if (l.anyUvs) {
-        const bool uvs = !mesh.uvs.empty();
-        l.hasUvs.v[to] = uvs ? ~0u : 0u;
-        setLane(l.t0, to, uvs ? mesh.uvs[tri.x] : vec2(0.0f));
-        setLane(l.t1, to, uvs ? mesh.uvs[tri.y] : vec2(0.0f));
-        setLane(l.t2, to, uvs ? mesh.uvs[tri.z] : vec2(0.0f));
-    }
+    if (l.anyNormals) setCorners(mesh.normals, tri, l.n0, l.n1, l.n2, l.hasNormals, to);
+    if (l.anyUvs) setCorners(mesh.uvs, tri, l.t0, l.t1, l.t2, l.hasUvs, to);
     setLane(l.dir, to, dir);
     l.coneWidth.v[to] = coneWidth(cone), l.coneSpread.v[to] = coneSpread(cone);
 }
