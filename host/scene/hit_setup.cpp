@@ -141,7 +141,7 @@ namespace {
 void setLane(simd::Vec3s& lanes, size_t j, vec3 v) {
     lanes.x.v[j] = v.x, lanes.y.v[j] = v.y, lanes.z.v[j] = v.z;
 }
-void setLane(Vec2s& lanes, size_t j, vec2 v) {
+void setLane(simd::Vec2s& lanes, size_t j, vec2 v) {
     lanes.x.v[j] = v.x, lanes.y.v[j] = v.y;
 }
 vec3 lane(const simd::Vec3s& lanes, size_t j) {
@@ -160,9 +160,9 @@ void setCorners(const std::vector<T>& values, uvec3 tri, Rows& a, Rows& b, Rows&
     setLane(c, to, any ? values[tri.z] : T(0.0f));
 }
 
-// A hit's triangle, ray and barycentrics into lane `to` of `l`: vertex normals and texture
-// coordinates where the block has any (l.anyNormals, l.anyUvs), zeros and a mask of 0 in the
-// lanes of a mesh without them.
+// A hit's triangle, ray and barycentrics into lane `to` of `l`: vertex normals, and texture
+// coordinates with the ray's direction and cone, where the block has any (l.anyNormals,
+// l.anyUvs), zeros and a mask of 0 in the lanes of a mesh without them.
 void gatherLane(const Mesh& mesh, const HitRecord& h, vec3 dir, uint cone, HitLanes& l, size_t to) {
     const uvec3 tri = mesh.triangles[h.prim];
     l.u.v[to] = h.u, l.v.v[to] = h.v, l.t.v[to] = h.t;
@@ -170,7 +170,8 @@ void gatherLane(const Mesh& mesh, const HitRecord& h, vec3 dir, uint cone, HitLa
     setLane(l.p1, to, mesh.positions[tri.y]);
     setLane(l.p2, to, mesh.positions[tri.z]);
     if (l.anyNormals) setCorners(mesh.normals, tri, l.n0, l.n1, l.n2, l.hasNormals, to);
-    if (l.anyUvs) setCorners(mesh.uvs, tri, l.t0, l.t1, l.t2, l.hasUvs, to);
+    if (!l.anyUvs) return; // the ray's direction and cone serve only the texture query
+    setCorners(mesh.uvs, tri, l.t0, l.t1, l.t2, l.hasUvs, to);
     setLane(l.dir, to, dir);
     l.coneWidth.v[to] = coneWidth(cone), l.coneSpread.v[to] = coneSpread(cone);
 }

@@ -17,7 +17,7 @@ struct V2 {
     V x, y;
 };
 
-HWY_INLINE V2 load(const spw::Vec2s& a, size_t i) {
+HWY_INLINE V2 load(const simd::Vec2s& a, size_t i) {
     return {load(a.x, i), load(a.y, i)};
 }
 

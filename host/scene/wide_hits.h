@@ -14,10 +14,6 @@
 
 namespace spw {
 
-struct Vec2s {
-    simd::Floats x, y;
-};
-
 // A block of hits, a row of lanes per value (host/simd/lanes.h).
 struct HitLanes {
     // In: Embree's barycentrics and distance, the triangle's vertices, vertex normals and
@@ -25,15 +21,16 @@ struct HitLanes {
     // direction and its cone's width and spread (shared/cone.h, unpacked).
     simd::Floats u, v, t;
     simd::Vec3s p0, p1, p2, n0, n1, n2, dir;
-    Vec2s t0, t1, t2;
-    simd::Uints hasNormals, hasUvs;          // all ones where the mesh has them
-    bool anyNormals = false, anyUvs = false; // false: those rows and masks are not read
+    simd::Vec2s t0, t1, t2;
+    simd::Uints hasNormals, hasUvs; // all ones where the mesh has them
+    // false: those rows and masks are not read (with anyUvs, nor dir and the cone's)
+    bool anyNormals = false, anyUvs = false;
     simd::Floats coneWidth, coneSpread;
     // Out: what SurfaceHit takes (p, ng, ns, offset), and the texture lookup's coordinates and
     // filter footprint (HitSetup::textureQuery).
     simd::Vec3s p, ng, ns;
     simd::Floats offset, footprint;
-    Vec2s uv;
+    simd::Vec2s uv;
 };
 
 // The results of lanes [0, count) (count a multiple of simd::kMaxLanes, at most simd::kBlock).

@@ -17,6 +17,9 @@ struct Floats {
 struct Uints { // masks (all bits set, or none) and integers
     alignas(64) std::uint32_t v[kBlock];
 };
+struct Vec2s {
+    Floats x, y;
+};
 struct Vec3s {
     Floats x, y, z;
 };
