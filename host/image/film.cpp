@@ -170,23 +170,31 @@ void Film::decideAdaptiveTiles() {
     active_.assign(size_t(tilesX_) * size_t(tilesY_), 1);
     activeTiles_ = active_.size();
     const double limit = adaptiveThreshold_ * adaptiveThreshold_; // on the mean square
-    for (int ty = 0; ty < tilesY_; ++ty)
-        for (int tx = 0; tx < tilesX_; ++tx) {
-            double total = 0.0;
-            size_t values = 0;
-            bool ready = tileSamples_[size_t(ty) * size_t(tilesX_) + size_t(tx)] >=
-                         std::uint32_t(adaptiveMinSamples_);
-            for (int y = ty * kAdaptiveTile; y < std::min(height_, (ty + 1) * kAdaptiveTile); ++y)
-                for (int x = tx * kAdaptiveTile; x < std::min(width_, (tx + 1) * kAdaptiveTile);
-                     ++x) {
-                    const size_t i = size_t(y) * size_t(width_) + size_t(x);
-                    if (!addHalfBufferRelMse(i, total, values)) ready = false;
+    forHalfBufferTerms([&](int y0, int y1, const double* terms) {
+        for (int ty = y0 / kAdaptiveTile; ty * kAdaptiveTile < y1; ++ty)
+            for (int tx = 0; tx < tilesX_; ++tx) {
+                double total = 0.0;
+                size_t values = 0;
+                bool ready = tileSamples_[size_t(ty) * size_t(tilesX_) + size_t(tx)] >=
+                             std::uint32_t(adaptiveMinSamples_);
+                for (int y = ty * kAdaptiveTile; y < std::min(y1, (ty + 1) * kAdaptiveTile); ++y)
+                    for (int x = tx * kAdaptiveTile; x < std::min(width_, (tx + 1) * kAdaptiveTile);
+                         ++x) {
+                        const double* t = terms + (size_t(y - y0) * size_t(width_) + size_t(x)) * 3;
+                        if (t[0] == kNoTerm) {
+                            ready = false;
+                            continue;
+                        }
+                        for (int c = 0; c < 3; ++c) // one at a time, as the sum always was
+                            total += t[c];
+                        values += 3;
+                    }
+                if (ready && values > 0 && total / double(values) < limit) {
+                    active_[size_t(ty) * size_t(tilesX_) + size_t(tx)] = 0;
+                    --activeTiles_;
                 }
-            if (ready && values > 0 && total / double(values) < limit) {
-                active_[size_t(ty) * size_t(tilesX_) + size_t(tx)] = 0;
-                --activeTiles_;
             }
-        }
+    });
 }
 
 void Film::setShare(int index, int shares) {
@@ -622,36 +630,90 @@ void imageFromSums(const Sums& sums, size_t first, size_t count, float* out) {
 }
 } // namespace
 
-bool Film::halfBufferTerms(size_t pixel, double* terms) const {
-    double s[8];
-    pixelSums(pixel, s);
-    if (!(s[3] > 0 && s[7] > 0)) return false;
-    for (int c = 0; c < 3; ++c) {
-        const double a = s[c] / s[3], b = s[4 + c] / s[7], m = (s[c] + s[4 + c]) / (s[3] + s[7]);
-        terms[c] = (a - b) * (a - b) / 4.0 / (m * m + kRelMseEpsilon);
-    }
-    return true;
+namespace {
+// The value d in one channel's term (A - B)^2 / 4 / (d^2 + 0.01) of a pixel whose halves read a
+// and b, m the two together, from `samples` samples, among neighbours (the 3 x 3 window, the
+// pixel included, `count` values) whose brightest, the pixel left out, reads `brightest`.
+//
+// d is m, the pixel's own value, unless its samples spread more than anything around it shows:
+// the per-sample standard deviation that the halves' difference gives, |a - b| sqrt(n / 4),
+// above the brightest neighbour's value. That is a spike no surface in view explains, a glint:
+// a rare path of large value (a glossy bounce into a small light), whose one sample inflates m
+// as much as the difference, so that with m as d the term reads at most about 1 where the
+// pixel's true relative error is tens. Such a pixel takes d = min(m, max(min(a, b), median of
+// the window)): its spike-free half, or its neighbourhood's level if that is higher. A pixel at
+// an edge (a sliver of the light, a bright wall behind a dark one) has spikes that a neighbour
+// shows as its steady value, and keeps m: its rare samples are a large part of its true value.
+// docs/performance.md ("The denominator") has the measurements behind the rule.
+double termValue(double a, double b, double m, double samples, double* window, int count,
+                 double brightest) {
+    const double spread = std::fabs(a - b) * std::sqrt(samples / 4.0);
+    if (!(spread > brightest)) return m;
+    std::nth_element(window, window + count / 2, window + count);
+    return std::min(m, std::max(std::min(a, b), window[count / 2]));
+}
+} // namespace
+
+void Film::halfBufferTermRows(int y0, int y1, double* terms) const {
+    // The image's rows y0 - 1 .. y1 (those inside it): every pixel's neighbours.
+    const int r0 = std::max(0, y0 - 1), r1 = std::min(height_, y1 + 1);
+    const size_t w = size_t(width_);
+    std::vector<double> value(size_t(r1 - r0) * w * 3);
+    forPixels(size_t(r1 - r0) * w, [&](size_t begin, size_t end) {
+        for (size_t j = begin; j < end; ++j) {
+            double s[8];
+            pixelSums(size_t(r0) * w + j, s);
+            const double weight = s[3] + s[7];
+            for (int c = 0; c < 3; ++c)
+                value[j * 3 + size_t(c)] = weight > 0 ? (s[c] + s[4 + c]) / weight : 0.0;
+        }
+    });
+    forPixels(size_t(y1 - y0) * w, [&](size_t begin, size_t end) {
+        for (size_t j = begin; j < end; ++j) {
+            const size_t pixel = size_t(y0) * w + j;
+            const int x = int(pixel % w), y = int(pixel / w);
+            double s[8];
+            pixelSums(pixel, s);
+            double* out = terms + j * 3;
+            if (!(s[3] > 0 && s[7] > 0)) {
+                out[0] = out[1] = out[2] = kNoTerm;
+                continue;
+            }
+            const double samples = double(tileSamples_[tileOf(pixel)]);
+            for (int c = 0; c < 3; ++c) {
+                double window[9], brightest = 0.0;
+                int count = 0;
+                for (int ny = std::max(0, y - 1); ny <= std::min(height_ - 1, y + 1); ++ny)
+                    for (int nx = std::max(0, x - 1); nx <= std::min(width_ - 1, x + 1); ++nx) {
+                        const double v = value[(size_t(ny - r0) * w + size_t(nx)) * 3 + size_t(c)];
+                        window[count++] = v;
+                        if (nx != x || ny != y) brightest = std::max(brightest, v);
+                    }
+                const double a = s[c] / s[3], b = s[4 + c] / s[7],
+                             m = value[(size_t(y - r0) * w + size_t(x)) * 3 + size_t(c)];
+                const double d = termValue(a, b, m, samples, window, count, brightest);
+                out[c] = (a - b) * (a - b) / 4.0 / (d * d + kRelMseEpsilon);
+            }
+        }
+    });
 }
 
-bool Film::addHalfBufferRelMse(size_t pixel, double& total, size_t& count) const {
-    double terms[3];
-    if (!halfBufferTerms(pixel, terms)) return false;
-    for (double t : terms) // one at a time, as the sum always was
-        total += t;
-    count += 3;
-    return true;
+template <typename Fn> void Film::forHalfBufferTerms(const Fn& fn) const {
+    constexpr int kBand = 8 * kAdaptiveTile; // rows: whole tiles, a few MB of terms
+    std::vector<double> terms;
+    for (int y0 = 0; y0 < height_; y0 += kBand) {
+        const int y1 = std::min(height_, y0 + kBand);
+        terms.resize(size_t(y1 - y0) * size_t(width_) * 3);
+        halfBufferTermRows(y0, y1, terms.data());
+        fn(y0, y1, terms.data());
+    }
 }
 
 void Film::errorRows(int y0, int y1, float* rgb) const {
-    const size_t first = size_t(y0) * size_t(width_);
-    forPixels(size_t(y1 - y0) * size_t(width_), [&](size_t begin, size_t end) {
-        for (size_t i = begin; i < end; ++i) {
-            double terms[3] = {0.0, 0.0, 0.0};
-            halfBufferTerms(first + i, terms);
-            for (int c = 0; c < 3; ++c)
-                rgb[i * 3 + size_t(c)] = float(terms[c]);
-        }
-    });
+    std::vector<double> terms(size_t(y1 - y0) * size_t(width_) * 3);
+    halfBufferTermRows(y0, y1, terms.data());
+    for (size_t i = 0; i < terms.size(); ++i)
+        rgb[i] = terms[i] == kNoTerm ? 0.0f : float(terms[i]);
 }
 
 std::vector<float> Film::image() const {
@@ -703,22 +765,26 @@ double Film::halfBufferRelMseStandardError() const {
     // independent (up to the filter's reach), so the variances add.
     double squares = 0.0;
     size_t n = 0;
-    for (size_t i = 0; i < pixels(); ++i) {
-        double terms[3];
-        if (!halfBufferTerms(i, terms)) continue;
-        const double p = terms[0] + terms[1] + terms[2];
-        squares += p * p;
-        n += 3;
-    }
+    forHalfBufferTerms([&](int y0, int y1, const double* terms) {
+        for (size_t i = 0; i < size_t(y1 - y0) * size_t(width_); ++i) {
+            const double* t = terms + i * 3;
+            if (t[0] == kNoTerm) continue;
+            const double p = t[0] + t[1] + t[2];
+            squares += p * p;
+            n += 3;
+        }
+    });
     return n > 0 ? std::sqrt(2.0 / 3.0 * squares) / double(n) : 0.0;
 }
 
 std::optional<double> Film::halfBufferRelMseEstimate() const {
-    const size_t n = size_t(width_) * height_;
     double total = 0;
     size_t count = 0;
-    for (size_t i = 0; i < n; ++i)
-        addHalfBufferRelMse(i, total, count);
+    forHalfBufferTerms([&](int y0, int y1, const double* terms) {
+        for (size_t i = 0; i < size_t(y1 - y0) * size_t(width_) * 3; ++i)
+            if (terms[i] != kNoTerm) // one at a time, in pixel order, as the sum always was
+                total += terms[i], ++count;
+    });
     if (count == 0) return std::nullopt;
     return total / double(count);
 }

@@ -198,11 +198,14 @@ class Film {
     void decideAdaptiveTiles();         // the adaptive mask, from the sums and counts
     // Pixel `pixel`'s eight sums in radiance and weight units.
     void pixelSums(size_t pixel, double* s) const;
-    // The pixel's three per-channel terms of the half-buffer relMSE, (A - B)^2 / 4 /
-    // (m^2 + 0.01), into terms; false (terms untouched) while a half has no samples.
-    bool halfBufferTerms(size_t pixel, double* terms) const;
-    // Adds them to total and count (nothing while a half has no samples).
-    bool addHalfBufferRelMse(size_t pixel, double& total, size_t& count) const;
+    // The half-buffer relMSE's terms of rows y0 .. y1 - 1, three a pixel, into terms: per
+    // channel (A - B)^2 / 4 / (d^2 + 0.01), d the pixel's value or, where its halves show a
+    // spike that none of its neighbours explains, a value that spike cannot inflate
+    // (termValue in film.cpp); kNoTerm for a pixel whose halves do not both hold samples yet.
+    void halfBufferTermRows(int y0, int y1, double* terms) const;
+    static constexpr double kNoTerm = -1.0;
+    // fn(y0, y1, terms) for bands of whole tile rows, top to bottom: the terms of every pixel.
+    template <typename Fn> void forHalfBufferTerms(const Fn& fn) const;
     float weight1D(float d) const;
     // fn(x, y, w) for each pixel of the filter's footprint around filmPos, w > 0 its weight.
     template <typename Fn> void forFootprint(vec2 filmPos, const Fn& fn) const;
