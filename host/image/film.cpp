@@ -636,22 +636,46 @@ namespace {
 // pixel included, `count` values) whose brightest, the pixel left out, reads `brightest`.
 //
 // d is m, the pixel's own value, unless its samples spread more than anything around it shows:
-// the per-sample standard deviation that the halves' difference gives, |a - b| sqrt(n / 4),
-// above the brightest neighbour's value. That is a spike no surface in view explains, a glint:
-// a rare path of large value (a glossy bounce into a small light), whose one sample inflates m
-// as much as the difference, so that with m as d the term reads at most about 1 where the
-// pixel's true relative error is tens. Such a pixel takes d = min(m, max(min(a, b), median of
-// the window)): its spike-free half, or its neighbourhood's level if that is higher. A pixel at
-// an edge (a sliver of the light, a bright wall behind a dark one) has spikes that a neighbour
-// shows as its steady value, and keeps m: its rare samples are a large part of its true value.
-// docs/performance.md ("The denominator") has the measurements behind the rule.
+// the per-sample standard deviation that the halves' difference gives, |a - b| sqrt(n / 4), and
+// its brighter half both above the brightest neighbour's value. That is a spike no surface in
+// view explains, a glint: a rare path of large value (a glossy bounce into a small light), whose
+// one sample inflates m as much as the difference, so that with m as d the term reads at most
+// about 1 where the pixel's true relative error is tens. Such a pixel takes d = min(m,
+// max(min(a, b), median of the window)): its spike-free half, or its neighbourhood's level if
+// that is higher. A pixel at an edge (a sliver of the light, a bright wall behind a dark one) has
+// spikes that a neighbour shows as its steady value, and keeps m: its rare samples are a large
+// part of its true value. What the rule cannot tell apart: a light smaller than a pixel or two,
+// seen directly, that one half has hit and the other not yet, reads as a glint, and its term is
+// far too high until both halves have hit it.
+// docs/performance.md ("The denominator: glints") has the measurements behind the rule.
 double termValue(double a, double b, double m, double samples, double* window, int count,
                  double brightest) {
     const double spread = std::fabs(a - b) * std::sqrt(samples / 4.0);
-    if (!(spread > brightest)) return m;
+    if (!(spread > brightest && std::max(a, b) > brightest)) return m;
     std::nth_element(window, window + count / 2, window + count);
     return std::min(m, std::max(std::min(a, b), window[count / 2]));
 }
+
+// The image's values m, three a pixel, from row r0 on: pixels' neighbourhoods.
+struct ValueRows {
+    const double* values;
+    int width, height, r0;
+    double at(int x, int y, int c) const {
+        return values[(size_t(y - r0) * size_t(width) + size_t(x)) * 3 + size_t(c)];
+    }
+    // Channel c of the 3 x 3 window around (x, y) inside the image, into window (the pixel
+    // included); returns the count, and the brightest value but the pixel's in brightest.
+    int window(int x, int y, int c, double* window, double& brightest) const {
+        int count = 0;
+        brightest = 0.0;
+        for (int ny = std::max(0, y - 1); ny <= std::min(height - 1, y + 1); ++ny)
+            for (int nx = std::max(0, x - 1); nx <= std::min(width - 1, x + 1); ++nx) {
+                window[count++] = at(nx, ny, c);
+                if (nx != x || ny != y) brightest = std::max(brightest, at(nx, ny, c));
+            }
+        return count;
+    }
+};
 } // namespace
 
 void Film::halfBufferTermRows(int y0, int y1, double* terms) const {
@@ -668,6 +692,7 @@ void Film::halfBufferTermRows(int y0, int y1, double* terms) const {
                 value[j * 3 + size_t(c)] = weight > 0 ? (s[c] + s[4 + c]) / weight : 0.0;
         }
     });
+    const ValueRows rows{value.data(), width_, height_, r0};
     forPixels(size_t(y1 - y0) * w, [&](size_t begin, size_t end) {
         for (size_t j = begin; j < end; ++j) {
             const size_t pixel = size_t(y0) * w + j;
@@ -681,17 +706,11 @@ void Film::halfBufferTermRows(int y0, int y1, double* terms) const {
             }
             const double samples = double(tileSamples_[tileOf(pixel)]);
             for (int c = 0; c < 3; ++c) {
-                double window[9], brightest = 0.0;
-                int count = 0;
-                for (int ny = std::max(0, y - 1); ny <= std::min(height_ - 1, y + 1); ++ny)
-                    for (int nx = std::max(0, x - 1); nx <= std::min(width_ - 1, x + 1); ++nx) {
-                        const double v = value[(size_t(ny - r0) * w + size_t(nx)) * 3 + size_t(c)];
-                        window[count++] = v;
-                        if (nx != x || ny != y) brightest = std::max(brightest, v);
-                    }
-                const double a = s[c] / s[3], b = s[4 + c] / s[7],
-                             m = value[(size_t(y - r0) * w + size_t(x)) * 3 + size_t(c)];
-                const double d = termValue(a, b, m, samples, window, count, brightest);
+                double window[9], brightest;
+                const int count = rows.window(x, y, c, window, brightest);
+                const double a = s[c] / s[3], b = s[4 + c] / s[7];
+                const double d =
+                    termValue(a, b, rows.at(x, y, c), samples, window, count, brightest);
                 out[c] = (a - b) * (a - b) / 4.0 / (d * d + kRelMseEpsilon);
             }
         }

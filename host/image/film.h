@@ -39,8 +39,8 @@
 //
 // Adaptive sampling (setAdaptive): the image is cut into 8 x 8 tiles, as MoonRay does; after each
 // whole iteration a tile whose pixels have at least the minimum samples and whose error
-// estimate, sqrt of the mean over its pixels and channels of (A - B)^2 / 4 / (m^2 + 0.01) (the
-// half buffers' relMSE, as a relative RMS error), is below the threshold stops taking samples
+// estimate, sqrt of the mean over its pixels and channels of the half-buffer relMSE's terms
+// (halfBufferTermRows), as a relative RMS error, is below the threshold stops taking samples
 // (sampling() false), and takes them again should its estimate rise above it. The decision reads
 // only the film's sums and per-pixel sample counts after whole iterations, so it is the same for
 // any thread count, batch size or backend, and a checkpoint (which keeps both) resumes it
@@ -120,8 +120,9 @@ class Film {
     void imageRows(int y0, int y1, float* rgb) const;
     // The render of one half's samples alone (half 0 or 1).
     std::vector<float> halfImage(int half) const;
-    // relMSE of image() estimated from the halves: per value (A - B)^2 / 4 / (m^2 + 0.01),
-    // averaged; (A - B)^2 / 4 is an unbiased estimate of the variance of m = (A + B) / 2.
+    // relMSE of image() estimated from the halves: per value (A - B)^2 / 4 / (d^2 + 0.01),
+    // averaged; (A - B)^2 / 4 is an unbiased estimate of the variance of m = (A + B) / 2, and d
+    // is m but where a glint inflates it (halfBufferTermRows).
     double halfBufferRelMse() const;
     // Its per-pixel terms, rows y0 .. y1 - 1 into rgb (width x (y1 - y0) x 3 floats): where the
     // noise is (--error-map). A pixel whose halves do not both hold samples yet reads 0.
