@@ -704,6 +704,8 @@ void Film::halfBufferTermRows(int y0, int y1, double* terms) const {
                 out[0] = out[1] = out[2] = kNoTerm;
                 continue;
             }
+            // The camera samples centred in the pixel. A wide filter's value averages more of
+            // them, so the spread reads low there and the rule errs towards m.
             const double samples = double(tileSamples_[tileOf(pixel)]);
             for (int c = 0; c < 3; ++c) {
                 double window[9], brightest;
