@@ -15,8 +15,9 @@ ErrorCsv::ErrorCsv(const std::string& path, std::optional<ImageRGB> reference)
 void ErrorCsv::addRow(int iteration, int spp, double seconds, const Film& film) {
     std::ostringstream row;
     row.precision(9);
-    row << iteration << "," << spp << "," << seconds << "," << film.halfBufferRelMse() << ","
-        << film.halfBufferRelMseStandardError();
+    const Film::ErrorEstimate error = film.halfBufferError();
+    row << iteration << "," << spp << "," << seconds << "," << error.relMse.value_or(0.0) << ","
+        << error.standardError;
     if (reference_) {
         ImageMetrics m = compareImages({film.width(), film.height(), film.image()}, *reference_);
         row << "," << m.mse << "," << m.rmse << "," << m.relMse << "," << m.mae << ","

@@ -780,34 +780,33 @@ double Film::halfBufferRelMse() const {
 }
 
 double Film::halfBufferRelMseStandardError() const {
-    // A pixel's term sum P (its three channels, whose noise is mostly shared) is a scaled
-    // chi-square of one degree of freedom where the halves' difference is Gaussian: its
-    // variance is 2/3 of E[P^2], and P^2 estimates E[P^2] from the pixel alone. Pixels are
-    // independent (up to the filter's reach), so the variances add.
-    double squares = 0.0;
-    size_t n = 0;
+    return halfBufferError().standardError;
+}
+
+std::optional<double> Film::halfBufferRelMseEstimate() const {
+    return halfBufferError().relMse;
+}
+
+Film::ErrorEstimate Film::halfBufferError() const {
+    // The standard error: a pixel's term sum P (its three channels, whose noise is mostly
+    // shared) is a scaled chi-square of one degree of freedom where the halves' difference is
+    // Gaussian: its variance is 2/3 of E[P^2], and P^2 estimates E[P^2] from the pixel alone.
+    // Pixels are independent (up to the filter's reach), so the variances add.
+    double total = 0.0, squares = 0.0;
+    size_t count = 0;
     forHalfBufferTerms([&](int y0, int y1, const double* terms) {
         for (size_t i = 0; i < size_t(y1 - y0) * size_t(width_); ++i) {
             const double* t = terms + i * 3;
             if (t[0] == kNoTerm) continue;
+            for (int c = 0; c < 3; ++c) // one at a time, in pixel order, as the sum always was
+                total += t[c];
             const double p = t[0] + t[1] + t[2];
             squares += p * p;
-            n += 3;
+            count += 3;
         }
     });
-    return n > 0 ? std::sqrt(2.0 / 3.0 * squares) / double(n) : 0.0;
-}
-
-std::optional<double> Film::halfBufferRelMseEstimate() const {
-    double total = 0;
-    size_t count = 0;
-    forHalfBufferTerms([&](int y0, int y1, const double* terms) {
-        for (size_t i = 0; i < size_t(y1 - y0) * size_t(width_) * 3; ++i)
-            if (terms[i] != kNoTerm) // one at a time, in pixel order, as the sum always was
-                total += terms[i], ++count;
-    });
-    if (count == 0) return std::nullopt;
-    return total / double(count);
+    if (count == 0) return {std::nullopt, 0.0};
+    return {total / double(count), std::sqrt(2.0 / 3.0 * squares) / double(count)};
 }
 
 } // namespace spw

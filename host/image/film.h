@@ -136,6 +136,12 @@ class Film {
     // The same, or nothing while no pixel has samples in both halves (one iteration of one
     // sample per pixel): then there is no estimate yet, rather than an estimate of 0.
     std::optional<double> halfBufferRelMseEstimate() const;
+    // Both in one pass over the image (each of the three above is one pass).
+    struct ErrorEstimate {
+        std::optional<double> relMse;
+        double standardError;
+    };
+    ErrorEstimate halfBufferError() const;
     // The last completed iteration alone (for per-iteration statistics), between endIteration()
     // and the next beginIteration() (throws std::logic_error otherwise).
     std::vector<float> lastIterationImage() const;
