@@ -170,7 +170,7 @@ void Film::decideAdaptiveTiles() {
     active_.assign(size_t(tilesX_) * size_t(tilesY_), 1);
     activeTiles_ = active_.size();
     const double limit = adaptiveThreshold_ * adaptiveThreshold_; // on the mean square
-    forHalfBufferTerms([&](int y0, int y1, const double* terms) {
+    forHalfBufferTerms(0, height_, [&](int y0, int y1, const double* terms) {
         for (int ty = y0 / kAdaptiveTile; ty * kAdaptiveTile < y1; ++ty)
             for (int tx = 0; tx < tilesX_; ++tx) {
                 double total = 0.0;
@@ -719,22 +719,23 @@ void Film::halfBufferTermRows(int y0, int y1, double* terms) const {
     });
 }
 
-template <typename Fn> void Film::forHalfBufferTerms(const Fn& fn) const {
+template <typename Fn> void Film::forHalfBufferTerms(int y0, int y1, const Fn& fn) const {
     constexpr int kBand = 8 * kAdaptiveTile; // rows: whole tiles, a few MB of terms
     std::vector<double> terms;
-    for (int y0 = 0; y0 < height_; y0 += kBand) {
-        const int y1 = std::min(height_, y0 + kBand);
-        terms.resize(size_t(y1 - y0) * size_t(width_) * 3);
-        halfBufferTermRows(y0, y1, terms.data());
-        fn(y0, y1, terms.data());
+    for (int b0 = y0; b0 < y1; b0 += kBand) {
+        const int b1 = std::min(y1, b0 + kBand);
+        terms.resize(size_t(b1 - b0) * size_t(width_) * 3);
+        halfBufferTermRows(b0, b1, terms.data());
+        fn(b0, b1, terms.data());
     }
 }
 
 void Film::errorRows(int y0, int y1, float* rgb) const {
-    std::vector<double> terms(size_t(y1 - y0) * size_t(width_) * 3);
-    halfBufferTermRows(y0, y1, terms.data());
-    for (size_t i = 0; i < terms.size(); ++i)
-        rgb[i] = terms[i] == kNoTerm ? 0.0f : float(terms[i]);
+    forHalfBufferTerms(y0, y1, [&](int b0, int b1, const double* terms) {
+        float* out = rgb + size_t(b0 - y0) * size_t(width_) * 3;
+        for (size_t i = 0; i < size_t(b1 - b0) * size_t(width_) * 3; ++i)
+            out[i] = terms[i] == kNoTerm ? 0.0f : float(terms[i]);
+    });
 }
 
 std::vector<float> Film::image() const {
@@ -794,7 +795,7 @@ Film::ErrorEstimate Film::halfBufferError() const {
     // Pixels are independent (up to the filter's reach), so the variances add.
     double total = 0.0, squares = 0.0;
     size_t count = 0;
-    forHalfBufferTerms([&](int y0, int y1, const double* terms) {
+    forHalfBufferTerms(0, height_, [&](int y0, int y1, const double* terms) {
         for (size_t i = 0; i < size_t(y1 - y0) * size_t(width_); ++i) {
             const double* t = terms + i * 3;
             if (t[0] == kNoTerm) continue;

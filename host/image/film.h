@@ -211,8 +211,9 @@ class Film {
     // (termValue in film.cpp); kNoTerm for a pixel whose halves do not both hold samples yet.
     void halfBufferTermRows(int y0, int y1, double* terms) const;
     static constexpr double kNoTerm = -1.0;
-    // fn(y0, y1, terms) for bands of whole tile rows, top to bottom: the terms of every pixel.
-    template <typename Fn> void forHalfBufferTerms(const Fn& fn) const;
+    // fn(b0, b1, terms) for bands of rows b0 .. b1 - 1 of y0 .. y1 - 1, top to bottom, 64 rows
+    // at most (from y0 = 0, whole tiles): the terms of every pixel, a band's at a time.
+    template <typename Fn> void forHalfBufferTerms(int y0, int y1, const Fn& fn) const;
     float weight1D(float d) const;
     // fn(x, y, w) for each pixel of the filter's footprint around filmPos, w > 0 its weight.
     template <typename Fn> void forFootprint(vec2 filmPos, const Fn& fn) const;
