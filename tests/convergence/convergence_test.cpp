@@ -28,27 +28,30 @@ struct Reference {
     ImageRGB image;
     double ownRelMse;
 };
+// `scene` rendered at `spp` as a reference: the reference backend, under Sobol (at 32^2 and
+// 16384 spp a Stratified reference's own error, 1.6e-5 by its estimate, is a third more than
+// that as the truth weighs it, pixels holding a sliver of the light, and the ratio below read
+// 0.92 at 1024 spp with any estimator; Sobol's is 4e-6 and reads as a 65536-spp Stratified
+// reference does), with a seed independent of the test renders' random numbers.
+Reference renderReference(Scene scene, int spp) {
+    RenderConfig cfg;
+    cfg.backend = BackendKind::Reference;
+    cfg.spp = spp;
+    scene.sampler = SamplerType::Sobol;
+    scene.settings.seed = 12345;
+    auto result = render(scene, cfg);
+    return Reference{ImageRGB{scene.image.width, scene.image.height, result->film->image()},
+                     result->film->halfBufferRelMse()};
+}
 const Reference& highSppReference(int size) {
     static std::map<int, Reference> refs;
     auto it = refs.find(size);
     if (it != refs.end()) return it->second;
-    Scene scene = cornell(size);
-    RenderConfig cfg;
-    cfg.backend = BackendKind::Reference;
     // 16x the highest spp a test compares with it: the 32^2 one, 16384 spp, also under the
     // sanitizers, where the tests still reach 1024 spp (with a quarter of the samples its own
     // noise is a third of the truth there, and its estimate of that noise too rough to remove).
     // The 48^2 one serves tests that take a quarter of their samples there.
-    cfg.spp = size < 48 ? 16384 : 4096 / kSanitizedFewer;
-    // Sobol: at 32^2 and 16384 spp a Stratified reference's own error, 1.6e-5 by its estimate,
-    // is a third more than that as the truth weighs it (pixels holding a sliver of the light),
-    // and the ratio below read 0.92 at 1024 spp with any estimator; Sobol's is 4e-6 and reads
-    // as a 65536-spp Stratified reference does.
-    scene.sampler = SamplerType::Sobol;
-    scene.settings.seed = 12345; // independent of the test renders' random numbers
-    auto result = render(scene, cfg);
-    return refs[size] = Reference{ImageRGB{size, size, result->film->image()},
-                                  result->film->halfBufferRelMse()};
+    return refs[size] = renderReference(cornell(size), size < 48 ? 16384 : 4096 / kSanitizedFewer);
 }
 
 // One render's error at five sample counts, each twice the last: the true relMSE (against the
@@ -199,17 +202,7 @@ TEST_P(GlintEstimate, TracksTrueRelMse) {
         scene.image.width = scene.image.height = kSize;
         return scene;
     };
-    static const Reference ref = [&] {
-        Scene scene = glossy();
-        scene.sampler = SamplerType::Sobol;
-        scene.settings.seed = 12345;
-        RenderConfig cfg;
-        cfg.backend = BackendKind::Reference;
-        cfg.spp = 4096 / kSanitizedFewer;
-        auto result = render(scene, cfg);
-        return Reference{ImageRGB{kSize, kSize, result->film->image()},
-                         result->film->halfBufferRelMse()};
-    }();
+    static const Reference ref = renderReference(glossy(), 4096 / kSanitizedFewer);
     const int spp[2] = {64 / kSanitizedFewer, 256 / kSanitizedFewer};
     double est[2] = {}, tru[2] = {};
     for (std::uint32_t seed = 1; seed <= std::uint32_t(kSeeds); ++seed) {
