@@ -1,6 +1,7 @@
 #include "test_util.h"
 
 #include "host/image/image_io.h"
+#include "host/loaders/scene_loader.h"
 #include "host/scene/camera.h"
 #include "host/vk/context.h"
 

@@ -9,6 +9,7 @@
 #include "host/app/usage_error.h"
 #include "host/image/image_io.h"
 #include "host/image/output_file.h"
+#include "host/loaders/scene_loader.h"
 #include "host/render/render.h"
 
 #include <tbb/info.h>

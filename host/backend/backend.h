@@ -6,10 +6,10 @@
 #include "host/backend/stats.h"
 #include "host/image/film.h"
 #include "host/scene/camera.h"
-#include "host/scene/hit_setup.h"
-#include "host/scene/lights.h"
 #include "host/scene/scene.h"
-#include "host/scene/textures.h"
+#include "host/scene_view/hit_setup.h"
+#include "host/scene_view/lights.h"
+#include "host/textures/textures.h"
 
 namespace spw {
 
@@ -19,7 +19,7 @@ struct RenderContext {
     const Scene& scene;
     const RenderConfig& config;
     const SceneLights& lights; // shaders and emitters, as shading reads them
-    const EmbreeScene& embree; // the BVH (host/accel/)
+    const EmbreeScene& embree; // the BVH (embree_backend/)
     const HitSetup& hitSetup;  // what a hit means
     const TextureResolver& textures;
     const CameraModel& camera;

@@ -19,7 +19,7 @@
 
 namespace spw {
 
-struct HitRecord; // host/scene/hit_setup.h
+struct HitRecord; // host/scene_view/hit_setup.h
 
 // A contiguous range of a batch's hits that one dispatch shades: all of one shader, so of one
 // surface model, or (hits unsorted) every hit, of any model: kMixedModels.

@@ -6,7 +6,7 @@
 // An engine says how many slots it has and how it shades a slot (reserve, submit, wait).
 #pragma once
 
-#include "host/accel/batch_traversal.h"
+#include "embree_backend/batch_traversal.h"
 #include "host/backend/backend.h"
 #include "host/pipeline/shading_engine.h"
 

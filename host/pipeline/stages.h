@@ -6,7 +6,7 @@
 //   load          the next batch from RAM or the spill file      BatchQueue::pop (batch_queue.h)
 //   decompress    34- or 50-byte records -> RayState
 //   sort rays     Morton radix sort, median split, or none        ray_sort.h; RaySortPolicy decides
-//   traverse      closest hits of the whole batch                 intersectBatch (host/accel/)
+//   traverse      closest hits of the whole batch                 intersectBatch (embree_backend/)
 //   sort hits     by (shader, object, texture order), misses last
 //   escape        misses see the environment (scenes with one)
 //   hit setup     world-space hit and texture albedo, in sorted order, into the engine's inputs
@@ -17,7 +17,7 @@
 //   bin           continuation rays -> thread-local ray buffers -> bins
 #pragma once
 
-#include "host/accel/batch_traversal.h"
+#include "embree_backend/batch_traversal.h"
 #include "host/backend/backend.h"
 #include "host/pipeline/batch_queue.h"
 #include "host/pipeline/directional_bins.h"

@@ -1,7 +1,7 @@
 // The C++ view of the emitter-kind registry (shaders/shared/emitter_kinds.h): each kind's name,
 // its kEmitter* constant, its shared header's stem, the `type:` a scene names it by, and its
 // flags. Read by the loader (punctual kinds: `{type: <Scene>, position | direction, ...}`), the
-// light table's power estimates (host/scene/lights.cpp), the Vulkan backend's --stats and the
+// light table's power estimates (host/scene_view/lights.cpp), the Vulkan backend's --stats and the
 // tests that check every kind is complete.
 //
 // Adding a kind: docs/adding-a-light.md.

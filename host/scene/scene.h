@@ -145,7 +145,7 @@ inline uint wrapMode(Texture::Wrap wrap) {
 // An alpha cut-out (glTF's alphaMode MASK): the surface is there only where its alpha, `alpha`
 // times the first channel of the texture tree `texture` (or alone, -1), is at least `cutoff`.
 // Elsewhere rays pass through it, camera, bounce and shadow rays alike (the BVH's hit filter,
-// host/accel/cutouts.h).
+// embree_backend/cutouts.h).
 struct Cutout {
     bool enabled = false;
     float alpha = 1.0f;
@@ -256,8 +256,7 @@ struct Scene {
 // says so, naming `what` (the loader and the OBJ reader report it at their own file and line).
 std::string beyondReach(const glm::dvec3& p, const std::string& what);
 
-// Parses and validates a scene file, or a glTF file (.gltf, .glb: host/scene/gltf_loader.h).
-// Throws SceneError (file:line: message) on any problem.
-Scene loadScene(const std::string& path);
+// A number as the scene format writes it in ranges and messages: 0.25, 1e20, 1e-5, inf.
+std::string formatNumber(double v);
 
 } // namespace spw

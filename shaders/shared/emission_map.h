@@ -1,8 +1,8 @@
 // Emission maps: an emitting triangle whose radiance varies over it by an image (glTF's
 // emissiveTexture), radiance = Emitter::radiance x the image at the point. The host bakes each
-// map into the light data (host/scene/lights.cpp) as it resolves texture images elsewhere: the
+// map into the light data (host/scene_view/lights.cpp) as it resolves texture images elsewhere: the
 // finest MIP level, decoded to linear RGB, read bilinearly and repeating, as the host's own
-// finest-level lookup reads it (host/scene/textures.cpp). The kernels read no texture, so the
+// finest-level lookup reads it (host/textures/textures.cpp). The kernels read no texture, so the
 // image must be where they can reach it: next-event estimation needs its value at the point it
 // picks on the triangle, and a ray that hits the triangle at the point it hit.
 //

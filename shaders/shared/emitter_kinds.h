@@ -10,7 +10,7 @@
 //     kinds the Vulkan backend reports in --stats;
 //   * the scene format: a kind with kLightTakesPosition or kLightTakesDirection is a punctual
 //     light, `{type: <Scene>, position | direction, intensity, colour}`, read and given its power
-//     by the loader and host/scene/lights.cpp without any code of its own.
+//     by the loader and host/scene_view/lights.cpp without any code of its own.
 // tests/architecture/emitter_kinds_test.cpp fails for a registered kind without its header, its
 // <stem>Sample or its TEST(<Scene>Light, ...) in tests/scene/lights_test.cpp or
 // tests/render/reference_test.cpp. How to add one: docs/adding-a-light.md.

@@ -1,5 +1,5 @@
 // What a texture coordinate outside [0, 1] reads (glTF's sampler wrap modes), for a filter that
-// repeats: the host's texture lookups (host/scene/textures.cpp) and the kernels' emission maps
+// repeats: the host's texture lookups (host/textures/textures.cpp) and the kernels' emission maps
 // (shared/emission_map.h) both wrap their coordinates through this one function.
 #ifndef SPILLWAY_SHARED_TEXTURE_WRAP_H
 #define SPILLWAY_SHARED_TEXTURE_WRAP_H

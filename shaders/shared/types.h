@@ -35,8 +35,8 @@ struct ShaderParams {
 };
 
 // What next-event estimation picks, with probability pickPdf, proportional to its power
-// (host/scene/lights.cpp says how each kind's power is estimated): kEmitter<Name> for every line
-// of the registry (shared/emitter_kinds.h), and their count.
+// (host/scene_view/lights.cpp says how each kind's power is estimated): kEmitter<Name> for every
+// line of the registry (shared/emitter_kinds.h), and their count.
 const uint kLightSurface = 1u;
 const uint kLightAtInfinity = 2u;
 const uint kLightDelta = 4u;

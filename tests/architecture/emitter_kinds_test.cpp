@@ -4,6 +4,7 @@
 // <stem>Sample, or its TEST(<Scene>Light, ...), and for a loader that does not take each
 // punctual kind by its scene name with exactly the keys its flags name. (That the Vulkan kernels
 // agree with the cpu on every kind: VulkanVsCpu.EveryEmitterKindAgreesUpToFloatRounding.)
+#include "host/loaders/scene_loader.h"
 #include "host/scene/emitter_kinds.h"
 #include "host/scene/scene.h"
 #include "test_util.h"

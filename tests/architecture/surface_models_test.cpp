@@ -5,6 +5,7 @@
 // scene keys the registry line names. (That the kernels are embedded and the kModel* constants
 // follow the registry's order is checked in tests/vk,
 // SurfaceModels.EveryRegisteredModelHasItsKernel.)
+#include "host/loaders/scene_loader.h"
 #include "host/scene/scene.h"
 #include "host/scene/surface_models.h"
 #include "test_util.h"

@@ -3,6 +3,7 @@
 // asserts: no signal, no hang, exit 2 with FILE:LINE for a scene error and exit 1 for a runtime
 // failure, and no file left in the output folder (nor a changed one) on failure.
 #include "host/image/image_io.h"
+#include "host/loaders/scene_loader.h"
 #include "host/scene/scene.h"
 #include "test_util.h"
 

@@ -1,6 +1,7 @@
 // Error against time: the half-buffer error estimate, the convergence rate of every backend,
 // --error-csv and --time-limit.
 #include "host/image/compare.h"
+#include "host/loaders/scene_loader.h"
 #include "test_util.h"
 
 #include <gtest/gtest.h>

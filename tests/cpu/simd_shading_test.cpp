@@ -6,6 +6,7 @@
 // metal (and with metallic and roughness per hit), and every model's hits mixed in runs
 // that are not a multiple of the vector width.
 #include "host/cpu/simd_shading.h"
+#include "host/loaders/scene_loader.h"
 #include "host/render/render.h"
 #include "host/scene/scene.h"
 #include "host/scene/surface_models.h"

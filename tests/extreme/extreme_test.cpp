@@ -16,6 +16,7 @@
 // over pixels when every pixel estimates the same value.
 #include "host/image/compare.h"
 #include "host/image/film.h"
+#include "host/loaders/scene_loader.h"
 #include "host/scene/camera.h"
 #include "test_util.h"
 

@@ -1,9 +1,10 @@
 #include "fuzz_targets.h"
 
 #include "host/image/image_io.h"
+#include "host/loaders/obj_mesh.h"
+#include "host/loaders/scene_loader.h"
 #include "host/render/checkpoint.h"
 #include "host/render/render.h"
-#include "host/scene/obj_mesh.h"
 #include "host/scene/scene.h"
 
 #include <cstdlib>

@@ -1,5 +1,6 @@
 // The sorted deferred pipeline (--backend cpu): it must render the reference's image, whatever
 // its batching, sorting, memory budget and thread count, and it must clean up after itself.
+#include "host/loaders/scene_loader.h"
 #include "host/pipeline/ray_record.h"
 #include "test_util.h"
 

@@ -1,5 +1,6 @@
 // Adaptive sampling (host/image/film.h): unbiased on closed forms, fewer samples where the image
 // is flat than at edges, and the same decisions for any thread count and on every backend.
+#include "host/loaders/scene_loader.h"
 #include "test_util.h"
 
 #include <gtest/gtest.h>

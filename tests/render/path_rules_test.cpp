@@ -1,6 +1,7 @@
 // The path tracer's stated rules, on every backend, from ray counts with closed forms: Russian
 // roulette from bounce `min depth` on, no shadow rays in a scene without emitters, and the
 // Dielectric's ior range (both ends render finite and passive).
+#include "host/loaders/scene_loader.h"
 #include "test_util.h"
 
 #include <gtest/gtest.h>

@@ -2,6 +2,7 @@
 // each colour 4 image textures layered by 3 image masks, 6.8 MB of tiled MIP-mapped textures
 // against a 1 MiB texture cache. Every backend renders it alike, and sorting the hits reads
 // fewer tiles than shading them in arrival order or tracing depth first.
+#include "host/loaders/scene_loader.h"
 #include "test_util.h"
 
 #include <gtest/gtest.h>

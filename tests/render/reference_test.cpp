@@ -1,6 +1,7 @@
 // The reference backend against closed forms: every assertion compares with an analytic value
 // within a standard error computed from the render's own samples. Every render here runs the
 // reference backend (the library's RenderConfig defaults to cpu).
+#include "host/loaders/scene_loader.h"
 #include "host/scene/camera.h"
 #include "test_util.h"
 

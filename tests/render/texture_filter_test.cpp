@@ -5,6 +5,7 @@
 // render is a white furnace seen through BSDF sampling at max depth 1, so a pixel is exactly the
 // albedo its lookups returned, on every backend. (The camera stands half a texel off the origin,
 // so that at height 16 the pixels' centres fall on texel centres, not between texels.)
+#include "host/loaders/scene_loader.h"
 #include "test_util.h"
 
 #include <OpenImageIO/imageio.h>

@@ -1,10 +1,11 @@
-// glTF 2.0 files (host/scene/gltf_loader.h), written by the tests: `.gltf` with embedded and
+// glTF 2.0 files (host/loaders/gltf_loader.h), written by the tests: `.gltf` with embedded and
 // external buffers and `.glb`; every index and accessor component type, strides, normalized
 // texture coordinates; node hierarchies of matrices and TRS; cameras, lights, emissive
 // materials and what is not rendered (warnings, once); malformed files, each a SceneError
 // naming the file and where in it; and rendering on every backend.
 #include "host/image/image_io.h"
-#include "host/scene/gltf_loader.h"
+#include "host/loaders/gltf_loader.h"
+#include "host/loaders/scene_loader.h"
 #include "test_util.h"
 
 #include "shared/gltf.h"

@@ -1,9 +1,9 @@
-// Hit setup SIMD-wide (HitSetup::setUpHits, host/scene/wide_hits.cpp) against one hit at a time
-// (setUpGeometry and textureQuery, the oracle): bit for bit, in every instruction set this
+// Hit setup SIMD-wide (HitSetup::setUpHits, host/scene_view/wide_hits.cpp) against one hit at a
+// time (setUpGeometry and textureQuery, the oracle): bit for bit, in every instruction set this
 // machine has, on meshes with and without vertex normals and texture coordinates, an emitter,
 // triangles from 1e-4 to 1e5 units and 1e6 units from the origin, degenerate triangles and
 // normals, grazing and head-on rays, and cones from none to wide.
-#include "host/scene/hit_setup.h"
+#include "host/scene_view/hit_setup.h"
 #include "host/simd/lanes.h"
 #include "shared/cone.h"
 #include "test_util.h"

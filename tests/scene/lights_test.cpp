@@ -3,8 +3,9 @@
 // furnace, the inverse-square law, the environment map's sampling density, and MIS with an
 // environment.
 #include "host/image/image_io.h"
+#include "host/loaders/scene_loader.h"
 #include "host/scene/camera.h"
-#include "host/scene/lights.h"
+#include "host/scene_view/lights.h"
 #include "shared/path.h"
 #include "test_util.h"
 

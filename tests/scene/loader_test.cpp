@@ -3,6 +3,7 @@
 // is rendered, a scene without entries takes the documented defaults, and transforms compose as
 // specified (scale, then R = Rz*Ry*Rx, then translation).
 #include "host/image/image_io.h"
+#include "host/loaders/scene_loader.h"
 #include "test_util.h"
 
 #include <OpenImageIO/imageio.h>

@@ -4,6 +4,7 @@
 #include "host/app/render_options.h"
 #include "host/app/usage.h"
 #include "host/app/usage_error.h"
+#include "host/loaders/scene_loader.h"
 #include "host/scene/settings_table.h"
 #include "test_util.h"
 

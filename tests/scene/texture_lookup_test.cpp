@@ -1,9 +1,10 @@
-// The texture lookups (host/scene/textures.cpp filter on OpenImageIO's cached tiles) against
+// The texture lookups (host/textures/textures.cpp filter on OpenImageIO's cached tiles) against
 // OpenImageIO's own TextureSystem as the oracle: bilinear at the finest level, repeating, on
 // images whose tiles do not divide them (edge tiles), on untiled images, in 16-bit, half and
 // float; and 8-bit images (sRGB unless they say otherwise) linearised per texel before filtering,
 // where OpenImageIO would filter the encoded values.
-#include "host/scene/textures.h"
+#include "host/loaders/scene_loader.h"
+#include "host/textures/textures.h"
 #include "test_util.h"
 
 #include <OpenImageIO/imagebuf.h>

@@ -2,7 +2,8 @@
 // image mask) on a plane in a white furnace, each pixel's centre on a texel's centre, rendered
 // with BSDF sampling only and max depth 1 so that every sample is exactly the albedo it found.
 // And the texture system exists only for scenes with image textures.
-#include "host/scene/textures.h"
+#include "host/loaders/scene_loader.h"
+#include "host/textures/textures.h"
 #include "test_util.h"
 
 #include <OpenImageIO/imageio.h>

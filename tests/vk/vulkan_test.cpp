@@ -2,13 +2,14 @@
 // silent skip), pass the Khronos validation layer without a single message, render the cpu
 // backend's image up to float rounding (the shading math is the same source), build only the
 // pipelines a scene needs, and fail or fall back cleanly when no driver is visible.
-#include "host/accel/embree_scene.h"
+#include "embree_backend/embree_scene.h"
 #include "host/cpu/cpu_shading.h"
 #include "host/image/image_io.h"
+#include "host/loaders/scene_loader.h"
 #include "host/pipeline/slotted_engine.h"
 #include "host/scene/camera.h"
 #include "host/scene/surface_models.h"
-#include "host/scene/textures.h"
+#include "host/textures/textures.h"
 #include "host/vk/check.h"
 #include "host/vk/context.h"
 #include "host/vk/spirv.h"

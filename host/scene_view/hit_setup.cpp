@@ -1,6 +1,6 @@
-#include "host/scene/hit_setup.h"
+#include "host/scene_view/hit_setup.h"
 
-#include "host/scene/wide_hits.h"
+#include "host/scene_view/wide_hits.h"
 
 #include "shared/cone.h"
 #include "shared/offset.h"
@@ -18,7 +18,7 @@ HitSetup::HitSetup(const Scene& scene, const SceneLights& lights) : src_(scene),
     }
 }
 
-// Wide twin: setUpHitLanes (host/scene/wide_hits.cpp), with textureQuery.
+// Wide twin: setUpHitLanes (host/scene_view/wide_hits.cpp), with textureQuery.
 void HitSetup::surfaceHit(uint meshIndex, uint prim, float u, float v, float t,
                           SurfaceHit& hit) const {
     const Mesh& mesh = src_.meshes[meshIndex];
@@ -114,7 +114,7 @@ void HitSetup::tiltNormal(const HitRecord& h, vec3 texel, float scale, SurfaceHi
     if (length > 0.0f && std::isfinite(length)) hit.ns = tilted / length;
 }
 
-// Wide twin: setUpHitLanes (host/scene/wide_hits.cpp), with surfaceHit.
+// Wide twin: setUpHitLanes (host/scene_view/wide_hits.cpp), with surfaceHit.
 void HitSetup::textureQuery(const HitRecord& h, vec3 dir, uint cone, const SurfaceHit& hit,
                             vec2& uv, float& footprint) const {
     // The filter width in texture space: the cone's width at the hit, stretched by the

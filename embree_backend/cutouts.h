@@ -5,9 +5,9 @@
 // the holes: a cut-out emitter emits over its whole area.
 #pragma once
 
-#include "host/accel/embree_scene.h"
+#include "embree_backend/embree_scene.h"
 #include "host/scene/scene.h"
-#include "host/scene/textures.h"
+#include "host/textures/textures.h"
 
 #include <vector>
 

@@ -3,7 +3,7 @@
 // for the depth-first reference. The batch calls split the batch into groups traced with
 // rtcIntersect1M / rtcOccluded1M, with the coherent context flag only when the batch was sorted
 // (Embree's coherent mode halves throughput on incoherent rays). What comes back is Spillway's
-// own HitRecord: no Embree type leaves host/accel/.
+// own HitRecord: no Embree type leaves embree_backend/.
 //
 // Why streams and not packets: on Morton-sorted batches, 8-wide packets (rtcIntersect8 over
 // consecutive sorted rays) measured slower than rtcIntersect1M with the coherent flag: traverse
@@ -12,8 +12,8 @@
 // forms its own packets from a coherent stream, so the stream call is kept for both cases.
 #pragma once
 
-#include "host/accel/embree_scene.h"
-#include "host/scene/hit_setup.h"
+#include "embree_backend/embree_scene.h"
+#include "host/scene_view/hit_setup.h"
 
 #include <cstdint>
 #include <vector>

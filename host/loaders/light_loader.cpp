@@ -1,4 +1,4 @@
-#include "host/scene/light_loader.h"
+#include "host/loaders/light_loader.h"
 
 #include "host/image/image_io.h"
 #include "host/scene/surface_models.h"

@@ -1,10 +1,10 @@
 // setUpHitLanes (wide_hits.h), compiled once per instruction set through foreach_target.h. It is
 // HitSetup::surfaceHit's arithmetic and HitSetup::textureQuery (hit_setup.cpp), lane by lane, in
 // the same operations.
-#include "host/scene/wide_hits.h"
+#include "host/scene_view/wide_hits.h"
 
 #undef HWY_TARGET_INCLUDE
-#define HWY_TARGET_INCLUDE "host/scene/wide_hits.cpp"
+#define HWY_TARGET_INCLUDE "host/scene_view/wide_hits.cpp"
 #include <hwy/foreach_target.h> // must come before highway.h
 #include <hwy/highway.h>
 

@@ -1,4 +1,4 @@
-#include "host/accel/cutouts.h"
+#include "embree_backend/cutouts.h"
 
 namespace spw {
 

@@ -2,10 +2,10 @@
 // foreach_target.h. They are TexelReader::bilinear (textures.cpp) and TexelReader::decode for
 // 8-bit texels, and the Layered blend of TextureResolver::evaluate, lane by lane, in the same
 // operations.
-#include "host/scene/wide_texels.h"
+#include "host/textures/wide_texels.h"
 
 #undef HWY_TARGET_INCLUDE
-#define HWY_TARGET_INCLUDE "host/scene/wide_texels.cpp"
+#define HWY_TARGET_INCLUDE "host/textures/wide_texels.cpp"
 #include <hwy/foreach_target.h> // must come before highway.h
 #include <hwy/highway.h>
 

@@ -1,7 +1,7 @@
-#include "host/scene/textures.h"
+#include "host/textures/textures.h"
 
 #include "host/image/image_io.h"
-#include "host/scene/wide_texels.h"
+#include "host/textures/wide_texels.h"
 
 #include "shared/texture_wrap.h"
 

@@ -1,7 +1,7 @@
 // A glTF 2.0 file into a Scene (gltf_loader.h). tinygltf parses the JSON and the buffers; every
 // index, accessor and value is checked here before it is used, so that a malformed file is a
 // SceneError naming the JSON pointer, never a crash.
-#include "host/scene/gltf_loader.h"
+#include "host/loaders/gltf_loader.h"
 
 #include "shared/gltf.h"
 

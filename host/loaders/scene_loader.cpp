@@ -1,13 +1,14 @@
 // The YAML scene loader: docs/scene-format.md made executable. Every value is checked for type and
 // range where it is read, and every error names the file and line of the offending node.
+#include "host/loaders/scene_loader.h"
 #include "host/image/image_io.h"
-#include "host/scene/gltf_loader.h"
-#include "host/scene/light_loader.h"
-#include "host/scene/obj_mesh.h"
+#include "host/loaders/gltf_loader.h"
+#include "host/loaders/light_loader.h"
+#include "host/loaders/obj_mesh.h"
+#include "host/loaders/yaml_reader.h"
 #include "host/scene/scene.h"
 #include "host/scene/settings_table.h"
 #include "host/scene/surface_models.h"
-#include "host/scene/yaml_reader.h"
 #include "shared/gltf.h"
 
 #include <OpenImageIO/imageio.h>
@@ -373,45 +374,6 @@ void readObject(const Reader& rd, const YAML::Node& n, const fs::path& dir, Scen
 }
 
 } // namespace
-
-std::string beyondReach(const glm::dvec3& p, const std::string& what) {
-    const double far = std::max({std::fabs(p.x), std::fabs(p.y), std::fabs(p.z)});
-    if (far <= kMaxDistance) return "";
-    return what + " lies " + Reader::fmt(far) + " units from the camera; Spillway renders within " +
-           Reader::fmt(kMaxDistance) + " units of it";
-}
-
-float Camera::tanHalfFovX() const {
-    if (fovDegrees) return std::tan(glm::radians(*fovDegrees) * 0.5f);
-    return 0.5f * filmWidth / focalLength;
-}
-
-const char* samplerName(SamplerType s) {
-    switch (s) {
-    case SamplerType::Independent:
-        return "Independent";
-    case SamplerType::Grid:
-        return "Grid";
-    case SamplerType::Stratified:
-        return "Stratified";
-    case SamplerType::Sobol:
-        return "Sobol";
-    }
-    return "?";
-}
-
-std::optional<SamplerType> parseSampler(const std::string& name) {
-    for (SamplerType s :
-         {SamplerType::Independent, SamplerType::Grid, SamplerType::Stratified, SamplerType::Sobol})
-        if (name == samplerName(s)) return s;
-    return std::nullopt;
-}
-
-bool Scene::usesTextures() const {
-    for (const Shader& s : shaders)
-        if (s.texture >= 0) return true;
-    return false;
-}
 
 namespace {
 

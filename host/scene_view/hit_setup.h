@@ -1,12 +1,12 @@
 // Hit setup, the same on every backend: from a closest hit (mesh, triangle, barycentrics,
 // distance) to the world-space SurfaceHit shading reads — position, normals, self-intersection
 // offset, shader, emitter — and the albedo the shader's texture gives there. It reads the scene
-// and the emitter table only; the BVH that found the hit is host/accel/'s.
+// and the emitter table only; the BVH that found the hit is embree_backend/'s.
 #pragma once
 
-#include "host/scene/lights.h"
 #include "host/scene/scene.h"
-#include "host/scene/textures.h"
+#include "host/scene_view/lights.h"
+#include "host/textures/textures.h"
 
 namespace spw {
 

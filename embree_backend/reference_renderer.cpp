@@ -1,6 +1,6 @@
-#include "host/reference/reference_renderer.h"
+#include "embree_backend/reference_renderer.h"
 
-#include "host/accel/batch_traversal.h"
+#include "embree_backend/batch_traversal.h"
 #include "shared/path.h"
 
 #include <tbb/blocked_range2d.h>

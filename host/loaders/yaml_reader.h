@@ -98,25 +98,7 @@ class Reader {
 
     const std::string& file() const { return file_; }
 
-    static std::string fmt(double v) {
-        if (std::isinf(v)) return v > 0 ? "inf" : "-inf";
-        std::string s = std::to_string(v);
-        if (std::fabs(v) >= 1e7 || (v != 0 && std::fabs(v) < 1e-4)) {
-            // 1e+20 -> 1e20, 1e-05 -> 1e-5: as the format's ranges are written.
-            char buf[32];
-            std::snprintf(buf, sizeof buf, "%g", v);
-            std::string g = buf;
-            const size_t e = g.find('e');
-            if (e == std::string::npos) return g;
-            std::string mant = g.substr(0, e), exp = g.substr(e + 1);
-            const bool neg = exp[0] == '-';
-            exp.erase(0, exp.find_first_not_of("+-0"));
-            return mant + "e" + (neg ? "-" : "") + (exp.empty() ? "0" : exp);
-        }
-        s.erase(s.find_last_not_of('0') + 1);
-        if (!s.empty() && s.back() == '.') s.pop_back();
-        return s;
-    }
+    static std::string fmt(double v) { return formatNumber(v); }
 
   private:
     std::string file_;

@@ -4,9 +4,9 @@
 // a scene error).
 #pragma once
 
+#include "host/loaders/yaml_reader.h"
 #include "host/scene/emitter_kinds.h"
 #include "host/scene/scene.h"
-#include "host/scene/yaml_reader.h"
 
 #include <filesystem>
 #include <vector>

@@ -1,7 +1,7 @@
-#include "host/scene/lights.h"
+#include "host/scene_view/lights.h"
 
 #include "host/scene/emitter_kinds.h"
-#include "host/scene/textures.h"
+#include "host/textures/textures.h"
 
 #include "shared/emission_map.h"
 #include "shared/sampling.h"

@@ -1,4 +1,4 @@
-#include "host/scene/obj_mesh.h"
+#include "host/loaders/obj_mesh.h"
 
 #include <tiny_obj_loader.h>
 

@@ -1,4 +1,4 @@
-#include "host/accel/batch_traversal.h"
+#include "embree_backend/batch_traversal.h"
 
 #include <embree3/rtcore.h>
 #include <tbb/parallel_for.h>

@@ -1,6 +1,7 @@
 // The scene as Embree sees it: one triangle geometry per mesh (geometry id = mesh index), built
-// with the robust flag. Only acceleration lives in host/accel/: what a hit means (hit setup) is
-// the scene's (host/scene/hit_setup.h), and so are the shaders and emitters (host/scene/lights.h).
+// with the robust flag. Only acceleration lives in embree_backend/: what a hit means (hit setup) is
+// the scene's (host/scene_view/hit_setup.h), and so are the shaders and emitters
+// (host/scene_view/lights.h).
 #pragma once
 
 #include "host/scene/scene.h"
@@ -8,7 +9,7 @@
 #include <string>
 
 // Embree's handles, declared as Embree declares them, so that <embree3/rtcore.h> stays inside
-// host/accel/.
+// embree_backend/.
 struct RTCDeviceTy;
 struct RTCSceneTy;
 

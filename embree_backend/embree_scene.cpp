@@ -1,4 +1,4 @@
-#include "host/accel/embree_scene.h"
+#include "embree_backend/embree_scene.h"
 
 #include <embree3/rtcore.h>
 

@@ -2,7 +2,7 @@
 // triangle of a mesh whose shader emits is an emitter, and so is every punctual light and the
 // environment; next-event estimation picks one with probability proportional to its power (the
 // CDF), and the film's fixed-point scale reads the brightest emission. Built from the Scene alone,
-// apart from the BVH (host/accel/), as pbrt-v4 builds its lights and light sampler apart from
+// apart from the BVH (embree_backend/), as pbrt-v4 builds its lights and light sampler apart from
 // the aggregate.
 #pragma once
 
