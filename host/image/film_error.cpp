@@ -1,0 +1,209 @@
+// The film's error without a reference: the half buffers' per-pixel terms (A - B)^2 / 4 over
+// d^2 + 0.01, with d resisting glints (termValue), computed in bands of rows; what reads them:
+// the relMSE estimate and its standard error (--error-csv, --target-error), the error map, and
+// adaptive sampling's tile decisions. docs/design.md, "Error without a reference".
+#include "host/image/film.h"
+
+#include "host/image/compare.h"
+#include "host/image/pixel_ranges.h"
+
+#include <algorithm>
+#include <cmath>
+#include <optional>
+#include <vector>
+
+namespace spw {
+
+namespace {
+// The value d in one channel's term (A - B)^2 / 4 / (d^2 + 0.01) of a pixel whose halves read a
+// and b, m the two together, from `samples` samples, among neighbours (the 3 x 3 window, the
+// pixel included, `count` values) whose brightest, the pixel left out, reads `brightest`.
+//
+// d is m, the pixel's own value, unless its samples spread more than anything around it shows:
+// the per-sample standard deviation that the halves' difference gives, |a - b| sqrt(n / 4), and
+// its brighter half both above the brightest neighbour's value. That is a spike no surface in
+// view explains, a glint: a rare path of large value (a glossy bounce into a small light), whose
+// one sample inflates m as much as the difference, so that with m as d the term reads at most
+// about 1 where the pixel's true relative error is tens. Such a pixel takes d = min(m,
+// max(min(a, b), median of the window)): its spike-free half, or its neighbourhood's level if
+// that is higher. A pixel at an edge (a sliver of the light, a bright wall behind a dark one) has
+// spikes that a neighbour shows as its steady value, and keeps m: its rare samples are a large
+// part of its true value. What the rule cannot tell apart: a light smaller than a pixel or two,
+// seen directly, that one half has hit and the other not yet, reads as a glint, and its term is
+// far too high until both halves have hit it.
+// docs/performance.md ("The denominator: glints") has the measurements behind the rule.
+double termValue(double a, double b, double m, double samples, double* window, int count,
+                 double brightest) {
+    const double spread = std::fabs(a - b) * std::sqrt(samples / 4.0);
+    if (!(spread > brightest && std::max(a, b) > brightest)) return m;
+    std::nth_element(window, window + count / 2, window + count);
+    return std::min(m, std::max(std::min(a, b), window[count / 2]));
+}
+
+// The image's values m, three a pixel, from row r0 on: pixels' neighbourhoods.
+struct ValueRows {
+    const double* values;
+    int width, height, r0;
+    double at(int x, int y, int c) const {
+        return values[(size_t(y - r0) * size_t(width) + size_t(x)) * 3 + size_t(c)];
+    }
+    // Channel c of the 3 x 3 window around (x, y) inside the image, into window (the pixel
+    // included); returns the count, and the brightest value but the pixel's in brightest.
+    int window(int x, int y, int c, double* window, double& brightest) const {
+        int count = 0;
+        brightest = 0.0;
+        for (int ny = std::max(0, y - 1); ny <= std::min(height - 1, y + 1); ++ny)
+            for (int nx = std::max(0, x - 1); nx <= std::min(width - 1, x + 1); ++nx) {
+                window[count++] = at(nx, ny, c);
+                if (nx != x || ny != y) brightest = std::max(brightest, at(nx, ny, c));
+            }
+        return count;
+    }
+};
+} // namespace
+
+void Film::halfBufferTermRows(int y0, int y1, double* terms) const {
+    // The image's rows y0 - 1 .. y1 (those inside it): every pixel's neighbours.
+    const int r0 = std::max(0, y0 - 1), r1 = std::min(height_, y1 + 1);
+    const size_t w = size_t(width_);
+    std::vector<double> value(size_t(r1 - r0) * w * 3);
+    forPixels(size_t(r1 - r0) * w, [&](size_t begin, size_t end) {
+        for (size_t j = begin; j < end; ++j) {
+            double s[8];
+            pixelSums(size_t(r0) * w + j, s);
+            const double weight = s[3] + s[7];
+            for (int c = 0; c < 3; ++c)
+                value[j * 3 + size_t(c)] = weight > 0 ? (s[c] + s[4 + c]) / weight : 0.0;
+        }
+    });
+    const ValueRows rows{value.data(), width_, height_, r0};
+    forPixels(size_t(y1 - y0) * w, [&](size_t begin, size_t end) {
+        for (size_t j = begin; j < end; ++j) {
+            const size_t pixel = size_t(y0) * w + j;
+            const int x = int(pixel % w), y = int(pixel / w);
+            double s[8];
+            pixelSums(pixel, s);
+            double* out = terms + j * 3;
+            if (!(s[3] > 0 && s[7] > 0)) {
+                out[0] = out[1] = out[2] = kNoTerm;
+                continue;
+            }
+            // The camera samples centred in the pixel. A wide filter's value averages more of
+            // them, so the spread reads low there and the rule errs towards m.
+            const double samples = double(tileSamples_[tileOf(pixel)]);
+            for (int c = 0; c < 3; ++c) {
+                double window[9], brightest;
+                const int count = rows.window(x, y, c, window, brightest);
+                const double a = s[c] / s[3], b = s[4 + c] / s[7];
+                const double d =
+                    termValue(a, b, rows.at(x, y, c), samples, window, count, brightest);
+                out[c] = (a - b) * (a - b) / 4.0 / (d * d + kRelMseEpsilon);
+            }
+        }
+    });
+}
+
+template <typename Fn> void Film::forHalfBufferTerms(int y0, int y1, const Fn& fn) const {
+    constexpr int kBand = 8 * kAdaptiveTile; // rows: whole tiles, a few MB of terms
+    std::vector<double> terms;
+    for (int b0 = y0; b0 < y1; b0 += kBand) {
+        const int b1 = std::min(y1, b0 + kBand);
+        terms.resize(size_t(b1 - b0) * size_t(width_) * 3);
+        halfBufferTermRows(b0, b1, terms.data());
+        fn(b0, b1, terms.data());
+    }
+}
+
+void Film::errorRows(int y0, int y1, float* rgb) const {
+    forHalfBufferTerms(y0, y1, [&](int b0, int b1, const double* terms) {
+        float* out = rgb + size_t(b0 - y0) * size_t(width_) * 3;
+        for (size_t i = 0; i < size_t(b1 - b0) * size_t(width_) * 3; ++i)
+            out[i] = terms[i] == kNoTerm ? 0.0f : float(terms[i]);
+    });
+}
+
+void Film::decideAdaptiveTiles() {
+    if (!(adaptiveThreshold_ > 0.0)) {
+        active_.clear();
+        activeTiles_ = 1;
+        return;
+    }
+    active_.assign(size_t(tilesX_) * size_t(tilesY_), 1);
+    activeTiles_ = active_.size();
+    const double limit = adaptiveThreshold_ * adaptiveThreshold_; // on the mean square
+    forHalfBufferTerms(0, height_, [&](int y0, int y1, const double* terms) {
+        for (int ty = y0 / kAdaptiveTile; ty * kAdaptiveTile < y1; ++ty)
+            for (int tx = 0; tx < tilesX_; ++tx) {
+                double total = 0.0;
+                size_t values = 0;
+                bool ready = tileSamples_[size_t(ty) * size_t(tilesX_) + size_t(tx)] >=
+                             std::uint32_t(adaptiveMinSamples_);
+                for (int y = ty * kAdaptiveTile; y < std::min(y1, (ty + 1) * kAdaptiveTile); ++y)
+                    for (int x = tx * kAdaptiveTile; x < std::min(width_, (tx + 1) * kAdaptiveTile);
+                         ++x) {
+                        const double* t = terms + (size_t(y - y0) * size_t(width_) + size_t(x)) * 3;
+                        if (t[0] == kNoTerm) {
+                            ready = false;
+                            continue;
+                        }
+                        for (int c = 0; c < 3; ++c) // one at a time, as the sum always was
+                            total += t[c];
+                        values += 3;
+                    }
+                if (ready && values > 0 && total / double(values) < limit) {
+                    active_[size_t(ty) * size_t(tilesX_) + size_t(tx)] = 0;
+                    --activeTiles_;
+                }
+            }
+    });
+}
+
+std::vector<float> Film::halfImage(int half) const {
+    const size_t n = size_t(width_) * height_;
+    std::vector<float> out(n * 3, 0.0f);
+    for (size_t i = 0; i < n; ++i) {
+        double all[8];
+        pixelSums(i, all);
+        const double* s = all + half * 4;
+        if (s[3] > 0)
+            for (int c = 0; c < 3; ++c)
+                out[i * 3 + c] = float(s[c] / s[3]);
+    }
+    return out;
+}
+
+double Film::halfBufferRelMse() const {
+    return halfBufferRelMseEstimate().value_or(0.0);
+}
+
+double Film::halfBufferRelMseStandardError() const {
+    return halfBufferError().standardError;
+}
+
+std::optional<double> Film::halfBufferRelMseEstimate() const {
+    return halfBufferError().relMse;
+}
+
+Film::ErrorEstimate Film::halfBufferError() const {
+    // The standard error: a pixel's term sum P (its three channels, whose noise is mostly
+    // shared) is a scaled chi-square of one degree of freedom where the halves' difference is
+    // Gaussian: its variance is 2/3 of E[P^2], and P^2 estimates E[P^2] from the pixel alone.
+    // Pixels are independent (up to the filter's reach), so the variances add.
+    double total = 0.0, squares = 0.0;
+    size_t count = 0;
+    forHalfBufferTerms(0, height_, [&](int y0, int y1, const double* terms) {
+        for (size_t i = 0; i < size_t(y1 - y0) * size_t(width_); ++i) {
+            const double* t = terms + i * 3;
+            if (t[0] == kNoTerm) continue;
+            for (int c = 0; c < 3; ++c) // one at a time, in pixel order, as the sum always was
+                total += t[c];
+            const double p = t[0] + t[1] + t[2];
+            squares += p * p;
+            count += 3;
+        }
+    });
+    if (count == 0) return {std::nullopt, 0.0};
+    return {total / double(count), std::sqrt(2.0 / 3.0 * squares) / double(count)};
+}
+
+} // namespace spw
