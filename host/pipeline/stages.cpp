@@ -2,6 +2,7 @@
 
 #include "host/pipeline/parallel.h"
 #include "host/pipeline/radix_sort.h"
+#include "host/pipeline/stage_chunks.h"
 #include "host/simd/lanes.h"
 #include "host/simd/simd_random.h"
 #include "shared/path.h"
@@ -15,31 +16,6 @@
 #include <memory>
 
 namespace spw {
-namespace {
-
-RenderParams paramsAt(const RenderContext& ctx, uint iteration) {
-    RenderParams rp = ctx.params;
-    rp.iteration = iteration;
-    return rp;
-}
-
-// The random numbers that round a ray's compact record: the path's own (dimension kDimRounding).
-uvec4 roundingBits(const RenderParams& rp, const PathState& path) {
-    return pcg4d(uvec4(pathPixel(rp, path.pathId), pathSample(rp, path.pathId),
-                       (path.bounce << 8u) | kDimRounding, rp.seed));
-}
-
-// Where a path's contributions land on the film.
-vec2 filmPosition(const RenderContext& ctx, const RenderParams& rp, uint pathId) {
-    const uint pixel = pathPixel(rp, pathId), s = pathId % rp.samplesPerIteration;
-    const uint width = uint(ctx.scene.image.width);
-    const uint x = pixel % width, y = pixel / width;
-    // The Box filter needs only the pixel: skip re-deriving the sample's position in it.
-    if (ctx.scene.filter.type == FilterType::Box) return vec2(float(x) + 0.5f, float(y) + 0.5f);
-    return ctx.camera.filmPosition(x, y, s, pathSample(rp, pathId), rp.seed);
-}
-
-} // namespace
 
 void CameraRays::begin(const RenderContext& ctx, uint iteration, const Film& film) {
     const Scene& scene = ctx.scene;
@@ -193,12 +169,6 @@ size_t sortHits(const Scene& scene, const ShaderOrder& shaders, const std::vecto
 }
 
 namespace {
-// Hits are set up a chunk at a time: a chunk's inputs and results (56 KiB) stay in L2 between
-// the fused stages, and its texture lookups go texture by texture. (256 hits measured 2-4 %
-// faster than 128 on the Cornell box and the textured scenes: longer runs of one texture.)
-constexpr size_t kChunk = 256;
-static_assert(kChunk <= 256, "chunk indices are bytes");
-
 // What setUpChunk reads that is likely a miss, asked for a whole chunk ahead (measured faster
 // than a fixed distance ahead within the loop): first the hits' rays (in traversal order while
 // the hits are in shader order) and triangles, then the triangles' vertices.
@@ -238,10 +208,8 @@ void setUpGeometry(const RenderContext& ctx, const std::vector<RayState>& rays,
     }
 }
 
-// Hit setup of the sorted hits order[0, n), n <= kChunk, into in[0, n): each hit's geometry and
-// path, then the albedos (and normal maps), a run of hits of one shader at a time, texture by
-// texture (TextureResolver::albedos: the same values as one hit at a time, bit for bit). Hits that
-// end their path (max depth) get no albedo: shading never reads it there.
+} // namespace
+
 void setUpChunk(const RenderContext& ctx, const std::vector<RayState>& rays,
                 const std::vector<HitRecord>& hits, const SortedHit* order, size_t n,
                 ShadeInput* in) {
@@ -288,7 +256,6 @@ void setUpChunk(const RenderContext& ctx, const std::vector<RayState>& rays,
         a = b;
     }
 }
-} // namespace
 
 void setUpHits(const RenderContext& ctx, const std::vector<RayState>& rays,
                const std::vector<HitRecord>& hits, const std::vector<SortedHit>& order,
@@ -342,69 +309,6 @@ void gatherShadowRays(const ShadeResult* results, size_t hitCount,
                       });
 }
 
-namespace {
-// One contribution for the film: which path, where, which sample, what, and its rounding key.
-struct Splat {
-    vec2 pos;
-    uint path;
-    uint sample;
-    uint key;
-    vec3 value;
-};
-// Splats gathered a few dozen at a time: each one's film line is prefetched when it joins, and
-// the adds wait until the batch is full, so that the lines' cache misses overlap instead of
-// stalling one atomic add after another (the sorted order has no pixel locality).
-class SplatBatch {
-  public:
-    explicit SplatBatch(Film& film) : film_(film), sums_(film.sumsSamples()) {}
-    ~SplatBatch() { flush(); }
-    // A contribution of path `path` (its id) at bounce `bounce`. Field by field into the slot:
-    // a Splat assembled and then copied goes through the stack in pieces that the copy's wider
-    // loads straddle, a store-forwarding stall.
-    void push(const RenderContext& ctx, const RenderParams& rp, uint path, uint bounce, bool shadow,
-              vec3 value) {
-        // A film that sums samples does not need where the sample lies.
-        const vec2 pos = sums_ ? vec2(0.0f) : filmPosition(ctx, rp, path);
-        film_.prefetch(path, pos);
-        Splat& s = splats_[count_++];
-        s.pos = pos;
-        s.path = path;
-        s.sample = pathSample(rp, path);
-        s.key = filmKey(path, bounce, shadow);
-        s.value = value;
-        if (count_ == kSize) flush();
-    }
-    // What a hit emitted, or its unoccluded shadow ray brings, for path (pathId, bounce).
-    void emitted(const RenderContext& ctx, const RenderParams& rp, const ShadeResult& res,
-                 uvec2 path) {
-        push(ctx, rp, path.x, path.y, false, res.emitted);
-    }
-    void shadow(const RenderContext& ctx, const RenderParams& rp, const ShadeResult& res,
-                uvec2 path) {
-        push(ctx, rp, path.x, path.y, true, res.shadowContribution);
-    }
-    // In the order pushed: a path's contributions stay in order (Film::splat).
-    void flush() {
-        for (size_t k = 0; k < count_; ++k) {
-            const Splat& s = splats_[k];
-            film_.splat(s.path, s.pos, s.sample, s.value, s.key);
-        }
-        count_ = 0;
-    }
-
-  private:
-    static constexpr size_t kSize = 64;
-    Film& film_;
-    const bool sums_;
-    Splat splats_[kSize];
-    size_t count_ = 0;
-};
-void binOne(const RenderParams& rp, RayFormat format, const ShadeResult& res, RayBuffer& buffer) {
-    if (!(res.flags & kShadeContinue)) return;
-    buffer.push(res.nextOrigin, res.nextDir, res.next, format, roundingBits(rp, res.next));
-}
-} // namespace
-
 void accumulate(const RenderContext& ctx, uint iteration, const ShadeResult* results,
                 const uvec2* paths, size_t hitCount, const std::vector<std::uint32_t>& shadowOwner,
                 const std::vector<std::uint8_t>& occluded, Film& film) {
@@ -452,161 +356,6 @@ void binContinuations(const RenderContext& ctx, uint iteration, RayFormat format
                               binOne(rp, format, results[i], buffer);
                           bins.add(buffer);
                       });
-}
-
-namespace {
-// The fused stages' working set: one chunk of hits through every per-hit stage.
-constexpr size_t kFusedChunk = kChunk;
-struct FusedChunk {
-    ShadeInput in[kFusedChunk];
-    ShadeResult out[kFusedChunk];
-    ShadowRay shadows[kFusedChunk];
-    std::uint8_t owner[kFusedChunk];
-    std::uint8_t occluded[kFusedChunk];
-    SortedHit hits[kFusedChunk]; // the chunk's hits when the batch's hits were not sorted
-};
-static_assert(kFusedChunk <= 256, "owner indices are bytes");
-
-enum FusedStage { kSetUp, kShade, kShadow, kAccumulate, kBin, kFusedStages };
-const char* const kFusedStageNames[kFusedStages] = {"hit setup", "shade", "shadow", "accumulate",
-                                                    "bin"};
-
-// One task's share of a fused loop: its stage clock, continuation rays and film splats.
-class FusedTask {
-  public:
-    using Clock = std::chrono::steady_clock;
-    explicit FusedTask(Film& film) : c(std::make_unique<FusedChunk>()), splats(film) {}
-
-    // The time since the last lap goes to `stage`.
-    void lap(FusedStage stage) {
-        const auto now = Clock::now();
-        ns[stage] += std::chrono::duration_cast<std::chrono::nanoseconds>(now - t_).count();
-        t_ = now;
-    }
-
-    // The stages after shading, for the results out[0, n) (n <= kFusedChunk) of the hits whose
-    // (pathId, bounce) pathOf(i) gives: their shadow rays traced, what they emitted and what
-    // their unoccluded shadow rays bring splatted, their continuation rays encoded.
-    template <class PathOf>
-    void finishChunk(const RenderContext& ctx, const RenderParams& rp, RayFormat format,
-                     const ShadeResult* out, size_t n, PathOf pathOf) {
-        size_t m = 0;
-        for (size_t i = 0; i < n; ++i)
-            if (out[i].flags & kShadeShadow) {
-                const ShadeResult& res = out[i];
-                c->owner[m] = std::uint8_t(i);
-                c->shadows[m++] = {res.shadowOrigin, res.shadowDir, res.shadowTmax};
-            }
-        occludedRange(ctx.embree, c->shadows, m, false, c->occluded);
-        shadowRays += m;
-        lap(kShadow);
-        for (size_t i = 0; i < n; ++i)
-            if (out[i].flags & kShadeEmitted) splats.emitted(ctx, rp, out[i], pathOf(i));
-        for (size_t j = 0; j < m; ++j)
-            if (!c->occluded[j]) {
-                const size_t i = c->owner[j];
-                splats.shadow(ctx, rp, out[i], pathOf(i));
-            }
-        splats.flush();
-        lap(kAccumulate);
-        for (size_t i = 0; i < n; ++i)
-            binOne(rp, format, out[i], buffer);
-        lap(kBin);
-    }
-
-    std::unique_ptr<FusedChunk> c;
-    RayBuffer buffer;
-    SplatBatch splats;
-    std::uint64_t shadowRays = 0;
-    std::int64_t ns[kFusedStages] = {};
-
-  private:
-    Clock::time_point t_ = Clock::now();
-};
-
-// What the tasks of one fused loop add up to, and its wall time shared among the stages in
-// proportion to their thread time, into --stats.
-class FusedTimes {
-  public:
-    void add(FusedTask& task, DirectionalBins& bins) {
-        bins.add(task.buffer);
-        task.lap(kBin);
-        for (int s = 0; s < kFusedStages; ++s)
-            threadNs_[s] += task.ns[s];
-        shadowRays_ += task.shadowRays;
-    }
-    // The stages from `first` on are this loop's.
-    void publish(const RenderContext& ctx, FusedStage first) const {
-        ctx.stats.shadowRays += shadowRays_.load();
-        const double wall = std::chrono::duration<double>(FusedTask::Clock::now() - start_).count();
-        double total = 0.0;
-        for (const auto& ns : threadNs_)
-            total += double(ns.load());
-        for (int s = first; s < kFusedStages; ++s)
-            ctx.stats.stages.add(kFusedStageNames[s],
-                                 total > 0.0 ? wall * double(threadNs_[s].load()) / total : 0.0);
-    }
-
-  private:
-    FusedTask::Clock::time_point start_ = FusedTask::Clock::now();
-    std::atomic<std::int64_t> threadNs_[kFusedStages] = {};
-    std::atomic<std::uint64_t> shadowRays_{0};
-};
-} // namespace
-
-void shadeFused(const RenderContext& ctx, uint iteration, RayFormat format, const ShadeChunk& shade,
-                const std::vector<RayState>& rays, const std::vector<HitRecord>& hits,
-                const std::vector<SortedHit>& order, size_t hitCount, Film& film,
-                DirectionalBins& bins) {
-    const RenderParams rp = paramsAt(ctx, iteration);
-    FusedTimes times;
-    const bool inTraversalOrder = order.empty();
-    // Tasks of up to `shading size` hits, each handing its continuation rays to the bins once.
-    const size_t grain = batchGrain(hitCount, kFusedChunk, size_t(ctx.scene.settings.shadingSize));
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, hitCount, grain),
-                      [&](const tbb::blocked_range<size_t>& r) {
-                          FusedTask task(film);
-                          FusedChunk& c = *task.c;
-                          for (size_t begin = r.begin(); begin < r.end(); begin += kFusedChunk) {
-                              size_t n = std::min(kFusedChunk, r.end() - begin);
-                              const SortedHit* chunk = inTraversalOrder ? c.hits : &order[begin];
-                              if (inTraversalOrder) {
-                                  size_t h = 0;
-                                  for (size_t i = begin; i < begin + n; ++i)
-                                      if (hits[i].mesh != kNoHit)
-                                          c.hits[h++] = {0, std::uint32_t(i)};
-                                  n = h;
-                              }
-                              setUpChunk(ctx, rays, hits, chunk, n, c.in);
-                              task.lap(kSetUp);
-                              shade(rp, c.in, n, c.out);
-                              task.lap(kShade);
-                              task.finishChunk(ctx, rp, format, c.out, n, [&](size_t i) {
-                                  return uvec2(c.in[i].path.pathId, c.in[i].path.bounce);
-                              });
-                          }
-                          times.add(task, bins);
-                      });
-    times.publish(ctx, kSetUp);
-}
-
-void finishFused(const RenderContext& ctx, uint iteration, RayFormat format,
-                 const ShadeResult* results, const uvec2* paths, size_t hitCount, Film& film,
-                 DirectionalBins& bins) {
-    const RenderParams rp = paramsAt(ctx, iteration);
-    FusedTimes times;
-    const size_t grain = batchGrain(hitCount, kFusedChunk, size_t(ctx.scene.settings.shadingSize));
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, hitCount, grain),
-                      [&](const tbb::blocked_range<size_t>& r) {
-                          FusedTask task(film);
-                          for (size_t begin = r.begin(); begin < r.end(); begin += kFusedChunk) {
-                              const size_t n = std::min(kFusedChunk, r.end() - begin);
-                              task.finishChunk(ctx, rp, format, results + begin, n,
-                                               [&](size_t i) { return paths[begin + i]; });
-                          }
-                          times.add(task, bins);
-                      });
-    times.publish(ctx, kShadow);
 }
 
 } // namespace spw
