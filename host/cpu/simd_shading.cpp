@@ -5,8 +5,8 @@
 // Each kernel is shadeSurface() (shared/path.h) for one surface model (shared/lambert.h,
 // conductor.h, dielectric.h, gltf.h) and triangle emitters: shadeLanes() is its control flow, and a
 // small struct per model supplies bsdfEval, bsdfSample and bsdfIsDelta as the SIMD twins of the
-// model's shared functions (host/simd/simd_math-inl.h, each checked against its scalar function
-// lane by lane).
+// model's shared functions (host/simd/simd_math-inl.h and simd_bsdf-inl.h, each checked against its
+// scalar function lane by lane).
 #include "host/cpu/simd_shading.h"
 
 #include "host/simd/lanes.h"
@@ -66,7 +66,7 @@ struct SurfaceResults {
 #include <hwy/foreach_target.h> // must come before highway.h
 #include <hwy/highway.h>
 
-#include "host/simd/simd_math-inl.h"
+#include "host/simd/simd_bsdf-inl.h" // and simd_math-inl.h
 
 HWY_BEFORE_NAMESPACE();
 namespace spw::HWY_NAMESPACE {

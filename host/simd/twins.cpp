@@ -1,6 +1,6 @@
-// runTwin (twins.h): each twin of simd_math-inl.h on rows of lanes, once per instruction set.
-// The rows each twin reads and writes are listed beside it, in its scalar function's parameter
-// order.
+// runTwin (twins.h): each twin of simd_math-inl.h and simd_bsdf-inl.h on rows of lanes, once per
+// instruction set. The rows each twin reads and writes are listed beside it, in its scalar
+// function's parameter order.
 #include "host/simd/twins.h"
 
 #undef HWY_TARGET_INCLUDE
@@ -8,7 +8,7 @@
 #include <hwy/foreach_target.h> // must come before highway.h
 #include <hwy/highway.h>
 
-#include "host/simd/simd_math-inl.h"
+#include "host/simd/simd_bsdf-inl.h" // and simd_math-inl.h
 
 HWY_BEFORE_NAMESPACE();
 namespace spw::HWY_NAMESPACE {

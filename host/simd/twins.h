@@ -1,9 +1,10 @@
 // The registry of SIMD twins: every scalar function of shaders/shared/ that has a SIMD twin in
-// host/simd/simd_math-inl.h, one line each, and a way to run each twin on lanes of inputs, so
-// that tests/simd/twins_test.cpp compares it with its scalar function lane by lane, bit for bit,
-// on random inputs: a change to either side fails at the function that drifted, not at the end
-// of a render. The scalar side carries the tag "// SIMD twin: host/simd/simd_math-inl.h" on
-// the line above its definition; the test checks that the tags and this list are the same set.
+// host/simd/simd_math-inl.h or simd_bsdf-inl.h, one line each, and a way to run each twin on lanes
+// of inputs, so that tests/simd/twins_test.cpp compares it with its scalar function lane by lane,
+// bit for bit, on random inputs: a change to either side fails at the function that drifted, not at
+// the end of a render. The scalar side carries the tag "// SIMD twin: host/simd/simd_math-inl.h"
+// (or simd_bsdf-inl.h, the one that holds the twin) on the line above its definition; the test
+// checks that the tags and this list are the same set.
 //
 // X(name, header): the function's name on both sides, and its shared header.
 #pragma once

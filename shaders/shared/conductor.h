@@ -17,14 +17,14 @@
 
 SHARED_BEGIN
 
-// SIMD twin: host/simd/simd_math-inl.h
+// SIMD twin: host/simd/simd_bsdf-inl.h
 SHARED_FN vec3 schlickFresnel(vec3 f0, float cosTheta) {
     float m = clamp(1.0f - cosTheta, 0.0f, 1.0f);
     float m2 = m * m;
     return f0 + (vec3(1.0f) - f0) * (m2 * m2 * m);
 }
 
-// SIMD twin: host/simd/simd_math-inl.h
+// SIMD twin: host/simd/simd_bsdf-inl.h
 SHARED_FN vec3 conductorEval(vec3 f0, float alpha, vec3 ng, vec3 ns, vec3 wo, vec3 wi,
                              OUT(float) pdf) {
     pdf = 0.0f;
@@ -46,7 +46,7 @@ SHARED_FN vec3 conductorEval(vec3 f0, float alpha, vec3 ng, vec3 ns, vec3 wo, ve
     return schlickFresnel(f0, dot(lo, h)) * (d * li.z / (2.0f * denom));
 }
 
-// SIMD twin: host/simd/simd_math-inl.h
+// SIMD twin: host/simd/simd_bsdf-inl.h
 SHARED_FN bool conductorSample(vec3 f0, float alpha, vec3 ng, vec3 ns, vec3 wo, vec2 u,
                                OUT(vec3) wi, OUT(vec3) weight, OUT(float) pdf, OUT(bool) specular) {
     Frame f = shadingFrame(ns, ng, wo);

@@ -25,7 +25,7 @@ SHARED_BEGIN
 // Fresnel reflectance of unpolarised light arriving at cosine cosI (> 0) on the side of index
 // n_i, eta = n_t / n_i. cosT gets the cosine of the refracted direction (0 under total internal
 // reflection, where the result is 1).
-// SIMD twin: host/simd/simd_math-inl.h
+// SIMD twin: host/simd/simd_bsdf-inl.h
 SHARED_FN float fresnelDielectric(float cosI, float eta, OUT(float) cosT) {
     float ci = clamp(cosI, 0.0f, 1.0f);
     float sin2T = (1.0f - ci * ci) / (eta * eta);
@@ -44,7 +44,7 @@ SHARED_FN float dielectricEta(float ior, vec3 ng, vec3 wo) {
     return dot(ng, wo) > 0.0f ? ior : 1.0f / ior;
 }
 
-// SIMD twin: host/simd/simd_math-inl.h
+// SIMD twin: host/simd/simd_bsdf-inl.h
 SHARED_FN vec3 dielectricEval(float ior, float alpha, vec3 ng, vec3 ns, vec3 wo, vec3 wi,
                               OUT(float) pdf) {
     pdf = 0.0f;
@@ -90,7 +90,7 @@ SHARED_FN vec3 dielectricEval(float ior, float alpha, vec3 ng, vec3 ns, vec3 wo,
     return vec3((1.0f - F) * d * 2.0f * ci * (-ih) * oh / (denomG * s2 * eta * eta));
 }
 
-// SIMD twin: host/simd/simd_math-inl.h
+// SIMD twin: host/simd/simd_bsdf-inl.h
 SHARED_FN bool dielectricSample(float ior, float alpha, vec3 ng, vec3 ns, vec3 wo, vec3 u,
                                 OUT(vec3) wi, OUT(vec3) weight, OUT(float) pdf,
                                 OUT(bool) specular) {

@@ -31,7 +31,7 @@ SHARED_FN bool ggxIsSmooth(float alpha) {
 }
 
 // D(h) for a unit half vector in the local frame (0 below the surface).
-// SIMD twin: host/simd/simd_math-inl.h
+// SIMD twin: host/simd/simd_bsdf-inl.h
 SHARED_FN float ggxD(vec3 h, float alpha) {
     if (h.z <= 0.0f) return 0.0f;
     float a2 = alpha * alpha;
@@ -40,7 +40,7 @@ SHARED_FN float ggxD(vec3 h, float alpha) {
 }
 
 // A(w) = sqrt(cos^2 + alpha^2 sin^2) = |cos| (1 + 2 Lambda(w)).
-// SIMD twin: host/simd/simd_math-inl.h
+// SIMD twin: host/simd/simd_bsdf-inl.h
 SHARED_FN float ggxA(vec3 w, float alpha) {
     return sqrt(w.z * w.z + alpha * alpha * (w.x * w.x + w.y * w.y));
 }
@@ -53,7 +53,7 @@ SHARED_FN float ggxG1(vec3 w, float alpha) {
 }
 
 // ao |ci| + ai |co|, the denominator of the height-correlated G2 = 2 |co| |ci| / (that).
-// SIMD twin: host/simd/simd_math-inl.h
+// SIMD twin: host/simd/simd_bsdf-inl.h
 SHARED_FN float ggxG2Denominator(vec3 wo, vec3 wi, float alpha) {
     return ggxA(wo, alpha) * abs(wi.z) + ggxA(wi, alpha) * abs(wo.z);
 }
@@ -67,7 +67,7 @@ SHARED_FN float ggxVisibleNormalPdf(vec3 wo, vec3 h, float alpha) {
 
 // A microfacet normal sampled from the visible normals seen from wo (wo.z > 0), u in [0, 1)^2
 // (Heitz 2018, listing 1, isotropic).
-// SIMD twin: host/simd/simd_math-inl.h
+// SIMD twin: host/simd/simd_bsdf-inl.h
 SHARED_FN vec3 ggxSampleVisibleNormal(vec3 wo, float alpha, vec2 u) {
     // The view direction in the stretched (alpha = 1) configuration, and a frame around it.
     vec3 vh = normalize(vec3(alpha * wo.x, alpha * wo.y, wo.z));

@@ -34,7 +34,7 @@ SHARED_FN float gltfAlpha(float roughness) {
 
 // The probability of sampling the specular lobe, seen from wo at cosine cosO to the shading
 // normal.
-// SIMD twin: host/simd/simd_math-inl.h
+// SIMD twin: host/simd/simd_bsdf-inl.h
 SHARED_FN float gltfSpecularProbability(vec3 f0, vec3 cDiff, float cosO) {
     vec3 F = schlickFresnel(f0, cosO);
     float fs = (F.x + F.y + F.z) / 3.0f;
@@ -44,7 +44,7 @@ SHARED_FN float gltfSpecularProbability(vec3 f0, vec3 cDiff, float cosO) {
     return clamp(fs / (fs + fd), 0.25f, 0.9f);
 }
 
-// SIMD twin: host/simd/simd_math-inl.h
+// SIMD twin: host/simd/simd_bsdf-inl.h
 SHARED_FN vec3 gltfEval(vec3 colour, float metallic, float alpha, vec3 ng, vec3 ns, vec3 wo,
                         vec3 wi, OUT(float) pdf) {
     pdf = 0.0f;
@@ -70,7 +70,7 @@ SHARED_FN vec3 gltfEval(vec3 colour, float metallic, float alpha, vec3 ng, vec3 
     return specular + diffuse;
 }
 
-// SIMD twin: host/simd/simd_math-inl.h
+// SIMD twin: host/simd/simd_bsdf-inl.h
 SHARED_FN bool gltfSample(vec3 colour, float metallic, float alpha, vec3 ng, vec3 ns, vec3 wo,
                           vec3 u, OUT(vec3) wi, OUT(vec3) weight, OUT(float) pdf,
                           OUT(bool) specular) {

@@ -447,11 +447,13 @@ TEST(SimdTwins, EachTwinIsItsScalarFunctionLaneByLaneInEveryInstructionSet) {
     hwy::SetSupportedTargetsForTest(0);
 }
 
-// The tags "// SIMD twin: host/simd/simd_math-inl.h" above SHARED_FN definitions in
-// shaders/shared/, as (header, function) pairs.
+// The tags "// SIMD twin: host/simd/simd_math-inl.h" (or simd_bsdf-inl.h) above SHARED_FN
+// definitions in shaders/shared/, as (header, function) pairs; the file a tag names must name the
+// function.
 std::set<std::string> taggedFunctions() {
     std::set<std::string> out;
     static const std::regex fn("^SHARED_FN \\w+ (\\w+)\\(");
+    static const std::regex tag("^// SIMD twin: (host/simd/simd_(math|bsdf)-inl\\.h)$");
     for (const char* header : {"sampling.h", "offset.h", "light_sample.h", "lights.h", "lambert.h",
                                "rng.h", "path.h", "bsdf.h", "ggx.h", "conductor.h", "dielectric.h",
                                "gltf.h", "cone.h", "types.h", "compat.h"}) {
@@ -459,14 +461,21 @@ std::set<std::string> taggedFunctions() {
         EXPECT_TRUE(in) << header;
         std::string line;
         bool tagged = false;
+        std::string twinFile;
         while (std::getline(in, line)) {
             std::smatch m;
-            if (tagged && std::regex_search(line, m, fn))
+            if (tagged && std::regex_search(line, m, fn)) {
                 out.insert(std::string(header) + " " + m[1].str());
-            else if (tagged)
+                EXPECT_TRUE(std::regex_search(test::readFile(test::sourceDir() + "/" + twinFile),
+                                              std::regex("\\b" + m[1].str() + "\\b")))
+                    << header << ": " << m[1] << "'s tag names " << twinFile
+                    << ", which has no twin of that name";
+            } else if (tagged) {
                 ADD_FAILURE() << header
                               << ": a SIMD twin tag not followed by a SHARED_FN: " << line;
-            tagged = line == "// SIMD twin: host/simd/simd_math-inl.h";
+            }
+            tagged = std::regex_search(line, m, tag);
+            if (tagged) twinFile = m[1];
         }
     }
     return out;
