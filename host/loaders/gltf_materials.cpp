@@ -1,0 +1,304 @@
+// GltfReader's materials (gltf_reader.h): glTF's metallic-roughness model as a MetallicRoughness
+// shader, one per material, with its images (base colour and its alpha, metallic-roughness,
+// normal map, emission) as textures read by OpenImageIO from the file or the bytes it embeds,
+// and KHR_texture_transform.
+#include "host/loaders/gltf_reader.h"
+
+#include "shared/gltf.h"
+
+#include <OpenImageIO/filesystem.h>
+#include <OpenImageIO/imageio.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <limits>
+#include <map>
+#include <memory>
+#include <set>
+
+namespace spw {
+
+namespace fs = std::filesystem;
+
+Shader GltfReader::defaultShader() {
+    Shader s;
+    s.typeName = "MetallicRoughness";
+    s.params.model = kModelMetallicRoughness;
+    s.params.colour = vec3(1.0f);
+    s.params.reflectance = 1.0f;
+    s.params.metallic = 1.0f;
+    s.params.alpha = gltfAlpha(1.0f);
+    s.params.ior = 1.5f;
+    return s;
+}
+
+int GltfReader::shaderFor(int material, const std::string& at) {
+    if (shaderOverride_ >= 0) return shaderOverride_;
+    if (material >= int(model_.materials.size()))
+        fail(at, "names material " + std::to_string(material) + " of " +
+                     std::to_string(model_.materials.size()));
+    // Materials 0 .. n-1 are shaders 0 .. n-1, made on first use; the default one is n.
+    const size_t count = model_.materials.size();
+    if (shaderOf_.empty()) shaderOf_.assign(count + 1, -1);
+    const size_t key = material < 0 ? count : size_t(material);
+    if (shaderOf_[key] < 0) {
+        if (scene_.shaders.size() >= size_t(kMaxShaders))
+            fail(at, "more than " + std::to_string(kMaxShaders) + " materials");
+        shaderOf_[key] = int(scene_.shaders.size());
+        scene_.shaders.push_back(material < 0 ? defaultShader() : readMaterial(material));
+    }
+    return shaderOf_[key];
+}
+
+Shader GltfReader::readMaterial(int index) {
+    const tinygltf::Material& mat = model_.materials[size_t(index)];
+    const std::string at = "/materials/" + std::to_string(index);
+    const std::string name =
+        "material " + std::to_string(index) + (mat.name.empty() ? "" : " (" + mat.name + ")");
+    Shader s = defaultShader();
+    const tinygltf::PbrMetallicRoughness& pbr = mat.pbrMetallicRoughness;
+    if (pbr.baseColorFactor.size() != 4)
+        fail(at + "/pbrMetallicRoughness/baseColorFactor", "needs 4 numbers");
+    for (int k = 0; k < 3; ++k)
+        s.params.colour[k] =
+            unit(pbr.baseColorFactor[size_t(k)], at + "/pbrMetallicRoughness/baseColorFactor");
+    s.params.metallic =
+        float(unit(pbr.metallicFactor, at + "/pbrMetallicRoughness/metallicFactor"));
+    s.roughness = float(unit(pbr.roughnessFactor, at + "/pbrMetallicRoughness/roughnessFactor"));
+    s.params.alpha = gltfAlpha(s.roughness);
+    readImages(mat, s, at, name);
+    if (mat.alphaMode == "BLEND")
+        warn(name + ": alphaMode BLEND is not rendered (it is drawn opaque)");
+    else if (mat.alphaMode != "OPAQUE" && mat.alphaMode != "MASK")
+        fail(at + "/alphaMode", "must be OPAQUE, MASK or BLEND");
+    readEmission(mat, s, at, name);
+    if (mat.doubleSided) s.params.flags |= kShaderTwoSided;
+    return s;
+}
+
+void GltfReader::readImages(const tinygltf::Material& mat, Shader& s, const std::string& at,
+                            const std::string& name) {
+    const tinygltf::PbrMetallicRoughness& pbr = mat.pbrMetallicRoughness;
+    if (pbr.baseColorTexture.index >= 0) baseColourTexture(pbr.baseColorTexture, s, at, name);
+    if (mat.alphaMode == "MASK") readCutout(mat, s, at, name);
+    if (pbr.metallicRoughnessTexture.index >= 0) {
+        Texture mr = imageTexture(pbr.metallicRoughnessTexture,
+                                  at + "/pbrMetallicRoughness/metallicRoughnessTexture",
+                                  name + ": its metallicRoughnessTexture");
+        mr.linear = true;
+        s.metallicRoughnessTexture = int(scene_.textures.size());
+        scene_.textures.push_back(mr);
+        s.params.flags |= kShaderHitParams;
+    }
+    if (mat.normalTexture.index >= 0) {
+        Texture normals =
+            imageTexture(mat.normalTexture, at + "/normalTexture", name + ": its normalTexture");
+        normals.linear = true;
+        s.normalTexture = int(scene_.textures.size());
+        scene_.textures.push_back(normals);
+        s.normalScale = float(mat.normalTexture.scale);
+        if (!std::isfinite(s.normalScale) || std::fabs(s.normalScale) > 1e3f)
+            fail(at + "/normalTexture/scale", "must be a finite number of at most 1000");
+    }
+    if (mat.occlusionTexture.index >= 0)
+        warn(name + ": its occlusionTexture is ignored (a path tracer finds occlusion itself)");
+}
+
+void GltfReader::readEmission(const tinygltf::Material& mat, Shader& s, const std::string& at,
+                              const std::string& name) {
+    double strength = 1.0;
+    if (const auto e = mat.extensions.find("KHR_materials_emissive_strength");
+        e != mat.extensions.end() && e->second.Has("emissiveStrength")) {
+        const tinygltf::Value& v = e->second.Get("emissiveStrength");
+        strength = v.IsNumber() ? v.GetNumberAsDouble() : -1.0;
+        if (!(strength >= 0.0) || !std::isfinite(strength))
+            fail(at + "/extensions/KHR_materials_emissive_strength/emissiveStrength",
+                 "must be a non-negative number");
+    }
+    if (mat.emissiveFactor.size() != 3) fail(at + "/emissiveFactor", "needs 3 numbers");
+    for (int k = 0; k < 3; ++k) {
+        const double e = unit(mat.emissiveFactor[size_t(k)], at + "/emissiveFactor") * strength;
+        if (!(e <= kMaxRadiance))
+            fail(at + "/extensions/KHR_materials_emissive_strength",
+                 "emission beyond " + std::to_string(kMaxRadiance));
+        s.params.emission[k] = float(e);
+    }
+    if (mat.emissiveTexture.index >= 0 && maxComponent(s.params.emission) > 0.0f) {
+        s.emissionTexture = int(scene_.textures.size());
+        scene_.textures.push_back(imageTexture(mat.emissiveTexture, at + "/emissiveTexture",
+                                               name + ": its emissiveTexture"));
+    }
+}
+
+void GltfReader::baseColourTexture(const tinygltf::TextureInfo& info, Shader& s,
+                                   const std::string& at, const std::string& name) {
+    Texture picture = imageTexture(info, at + "/pbrMetallicRoughness/baseColorTexture",
+                                   name + ": its baseColorTexture");
+    Texture zero{};
+    zero.colour = vec3(0.0f);
+    Texture factor{};
+    factor.colour = s.params.colour;
+    const int base = int(scene_.textures.size());
+    scene_.textures.push_back(picture);
+    scene_.textures.push_back(zero);
+    scene_.textures.push_back(factor);
+    Texture layered{};
+    layered.type = TextureType::Layered;
+    layered.upper = base, layered.lower = base + 1, layered.mask = base + 2;
+    scene_.textures.push_back(layered);
+    s.texture = base + 3;
+    s.params.flags |= kShaderTextured;
+}
+
+void GltfReader::readCutout(const tinygltf::Material& mat, Shader& s, const std::string& at,
+                            const std::string& name) {
+    const tinygltf::PbrMetallicRoughness& pbr = mat.pbrMetallicRoughness;
+    Cutout& c = s.cutout;
+    c.alpha = float(unit(pbr.baseColorFactor[3], at + "/pbrMetallicRoughness/baseColorFactor"));
+    c.cutoff = float(mat.alphaCutoff);
+    if (!(c.cutoff >= 0.0f) || !std::isfinite(mat.alphaCutoff))
+        fail(at + "/alphaCutoff", "must be a non-negative number");
+    if (pbr.baseColorTexture.index >= 0) {
+        Texture alpha =
+            imageTexture(pbr.baseColorTexture, at + "/pbrMetallicRoughness/baseColorTexture",
+                         name + ": its baseColorTexture");
+        alpha.channel = 3;
+        alpha.linear = true;
+        c.texture = int(scene_.textures.size());
+        scene_.textures.push_back(alpha);
+    }
+    c.enabled = c.texture >= 0 || c.alpha < c.cutoff;
+}
+
+template <class Info>
+Texture GltfReader::imageTexture(const Info& info, const std::string& where,
+                                 const std::string& what) {
+    const int index = info.index;
+    if (info.texCoord != 0)
+        warn(what + "'s texCoord " + std::to_string(info.texCoord) + " is read as TEXCOORD_0");
+    if (index >= int(model_.textures.size()))
+        fail(where, "names texture " + std::to_string(index) + " of " +
+                        std::to_string(model_.textures.size()));
+    const int source = model_.textures[size_t(index)].source;
+    if (source < 0 || source >= int(model_.images.size()))
+        fail("/textures/" + std::to_string(index) + "/source", "names no image");
+    const tinygltf::Image& image = model_.images[size_t(source)];
+    Texture picture{};
+    picture.type = TextureType::Standard;
+    const std::string imageAt = "/images/" + std::to_string(source);
+    if (const auto e = embedded_.find(source); e != embedded_.end()) {
+        // A name no file has, its extension telling OpenImageIO the format.
+        const std::string ext = image.mimeType == "image/jpeg" ? ".jpg" : ".png";
+        picture.path = fs::absolute(path_).lexically_normal().string() + "#image" +
+                       std::to_string(source) + ext;
+        picture.bytes = e->second;
+        OIIO::Filesystem::IOMemReader proxy(const_cast<char*>(picture.bytes->data()),
+                                            picture.bytes->size());
+        auto in = OIIO::ImageInput::open(picture.path, nullptr, &proxy);
+        if (!in || in->spec().width < 1 || in->spec().height < 1)
+            fail(imageAt, "the embedded image is not one OpenImageIO can read" + imageError());
+        in->close();
+    } else {
+        if (image.uri.empty()) fail(imageAt, "an image needs a uri or a bufferView");
+        picture.path = fs::absolute(dir_ / decodeUri(image.uri)).lexically_normal().string();
+        auto in = OIIO::ImageInput::open(picture.path);
+        if (!in)
+            fail(imageAt + "/uri",
+                 "'" + picture.path + "' is not an image OpenImageIO can read" + imageError());
+        in->close();
+    }
+    readTextureTransform(info, where, picture);
+    if (const int sampler = model_.textures[size_t(index)].sampler; sampler >= 0) {
+        if (sampler >= int(model_.samplers.size()))
+            fail("/textures/" + std::to_string(index) + "/sampler",
+                 "names sampler " + std::to_string(sampler) + " of " +
+                     std::to_string(model_.samplers.size()));
+        readSampler(model_.samplers[size_t(sampler)], "/samplers/" + std::to_string(sampler), what,
+                    picture);
+    }
+    return picture;
+}
+
+std::string GltfReader::imageError() {
+    std::string why = OIIO::geterror();
+    while (!why.empty() && (why.back() == '\n' || why.back() == '\r'))
+        why.pop_back();
+    return why.empty() ? "" : ": " + why;
+}
+
+void GltfReader::readSampler(const tinygltf::Sampler& s, const std::string& at,
+                             const std::string& what, Texture& picture) {
+    auto wrap = [&](int mode, const char* field) {
+        switch (mode) {
+        case TINYGLTF_TEXTURE_WRAP_REPEAT:
+            return Texture::Wrap::Repeat;
+        case TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE:
+            return Texture::Wrap::Clamp;
+        case TINYGLTF_TEXTURE_WRAP_MIRRORED_REPEAT:
+            return Texture::Wrap::Mirror;
+        default:
+            fail(at + "/" + field, "must be 33071, 33648 or 10497");
+        }
+    };
+    picture.wrapU = wrap(s.wrapS, "wrapS");
+    picture.wrapV = wrap(s.wrapT, "wrapT");
+    if (s.magFilter == TINYGLTF_TEXTURE_FILTER_NEAREST ||
+        s.minFilter == TINYGLTF_TEXTURE_FILTER_NEAREST ||
+        s.minFilter == TINYGLTF_TEXTURE_FILTER_NEAREST_MIPMAP_NEAREST ||
+        s.minFilter == TINYGLTF_TEXTURE_FILTER_NEAREST_MIPMAP_LINEAR)
+        warn(what + "'s sampler asks for NEAREST filtering: rendered bilinear");
+}
+
+template <class Info>
+void GltfReader::readTextureTransform(const Info& info, const std::string& where,
+                                      Texture& picture) {
+    const auto e = info.extensions.find("KHR_texture_transform");
+    if (e == info.extensions.end()) return;
+    const std::string at = where + "/extensions/KHR_texture_transform";
+    auto numbers = [&](const char* key, std::vector<double> fallback) {
+        if (!e->second.Has(key)) return fallback;
+        const tinygltf::Value& v = e->second.Get(key);
+        std::vector<double> out;
+        if (v.IsNumber()) out.push_back(v.GetNumberAsDouble());
+        for (int i = 0; v.IsArray() && i < int(v.ArrayLen()); ++i)
+            out.push_back(v.Get(i).IsNumber() ? v.Get(i).GetNumberAsDouble() : NAN);
+        for (double x : out)
+            if (!std::isfinite(x) || std::fabs(x) > 1e6)
+                fail(at + "/" + key, "must be finite numbers of at most 1e6");
+        if (out.size() != fallback.size())
+            fail(at + "/" + key, "needs " + std::to_string(fallback.size()) + " numbers");
+        return out;
+    };
+    const std::vector<double> offset = numbers("offset", {0.0, 0.0});
+    const double rotation = numbers("rotation", {0.0})[0];
+    const std::vector<double> scale = numbers("scale", {1.0, 1.0});
+    if (e->second.Has("texCoord")) warn("KHR_texture_transform's texCoord is read as TEXCOORD_0");
+    const double c = std::cos(rotation), sn = std::sin(rotation);
+    // Column by column, as the extension's GLSL writes them.
+    const glm::dmat3 t(1, 0, 0, 0, 1, 0, offset[0], offset[1], 1);
+    const glm::dmat3 r(c, sn, 0, -sn, c, 0, 0, 0, 1);
+    const glm::dmat3 sc(scale[0], 0, 0, 0, scale[1], 0, 0, 0, 1);
+    const glm::dmat3 flip(1, 0, 0, 0, -1, 0, 0, 1, 1); // (u, v) -> (u, 1 - v)
+    picture.uvTransformed = true;
+    picture.uvTransform = mat3(flip * t * r * sc * flip);
+    picture.footprintScale = float(std::max({std::fabs(scale[0]), std::fabs(scale[1]), 1e-6}));
+}
+
+std::string GltfReader::decodeUri(const std::string& uri) {
+    std::string out;
+    for (size_t i = 0; i < uri.size(); ++i) {
+        if (uri[i] == '%' && i + 2 < uri.size() && std::isxdigit(uri[i + 1]) &&
+            std::isxdigit(uri[i + 2])) {
+            out += char(std::stoi(uri.substr(i + 1, 2), nullptr, 16));
+            i += 2;
+        } else {
+            out += uri[i];
+        }
+    }
+    return out;
+}
+
+} // namespace spw

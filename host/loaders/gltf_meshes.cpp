@@ -1,0 +1,286 @@
+// GltfReader's accessors and meshes (gltf_reader.h): every accessor read through bounds-checked
+// buffer views, sparse substitutions applied; each primitive's positions, normals, texture
+// coordinates, vertex colours and triangles into a Mesh in the camera-relative world.
+#include "host/loaders/gltf_reader.h"
+
+#include "shared/gltf.h"
+
+#include <glm/gtc/matrix_inverse.hpp>
+#include <glm/gtc/quaternion.hpp>
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <limits>
+#include <map>
+#include <memory>
+#include <set>
+
+namespace spw {
+
+namespace fs = std::filesystem;
+
+std::vector<double> GltfReader::readAccessor(int index, int components, const std::string& at,
+                                             bool integersOnly) const {
+    if (index < 0 || index >= int(model_.accessors.size()))
+        fail(at, "names accessor " + std::to_string(index) + " of " +
+                     std::to_string(model_.accessors.size()));
+    const std::string self = "/accessors/" + std::to_string(index);
+    const tinygltf::Accessor& a = model_.accessors[size_t(index)];
+    const int have = tinygltf::GetNumComponentsInType(uint32_t(a.type));
+    if (have != components)
+        fail(self + "/type", "has " + std::to_string(have) + " components where " +
+                                 std::to_string(components) + " are needed");
+    const int size = tinygltf::GetComponentSizeInBytes(uint32_t(a.componentType));
+    if (size <= 0) fail(self + "/componentType", "unknown component type");
+    const bool isFloat = a.componentType == TINYGLTF_COMPONENT_TYPE_FLOAT;
+    if (integersOnly && isFloat) fail(self + "/componentType", "indices must be integers");
+    const size_t element = size_t(size) * size_t(components);
+    std::vector<double> out(a.count * size_t(components), 0.0);
+    if (a.bufferView >= 0) { // without one, all zeros (the specification's rule)
+        size_t stride = 0;
+        const unsigned char* base =
+            viewBytes(a.bufferView, a.byteOffset, a.count, element, self, stride);
+        for (size_t i = 0; i < a.count; ++i)
+            for (int k = 0; k < components; ++k)
+                out[i * size_t(components) + size_t(k)] = component(
+                    base + i * stride + size_t(k) * size_t(size), a.componentType, a.normalized);
+    }
+    if (a.sparse.isSparse) applySparse(a, components, self, out);
+    return out;
+}
+
+void GltfReader::applySparse(const tinygltf::Accessor& a, int components, const std::string& self,
+                             std::vector<double>& out) const {
+    const std::string at = self + "/sparse";
+    const auto& s = a.sparse;
+    if (s.count < 0 || size_t(s.count) > a.count)
+        fail(at + "/count", "must lie between 0 and the accessor's count");
+    const int indexType = s.indices.componentType;
+    if (indexType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE &&
+        indexType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
+        indexType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT)
+        fail(at + "/indices/componentType", "must be an unsigned integer type");
+    const size_t indexSize = size_t(tinygltf::GetComponentSizeInBytes(uint32_t(indexType)));
+    const size_t size = size_t(tinygltf::GetComponentSizeInBytes(uint32_t(a.componentType)));
+    size_t indexStride = 0, valueStride = 0;
+    const unsigned char* indices =
+        viewBytes(s.indices.bufferView, size_t(s.indices.byteOffset), size_t(s.count), indexSize,
+                  at + "/indices", indexStride);
+    const unsigned char* values =
+        viewBytes(s.values.bufferView, size_t(s.values.byteOffset), size_t(s.count),
+                  size * size_t(components), at + "/values", valueStride);
+    for (size_t j = 0; j < size_t(s.count); ++j) {
+        const double i = component(indices + j * indexStride, indexType, false);
+        if (!(i < double(a.count)))
+            fail(at + "/indices", "index " + std::to_string(uint64_t(i)) +
+                                      " is past the accessor's count " + std::to_string(a.count));
+        for (int k = 0; k < components; ++k)
+            out[size_t(i) * size_t(components) + size_t(k)] = component(
+                values + j * valueStride + size_t(k) * size, a.componentType, a.normalized);
+    }
+}
+
+const unsigned char* GltfReader::viewBytes(int view, size_t byteOffset, size_t count,
+                                           size_t element, const std::string& at,
+                                           size_t& stride) const {
+    const std::string viewAt = "/bufferViews/" + std::to_string(view);
+    if (view < 0 || view >= int(model_.bufferViews.size()))
+        fail(at + "/bufferView", "names buffer view " + std::to_string(view) + " of " +
+                                     std::to_string(model_.bufferViews.size()));
+    const tinygltf::BufferView& v = model_.bufferViews[size_t(view)];
+    if (v.buffer < 0 || v.buffer >= int(model_.buffers.size()))
+        fail(viewAt + "/buffer", "names no buffer");
+    const std::vector<unsigned char>& data = model_.buffers[size_t(v.buffer)].data;
+    stride = v.byteStride ? v.byteStride : element;
+    if (stride < element) fail(viewAt + "/byteStride", "is smaller than an element");
+    if (v.byteOffset > data.size() || v.byteLength > data.size() - v.byteOffset)
+        fail(viewAt, "reaches past the end of its buffer");
+    const size_t room = byteOffset <= v.byteLength ? v.byteLength - byteOffset : 0;
+    if (byteOffset > v.byteLength ||
+        (count > 0 && (room < element || (count - 1) > (room - element) / stride)))
+        fail(at, "reaches past the end of its buffer view");
+    return data.data() + v.byteOffset + byteOffset;
+}
+
+double GltfReader::component(const unsigned char* p, int componentType, bool norm) {
+    auto get = [&](auto type) {
+        decltype(type) x;
+        std::memcpy(&x, p, sizeof x);
+        return x;
+    };
+    switch (componentType) {
+    case TINYGLTF_COMPONENT_TYPE_FLOAT:
+        return get(float{});
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE:
+        return norm ? get(uint8_t{}) / 255.0 : get(uint8_t{});
+    case TINYGLTF_COMPONENT_TYPE_BYTE:
+        return norm ? std::max(get(int8_t{}) / 127.0, -1.0) : get(int8_t{});
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT:
+        return norm ? get(uint16_t{}) / 65535.0 : get(uint16_t{});
+    case TINYGLTF_COMPONENT_TYPE_SHORT:
+        return norm ? std::max(get(int16_t{}) / 32767.0, -1.0) : get(int16_t{});
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT:
+        return get(uint32_t{});
+    case TINYGLTF_COMPONENT_TYPE_INT:
+        return get(int32_t{});
+    default:
+        return 0.0;
+    }
+}
+
+void GltfReader::readMesh(int index, const glm::dmat4& world, const std::string& at) {
+    if (index >= int(model_.meshes.size()))
+        fail(at,
+             "names mesh " + std::to_string(index) + " of " + std::to_string(model_.meshes.size()));
+    const tinygltf::Mesh& mesh = model_.meshes[size_t(index)];
+    for (size_t p = 0; p < mesh.primitives.size(); ++p)
+        readPrimitive(mesh.primitives[p], world,
+                      "/meshes/" + std::to_string(index) + "/primitives/" + std::to_string(p),
+                      mesh.name.empty() ? "mesh " + std::to_string(index) : mesh.name);
+}
+
+void GltfReader::readPrimitive(const tinygltf::Primitive& prim, const glm::dmat4& world,
+                               const std::string& at, const std::string& name) {
+    const int mode = prim.mode < 0 ? TINYGLTF_MODE_TRIANGLES : prim.mode;
+    if (mode != TINYGLTF_MODE_TRIANGLES && mode != TINYGLTF_MODE_TRIANGLE_STRIP &&
+        mode != TINYGLTF_MODE_TRIANGLE_FAN) {
+        warn("has points or lines (primitive mode " + std::to_string(mode) + "), not rendered");
+        return;
+    }
+    if (!prim.targets.empty()) warn("has morph targets: rendered without them");
+    const auto position = prim.attributes.find("POSITION");
+    if (position == prim.attributes.end()) fail(at + "/attributes", "has no POSITION");
+    const std::vector<double> pos = readAccessor(position->second, 3, at + "/attributes/POSITION");
+    const size_t vertices = pos.size() / 3;
+    Mesh m;
+    m.name = path_ + ": " + name;
+    m.shader = shaderFor(prim.material, at + "/material");
+    m.positions.resize(vertices);
+    for (size_t i = 0; i < vertices; ++i) {
+        const glm::dvec3 local(pos[3 * i], pos[3 * i + 1], pos[3 * i + 2]);
+        const glm::dvec3 w = glm::dvec3(world * glm::dvec4(local, 1.0));
+        if (!std::isfinite(w.x) || !std::isfinite(w.y) || !std::isfinite(w.z))
+            fail("/accessors/" + std::to_string(position->second),
+                 "position " + std::to_string(i) + " is not finite");
+        include(w);
+        const glm::dvec3 rel = w - scene_.origin;
+        if (const std::string far = beyondReach(rel, "position " + std::to_string(i)); !far.empty())
+            fail("/accessors/" + std::to_string(position->second), far);
+        m.positions[i] = vec3(rel);
+    }
+    readNormals(prim, world, vertices, at, m);
+    if (prim.attributes.count("TANGENT"))
+        warn("TANGENT attributes are not read: normal maps take tangents made from the "
+             "texture coordinates, triangle by triangle");
+    readTextureCoordinates(prim, vertices, at, m);
+    readColours(prim, vertices, at, m);
+    readTriangles(prim, mode, world, vertices, at, m);
+    if (m.triangles.empty()) return;
+    if (scene_.meshes.size() >= size_t(kMaxObjects))
+        fail(at, "more than " + std::to_string(kMaxObjects) + " primitives");
+    scene_.meshes.push_back(std::move(m));
+}
+
+void GltfReader::readNormals(const tinygltf::Primitive& prim, const glm::dmat4& world,
+                             size_t vertices, const std::string& at, Mesh& m) {
+    const auto n = prim.attributes.find("NORMAL");
+    if (n == prim.attributes.end()) return;
+    const glm::dmat3 normalMatrix = glm::inverseTranspose(glm::dmat3(world));
+    const std::vector<double> nor = readAccessor(n->second, 3, at + "/attributes/NORMAL");
+    if (nor.size() != 3 * vertices)
+        fail(at + "/attributes/NORMAL", "has another count than POSITION");
+    m.normals.resize(vertices);
+    for (size_t i = 0; i < vertices && !m.normals.empty(); ++i) {
+        const glm::dvec3 w = normalMatrix * glm::dvec3(nor[3 * i], nor[3 * i + 1], nor[3 * i + 2]);
+        const double len = glm::length(w);
+        if (!(len > 1e-30) || !std::isfinite(len)) {
+            warn("has zero or non-finite normals: its faces' own normals used there");
+            m.normals.clear();
+        } else {
+            m.normals[i] = vec3(w / len);
+        }
+    }
+}
+
+void GltfReader::readTextureCoordinates(const tinygltf::Primitive& prim, size_t vertices,
+                                        const std::string& at, Mesh& m) const {
+    const auto t = prim.attributes.find("TEXCOORD_0");
+    if (t == prim.attributes.end()) return;
+    const std::vector<double> uv = readAccessor(t->second, 2, at + "/attributes/TEXCOORD_0");
+    if (uv.size() != 2 * vertices)
+        fail(at + "/attributes/TEXCOORD_0", "has another count than POSITION");
+    m.uvs.resize(vertices);
+    for (size_t i = 0; i < vertices; ++i) {
+        m.uvs[i] = vec2(float(uv[2 * i]), float(1.0 - uv[2 * i + 1]));
+        if (!std::isfinite(m.uvs[i].x) || !std::isfinite(m.uvs[i].y))
+            fail("/accessors/" + std::to_string(t->second), "a texture coordinate is not finite");
+    }
+}
+
+void GltfReader::readColours(const tinygltf::Primitive& prim, size_t vertices,
+                             const std::string& at, Mesh& m) const {
+    const auto c = prim.attributes.find("COLOR_0");
+    if (c == prim.attributes.end() || shaderOverride_ >= 0) return;
+    const std::string where = at + "/attributes/COLOR_0";
+    const int index = c->second;
+    const std::string self = "/accessors/" + std::to_string(index);
+    const int components =
+        index >= 0 && index < int(model_.accessors.size())
+            ? tinygltf::GetNumComponentsInType(uint32_t(model_.accessors[size_t(index)].type))
+            : 3; // readAccessor names the bad index
+    if (components != 3 && components != 4) fail(self + "/type", "COLOR_0 must be VEC3 or VEC4");
+    const std::vector<double> rgba = readAccessor(index, components, where);
+    if (rgba.size() != size_t(components) * vertices)
+        fail(where, "has another count than POSITION");
+    m.colours.resize(vertices);
+    for (size_t i = 0; i < vertices; ++i)
+        for (int k = 0; k < 3; ++k) {
+            const double x = rgba[i * size_t(components) + size_t(k)];
+            if (!std::isfinite(x)) fail(self, "a colour is not finite");
+            m.colours[i][k] = float(std::clamp(x, 0.0, 1.0));
+        }
+}
+
+void GltfReader::readTriangles(const tinygltf::Primitive& prim, int mode, const glm::dmat4& world,
+                               size_t vertices, const std::string& at, Mesh& m) const {
+    std::vector<uint> indices;
+    if (prim.indices >= 0) {
+        for (double x : readAccessor(prim.indices, 1, at + "/indices", true)) {
+            if (!(x >= 0.0) || x >= double(vertices))
+                fail("/accessors/" + std::to_string(prim.indices),
+                     "index " + std::to_string(uint64_t(std::max(x, 0.0))) +
+                         " is past the vertex count " + std::to_string(vertices));
+            indices.push_back(uint(x));
+        }
+    } else {
+        for (size_t i = 0; i < vertices; ++i)
+            indices.push_back(uint(i));
+    }
+    // A mirroring transform turns the winding: keep the front faces the file's.
+    const bool mirrored = glm::determinant(glm::dmat3(world)) < 0.0;
+    auto add = [&](uint a, uint b, uint c) {
+        if (mirrored) std::swap(b, c);
+        const vec3 e1 = m.positions[b] - m.positions[a], e2 = m.positions[c] - m.positions[a];
+        if (glm::length(glm::cross(e1, e2)) > 0.0f)
+            m.triangles.push_back(uvec3(a, b, c));
+        else
+            ++m.droppedTriangles;
+    };
+    if (mode == TINYGLTF_MODE_TRIANGLES) {
+        if (indices.size() % 3 != 0) fail(at + "/indices", "a triangle list needs 3n indices");
+        for (size_t i = 0; i + 2 < indices.size(); i += 3)
+            add(indices[i], indices[i + 1], indices[i + 2]);
+    } else if (mode == TINYGLTF_MODE_TRIANGLE_STRIP) {
+        for (size_t i = 0; i + 2 < indices.size(); ++i)
+            i % 2 ? add(indices[i + 1], indices[i], indices[i + 2])
+                  : add(indices[i], indices[i + 1], indices[i + 2]);
+    } else {
+        for (size_t i = 1; i + 1 < indices.size(); ++i)
+            add(indices[0], indices[i], indices[i + 1]);
+    }
+}
+
+} // namespace spw

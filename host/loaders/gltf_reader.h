@@ -1,0 +1,193 @@
+// The glTF reader that gltf_loader.cpp (the document, its node graph, cameras and lights),
+// gltf_meshes.cpp (accessors and meshes) and gltf_materials.cpp (materials and their images)
+// each implement a part of. Internal to host/loaders/.
+#pragma once
+
+#include "host/scene/scene.h"
+
+#include <glm/mat4x4.hpp>
+#include <tiny_gltf.h>
+
+#include <filesystem>
+#include <map>
+#include <memory>
+#include <set>
+#include <string>
+#include <vector>
+
+namespace spw {
+
+// tinygltf reads every image's bytes; the pixels are left to OpenImageIO's texture cache, which
+// reads an image file itself, and an embedded image (a buffer view, a data: URI) from these
+// bytes, kept here per image.
+using ImageBytes = std::map<int, std::shared_ptr<const std::string>>;
+
+class GltfReader {
+  public:
+    GltfReader(const std::string& path, Scene& scene)
+        : path_(path), dir_(std::filesystem::path(path).parent_path()), scene_(scene) {}
+
+    // The whole file as the scene: its camera (or one framing it), its lights (or a uniform
+    // environment).
+    void readScene();
+
+    // The file's meshes and lights placed by `transform` into a scene whose camera is set;
+    // every mesh takes `shader` where it is >= 0, else the file's materials, appended.
+    void readObject(const glm::dmat4& transform, int shader);
+
+  private:
+    void read(const glm::dmat4& transform, bool takesCamera);
+
+    enum class Pass { Camera, Geometry };
+
+    [[noreturn]] void fail(const std::string& pointer, const std::string& message) const {
+        throw SceneError(path_, 0, (pointer.empty() ? "" : pointer + ": ") + message);
+    }
+    void warn(const std::string& message) {
+        if (warned_.insert(message).second) scene_.warnings.push_back(path_ + ": " + message);
+    }
+
+    void parse();
+
+    void checkExtensions();
+
+    // The node's local transform: its matrix, or translation x rotation x scale.
+    glm::dmat4 localTransform(const tinygltf::Node& n, const std::string& at) const;
+    glm::dmat4 finite(const glm::dmat4& m, const std::string& at) const;
+
+    void visit(int index, const glm::dmat4& parent, const std::string& at, Pass pass, int depth);
+
+    void readCamera(int index, const glm::dmat4& world, const std::string& at);
+
+    // The camera at `world`'s origin, looking along its -Z with +Y up (scale taken out).
+    void placeCamera(const glm::dmat4& world, double yfov, double aspect);
+
+    // Without a camera: one on the scene's +Z side looking at the centre of its bounds, far
+    // enough back that a 40-degree vertical field of view holds the bounding sphere.
+    void frameBounds();
+    void include(const glm::dvec3& p);
+
+    // --- accessors -------------------------------------------------------------------------
+
+    // Accessor `index` as `count` elements of `components` doubles each (normalized integers
+    // mapped to [0, 1] or [-1, 1]), its sparse substitutions applied; every byte it reads checked
+    // to lie inside its buffer.
+    std::vector<double> readAccessor(int index, int components, const std::string& at,
+                                     bool integersOnly = false) const;
+
+    // A sparse accessor's substitutions: element indices[j] of `out` becomes values[j].
+    void applySparse(const tinygltf::Accessor& a, int components, const std::string& self,
+                     std::vector<double>& out) const;
+
+    // The first of `count` elements of `element` bytes at `byteOffset` in buffer view `view`,
+    // and their stride; `at` (what reads them) names the error when any would lie outside.
+    const unsigned char* viewBytes(int view, size_t byteOffset, size_t count, size_t element,
+                                   const std::string& at, size_t& stride) const;
+
+    static double component(const unsigned char* p, int componentType, bool norm);
+
+    // --- meshes ----------------------------------------------------------------------------
+
+    void readMesh(int index, const glm::dmat4& world, const std::string& at);
+
+    void readPrimitive(const tinygltf::Primitive& prim, const glm::dmat4& world,
+                       const std::string& at, const std::string& name);
+
+    // NORMAL, turned into world space (the inverse transpose); where one is zero or not finite,
+    // none (the faces' own normals).
+    void readNormals(const tinygltf::Primitive& prim, const glm::dmat4& world, size_t vertices,
+                     const std::string& at, Mesh& m);
+
+    // TEXCOORD_0, its v turned to run up: glTF's v runs down the image, Spillway's (OBJ's) up.
+    void readTextureCoordinates(const tinygltf::Primitive& prim, size_t vertices,
+                                const std::string& at, Mesh& m) const;
+
+    // COLOR_0 (RGB, or RGBA whose alpha is not read): per-vertex factors of the base colour,
+    // clamped to [0, 1]. Not read where a YAML shader overrides the file's materials.
+    void readColours(const tinygltf::Primitive& prim, size_t vertices, const std::string& at,
+                     Mesh& m) const;
+
+    // The primitive's triangles (a list, strip or fan; without indices, its vertices in order),
+    // each index checked against the vertex count; zero-area triangles counted, not kept.
+    void readTriangles(const tinygltf::Primitive& prim, int mode, const glm::dmat4& world,
+                       size_t vertices, const std::string& at, Mesh& m) const;
+
+    // --- materials -------------------------------------------------------------------------
+
+    // glTF's default material: white, metallic 1, roughness 1.
+    static Shader defaultShader();
+
+    int shaderFor(int material, const std::string& at);
+
+    Shader readMaterial(int index);
+
+    // The material's images: base colour (and its alpha, for MASK), metallic-roughness and
+    // normal map, and what is not rendered of the rest.
+    void readImages(const tinygltf::Material& mat, Shader& s, const std::string& at,
+                    const std::string& name);
+
+    // emissiveFactor times KHR_materials_emissive_strength's strength, times emissiveTexture's
+    // image (sRGB) where the material has one and the factor is not black.
+    void readEmission(const tinygltf::Material& mat, Shader& s, const std::string& at,
+                      const std::string& name);
+
+    double unit(double x, const std::string& at) const {
+        if (!(x >= 0.0 && x <= 1.0)) fail(at, "must lie in [0, 1]");
+        return x;
+    }
+
+    // The base colour's image, times the factor: Layered(upper: image, lower: 0, mask: factor).
+    void baseColourTexture(const tinygltf::TextureInfo& info, Shader& s, const std::string& at,
+                           const std::string& name);
+
+    // alphaMode MASK: a cut-out where baseColorFactor's alpha times the base colour image's
+    // alpha channel (1 where it has none) is below alphaCutoff. A factor that decides alone is
+    // no cut-out at all (at least the cutoff) or hides the whole surface.
+    void readCutout(const tinygltf::Material& mat, Shader& s, const std::string& at,
+                    const std::string& name);
+
+    // A texture reference's image, as a Standard texture with its KHR_texture_transform: read
+    // from memory where the file embeds it (checked readable now), else from beside the file.
+    template <class Info> // tinygltf::TextureInfo, NormalTextureInfo
+    Texture imageTexture(const Info& info, const std::string& where, const std::string& what);
+
+    // OpenImageIO's error after a failed open, as ": why" (or nothing). Asking also clears it:
+    // OpenImageIO keeps it per thread until asked, and reports it at exit otherwise.
+    static std::string imageError();
+
+    // A sampler's wrap modes; its filters are always bilinear and trilinear across MIP levels,
+    // and a NEAREST one is warned about.
+    void readSampler(const tinygltf::Sampler& s, const std::string& at, const std::string& what,
+                     Texture& picture);
+
+    // KHR_texture_transform on a texture reference: T(offset) R(rotation) S(scale) of glTF's
+    // texture coordinates, written for Spillway's (v = 1 - glTF's v) as F M F, F that flip.
+    template <class Info>
+    void readTextureTransform(const Info& info, const std::string& where, Texture& picture);
+
+    static std::string decodeUri(const std::string& uri);
+
+    // --- lights ----------------------------------------------------------------------------
+
+    void readLight(const tinygltf::Node& n, const glm::dmat4& world, const std::string& at);
+
+    void warnUnrendered() {
+        if (!model_.animations.empty()) warn("has animations: rendered at rest");
+        if (model_.scenes.size() > 1) warn("has more than one scene: the default one rendered");
+    }
+
+    std::string path_;
+    std::filesystem::path dir_;
+    Scene& scene_;
+    tinygltf::Model model_;
+    ImageBytes embedded_;
+    std::set<std::string> warned_;
+    std::set<int> onPath_;
+    std::vector<int> shaderOf_;
+    glm::dvec3 lo_{0.0}, hi_{0.0}; // the bounds of every position and point light read
+    bool bounded_ = false;
+    bool cameraFound_ = false, cameraSeen_ = false;
+    int shaderOverride_ = -1;
+};
+
+} // namespace spw
