@@ -5,7 +5,8 @@
 # REVISION once in a cached copy (under ${SPILLWAY_IDENTICAL_CACHE:-/tmp/spillway-identical}),
 # builds the working tree in build/, renders the Cornell box, scenes/every-model.yaml (every
 # surface model, a Layered image texture, thin lens, Gaussian filter), scenes/open-box-lights.yaml
-# and, where it has been made, the in-core benchmark's textured scene with both binaries on
+# and, where they have been made, the in-core benchmark's textured scene and the glTF test files
+# (out/gltf/*.glb) with both binaries on
 # every backend and pipeline variant below, and compares the pixels (`spillway compare` says
 # "images identical" only when every value is equal). Exit 0 when all are identical, 1 when any
 # differs; the Vulkan variants are skipped, and said so, where no Vulkan device exists.
@@ -47,6 +48,9 @@ have_vulkan=1
 # `scripts/bench.py incore` has made it.
 scenes=(scenes/cornell-box.yaml scenes/every-model.yaml scenes/open-box-lights.yaml)
 [[ -f "$root/out/incore-textured/scene.yaml" ]] && scenes+=(out/incore-textured/scene.yaml)
+# And the glTF files `scripts/cycles_compare.py --make-test-files out/gltf` makes (materials,
+# images, a normal map, an emission image), where they have been made.
+for f in "$root"/out/gltf/*.glb; do [[ -f $f ]] && scenes+=("out/gltf/$(basename "$f")"); done
 
 failed=0
 for scene in "${scenes[@]}"; do
@@ -57,7 +61,7 @@ for scene in "${scenes[@]}"; do
             echo "skipped    $scene $name (no Vulkan device)"
             continue
         fi
-        tag="$(basename "$scene" .yaml)-$name"
+        tag="$(basename "${scene%.*}")-$name"
         if ! (cd "$root" && "$base/build/spillway" render "$scene" --spp 16 --seed 7 --quiet "${flags[@]}" -o "$out/$tag-base.exr" 2>/dev/null); then
             echo "skipped    $scene $name ($rev cannot render it: a scene newer than the revision)"
             continue

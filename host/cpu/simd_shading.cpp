@@ -390,6 +390,48 @@ bool simdShadingApplies(const SceneView& view) {
     return true;
 }
 
+namespace {
+// A block of hits per model with a kernel, filled as the hits come: runs of one shader where the
+// hits are sorted, interleaved models where they are not.
+struct ModelBlock {
+    SurfaceLanes lanes;
+    std::uint32_t hitOf[kBlock];
+    size_t count = 0;
+};
+
+// The hits of a block of one model with a kernel, shaded SIMD-wide into out[b.hitOf[k]]; the
+// block is emptied. `results` is scratch.
+void shadeBlock(const SceneView& view, const RenderParams& rp, bool nee, bool mis, uint model,
+                const ShadeInput* in, ModelBlock& b, SurfaceResults& results, ShadeResult* out) {
+    const size_t end = wholeVectors(b.count);
+    padLanes(b.lanes, b.count, end);
+    HWY_DYNAMIC_DISPATCH(MakeRandomNumbers)(b.lanes.random, end, rp.sampling, rp.seed);
+    for (size_t k = 0; k < end; ++k)
+        pickLaneEmitter(view, rp, nee, b.lanes, k);
+    switch (model) {
+    case kModelLambert:
+        HWY_DYNAMIC_DISPATCH(ShadeLambertLanes)(b.lanes, end, nee, mis, rp.threshold, results);
+        break;
+    case kModelConductor:
+        HWY_DYNAMIC_DISPATCH(ShadeConductorLanes)(b.lanes, end, nee, mis, rp.threshold, results);
+        break;
+    case kModelDielectric:
+        HWY_DYNAMIC_DISPATCH(ShadeDielectricLanes)(b.lanes, end, nee, mis, rp.threshold, results);
+        break;
+    case kModelMetallicRoughness:
+        HWY_DYNAMIC_DISPATCH(ShadeMetallicRoughnessLanes)
+        (b.lanes, end, nee, mis, rp.threshold, results);
+        break;
+    }
+    for (size_t k = 0; k < b.count; ++k) {
+        const ShadeInput& hit = in[b.hitOf[k]];
+        takeLane(shaderAtHit(view.shaders[hit.hit.shader], hit.hit), results, k, hit,
+                 out[b.hitOf[k]]);
+    }
+    b.count = 0;
+}
+} // namespace
+
 void shadeHits(const SceneView& view, const RenderParams& rp, bool simd, const ShadeInput* in,
                size_t n, ShadeResult* out) {
     if (!simd) {
@@ -417,45 +459,10 @@ void shadeHits(const SceneView& view, const RenderParams& rp, bool simd, const S
         }
         otherCount = 0;
     };
-    // A block of hits per model with a kernel, filled as the hits come: runs of one shader
-    // where the hits are sorted, interleaved models where they are not.
-    struct Block {
-        SurfaceLanes lanes;
-        std::uint32_t hitOf[kBlock];
-        size_t count = 0;
-    };
-    Block blocks[kModelCount];
+    ModelBlock blocks[kModelCount];
     SurfaceResults results;
     auto run = [&](uint model) {
-        Block& b = blocks[model];
-        const size_t end = wholeVectors(b.count);
-        padLanes(b.lanes, b.count, end);
-        HWY_DYNAMIC_DISPATCH(MakeRandomNumbers)(b.lanes.random, end, rp.sampling, rp.seed);
-        for (size_t k = 0; k < end; ++k)
-            pickLaneEmitter(view, rp, nee, b.lanes, k);
-        switch (model) {
-        case kModelLambert:
-            HWY_DYNAMIC_DISPATCH(ShadeLambertLanes)(b.lanes, end, nee, mis, rp.threshold, results);
-            break;
-        case kModelConductor:
-            HWY_DYNAMIC_DISPATCH(ShadeConductorLanes)
-            (b.lanes, end, nee, mis, rp.threshold, results);
-            break;
-        case kModelDielectric:
-            HWY_DYNAMIC_DISPATCH(ShadeDielectricLanes)
-            (b.lanes, end, nee, mis, rp.threshold, results);
-            break;
-        case kModelMetallicRoughness:
-            HWY_DYNAMIC_DISPATCH(ShadeMetallicRoughnessLanes)
-            (b.lanes, end, nee, mis, rp.threshold, results);
-            break;
-        }
-        for (size_t k = 0; k < b.count; ++k) {
-            const ShadeInput& hit = in[b.hitOf[k]];
-            takeLane(shaderAtHit(view.shaders[hit.hit.shader], hit.hit), results, k, hit,
-                     out[b.hitOf[k]]);
-        }
-        b.count = 0;
+        shadeBlock(view, rp, nee, mis, model, in, blocks[model], results, out);
     };
     for (size_t i = 0; i < n; ++i) {
         const ShaderParams& sh = view.shaders[in[i].hit.shader];
@@ -470,7 +477,7 @@ void shadeHits(const SceneView& view, const RenderParams& rp, bool simd, const S
             if (otherCount == kBlock) runOthers();
             continue;
         }
-        Block& b = blocks[sh.model];
+        ModelBlock& b = blocks[sh.model];
         fillLane(view, rp, in[i], b.lanes, b.count, out[i]);
         b.hitOf[b.count++] = std::uint32_t(i);
         if (b.count == kBlock) run(sh.model);

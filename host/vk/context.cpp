@@ -209,6 +209,30 @@ std::string listing(const std::vector<DeviceInfo>& infos) {
     return s;
 }
 
+// The device `--device` names (an index, or part of a name, any case), or the first usable one
+// where it names none; throws where there is no such device or it is not usable.
+size_t chooseDevice(const std::string& device, const std::vector<DeviceInfo>& infos) {
+    if (device.empty()) {
+        for (const DeviceInfo& d : infos)
+            if (d.usable) return d.index;
+        throw NoDeviceError("no usable Vulkan device:" + listing(infos));
+    }
+    const bool numeric = std::all_of(device.begin(), device.end(), [](char c) {
+        return std::isdigit(static_cast<unsigned char>(c));
+    });
+    for (const DeviceInfo& d : infos) {
+        const bool match = numeric ? std::to_string(d.index) == device
+                                   : lower(d.name).find(lower(device)) != std::string::npos;
+        if (!match) continue;
+        if (!d.usable)
+            throw std::runtime_error("--device " + device + ": " + d.name +
+                                     " is not usable: " + d.whyNot);
+        return d.index;
+    }
+    throw std::runtime_error("--device " + device +
+                             ": no such Vulkan device; there are:" + listing(infos));
+}
+
 } // namespace
 
 std::uint64_t validationMessageCount() {
@@ -267,37 +291,9 @@ Context::Context(const VulkanConfig& config) {
         if (devices.empty())
             throw NoDeviceError("no Vulkan device found (the loader sees drivers but no device)");
 
-        int chosen = -1;
-        if (config.device.empty()) {
-            for (const DeviceInfo& d : infos)
-                if (d.usable) {
-                    chosen = int(d.index);
-                    break;
-                }
-            if (chosen < 0) throw NoDeviceError("no usable Vulkan device:" + listing(infos));
-        } else {
-            const bool numeric =
-                std::all_of(config.device.begin(), config.device.end(),
-                            [](char c) { return std::isdigit(static_cast<unsigned char>(c)); });
-            for (const DeviceInfo& d : infos) {
-                bool match = numeric
-                                 ? std::to_string(d.index) == config.device
-                                 : lower(d.name).find(lower(config.device)) != std::string::npos;
-                if (match) {
-                    chosen = int(d.index);
-                    break;
-                }
-            }
-            if (chosen < 0)
-                throw std::runtime_error("--device " + config.device +
-                                         ": no such Vulkan device; there are:" + listing(infos));
-            if (!infos[size_t(chosen)].usable)
-                throw std::runtime_error("--device " + config.device + ": " +
-                                         infos[size_t(chosen)].name +
-                                         " is not usable: " + infos[size_t(chosen)].whyNot);
-        }
-        physical_ = devices[size_t(chosen)];
-        info_ = infos[size_t(chosen)];
+        const size_t chosen = chooseDevice(config.device, infos);
+        physical_ = devices[chosen];
+        info_ = infos[chosen];
         info_.usable = true;
         vkGetPhysicalDeviceProperties(physical_, &properties_);
         vkGetPhysicalDeviceMemoryProperties(physical_, &memory_);

@@ -90,6 +90,25 @@ TEST(Architecture, EveryIncludeGoesDownTheLayers) {
     EXPECT_GT(checked, 50u);
 }
 
+// Every folder of code says what it holds, in a README of its own, and is a layer the test knows.
+TEST(Architecture, EveryFolderOpensWithAReadme) {
+    size_t folders = 0;
+    for (const std::string dir : {"host", "embree_backend"}) {
+        std::vector<fs::path> paths = {fs::path(sourceDir()) / dir};
+        if (dir == "host")
+            for (const auto& e : fs::directory_iterator(paths[0]))
+                if (e.is_directory()) paths.push_back(e.path());
+        for (const fs::path& p : paths) {
+            if (p.filename() == "host") continue;
+            ++folders;
+            const std::string layer = layerOf(fs::relative(p, sourceDir()).generic_string() + "/");
+            EXPECT_NE(std::find(kLayers.begin(), kLayers.end(), layer), kLayers.end()) << p;
+            EXPECT_TRUE(fs::is_regular_file(p / "README.md")) << p << " has no README.md";
+        }
+    }
+    EXPECT_GE(folders, 13u);
+}
+
 TEST(Architecture, NoEmbreeTypeOutsideTheEmbreeBackend) {
     static const std::regex embree("embree3/|\\bRTC[A-Z][A-Za-z]*\\b|\\brtc[A-Z][A-Za-z0-9]*\\(");
     for (const std::string& file : sources()) {
