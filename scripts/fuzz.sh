@@ -28,8 +28,10 @@ for name in "${names[@]}"; do
   crashers="$root/tests/fuzz/crashers/$name"
   mkdir -p "$corpus" "$crashers"
   echo "== $name: ${seconds} s" >&2
+  dict=()
+  [ -f "$root/tests/fuzz/$name.dict" ] && dict=(-dict="$root/tests/fuzz/$name.dict")
   ( status=0
-    "$build/${name}_fuzzer" "$corpus" "$root/tests/fuzz/seeds/$name" -max_total_time="$seconds" \
+    "$build/${name}_fuzzer" "$corpus" "$root/tests/fuzz/seeds/$name" -max_total_time="$seconds" "${dict[@]}" \
       -timeout=10 -rss_limit_mb=4096 -max_len=65536 -print_final_stats=1 -artifact_prefix="$crashers/" \
       >"$build/$name.log" 2>&1 || status=$?
     echo "$status" >"$build/$name.status" ) &

@@ -113,6 +113,12 @@ CompareOptions parseCompareOptions(const std::vector<std::string>& args) {
     if (o.files.size() != 2)
         throw UsageError("compare takes two images, A and the reference B (" +
                          std::to_string(o.files.size()) + " given)");
+    // The heatmap would replace an input it is computed from (however the path is spelt: a link,
+    // ./, another folder's ..).
+    for (const std::string& input : o.files)
+        if (!o.heatmapPath.empty() && sameFile(o.heatmapPath, input))
+            throw UsageError("--heatmap '" + o.heatmapPath + "' names the input '" + input +
+                             "'; write the heatmap to another file");
     return o;
 }
 

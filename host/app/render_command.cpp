@@ -68,7 +68,8 @@ Scene loadForRender(const RenderOptions& o, bool writes) {
     return scene;
 }
 
-std::unique_ptr<ErrorCsv> openErrorCsv(const RenderOptions& o, const Scene& scene) {
+std::unique_ptr<ErrorCsv> openErrorCsv(const RenderOptions& o, const Scene& scene,
+                                       const std::optional<Checkpoint>& resume) {
     if (o.errorCsvPath.empty()) return nullptr;
     std::optional<ImageRGB> reference;
     if (!o.referencePath.empty()) {
@@ -83,7 +84,13 @@ std::unique_ptr<ErrorCsv> openErrorCsv(const RenderOptions& o, const Scene& scen
                 std::to_string(reference->height) + ", the scene renders " +
                 std::to_string(scene.image.width) + "x" + std::to_string(scene.image.height));
     }
-    return std::make_unique<ErrorCsv>(o.errorCsvPath, std::move(reference));
+    std::optional<int> resumed;
+    if (resume) resumed = resume->iterations; // the rows count iterations from the range's start
+    try {
+        return std::make_unique<ErrorCsv>(o.errorCsvPath, std::move(reference), resumed);
+    } catch (const std::invalid_argument& e) {
+        throw UsageError(e.what());
+    }
 }
 
 // --progress auto: a bar on a terminal, nothing otherwise.
@@ -205,7 +212,7 @@ int renderCommand(const std::vector<std::string>& args, Ranks* ranks) {
     fitToRank(o, ranks, writes);
     const std::optional<Checkpoint> resume = readResume(o);
     const Scene scene = loadForRender(o, writes);
-    const std::unique_ptr<ErrorCsv> errorCsv = openErrorCsv(o, scene);
+    const std::unique_ptr<ErrorCsv> errorCsv = openErrorCsv(o, scene, resume);
     // Under mpirun at most four updates a second (progress.h says why).
     ProgressBar progress(progressStyle(o.progress), ranks ? 0.25 : 0.0);
     const SamplingPlan plan = planSampling(scene.image, o.config.spp);

@@ -169,12 +169,16 @@ void writeImage8(const std::string& path, int width, int height, const unsigned 
     writeFileAtomically(path, bytes.data(), bytes.size());
 }
 
-std::string imageSizeProblem(const std::string& path, long long width, long long height) {
-    if (width >= 1 && height >= 1 && width <= kMaxImagePixels && height <= kMaxImagePixels &&
-        width * height <= kMaxImagePixels)
+std::string imageSizeProblem(const std::string& path, long long width, long long height,
+                             long long maxPixels, long long maxSide) {
+    if (width >= 1 && height >= 1 && width <= maxSide && height <= maxSide &&
+        width <= maxPixels / height)
         return "";
+    std::string limit =
+        "1 to 2^" + std::to_string(63 - __builtin_clzll(std::uint64_t(maxPixels))) + " pixels";
+    if (maxSide < maxPixels) limit += ", sides up to " + std::to_string(maxSide);
     return "image '" + path + "' is " + std::to_string(width) + " x " + std::to_string(height) +
-           " pixels; Spillway reads images of 1 to 2^26 pixels";
+           " pixels; Spillway reads images of " + limit;
 }
 
 namespace {
@@ -354,8 +358,15 @@ std::string exrHeaderProblem(const std::string& path) {
 }
 
 ImageRGB readImage(const std::string& path) {
+    // A FIFO or a folder would block the open or read as nonsense: regular files only.
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(path, ec))
+        throw std::runtime_error("image '" + path + "' is not a regular file");
     if (const std::string why = exrHeaderProblem(path); !why.empty()) throw std::runtime_error(why);
-    auto in = OIIO::ImageInput::open(path);
+    // Colour as stored: not premultiplied by an alpha channel the reader would otherwise apply.
+    OIIO::ImageSpec config;
+    config.attribute("oiio:UnassociatedAlpha", 1);
+    auto in = OIIO::ImageInput::open(path, &config);
     if (!in) throw std::runtime_error("cannot read image '" + path + "': " + OIIO::geterror());
     const OIIO::ImageSpec& spec = in->spec();
     if (const std::string why = imageSizeProblem(path, spec.width, spec.height); !why.empty())
@@ -364,7 +375,8 @@ ImageRGB readImage(const std::string& path) {
     ImageRGB img;
     img.width = spec.width;
     img.height = spec.height;
-    const int nc = std::min(spec.nchannels, 3); // RGB, or grey; never the file's other channels
+    // RGB, or grey (grey and alpha: the grey); never the file's other channels.
+    const int nc = spec.nchannels == 2 ? 1 : std::min(spec.nchannels, 3);
     const size_t pixels = size_t(spec.width) * size_t(spec.height);
     std::vector<float> all(pixels * size_t(nc));
     if (!in->read_image(0, 0, 0, nc, OIIO::TypeDesc::FLOAT, all.data()))

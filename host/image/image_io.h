@@ -50,10 +50,13 @@ constexpr long long kMaxImagePixels = 1LL << 26;
 // (encodeImage says why).
 constexpr long long kZipImagePixels = 1LL << 22;
 
-// Whether a header's size is one Spillway reads: 1 .. kMaxImagePixels pixels. "" if so, else
-// why not, naming `path` (checked before any pixel is allocated: a header is a few bytes that
-// may claim gigabytes).
-std::string imageSizeProblem(const std::string& path, long long width, long long height);
+// Whether a header's size is one Spillway reads: 1 .. maxPixels pixels (a power of two), each
+// side at most maxSide. "" if so, else why not, naming `path` (checked before any pixel is
+// allocated: a header is a few bytes that may claim gigabytes). Textures read tile by tile have
+// limits of their own (host/scene/scene.h, kMaxTexturePixels).
+std::string imageSizeProblem(const std::string& path, long long width, long long height,
+                             long long maxPixels = kMaxImagePixels,
+                             long long maxSide = kMaxImagePixels);
 
 // Whether an OpenEXR file's header can be handed to OpenEXR: "" if so (or if the file is not an
 // EXR), else why not, naming `path`. OpenEXR allocates what a header claims before reading it: an

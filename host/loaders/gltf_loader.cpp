@@ -5,6 +5,7 @@
 // bounds; gltf_meshes.cpp reads accessors and meshes, gltf_materials.cpp materials and images.
 #include "host/loaders/gltf_loader.h"
 
+#include "host/loaders/gltf_preflight.h"
 #include "host/loaders/gltf_reader.h"
 #include "shared/gltf.h"
 
@@ -34,16 +35,31 @@ const std::set<std::string> kHonoured = {"KHR_lights_punctual", "KHR_materials_e
 // The image of a `spillway render model.glb` without an aspect ratio: 640 pixels wide.
 constexpr int kDefaultWidth = 640;
 constexpr double kDefaultAspect = 4.0 / 3.0;
+constexpr double kMinAspect = 0.01, kMaxAspect = 100.0;
 
 // glTF's photometric units into the radiometric ones Spillway's lights take, as Blender's glTF
 // importer converts them (683 lm/W): a point light's candela into W/sr, a directional light's
 // lux into W/m^2.
 constexpr double kLumensPerWatt = 683.0;
 
+// What the image callback is handed: where to keep an embedded image's bytes, the model being
+// parsed (its buffers and views are read before its images), and the first problem found.
+struct ImageCallback {
+    ImageBytes* bytes;
+    const tinygltf::Model* model;
+    std::string problem;
+};
+
 bool keepImageUndecoded(tinygltf::Image* image, const int index, std::string*, std::string*, int,
                         int, const unsigned char* bytes, int size, void* user) {
+    ImageCallback& cb = *static_cast<ImageCallback*>(user);
+    // tinygltf hands an image's buffer view without checking that it lies in its buffer.
+    if (const std::string why = imageViewProblem(*cb.model, *image, index); !why.empty()) {
+        cb.problem = why;
+        return false;
+    }
     if (image->uri.empty() || image->uri.rfind("data:", 0) == 0)
-        (*static_cast<ImageBytes*>(user))[index] = std::make_shared<const std::string>(
+        (*cb.bytes)[index] = std::make_shared<const std::string>(
             reinterpret_cast<const char*>(bytes), size_t(std::max(size, 0)));
     return true;
 }
@@ -97,12 +113,25 @@ void GltfReader::parse() {
     std::error_code ec;
     if (!fs::is_regular_file(path_, ec))
         throw SceneError(path_, 0, "cannot open the glTF file: not a readable file");
+    preflightGltf(path_, kHonoured);
     tinygltf::TinyGLTF loader;
-    loader.SetImageLoader(keepImageUndecoded, &embedded_);
+    loader.SetFsCallbacks(regularFilesOnly());
+    ImageCallback images{&embedded_, &model_, ""};
+    loader.SetImageLoader(keepImageUndecoded, &images);
     std::string err, warnings;
     const bool binary = lower(fs::path(path_).extension().string()) == ".glb";
     const bool ok = binary ? loader.LoadBinaryFromFile(&model_, &err, &warnings, path_)
                            : loader.LoadASCIIFromFile(&model_, &err, &warnings, path_);
+    if (!images.problem.empty()) throw SceneError(path_, 0, images.problem);
+    // tinygltf 2.7 reports a skin without inverseBindMatrices as an error, yet parses it: the
+    // specification makes them optional (identity matrices), and skins render in bind pose.
+    for (size_t at; (at = err.find("'inverseBindMatrices' property is missing in Skin.\n")) !=
+                    std::string::npos;)
+        err.erase(at, std::strlen("'inverseBindMatrices' property is missing in Skin.\n"));
+    scene_.inputs.push_back(path_);
+    for (const tinygltf::Buffer& b : model_.buffers)
+        if (!b.uri.empty() && b.uri.rfind("data:", 0) != 0)
+            scene_.inputs.push_back((dir_ / decodeGltfUri(b.uri)).string());
     if (!ok || !err.empty()) {
         while (!err.empty() && (err.back() == '\n' || err.back() == '\r'))
             err.pop_back();
@@ -198,6 +227,12 @@ void GltfReader::readCamera(int index, const glm::dmat4& world, const std::strin
         fail("/cameras/" + std::to_string(index) + "/perspective/yfov", "yfov must lie in (0, pi)");
     const double aspect =
         c.perspective.aspectRatio > 0.0 ? c.perspective.aspectRatio : kDefaultAspect;
+    // Past these the image (640 pixels wide) would be squeezed to a row, or millions tall.
+    if (!(aspect >= kMinAspect && aspect <= kMaxAspect))
+        fail("/cameras/" + std::to_string(index) + "/perspective/aspectRatio",
+             "is " + formatNumber(aspect) +
+                 "; Spillway renders aspect ratios (width / height) from " +
+                 formatNumber(kMinAspect) + " to " + formatNumber(kMaxAspect));
     placeCamera(world, yfov, aspect);
     cameraFound_ = true;
 }
@@ -266,7 +301,9 @@ void GltfReader::readLight(const tinygltf::Node& n, const glm::dmat4& world,
             colour[k] = float(unit(l.color[size_t(k)], where + "/color"));
     }
     if (!(l.intensity >= 0.0) || !(l.intensity / kLumensPerWatt <= kMaxRadiance))
-        fail(where, "a light's intensity must lie in [0, " + std::to_string(kMaxRadiance) + "]");
+        fail(where, "a light's intensity must lie in [0, " +
+                        formatNumber(kMaxRadiance * kLumensPerWatt) + "] (candela or lux; " +
+                        formatNumber(kMaxRadiance) + " W/sr or W/m^2 at 683 lm/W)");
     PunctualLight p;
     p.intensity = colour * float(l.intensity / kLumensPerWatt);
     if (l.type == "point") {

@@ -2,6 +2,8 @@
 // shader, one per material, with its images (base colour and its alpha, metallic-roughness,
 // normal map, emission) as textures read by OpenImageIO from the file or the bytes it embeds,
 // and KHR_texture_transform.
+#include "host/image/image_io.h"
+#include "host/loaders/gltf_preflight.h"
 #include "host/loaders/gltf_reader.h"
 
 #include "shared/gltf.h"
@@ -14,6 +16,7 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <limits>
 #include <map>
 #include <memory>
@@ -22,6 +25,15 @@
 namespace spw {
 
 namespace fs = std::filesystem;
+
+namespace {
+// glTF 2.0's image formats, from an image's first bytes: ".png", ".jpg", or "" for anything else.
+std::string imageFormat(const std::string& head) {
+    if (head.size() >= 8 && head.compare(0, 8, "\x89PNG\r\n\x1a\n", 8) == 0) return ".png";
+    if (head.size() >= 3 && head.compare(0, 3, "\xFF\xD8\xFF", 3) == 0) return ".jpg";
+    return "";
+}
+} // namespace
 
 Shader GltfReader::defaultShader() {
     Shader s;
@@ -189,27 +201,40 @@ Texture GltfReader::imageTexture(const Info& info, const std::string& where,
     Texture picture{};
     picture.type = TextureType::Standard;
     const std::string imageAt = "/images/" + std::to_string(source);
+    std::unique_ptr<OIIO::ImageInput> in;
     if (const auto e = embedded_.find(source); e != embedded_.end()) {
-        // A name no file has, its extension telling OpenImageIO the format.
-        const std::string ext = image.mimeType == "image/jpeg" ? ".jpg" : ".png";
+        // A name no file has, its extension telling OpenImageIO the format its bytes are (not
+        // the mimeType, which a file may get wrong).
+        const std::string ext = imageFormat(e->second->substr(0, 8));
+        if (ext.empty()) fail(imageAt, "the embedded image is neither a PNG nor a JPEG");
         picture.path = fs::absolute(path_).lexically_normal().string() + "#image" +
                        std::to_string(source) + ext;
         picture.bytes = e->second;
         OIIO::Filesystem::IOMemReader proxy(const_cast<char*>(picture.bytes->data()),
                                             picture.bytes->size());
-        auto in = OIIO::ImageInput::open(picture.path, nullptr, &proxy);
+        in = OIIO::ImageInput::open(picture.path, nullptr, &proxy);
         if (!in || in->spec().width < 1 || in->spec().height < 1)
             fail(imageAt, "the embedded image is not one OpenImageIO can read" + imageError());
-        in->close();
     } else {
         if (image.uri.empty()) fail(imageAt, "an image needs a uri or a bufferView");
-        picture.path = fs::absolute(dir_ / decodeUri(image.uri)).lexically_normal().string();
-        auto in = OIIO::ImageInput::open(picture.path);
+        picture.path = fs::absolute(dir_ / decodeGltfUri(image.uri)).lexically_normal().string();
+        std::ifstream file(picture.path, std::ios::binary);
+        char head[8] = {};
+        file.read(head, 8);
+        if (imageFormat(std::string(head, size_t(file.gcount()))).empty())
+            fail(imageAt + "/uri", "'" + picture.path + "' is neither a PNG nor a JPEG image");
+        in = OIIO::ImageInput::open(picture.path);
         if (!in)
             fail(imageAt + "/uri",
                  "'" + picture.path + "' is not an image OpenImageIO can read" + imageError());
-        in->close();
     }
+    // Its size, from the header, before any pixel is read (a 400-byte PNG can claim 100000^2).
+    const OIIO::ImageSpec& spec = in->spec();
+    if (const std::string why = imageSizeProblem(picture.path, spec.width, spec.height,
+                                                 kMaxTexturePixels, kMaxTextureSide);
+        !why.empty())
+        fail(imageAt, why);
+    in->close();
     readTextureTransform(info, where, picture);
     if (const int sampler = model_.textures[size_t(index)].sampler; sampler >= 0) {
         if (sampler >= int(model_.samplers.size()))
@@ -285,20 +310,6 @@ void GltfReader::readTextureTransform(const Info& info, const std::string& where
     picture.uvTransformed = true;
     picture.uvTransform = mat3(flip * t * r * sc * flip);
     picture.footprintScale = float(std::max({std::fabs(scale[0]), std::fabs(scale[1]), 1e-6}));
-}
-
-std::string GltfReader::decodeUri(const std::string& uri) {
-    std::string out;
-    for (size_t i = 0; i < uri.size(); ++i) {
-        if (uri[i] == '%' && i + 2 < uri.size() && std::isxdigit(uri[i + 1]) &&
-            std::isxdigit(uri[i + 2])) {
-            out += char(std::stoi(uri.substr(i + 1, 2), nullptr, 16));
-            i += 2;
-        } else {
-            out += uri[i];
-        }
-    }
-    return out;
 }
 
 } // namespace spw

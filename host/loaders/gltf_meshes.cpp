@@ -37,7 +37,15 @@ std::vector<double> GltfReader::readAccessor(int index, int components, const st
     if (size <= 0) fail(self + "/componentType", "unknown component type");
     const bool isFloat = a.componentType == TINYGLTF_COMPONENT_TYPE_FLOAT;
     if (integersOnly && isFloat) fail(self + "/componentType", "indices must be integers");
+    // Normalized indices would read as fractions of the largest index, most of them 0.
+    if (integersOnly && a.normalized) fail(self + "/normalized", "indices are never normalized");
     const size_t element = size_t(size) * size_t(components);
+    // Before anything is allocated: the values a count asks for, within the loader's limit (a
+    // count whose product with the components wraps would otherwise allocate a few bytes).
+    if (a.count > kMaxGltfAccessorValues / size_t(components))
+        fail(self + "/count", "is " + std::to_string(a.count) + ": an accessor holds at most " +
+                                  std::to_string(kMaxGltfAccessorValues) +
+                                  " values (2^28) in Spillway");
     std::vector<double> out(a.count * size_t(components), 0.0);
     if (a.bufferView >= 0) { // without one, all zeros (the specification's rule)
         size_t stride = 0;
@@ -144,7 +152,9 @@ void GltfReader::readMesh(int index, const glm::dmat4& world, const std::string&
 
 void GltfReader::readPrimitive(const tinygltf::Primitive& prim, const glm::dmat4& world,
                                const std::string& at, const std::string& name) {
-    const int mode = prim.mode < 0 ? TINYGLTF_MODE_TRIANGLES : prim.mode;
+    const int mode = prim.mode; // tinygltf's default where the file has none: triangles
+    if (mode < 0 || mode > TINYGLTF_MODE_TRIANGLE_FAN) // points, lines (3), triangles (3)
+        fail(at + "/mode", "is " + std::to_string(mode) + ", not a glTF primitive mode (0 to 6)");
     if (mode != TINYGLTF_MODE_TRIANGLES && mode != TINYGLTF_MODE_TRIANGLE_STRIP &&
         mode != TINYGLTF_MODE_TRIANGLE_FAN) {
         warn("has points or lines (primitive mode " + std::to_string(mode) + "), not rendered");

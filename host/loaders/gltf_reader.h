@@ -165,8 +165,6 @@ class GltfReader {
     template <class Info>
     void readTextureTransform(const Info& info, const std::string& where, Texture& picture);
 
-    static std::string decodeUri(const std::string& uri);
-
     // --- lights ----------------------------------------------------------------------------
 
     void readLight(const tinygltf::Node& n, const glm::dmat4& world, const std::string& at);

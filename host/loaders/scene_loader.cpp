@@ -367,6 +367,7 @@ void readObject(const Reader& rd, const YAML::Node& n, const fs::path& dir, Scen
         return;
     }
     Mesh mesh = loadObjMesh(p.string(), xf, scene.origin, rd.file(), n["filename"].Mark().line + 1);
+    scene.inputs.push_back(p.string());
     mesh.shader = shader;
     scene.meshes.push_back(std::move(mesh));
     // A bad index is reported at the `shader:` value, or at the object when it has none.

@@ -124,6 +124,8 @@ std::uint64_t environmentHash(const Scene& scene) {
 std::uint64_t sceneHash(const Scene& scene) {
     Fnv f;
     f.text(fileText(scene.file));
+    for (const std::string& input : scene.inputs)
+        hashFileContents(f, input);
     for (const Mesh& m : scene.meshes) {
         f.array(m.positions);
         f.array(m.normals);

@@ -53,6 +53,15 @@ constexpr int kMaxTextures = 1 << 16;
 // (one per light included).
 constexpr int kMaxShaders = (1 << 12) - 1;
 constexpr int kMaxObjects = 1 << 20;
+// A glTF accessor holds at most this many values (elements x components): 2 GiB as the doubles
+// the loader reads them into, and 2^28 / 3 vertices a primitive, far past what one mesh needs.
+constexpr size_t kMaxGltfAccessorValues = size_t(1) << 28;
+// An image texture, read tile by tile through the cache, has at most this many pixels (32768^2)
+// and sides of at most 65536; images read whole (emission textures, environment maps) are
+// limited to image_io.h's kMaxImagePixels (2^26, 8192^2). Checked from the file's header,
+// before any pixel is read: a 400-byte PNG can claim 100000 x 100000.
+constexpr long long kMaxTexturePixels = 1LL << 30;
+constexpr long long kMaxTextureSide = 1LL << 16;
 
 struct ImageSettings {
     int width = 512;
@@ -248,6 +257,11 @@ struct Scene {
     std::optional<Environment> environment;
     // What the file holds that is not rendered ("file: what"), once each: the CLI prints them.
     std::vector<std::string> warnings;
+    // Every file the loaders read besides `file` whose bytes the image depends on and that the
+    // model does not hold whole: OBJ files, glTF files and their external buffers. A checkpoint's
+    // identity hashes them (host/render/checkpoint.cpp), so a placed file changed between a
+    // checkpoint and --resume (or between partials) is found.
+    std::vector<std::string> inputs;
 
     bool usesTextures() const;
 };

@@ -18,6 +18,7 @@
 #include <atomic>
 #include <cmath>
 #include <cstring>
+#include <filesystem>
 #include <mutex>
 #include <stdexcept>
 
@@ -50,7 +51,12 @@ void visit(const Scene& scene, int t, std::vector<int>& slotOf, std::vector<int>
 
 // Opens a Standard texture's image in the cache (an embedded one through a proxy it keeps):
 // its channels, encoding and MIP levels. Throws where the image cannot be read.
-void openImage(TextureResolver::Impl& impl, const Texture& t, TextureResolver::Impl::Image& img) {
+void openImage(const Scene& scene, TextureResolver::Impl& impl, const Texture& t,
+               TextureResolver::Impl::Image& img) {
+    // A file must be a regular file before the cache opens it: a FIFO would block the render.
+    std::error_code ec;
+    if (!t.bytes && !std::filesystem::is_regular_file(t.path, ec))
+        throw SceneError(scene.file, t.line, "texture file '" + t.path + "' is not a regular file");
     OIIO::ustring name(t.path);
     if (t.bytes) { // embedded: read from memory, through a proxy the cache keeps using
         auto& proxy = impl.proxies.emplace_back(std::make_unique<OIIO::Filesystem::IOMemReader>(
@@ -65,9 +71,22 @@ void openImage(TextureResolver::Impl& impl, const Texture& t, TextureResolver::I
         img.handle ? impl.cache->imagespec(img.handle, nullptr, 0, 0) : nullptr;
     if (!spec || spec->width < 1 || spec->height < 1)
         throw std::runtime_error("cannot read texture '" + t.path + "': " + impl.cache->geterror());
+    // The header's size, before any tile is read.
+    if (const std::string why =
+            imageSizeProblem(t.path, spec->width, spec->height, kMaxTexturePixels, kMaxTextureSide);
+        !why.empty())
+        throw SceneError(scene.file, t.line, why);
     img.firstChannel = std::max(t.channel, 0);
-    img.absent = img.firstChannel >= spec->nchannels;
-    img.channels = img.absent ? 1 : spec->nchannels - img.firstChannel;
+    if (spec->nchannels == 2) {
+        // Grey and alpha: the grey is every colour channel (one channel read), the alpha the
+        // second (Texture::channel 3, the alpha of RGBA).
+        img.firstChannel = t.channel == 3 ? 1 : std::min(img.firstChannel, 1);
+        img.absent = false;
+        img.channels = 1;
+    } else {
+        img.absent = img.firstChannel >= spec->nchannels;
+        img.channels = img.absent ? 1 : spec->nchannels - img.firstChannel;
+    }
     img.eightBit = spec->format == OIIO::TypeDesc::UINT8;
     std::string cs = spec->get_string_attribute("oiio:ColorSpace");
     img.srgb = !t.linear && (cs == "sRGB" || (cs.empty() && spec->format == OIIO::TypeDesc::UINT8));
@@ -116,6 +135,10 @@ TextureResolver::TextureResolver(const Scene& scene, double cacheMiB, bool filte
     impl_->wide = wide;
     impl_->cache = OIIO::ImageCache::create(false);
     impl_->cache->attribute("max_memory_MB", float(cacheMiB));
+    // Colours as the file stores them: OpenImageIO would premultiply a PNG's colour by its alpha
+    // on reading (darkening a grey-and-alpha or RGBA base colour wherever alpha < 1), where glTF's
+    // base colour and every other image Spillway reads are straight colour, the alpha apart.
+    impl_->cache->attribute("unassociatedalpha", 1);
     // Keep every texture file open if the process may (OpenImageIO's default of 100 made the
     // production scene's 448 files re-open 1400 times a render), half the descriptors at most.
     rlimit files{};
@@ -128,7 +151,7 @@ TextureResolver::TextureResolver(const Scene& scene, double cacheMiB, bool filte
         const Texture& t = scene.textures[i];
         if (t.type != TextureType::Standard) continue;
         Impl::Image& img = impl_->images[i];
-        openImage(*impl_, t, img);
+        openImage(scene, *impl_, t, img);
         img.firstHeld = impl_->heldSlots;
         impl_->heldSlots += img.levels.size();
     }
@@ -187,6 +210,10 @@ std::vector<vec3> TextureResolver::finestLevel(int texture, int& width, int& hei
     const Impl::Image& image = impl_->images[size_t(texture)];
     width = image.levels[0].width;
     height = image.levels[0].height;
+    // Read whole, as floats: within the limit of images read whole.
+    const Texture& t = scene_.textures[size_t(texture)];
+    if (const std::string why = imageSizeProblem(t.path, width, height); !why.empty())
+        throw SceneError(scene_.file, t.line, why + " when read whole (an emission texture)");
     std::vector<vec3> out;
     TexelReader(*impl_, impl_->thread(), texture).finestLevel(out);
     checkErrors();

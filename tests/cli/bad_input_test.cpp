@@ -677,6 +677,28 @@ TEST(BadInputs, CompareHeatmapIntoAMissingFolderIsADiskFailure) {
     EXPECT_FALSE(fs::exists(dir.file("h.png")));
 }
 
+// 8. A heatmap that names an input, however spelt (./, a link), is refused before anything is
+// read or written: exit 2, the input unchanged.
+TEST(BadInputs, CompareHeatmapNamingAnInputIsRefused) {
+    TempDir dir;
+    const std::string a = dir.file("a.png"), b = dir.file("b.png");
+    writeImage(a, ImageRGB{2, 2, std::vector<float>(2 * 2 * 3, 0.5f)});
+    writeImage(b, ImageRGB{2, 2, std::vector<float>(2 * 2 * 3, 0.25f)});
+    fs::create_symlink(a, dir.file("link.png"));
+    const std::string before = readFile(a);
+    for (const std::string& heatmap :
+         {a, dir.path() + "/./a.png", dir.file("link.png"),
+          dir.path() + "/../" + fs::path(dir.path()).filename().string() + "/b.png"}) {
+        const Outcome r = runLimited("compare " + a + " " + b + " --heatmap " + heatmap, 30);
+        ASSERT_FALSE(r.signalled) << r.output;
+        EXPECT_EQ(r.status, 2) << heatmap << ": " << r.output;
+        EXPECT_NE(r.output.find("names the input"), std::string::npos) << r.output;
+    }
+    EXPECT_EQ(readFile(a), before);
+    EXPECT_EQ(runLimited("compare " + a + " " + b + " --heatmap " + dir.file("h.png"), 30).status,
+              0);
+}
+
 // 10. --spp that the scene's n x n pattern does not divide takes one sample per iteration, so a
 // checkpoint of the scene's own pattern cannot continue: the message says that, and how to ask,
 // instead of blaming a sample base the user never set.

@@ -3,11 +3,13 @@
 // every backend; a checkpoint of another render is refused with exit 2.
 #include "host/image/image_io.h"
 #include "host/render/checkpoint.h"
+#include "scene/gltf_builder.h"
 #include "test_util.h"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <chrono>
 #include <csignal>
 #include <cstring>
@@ -15,11 +17,14 @@
 #include <fstream>
 #include <functional>
 #include <limits>
+#include <sstream>
 #include <thread>
 #include <unistd.h>
 
 namespace spw::test {
 namespace {
+
+namespace fs = std::filesystem;
 
 const std::vector<std::string> kSpilling = {"--memory-budget", "0.05", "--bin-exponent", "8"};
 
@@ -119,6 +124,88 @@ TEST(Checkpoint, AdaptiveSobolRenderResumesToTheSameImageAndSamples) {
 
 // A checkpoint of another render is refused before any work: exit 2, the reason named, nothing
 // written. Backends may differ (they trace the same paths).
+// A checkpoint's identity covers the files a YAML scene places, not only the scene's own text:
+// a placed glTF file whose material changed since the checkpoint is another scene, for --resume
+// and for merging partials.
+TEST(Checkpoint, AChangedPlacedGltfFileIsAnotherScene) {
+    TempDir dir;
+    const auto writeGltf = [&](float roughness) {
+        GltfBuilder b;
+        b.doc["materials"] = json::array({material(vec3(0.7f), 0.0f, roughness, vec3(1.0f))});
+        b.scene({b.node({{"mesh", b.mesh(b.quad(0))}})});
+        b.external(dir, "quad.gltf");
+    };
+    writeGltf(0.5f);
+    const std::string scene = dir.write(
+        "scene.yaml", "image: {width: 16, height: 16, sample base: 1, iterations: 4}\n"
+                      "camera: {type: PinHole, look at: {eye: [0.5, 0.5, 3], target: [0.5, 0.5, "
+                      "0]}, fov: 40}\n"
+                      "objects:\n  - {type: Gltf, filename: quad.gltf}\n");
+    const std::vector<std::string> common = {"--backend", "cpu", "--quiet", "-o",
+                                             dir.file("out.exr")};
+    auto run = [&](std::vector<std::string> args) {
+        args.insert(args.end(), common.begin(), common.end());
+        return runChild(args);
+    };
+    const ChildResult first =
+        run({"render", scene, "--spp", "2", "--checkpoint", dir.file("ck.exr")});
+    ASSERT_EQ(first.status, 0) << first.output;
+    ASSERT_EQ(
+        run({"render", scene, "--spp", "4", "--samples", "0:2", "--partial", dir.file("a.exr")})
+            .status,
+        0);
+    writeGltf(0.25f); // the material, not the geometry
+    const ChildResult resumed =
+        run({"render", scene, "--spp", "4", "--resume", dir.file("ck.exr")});
+    EXPECT_EQ(resumed.status, 2) << resumed.output;
+    EXPECT_NE(resumed.output.find("another scene"), std::string::npos) << resumed.output;
+    ASSERT_EQ(
+        run({"render", scene, "--spp", "4", "--samples", "2:4", "--partial", dir.file("b.exr")})
+            .status,
+        0);
+    const ChildResult merged =
+        runChild({"merge", dir.file("a.exr"), dir.file("b.exr"), "-o", dir.file("m.exr")});
+    EXPECT_NE(merged.status, 0) << merged.output;
+    EXPECT_FALSE(fs::exists(dir.file("m.exr")));
+}
+
+// --error-csv on a resumed render keeps the rows the first run wrote for the iterations the
+// checkpoint holds, and adds its own: one CSV of the whole render, the uninterrupted one's.
+TEST(Checkpoint, TheErrorCsvOfAResumedRenderKeepsTheFirstRunsRows) {
+    TempDir dir;
+    const std::string scene = smallCornellBox(dir, 24, 24);
+    const std::vector<std::string> common = {"--backend", "cpu", "--quiet", "-o",
+                                             dir.file("out.exr")};
+    auto run = [&](std::vector<std::string> args) {
+        args.insert(args.end(), common.begin(), common.end());
+        return runChild(args);
+    };
+    ASSERT_EQ(run({"render", scene, "--spp", "3", "--checkpoint", dir.file("ck.exr"), "--error-csv",
+                   dir.file("e.csv")})
+                  .status,
+              0);
+    ASSERT_EQ(run({"render", scene, "--spp", "6", "--resume", dir.file("ck.exr"), "--error-csv",
+                   dir.file("e.csv")})
+                  .status,
+              0);
+    ASSERT_EQ(run({"render", scene, "--spp", "6", "--error-csv", dir.file("whole.csv")}).status, 0);
+    // The columns but the seconds are the uninterrupted render's.
+    const auto withoutSeconds = [](const std::string& text) {
+        std::string out;
+        std::istringstream in(text);
+        for (std::string line; std::getline(in, line);) {
+            const size_t a = line.find(',', line.find(',') + 1), b = line.find(',', a + 1);
+            out += line.substr(0, a) + line.substr(b) + "\n";
+        }
+        return out;
+    };
+    const std::string resumed = withoutSeconds(readFile(dir.file("e.csv")));
+    EXPECT_EQ(resumed, withoutSeconds(readFile(dir.file("whole.csv"))));
+    EXPECT_EQ(std::count(resumed.begin(), resumed.end(), '\n'), 7); // the header and 6 rows
+    // The first row (one sample: one half buffer empty) has no estimate: empty cells, not 0.
+    EXPECT_EQ(resumed.substr(resumed.find('\n') + 1, 6), "1,1,,\n");
+}
+
 TEST(Checkpoint, ACheckpointOfAnotherRenderIsRefused) {
     TempDir dir;
     const std::string scene = smallCornellBox(dir, 40, 40);

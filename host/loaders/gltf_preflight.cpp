@@ -1,0 +1,328 @@
+#include "host/loaders/gltf_preflight.h"
+
+#include "host/scene/scene.h"
+
+#include <nlohmann/json.hpp>
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cctype>
+#include <climits>
+#include <cstdint>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <vector>
+
+namespace spw {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+[[noreturn]] void fail(const std::string& path, const std::string& pointer,
+                       const std::string& message) {
+    throw SceneError(path, 0, (pointer.empty() ? "" : pointer + ": ") + message);
+}
+
+std::uint32_t u32(const std::string& bytes, size_t at) {
+    std::uint32_t v;
+    std::memcpy(&v, bytes.data() + at, 4);
+    return v;
+}
+
+std::string readBytes(std::ifstream& in, size_t count) {
+    std::string out(count, '\0');
+    in.read(out.data(), std::streamsize(count));
+    out.resize(size_t(in.gcount()));
+    return out;
+}
+
+// The JSON of a .glb: its framing checked against the file's size first (tinygltf trusts the
+// chunk lengths, and reads past the file's end where they claim more).
+std::string glbJson(const std::string& path, std::ifstream& in, std::uint64_t size) {
+    const std::string head = readBytes(in, 20);
+    if (head.size() < 12 || u32(head, 0) != 0x46546C67u)
+        fail(path, "", "not a GLB file: it does not start with the 'glTF' magic");
+    if (u32(head, 4) == 1u)
+        fail(path, "",
+             "glTF 1.0 is not supported (this is a glTF 1.0 binary); Spillway reads "
+             "glTF 2.0");
+    if (u32(head, 4) != 2u)
+        fail(path, "",
+             "GLB version " + std::to_string(u32(head, 4)) + "; Spillway reads version 2");
+    const std::uint64_t length = u32(head, 8);
+    if (length > size)
+        fail(path, "",
+             "the GLB header claims " + std::to_string(length) + " bytes; the file has " +
+                 std::to_string(size));
+    if (head.size() < 20 || length < 20) fail(path, "", "the GLB file has no JSON chunk");
+    const std::uint64_t jsonLength = u32(head, 12);
+    if (u32(head, 16) != 0x4E4F534Au) fail(path, "", "the GLB file's first chunk is not JSON");
+    if (20 + jsonLength > length)
+        fail(path, "",
+             "the JSON chunk claims " + std::to_string(jsonLength) + " bytes, past the file's end");
+    std::string text = readBytes(in, size_t(jsonLength));
+    if (20 + jsonLength + 8 <= length) {
+        const std::string chunk = readBytes(in, 8);
+        const std::uint64_t binLength = chunk.size() == 8 ? u32(chunk, 0) : 0;
+        if (chunk.size() == 8 && 28 + jsonLength + binLength > length)
+            fail(path, "",
+                 "the BIN chunk claims " + std::to_string(binLength) +
+                     " bytes, past the file's end");
+    }
+    return text;
+}
+
+// The deepest nesting of arrays and objects in `text`, outside strings, counted up to `limit` + 1.
+int nestingDepth(const std::string& text, int limit) {
+    int depth = 0, deepest = 0;
+    bool inString = false;
+    for (size_t i = 0; i < text.size(); ++i) {
+        const char c = text[i];
+        if (inString) {
+            if (c == '\\')
+                ++i;
+            else if (c == '"')
+                inString = false;
+        } else if (c == '"') {
+            inString = true;
+        } else if (c == '[' || c == '{') {
+            deepest = std::max(deepest, ++depth);
+            if (deepest > limit) return deepest;
+        } else if (c == ']' || c == '}') {
+            --depth;
+        }
+    }
+    return deepest;
+}
+
+// What a path names when it is not a regular file ("" when it is one).
+std::string notRegular(const fs::path& p) {
+    std::error_code ec;
+    const fs::file_status st = fs::status(p, ec);
+    if (ec || !fs::exists(st)) return "which does not exist";
+    if (fs::is_regular_file(st)) return "";
+    if (fs::is_directory(st)) return "which is a folder";
+    if (fs::is_fifo(st)) return "which is a FIFO";
+    return "which is not a regular file";
+}
+
+// The files that buffers and images name must be regular files: tinygltf would block on a FIFO
+// for ever, and read a folder as a file of nonsense size.
+void checkUris(const std::string& path, const json& doc) {
+    const fs::path dir = fs::path(path).parent_path();
+    for (const char* kind : {"buffers", "images"}) {
+        if (!doc.contains(kind) || !doc[kind].is_array()) continue;
+        for (size_t i = 0; i < doc[kind].size(); ++i) {
+            const json& entry = doc[kind][i];
+            if (!entry.is_object() || !entry.contains("uri") || !entry["uri"].is_string()) continue;
+            const std::string uri = entry["uri"].get<std::string>();
+            if (uri.rfind("data:", 0) == 0) continue;
+            const std::string why = notRegular(dir / decodeGltfUri(uri));
+            if (!why.empty())
+                fail(path, "/" + std::string(kind) + "/" + std::to_string(i) + "/uri",
+                     "names '" + uri + "', " + why +
+                         "; a glTF file's buffers and images are "
+                         "regular files");
+        }
+    }
+}
+
+void checkVersion(const std::string& path, const json& doc) {
+    if (doc.contains("scenes") && doc["scenes"].is_object())
+        fail(path, "/scenes",
+             "glTF 1.0 is not supported (its scenes are a dictionary); Spillway "
+             "reads glTF 2.0");
+    if (!doc.contains("asset") || !doc["asset"].is_object() || !doc["asset"].contains("version") ||
+        !doc["asset"]["version"].is_string())
+        return; // tinygltf says what is missing
+    const std::string v = doc["asset"]["version"].get<std::string>();
+    if (v == "1" || v.rfind("1.", 0) == 0)
+        fail(path, "/asset/version",
+             "is '" + v +
+                 "': glTF 1.0 is not supported; Spillway reads "
+                 "glTF 2.0");
+    if (v != "2" && v.rfind("2.", 0) != 0)
+        fail(path, "/asset/version", "is '" + v + "'; Spillway reads glTF 2.0");
+}
+
+void checkRequired(const std::string& path, const json& doc,
+                   const std::set<std::string>& honoured) {
+    if (!doc.contains("extensionsRequired") || !doc["extensionsRequired"].is_array()) return;
+    for (const json& e : doc["extensionsRequired"]) {
+        if (!e.is_string() || honoured.count(e.get<std::string>())) continue;
+        const std::string name = e.get<std::string>();
+        if (name == "KHR_draco_mesh_compression")
+            fail(path, "/extensionsRequired",
+                 "requires KHR_draco_mesh_compression (Draco-compressed meshes), which Spillway "
+                 "does not decode; export the file without Draco compression");
+        if (name == "EXT_meshopt_compression")
+            fail(path, "/extensionsRequired",
+                 "requires EXT_meshopt_compression (meshoptimizer-compressed buffers), which "
+                 "Spillway does not decode");
+        fail(path, "/extensionsRequired",
+             "requires the extension " + name + ", which Spillway does not render");
+    }
+}
+
+// The node hierarchy is a set of disjoint trees (glTF 2.0, 3.5.3): a node is the child of one
+// node at most, and a scene's nodes are roots, each named once.
+void checkForest(const std::string& path, const json& doc) {
+    if (!doc.contains("nodes") || !doc["nodes"].is_array()) return;
+    const json& nodes = doc["nodes"];
+    std::vector<long long> parent(nodes.size(), -1);
+    for (size_t i = 0; i < nodes.size(); ++i) {
+        if (!nodes[i].is_object() || !nodes[i].contains("children") ||
+            !nodes[i]["children"].is_array())
+            continue;
+        const json& children = nodes[i]["children"];
+        for (size_t k = 0; k < children.size(); ++k) {
+            if (!children[k].is_number_integer()) continue; // tinygltf refuses it
+            const long long c = children[k].get<long long>();
+            if (c < 0 || c >= (long long)nodes.size()) continue; // the reader names it
+            if (parent[size_t(c)] >= 0)
+                fail(path, "/nodes/" + std::to_string(i) + "/children/" + std::to_string(k),
+                     "names node " + std::to_string(c) + ", which node " +
+                         std::to_string(parent[size_t(c)]) +
+                         " names too: a glTF node has one parent at most");
+            parent[size_t(c)] = (long long)i;
+        }
+    }
+    if (!doc.contains("scenes") || !doc["scenes"].is_array()) return;
+    for (size_t s = 0; s < doc["scenes"].size(); ++s) {
+        const json& scene = doc["scenes"][s];
+        if (!scene.is_object() || !scene.contains("nodes") || !scene["nodes"].is_array()) continue;
+        std::vector<bool> named(nodes.size(), false);
+        for (size_t k = 0; k < scene["nodes"].size(); ++k) {
+            const json& n = scene["nodes"][k];
+            if (!n.is_number_integer()) continue;
+            const long long r = n.get<long long>();
+            if (r < 0 || r >= (long long)nodes.size()) continue;
+            const std::string at = "/scenes/" + std::to_string(s) + "/nodes/" + std::to_string(k);
+            if (parent[size_t(r)] >= 0)
+                fail(path, at,
+                     "names node " + std::to_string(r) + ", a child of node " +
+                         std::to_string(parent[size_t(r)]) + ": a scene's nodes are roots");
+            if (named[size_t(r)]) fail(path, at, "names node " + std::to_string(r) + " twice");
+            named[size_t(r)] = true;
+        }
+    }
+}
+
+// Every extension an object uses is declared in extensionsUsed (glTF 2.0, 3.12): a file that
+// uses one it does not declare is not valid, and its author would not know what is read.
+void checkDeclared(const std::string& path, const json& j, const std::set<std::string>& used,
+                   const std::string& at) {
+    if (j.is_object()) {
+        for (const auto& [key, value] : j.items()) {
+            const std::string here = at + "/" + key;
+            if (key == "extensions" && value.is_object())
+                for (const auto& [name, body] : value.items())
+                    if (!used.count(name))
+                        fail(path, here + "/" + name,
+                             "uses the extension " + name +
+                                 ", which the file's extensionsUsed does not declare");
+            checkDeclared(path, value, used, here);
+        }
+    } else if (j.is_array()) {
+        for (size_t i = 0; i < j.size(); ++i)
+            checkDeclared(path, j[i], used, at + "/" + std::to_string(i));
+    }
+}
+
+// ReadWholeFile for regular files only: opened without blocking (a FIFO with no writer would
+// block the open), then checked on the open descriptor, so that nothing can swap the file.
+bool readRegularFile(std::vector<unsigned char>* out, std::string* err, const std::string& path,
+                     void*) {
+    const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+    struct stat st {};
+    if (fd < 0 || ::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+        if (fd >= 0) ::close(fd);
+        if (err) *err += "'" + path + "' is not a readable regular file\n";
+        return false;
+    }
+    out->resize(size_t(st.st_size));
+    size_t done = 0;
+    while (done < out->size()) {
+        const ssize_t n = ::read(fd, out->data() + done, out->size() - done);
+        if (n <= 0) break;
+        done += size_t(n);
+    }
+    ::close(fd);
+    if (done != out->size()) {
+        if (err) *err += "'" + path + "' could not be read whole\n";
+        return false;
+    }
+    return true;
+}
+
+} // namespace
+
+std::string decodeGltfUri(const std::string& uri) {
+
+    std::string out;
+    for (size_t i = 0; i < uri.size(); ++i) {
+        if (uri[i] == '%' && i + 2 < uri.size() && std::isxdigit(uint8_t(uri[i + 1])) &&
+            std::isxdigit(uint8_t(uri[i + 2]))) {
+            out += char(std::stoi(uri.substr(i + 1, 2), nullptr, 16));
+            i += 2;
+        } else {
+            out += uri[i];
+        }
+    }
+    return out;
+}
+
+void preflightGltf(const std::string& path, const std::set<std::string>& honoured) {
+    std::error_code ec;
+    const std::uint64_t size = fs::file_size(path, ec);
+    std::ifstream in(path, std::ios::binary);
+    if (ec || !in) fail(path, "", "cannot open the glTF file: not a readable file");
+    std::string ext = fs::path(path).extension().string();
+    for (char& c : ext)
+        c = char(std::tolower(static_cast<unsigned char>(c)));
+    const std::string text = ext == ".glb" ? glbJson(path, in, size) : readBytes(in, size_t(size));
+    if (nestingDepth(text, kMaxGltfJsonDepth) > kMaxGltfJsonDepth)
+        fail(path, "",
+             "its JSON nests deeper than " + std::to_string(kMaxGltfJsonDepth) +
+                 " levels (glTF's own objects nest about 8)");
+    const json doc = json::parse(text, nullptr, false);
+    if (doc.is_discarded() || !doc.is_object()) return; // tinygltf says what is wrong
+    checkVersion(path, doc);
+    checkRequired(path, doc, honoured);
+    checkForest(path, doc);
+    std::set<std::string> used;
+    if (doc.contains("extensionsUsed") && doc["extensionsUsed"].is_array())
+        for (const json& e : doc["extensionsUsed"])
+            if (e.is_string()) used.insert(e.get<std::string>());
+    checkDeclared(path, doc, used, "");
+    checkUris(path, doc);
+}
+
+tinygltf::FsCallbacks regularFilesOnly() {
+    return {&tinygltf::FileExists, &tinygltf::ExpandFilePath, &readRegularFile,
+            &tinygltf::WriteWholeFile, nullptr};
+}
+
+std::string imageViewProblem(const tinygltf::Model& model, const tinygltf::Image& image,
+                             int index) {
+    if (image.bufferView < 0 || size_t(image.bufferView) >= model.bufferViews.size()) return "";
+    const tinygltf::BufferView& v = model.bufferViews[size_t(image.bufferView)];
+    if (v.buffer < 0 || size_t(v.buffer) >= model.buffers.size()) return "";
+    const size_t have = model.buffers[size_t(v.buffer)].data.size();
+    const std::string at = "/images/" + std::to_string(index) + "/bufferView: ";
+    if (v.byteOffset > have || v.byteLength > have - v.byteOffset)
+        return at + "buffer view " + std::to_string(image.bufferView) + " (bytes " +
+               std::to_string(v.byteOffset) + " + " + std::to_string(v.byteLength) +
+               ") reaches past the end of buffer " + std::to_string(v.buffer) + " (" +
+               std::to_string(have) + " bytes)";
+    if (v.byteLength > size_t(INT_MAX))
+        return at + "an embedded image of " + std::to_string(v.byteLength) +
+               " bytes; Spillway reads embedded images of up to 2 GiB";
+    return "";
+}
+
+} // namespace spw

@@ -1,0 +1,39 @@
+// What is checked of a glTF file before tinygltf parses it, because tinygltf itself would crash,
+// hang or misread it: the GLB framing (magic, version, chunk lengths within the file), the JSON's
+// nesting (its parser recurses), the asset's version (glTF 1.0 is refused by name), the
+// extensions it requires (Draco and the rest, named before tinygltf trips over their buffers),
+// and the node graph (a forest: one parent a node at most, so that a DAG of 64 nodes cannot
+// unfold into 2^63 paths). And while tinygltf reads: every file a buffer or image names must be
+// a regular file (a FIFO would block forever, a folder allocate nonsense), and an image's buffer
+// view must lie inside its buffer before its bytes are taken.
+//
+// Every failure is a SceneError naming the file and a JSON pointer.
+#pragma once
+
+#include <tiny_gltf.h>
+
+#include <set>
+#include <string>
+
+namespace spw {
+
+// The deepest the JSON of a glTF file may nest. The format's own objects nest about 8 deep;
+// `extras` and `extensions` may hold any JSON, and 64 levels leave room for that.
+constexpr int kMaxGltfJsonDepth = 64;
+
+// Checks the file at `path` before it is parsed; `honoured` are the extensions a file may require.
+// Throws SceneError.
+void preflightGltf(const std::string& path, const std::set<std::string>& honoured);
+
+// A URI's %XX escapes decoded (glTF's URIs are RFC 3986 references): the file a relative URI
+// names, beside the glTF file.
+std::string decodeGltfUri(const std::string& uri);
+
+// tinygltf's file callbacks with one change: ReadWholeFile reads only regular files.
+tinygltf::FsCallbacks regularFilesOnly();
+
+// Whether image `image`'s buffer view (in `model`, being parsed) lies inside its buffer: "" if so,
+// else why not. Called from the image callback, before the bytes are read.
+std::string imageViewProblem(const tinygltf::Model& model, const tinygltf::Image& image, int index);
+
+} // namespace spw
