@@ -40,6 +40,12 @@ import sys
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
 
+def number(cell):
+    """A CSV cell as a float; an empty one (no estimate yet: one half buffer without samples) as 0,
+    which the tables and plots leave out."""
+    return float(cell) if cell != "" else 0.0
+
+
 FIELDS = ["config", "backend", "sampler", "iteration", "spp", "seconds", "relmse", "relmse_estimate",
           "relmse_estimate_stderr", "relmse_true"]
 
@@ -63,8 +69,8 @@ def main():
     if a.replot:
         with open(out_csv) as f:
             rows = [dict(r, iteration=int(r["iteration"]), spp=int(r["spp"]), seconds=float(r["seconds"]),
-                         relmse=float(r["relmse"]), relmse_estimate=float(r["relmse_estimate"]),
-                         relmse_estimate_stderr=float(r.get("relmse_estimate_stderr", 0.0)),
+                         relmse=float(r["relmse"]), relmse_estimate=number(r["relmse_estimate"]),
+                         relmse_estimate_stderr=number(r.get("relmse_estimate_stderr", 0.0)),
                          relmse_true=float(r.get("relmse_true", r["relmse"])))
                     for r in csv.DictReader(f)]
         report(a, rows)
@@ -79,7 +85,7 @@ def main():
         subprocess.check_call([a.spillway, "render", a.scene, "--backend", "reference", "--spp", str(a.reference_spp),
                                "--seed", "1000003", "--quiet", "-o", ref, "--error-csv", ref_csv])
         with open(ref_csv) as f:
-            ref_own = float(list(csv.DictReader(f))[-1]["relmse_estimate"])
+            ref_own = number(list(csv.DictReader(f))[-1]["relmse_estimate"])
         print("the reference's own relMSE (estimated): %.4g" % ref_own)
 
     rows = []
@@ -107,8 +113,8 @@ def main():
                     rows.append({"config": name, "backend": backend, "sampler": sampler or "scene",
                                  "iteration": int(r["iteration"]), "spp": int(r["spp"]),
                                  "seconds": float(r["seconds"]), "relmse": float(r["relmse"]),
-                                 "relmse_estimate": float(r["relmse_estimate"]),
-                                 "relmse_estimate_stderr": float(r["relmse_estimate_stderr"]),
+                                 "relmse_estimate": number(r["relmse_estimate"]),
+                                 "relmse_estimate_stderr": number(r["relmse_estimate_stderr"]),
                                  "relmse_true": float(r["relmse"]) - ref_own})
     if not rows:
         sys.exit("no configuration rendered")

@@ -76,29 +76,6 @@ std::string glbJson(const std::string& path, std::ifstream& in, std::uint64_t si
     return text;
 }
 
-// The deepest nesting of arrays and objects in `text`, outside strings, counted up to `limit` + 1.
-int nestingDepth(const std::string& text, int limit) {
-    int depth = 0, deepest = 0;
-    bool inString = false;
-    for (size_t i = 0; i < text.size(); ++i) {
-        const char c = text[i];
-        if (inString) {
-            if (c == '\\')
-                ++i;
-            else if (c == '"')
-                inString = false;
-        } else if (c == '"') {
-            inString = true;
-        } else if (c == '[' || c == '{') {
-            deepest = std::max(deepest, ++depth);
-            if (deepest > limit) return deepest;
-        } else if (c == ']' || c == '}') {
-            --depth;
-        }
-    }
-    return deepest;
-}
-
 // What a path names when it is not a regular file ("" when it is one).
 std::string notRegular(const fs::path& p) {
     std::error_code ec;
@@ -261,6 +238,28 @@ bool readRegularFile(std::vector<unsigned char>* out, std::string* err, const st
 
 } // namespace
 
+int jsonNestingDepth(const std::string& text, int limit) {
+    int depth = 0, deepest = 0;
+    bool inString = false;
+    for (size_t i = 0; i < text.size(); ++i) {
+        const char c = text[i];
+        if (inString) {
+            if (c == '\\')
+                ++i;
+            else if (c == '"')
+                inString = false;
+        } else if (c == '"') {
+            inString = true;
+        } else if (c == '[' || c == '{') {
+            deepest = std::max(deepest, ++depth);
+            if (deepest > limit) return deepest;
+        } else if (c == ']' || c == '}') {
+            --depth;
+        }
+    }
+    return deepest;
+}
+
 std::string decodeGltfUri(const std::string& uri) {
 
     std::string out;
@@ -285,7 +284,7 @@ void preflightGltf(const std::string& path, const std::set<std::string>& honoure
     for (char& c : ext)
         c = char(std::tolower(static_cast<unsigned char>(c)));
     const std::string text = ext == ".glb" ? glbJson(path, in, size) : readBytes(in, size_t(size));
-    if (nestingDepth(text, kMaxGltfJsonDepth) > kMaxGltfJsonDepth)
+    if (jsonNestingDepth(text, kMaxGltfJsonDepth) > kMaxGltfJsonDepth)
         fail(path, "",
              "its JSON nests deeper than " + std::to_string(kMaxGltfJsonDepth) +
                  " levels (glTF's own objects nest about 8)");

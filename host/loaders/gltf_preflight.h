@@ -21,6 +21,10 @@ namespace spw {
 // `extras` and `extensions` may hold any JSON, and 64 levels leave room for that.
 constexpr int kMaxGltfJsonDepth = 64;
 
+// The deepest nesting of arrays and objects in a JSON text, outside strings, counted up to
+// `limit` + 1 (the scan stops there): without parsing, so that no depth can overflow a stack.
+int jsonNestingDepth(const std::string& text, int limit);
+
 // Checks the file at `path` before it is parsed; `honoured` are the extensions a file may require.
 // Throws SceneError.
 void preflightGltf(const std::string& path, const std::set<std::string>& honoured);

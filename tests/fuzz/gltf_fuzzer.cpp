@@ -10,6 +10,7 @@
 // vocabulary (tests/fuzz/gltf.dict) added with a number; a string made a version, a MIME type or
 // an extension name. A document that does not parse gets libFuzzer's byte mutations.
 #include "fuzz_targets.h"
+#include "host/loaders/gltf_preflight.h"
 
 #include <nlohmann/json.hpp>
 
@@ -72,6 +73,9 @@ const double kNumbers[] = {0,
                            34962,
                            4,
                            7};
+
+// The deepest the mutator parses a document: as deep as the loader reads.
+constexpr int kMaxTreeDepth = spw::kMaxGltfJsonDepth;
 
 // Every value in the document, each once (pointers into it, valid until it changes).
 void collect(json& j, std::vector<json*>& out, int depth) {
@@ -195,6 +199,10 @@ extern "C" size_t LLVMFuzzerCustomMutator(std::uint8_t* data, size_t size, size_
     Rng rng(seed);
     Split s;
     if (rng() % 4 == 0 || !split(data, size, s)) return LLVMFuzzerMutate(data, size, maxSize);
+    // A document nested deeper than the loader takes (one an earlier mutation deepened) is left
+    // to the byte mutations: copying or dumping it would recurse through the mutator's own stack.
+    if (spw::jsonNestingDepth(s.json, kMaxTreeDepth) > kMaxTreeDepth)
+        return LLVMFuzzerMutate(data, size, maxSize);
     json doc = json::parse(s.json, nullptr, false);
     if (doc.is_discarded()) return LLVMFuzzerMutate(data, size, maxSize);
     const int edits = 1 + int(rng() % 3);
