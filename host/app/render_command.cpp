@@ -162,6 +162,20 @@ void warnAboutSamples(const RenderStats& stats) {
                      (unsigned long long)stats.saturatedSamples);
 }
 
+// An --error-csv whose estimate cells stayed empty says why: the estimate compares two half
+// buffers, which takes two iterations, and names the reason the render stopped before those.
+void explainMissingEstimate(const RenderResult& result) {
+    if (result.film->halfBufferRelMseEstimate()) return;
+    const auto reason = result.stats.extra.find("stop_reason");
+    const std::string why = reason != result.stats.extra.end() ? reason->get<std::string>() : "";
+    std::fprintf(stderr,
+                 "spillway: --error-csv has no relMSE estimate (its cells are empty): the "
+                 "estimate compares two half buffers, which takes 2 iterations, and the render "
+                 "stopped after %d (stop reason: %s); ask for more samples than one iteration "
+                 "takes (--spp)\n",
+                 result.stats.iterations, why.c_str());
+}
+
 // Every output is written whole, and flushed, before any is given its name: a failure in any of
 // them leaves none (host/image/output_file.h).
 void writeOutputs(const RenderOptions& o, const Scene& scene, RenderResult& result,
@@ -260,6 +274,7 @@ int renderCommand(const std::vector<std::string>& args, Ranks* ranks) {
     else if (signal != 0)
         std::fprintf(stderr, "spillway: stopped by signal %d after %d spp; writing them\n", signal,
                      result->stats.spp);
+    if (errorCsv) explainMissingEstimate(*result);
     writeOutputs(o, scene, *result, errorCsv.get());
     return status;
 }

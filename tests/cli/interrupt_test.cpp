@@ -148,6 +148,28 @@ TEST(Interrupt, TargetErrorStopsWhereTheErrorCsvCrossesIt) {
     EXPECT_EQ(nlohmann::json::parse(std::ifstream(dir.file("v.json")))["stop_reason"], "spp");
 }
 
+// A render of one iteration has no error estimate (two half buffers need two iterations): its
+// --error-csv cells are empty, and the render says so and why it stopped, once; a render of two
+// iterations has an estimate and says nothing of it.
+TEST(Interrupt, AnErrorCsvWithoutAnEstimateSaysWhyTheRenderStopped) {
+    TempDir dir;
+    const std::string scene = smallCornellBox(dir, 32, 32);
+    ChildResult one = runChild({"render", scene, "--backend", "cpu", "--quiet", "--spp", "1",
+                                "--error-csv", dir.file("one.csv"), "-o", dir.file("one.exr")});
+    ASSERT_EQ(one.status, 0) << one.output;
+    EXPECT_NE(one.output.find("--error-csv has no relMSE estimate (its cells are empty)"),
+              std::string::npos)
+        << one.output;
+    EXPECT_NE(one.output.find("stopped after 1 (stop reason: spp)"), std::string::npos)
+        << one.output;
+    const std::string csv = readFile(dir.file("one.csv"));
+    EXPECT_EQ(csv.substr(csv.size() - 3), ",,\n") << csv;
+    ChildResult two = runChild({"render", scene, "--backend", "cpu", "--quiet", "--spp", "2",
+                                "--error-csv", dir.file("two.csv"), "-o", dir.file("two.exr")});
+    ASSERT_EQ(two.status, 0) << two.output;
+    EXPECT_EQ(two.output.find("no relMSE estimate"), std::string::npos) << two.output;
+}
+
 // Progress for logs: a plain line per iteration with spp, elapsed, ETA and the error estimate,
 // never a control character; on a non-terminal without --progress, nothing.
 TEST(Interrupt, ProgressLinesForLogsAndNothingByDefaultOffATerminal) {
