@@ -148,6 +148,13 @@ class VulkanShading : public SlottedEngine {
     double submitSeconds_ = 0,
            waitSeconds_ = 0; // host time recording + submitting, and blocked in wait()
     std::uint64_t bufferBytes_ = 0;
+    std::uint64_t bytesUp_ = 0, bytesDown_ = 0; // records written for and read back from the device
+    // From the timestamps: device seconds copying in, shading and copying out; the device's idle
+    // time between one submit's end and the next one's start (waiting on the host); and the
+    // last submit's end tick, so a gap spanning a read of the query pool is counted too.
+    double gpuUpload_ = 0, gpuDispatch_ = 0, gpuDownload_ = 0, gpuIdle_ = 0;
+    std::uint64_t lastEndTick_ = 0;
+    bool anyTick_ = false;
 };
 
 } // namespace spw::vk_engine

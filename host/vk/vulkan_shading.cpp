@@ -2,6 +2,7 @@
 
 #include "host/scene/emitter_kinds.h"
 
+#include <algorithm>
 #include <cctype>
 
 namespace spw::vk_engine {
@@ -133,6 +134,8 @@ void VulkanShading::submit(int slot, const std::vector<ShadeRange>& ranges) {
     SPW_VK_CHECK(vkQueueSubmit(vk_.queue(), 1, &info, s.fence));
     s.inFlight = true;
     s.submitted = std::chrono::steady_clock::now();
+    bytesUp_ += s.count * sizeof(ShadeInput);
+    bytesDown_ += s.count * sizeof(ShadeResult);
     submitSeconds_ += seconds(start);
     ++submits_;
     // The other slot's batch still shading now: its shading overlapped this batch's traversal.
@@ -161,16 +164,23 @@ void VulkanShading::readTimestamps() {
     SPW_VK_CHECK(vkGetQueryPoolResults(
         device_, queries_, 0, queriesUsed_, t.size() * sizeof(std::uint64_t), t.data(),
         sizeof(std::uint64_t), VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT));
+    const double ns = vk_.timestampPeriodNs() * 1e-9;
     double upload = 0, dispatch = 0, download = 0;
     for (uint32_t i = 0; i < queriesUsed_; i += kTimestamps) {
-        upload += double(t[i + 1] - t[i]);
-        dispatch += double(t[i + 2] - t[i + 1]);
-        download += double(t[i + 3] - t[i + 2]);
+        upload += double(t[i + 1] - t[i]) * ns;
+        dispatch += double(t[i + 2] - t[i + 1]) * ns;
+        download += double(t[i + 3] - t[i + 2]) * ns;
+        // Submits run in order on the one queue: a start after the last end is the device idle.
+        if (anyTick_ && t[i] > lastEndTick_) gpuIdle_ += double(t[i] - lastEndTick_) * ns;
+        lastEndTick_ = std::max(lastEndTick_, t[i + 3]);
+        anyTick_ = true;
     }
-    const double ns = vk_.timestampPeriodNs() * 1e-9;
-    stages_.add("upload", upload * ns);
-    stages_.add("dispatch", dispatch * ns);
-    stages_.add("download", download * ns);
+    stages_.add("upload", upload);
+    stages_.add("dispatch", dispatch);
+    stages_.add("download", download);
+    gpuUpload_ += upload;
+    gpuDispatch_ += dispatch;
+    gpuDownload_ += download;
     queriesUsed_ = 0;
 }
 
@@ -216,6 +226,15 @@ void VulkanShading::publishStats(RenderStats& stats) {
     v["binding_window_records"] = windowRecords_;
     v["binding_windows_used"] = std::max<std::uint64_t>(windowsUsed_, 1);
     v["timestamps"] = timestamps_;
+    v["bytes_uploaded"] = bytesUp_;
+    v["bytes_downloaded"] = bytesDown_;
+    if (timestamps_) // device time, from the timestamp queries around each submit's commands
+        v["gpu_seconds"] = {
+            {"upload", gpuUpload_},
+            {"dispatch", gpuDispatch_},
+            {"download", gpuDownload_},
+            {"per_dispatch", dispatches_ ? gpuDispatch_ / double(dispatches_) : 0.0},
+            {"idle_between_submits", gpuIdle_}};
     v["validation"] = vk_.validation();
     v["validation_messages"] = vk_.validationMessages();
     stats.extra["vulkan"] = v;
