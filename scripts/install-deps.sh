@@ -24,6 +24,12 @@ packages=(
   blender                                  # scripts/cycles_compare.py: glTF files in Cycles
 )
 
+# scripts/bundle.sh: what the lean OpenImageIO builds with (scripts/build-lean-oiio.sh), and the
+# tools that make the release (patchelf, zstd) and test it in a bare root (debootstrap).
+if [ "${1:-}" = "--bundle" ]; then
+  packages+=(libboost-thread-dev libboost-filesystem-dev robin-map-dev libfmt-dev libtiff-dev
+             libjpeg-dev libpng-dev zlib1g-dev patchelf zstd debootstrap)
+fi
 # scripts/fuzz.sh: clang with libFuzzer and the sanitizer runtimes.
 if [ "${1:-}" = "--fuzz" ]; then packages+=(clang libclang-rt-dev); fi
 

@@ -14,11 +14,13 @@ int devicesCommand(const std::vector<std::string>& args) {
         devices = vk::listDevices();
     } catch (const vk::NoDeviceError& e) {
         std::fprintf(stderr, "spillway: no Vulkan device: %s\n", e.what());
+        std::printf("--backend auto takes cpu: no Vulkan device (%s)\n", e.what());
         return 1;
     }
     if (devices.empty()) {
         std::fprintf(stderr,
                      "spillway: no Vulkan device (the loader found drivers but no device)\n");
+        std::printf("--backend auto takes cpu: no Vulkan device (the drivers offer none)\n");
         return 1;
     }
     for (const vk::DeviceInfo& d : devices)

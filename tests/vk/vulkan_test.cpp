@@ -684,6 +684,9 @@ TEST(VulkanCli, NoDriverVisibleVulkanExitsOneAndAutoRendersOnCpu) {
     CommandResult d = runWithEnv(noDriver, "devices");
     EXPECT_EQ(d.status, 1) << d.output;
     EXPECT_TRUE(contains(d.output, "no Vulkan")) << d.output;
+    // It still says what --backend auto does, and why.
+    EXPECT_TRUE(contains(d.output, "--backend auto takes cpu: no Vulkan device (no Vulkan driver"))
+        << d.output;
 
     // cpu never touches Vulkan: no fallback line.
     CommandResult c =

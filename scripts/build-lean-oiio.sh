@@ -1,0 +1,72 @@
+#!/usr/bin/env bash
+# Builds OpenImageIO lean, for the release bundle: from Debian's source package, with the image
+# formats Spillway reads and writes (OpenEXR, TIFF, PNG, JPEG, Radiance HDR) and nothing else, so
+# the bundle carries none of the OpenCV, FFmpeg, GDAL, OpenVDB and codec closure that Debian's
+# binary package links.
+#
+#   scripts/build-lean-oiio.sh PREFIX      # installs into PREFIX (lib/, include/, lib/cmake/)
+#
+# The source is Debian's openimageio package. Bookworm's own source (2.4.7.1) is tried first; the
+# Debian mirror this project's machines reach serves only trixie's (2.5.18.0), so that one is
+# the fallback, pinned by its SHA-256 from trixie's Sources index. Either builds against
+# bookworm's libraries. Set OIIO_TARBALL to a Debian orig tarball already on disk to skip the
+# download. Idempotent: a PREFIX that already holds this build is left alone.
+set -euo pipefail
+prefix="$(realpath -m "${1:?usage: build-lean-oiio.sh PREFIX}")"
+work="$prefix.build"
+stamp="$prefix/.spillway-lean-oiio"
+[ -f "$stamp" ] && { echo "build-lean-oiio: $prefix is built ($(cat "$stamp"))"; exit 0; }
+
+pool="http://deb.debian.org/debian/pool/main/o/openimageio"
+candidates=(
+  # version                 sha256 of openimageio_VERSION.orig.tar.xz (bookworm's and trixie's .dsc)
+  "2.4.7.1+dfsg  9c9cfe65acd55e14d12344009f30515c0d336b96976af2a2ea18a695a5a1c930"
+  "2.5.18.0+dfsg 0dc2185aac5e01a2e5a1a804f558c1190ea048650a7fedef1033a1616abcac80"
+)
+mkdir -p "$work"
+tarball="${OIIO_TARBALL:-}"
+if [ -z "$tarball" ]; then
+  for c in "${candidates[@]}"; do
+    read -r version sha <<<"$c"
+    file="$work/openimageio_${version}.orig.tar.xz"
+    if [ ! -f "$file" ]; then
+      url="$pool/openimageio_${version/+/%2b}.orig.tar.xz"
+      curl -fsS -o "$file.part" "$url" 2>/dev/null && mv "$file.part" "$file" || {
+        rm -f "$file.part"; echo "build-lean-oiio: $url is not served; trying the next" >&2; continue; }
+    fi
+    if [ "$(sha256sum "$file" | cut -d' ' -f1)" != "$sha" ]; then
+      echo "build-lean-oiio: $file does not match its SHA-256 $sha" >&2; rm -f "$file"; exit 1
+    fi
+    tarball="$file"; break
+  done
+fi
+[ -n "$tarball" ] || { echo "build-lean-oiio: no OpenImageIO source package could be fetched" >&2; exit 1; }
+
+src="$work/src"
+rm -rf "$src" && mkdir -p "$src"
+tar -xf "$tarball" -C "$src" --strip-components=1
+
+# Every format plugin off except the five Spillway uses; the null reader too (a scene must never
+# open an image that is not there).
+off=()
+for dir in "$src"/src/*.imageio; do
+  name="$(basename "$dir" .imageio)"
+  case "$name" in openexr | tiff | png | jpeg | hdr) ;; *) off+=("-DENABLE_${name}=OFF") ;; esac
+done
+deps_off=()
+for pkg in OpenColorIO OpenCV TBB DCMTK FFmpeg GIF Libheif LibRaw OpenJPEG OpenVDB Ptex WebP \
+  Freetype Nuke R3DSDK Qt5 Qt6 OpenGL Python pybind11 libuhdr JXL; do
+  deps_off+=("-DENABLE_${pkg}=OFF")
+done
+
+cmake -S "$src" -B "$work/build" -G Ninja \
+  -DCMAKE_BUILD_TYPE=Release -DCMAKE_INSTALL_PREFIX="$prefix" -DCMAKE_INSTALL_LIBDIR=lib \
+  -DOIIO_BUILD_TOOLS=OFF -DOIIO_BUILD_TESTS=OFF -DBUILD_DOCS=OFF -DINSTALL_DOCS=OFF \
+  -DINSTALL_FONTS=OFF -DUSE_PYTHON=OFF -DUSE_QT=OFF -DEMBEDPLUGINS=ON -DUSE_CCACHE=OFF \
+  -DSTOP_ON_WARNING=OFF -DBUILD_MISSING_FMT=OFF -DBUILD_MISSING_ROBINMAP=OFF \
+  -DCMAKE_INSTALL_RPATH='$ORIGIN' \
+  "${deps_off[@]}" "${off[@]}" >"$work/configure.log"
+cmake --build "$work/build" --parallel "$(nproc)"
+cmake --install "$work/build" >/dev/null
+basename "$tarball" >"$stamp"
+echo "build-lean-oiio: installed $(basename "$tarball") into $prefix"
