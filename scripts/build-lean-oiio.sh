@@ -1,6 +1,9 @@
 #!/usr/bin/env bash
 # Builds OpenImageIO lean, for the release bundle: from Debian's source package, with the image
-# formats Spillway reads and writes (OpenEXR, TIFF, PNG, JPEG, Radiance HDR) and nothing else, so
+# formats Spillway reads and writes and nothing else (formats=, below: OpenEXR, TIFF, PNG, JPEG,
+# Radiance HDR, and the uncompressed PNM, Targa and BMP that sample scenes and asset libraries'
+# textures come in; none of them needs a library of its own beyond zlib, libpng, libjpeg, libtiff
+# and OpenEXR), so
 # the bundle carries none of the OpenCV, FFmpeg, GDAL, OpenVDB and codec closure that Debian's
 # binary package links.
 #
@@ -15,7 +18,11 @@ set -euo pipefail
 prefix="$(realpath -m "${1:?usage: build-lean-oiio.sh PREFIX}")"
 work="$prefix.build"
 stamp="$prefix/.spillway-lean-oiio"
-[ -f "$stamp" ] && { echo "build-lean-oiio: $prefix is built ($(cat "$stamp"))"; exit 0; }
+formats="openexr tiff png jpeg hdr pnm targa bmp"
+if [ -f "$stamp" ] && [ "$(tail -1 "$stamp")" = "$formats" ]; then
+  echo "build-lean-oiio: $prefix is built ($(head -1 "$stamp"))"
+  exit 0
+fi
 
 pool="http://deb.debian.org/debian/pool/main/o/openimageio"
 candidates=(
@@ -43,15 +50,15 @@ fi
 [ -n "$tarball" ] || { echo "build-lean-oiio: no OpenImageIO source package could be fetched" >&2; exit 1; }
 
 src="$work/src"
-rm -rf "$src" && mkdir -p "$src"
+rm -rf "$src" "$work/build" "$prefix" && mkdir -p "$src"
 tar -xf "$tarball" -C "$src" --strip-components=1
 
-# Every format plugin off except the five Spillway uses; the null reader too (a scene must never
-# open an image that is not there).
+# Every format plugin off but those above; the null reader too (a scene must never open an image
+# that is not there).
 off=()
 for dir in "$src"/src/*.imageio; do
   name="$(basename "$dir" .imageio)"
-  case "$name" in openexr | tiff | png | jpeg | hdr) ;; *) off+=("-DENABLE_${name}=OFF") ;; esac
+  [[ " $formats " == *" $name "* ]] || off+=("-DENABLE_${name}=OFF")
 done
 deps_off=()
 for pkg in OpenColorIO OpenCV TBB DCMTK FFmpeg GIF Libheif LibRaw OpenJPEG OpenVDB Ptex WebP \
@@ -68,5 +75,5 @@ cmake -S "$src" -B "$work/build" -G Ninja \
   "${deps_off[@]}" "${off[@]}" >"$work/configure.log"
 cmake --build "$work/build" --parallel "$(nproc)"
 cmake --install "$work/build" >/dev/null
-basename "$tarball" >"$stamp"
+printf '%s\n%s\n' "$(basename "$tarball")" "$formats" >"$stamp"
 echo "build-lean-oiio: installed $(basename "$tarball") into $prefix"

@@ -62,7 +62,8 @@ copy_closure "$stage/bin/spillway" "$stage/bin/orterun"
 heavy='libuc[pstm]\.|libfabric\.|libibverbs\.|librdmacm\.|libpsm|libnl-|libefa\.|liboshmem\.|libhcoll'
 mkdir -p "$stage/lib/openmpi3" "$stage/lib/pmix"
 for c in "$ompi_lib"/openmpi3/mca_*.so; do
-  ldd "$c" | grep -Eq "$heavy" && continue
+  needs="$(ldd "$c")" # whole, then searched: grep -q closing ldd's pipe early fails under pipefail
+  grep -Eq "$heavy" <<<"$needs" && continue
   cp "$c" "$stage/lib/openmpi3/"
 done
 cp /usr/lib/x86_64-linux-gnu/pmix2/lib/pmix/*.so "$stage/lib/pmix/"
@@ -112,10 +113,8 @@ cp "$root/scripts/release-README.md" "$stage/README.md"
 
 # Everything a program in bin/ loads must now resolve inside the bundle.
 for f in "$stage/bin/spillway" "$stage/bin/orterun" "$stage"/lib/*.so* "$stage"/lib/*/*.so; do
-  if ldd "$f" | grep -q "not found"; then
-    echo "bundle: $f: $(ldd "$f" | grep "not found" | head -1)" >&2
-    exit 1
-  fi
+  missing="$(ldd "$f" | grep "not found" || true)"
+  [ -z "$missing" ] || { echo "bundle: $f:$(head -1 <<<"$missing")" >&2; exit 1; }
 done
 
 mkdir -p "$dist"

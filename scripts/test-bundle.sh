@@ -4,8 +4,8 @@
 # build-bundle/bare-root) and there checks, in order:
 #   1. ldd resolves every library of every program and library in the release;
 #   2. `spillway devices` runs, and says why it picks what it picks, with no Vulkan driver;
-#   3. the Cornell box renders with reference and cpu, each equal bit for bit to the build tree's
-#      render (build/spillway, made by scripts/build.sh);
+#   3. the Cornell box renders with reference, and every sample scene (scenes/*.yaml) with cpu,
+#      each equal bit for bit to the build tree's render (build/spillway, scripts/build.sh);
 #   4. mpirun -np 2 from the release equals one process, bit for bit;
 #   5. a glTF file with image textures renders, equal to the build tree's render;
 #   6. with the host's lavapipe installed into the root the way a GPU driver is (its ICD manifest
@@ -75,21 +75,30 @@ pass "ldd resolves every library in the release"
 # 2. devices, with no Vulkan driver installed: exit 1 (no device), saying what auto takes and why.
 status=0
 out="$(in_jail "$opt/bin/spillway" devices 2>&1)" || status=$?
-[ "$status" = 1 ] && echo "$out" | grep -q -- "--backend auto takes cpu: no Vulkan device" ||
+[ "$status" = 1 ] && grep -q -- "--backend auto takes cpu: no Vulkan device" <<<"$out" ||
   fail "devices without a driver (exit $status): $out"
 pass "spillway devices without a driver: $(echo "$out" | tail -1)"
 
 render_args=(--width 96 --height 96 --spp 8 --threads 2 --progress none)
-# 3. The Cornell box, reference and cpu, against the build tree's renders.
-for backend in reference cpu; do
-  "$host_spillway" render "$root/scenes/cornell-box.yaml" --backend "$backend" "${render_args[@]}" \
-    -o "$work/host-$backend.exr" 2>/dev/null
-  in_jail sh -c "cd $opt && bin/spillway render scenes/cornell-box.yaml --backend $backend \
-    ${render_args[*]} -o /tmp/$backend.exr" || fail "the release's $backend render failed"
-  same "$jail/tmp/$backend.exr" "$work/host-$backend.exr" ||
-    fail "the release's $backend render differs from build/spillway's"
-  pass "Cornell box, $backend: equal to build/spillway's"
+# 3. The Cornell box with reference, and every sample scene with cpu, against the build tree's.
+bundle_render() { # SCENE BACKEND OUT: the release's render, in the root
+  in_jail sh -c "cd $opt && bin/spillway render scenes/$1 --backend $2 ${render_args[*]} -o $3" ||
+    fail "the release's $2 render of $1 failed"
+}
+host_render() { # SCENE BACKEND OUT
+  "$host_spillway" render "$root/scenes/$1" --backend "$2" "${render_args[@]}" -o "$3" 2>/dev/null
+}
+runs=("cornell-box.yaml reference")
+for scene in "$root"/scenes/*.yaml; do runs+=("$(basename "$scene") cpu"); done
+for r in "${runs[@]}"; do
+  read -r scene backend <<<"$r"
+  host_render "$scene" "$backend" "$work/host.exr"
+  bundle_render "$scene" "$backend" /tmp/bundle.exr
+  same "$jail/tmp/bundle.exr" "$work/host.exr" ||
+    fail "the release's $backend render of $scene differs from build/spillway's"
+  pass "$scene, $backend: equal to build/spillway's"
 done
+bundle_render cornell-box.yaml cpu /tmp/cpu.exr # one process, for step 4
 
 # 4. Two ranks through the release's mpirun equal one process.
 in_jail sh -c "cd $opt && OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 \
@@ -120,11 +129,9 @@ for lib in "$driver" $(ldd "$driver" | awk '/=>/ && $3 ~ /^\// {print $3}'); do
   [ -e "$jail$lib" ] || { mkdir -p "$jail$(dirname "$lib")"; cp -L "$lib" "$jail$lib"; }
 done
 out="$(in_jail "$opt/bin/spillway" devices 2>&1)" || fail "devices with lavapipe: $out"
-echo "$out" | grep -q llvmpipe || fail "devices does not list lavapipe: $out"
-"$host_spillway" render "$root/scenes/cornell-box.yaml" --backend vulkan "${render_args[@]}" \
-  -o "$work/host-vulkan.exr" 2>/dev/null
-in_jail sh -c "cd $opt && bin/spillway render scenes/cornell-box.yaml --backend vulkan \
-  ${render_args[*]} -o /tmp/vulkan.exr" || fail "the release's vulkan render failed"
+grep -q llvmpipe <<<"$out" || fail "devices does not list lavapipe: $out"
+host_render cornell-box.yaml vulkan "$work/host-vulkan.exr"
+bundle_render cornell-box.yaml vulkan /tmp/vulkan.exr
 same "$jail/tmp/vulkan.exr" "$work/host-vulkan.exr" ||
   fail "the release's vulkan render differs from build/spillway's"
 pass "Cornell box, vulkan on lavapipe: equal to build/spillway's"
