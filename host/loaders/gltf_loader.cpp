@@ -347,6 +347,7 @@ Scene loadGltfScene(const std::string& path) {
     Scene scene;
     scene.file = path;
     GltfReader(path, scene).readScene();
+    scene.image.samplingStated = false; // glTF has no sampling settings
     return scene;
 }
 

@@ -68,6 +68,9 @@ struct ImageSettings {
     int height = 512;
     int sampleBase = 1; // n: n*n samples per pixel per iteration
     int iterations = 1;
+    // False for a file whose format carries no sampling setting (a glTF file rendered as the
+    // scene): `spillway render` then picks a default a user would accept (render_command.cpp).
+    bool samplingStated = true;
     int samplesPerIteration() const { return sampleBase * sampleBase; }
 };
 

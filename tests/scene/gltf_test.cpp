@@ -246,6 +246,44 @@ TEST(Gltf, EveryBackendRendersAFileDirectly) {
     EXPECT_FALSE(std::filesystem::exists(dir.file("bad.exr")));
 }
 
+// glTF carries no sampling setting: rendered with none on the command line, a file renders
+// progressively to a default error estimate or a cap, and says so on stderr, on every backend;
+// any of --spp, --target-error or --time-limit is the user's choice instead, and says nothing.
+TEST(Gltf, AFileWithoutSamplingRendersToADefaultErrorAndSaysSo) {
+    TempDir dir;
+    GltfBuilder b = cameraAndQuads();
+    const std::string glb = b.binary(dir, "model.glb");
+    for (const std::string& backend : backendsUnderTest()) {
+        SCOPED_TRACE(backend);
+        const std::string stats = dir.file(backend + ".json");
+        CommandResult r = runSpillway("render " + glb + " --backend " + backend +
+                                      " --width 16 --height 8 --quiet -o " +
+                                      dir.file(backend + ".exr") + " --stats " + stats);
+        ASSERT_EQ(r.status, 0) << r.output;
+        EXPECT_NE(r.output.find(glb + " carries no sampling setting: rendering until the relMSE "
+                                      "estimate reaches 0.002, at most 1024 spp"),
+                  std::string::npos)
+            << r.output;
+        const json s = json::parse(readFile(stats));
+        const std::string reason = s["stop_reason"];
+        // One sample a pixel an iteration; the estimate exists from the second on.
+        EXPECT_EQ(s["iterations"], s["spp"]) << s.dump();
+        if (reason == "target error") {
+            EXPECT_GE(s["spp"].get<int>(), 2);
+            EXPECT_LT(s["spp"].get<int>(), 1024);
+        } else {
+            EXPECT_EQ(reason, "spp");
+            EXPECT_EQ(s["spp"], 1024);
+        }
+        for (const char* choice : {"--spp 2", "--target-error 0.5", "--time-limit 60"}) {
+            r = runSpillway("render " + glb + " --backend " + backend + " " + choice +
+                            " --width 16 --height 8 --quiet -o " + dir.file("chosen.exr"));
+            ASSERT_EQ(r.status, 0) << choice << ": " << r.output;
+            EXPECT_EQ(r.output.find("carries no sampling setting"), std::string::npos) << choice;
+        }
+    }
+}
+
 // `type: Gltf` places a file in a YAML scene: moved by the object's transform, relative to the
 // scene's camera; its materials follow the scene's shaders, or `shader:` replaces them all.
 TEST(Gltf, AYamlSceneObjectPlacesAFileWithItsMaterialsOrAShader) {
