@@ -201,7 +201,7 @@ void shadeLanes(const simd_shading::SurfaceLanes& in, size_t count, bool nee, bo
         h.ng = load(in.ng, i), h.albedo = load(in.albedo, i), h.wo = load(in.wo, i);
         h.alpha = load(in.alpha, i), h.ior = load(in.ior, i), h.metallic = load(in.metallic, i);
         h.ngDotWo = dot(h.ng, h.wo);
-        h.n = facingShadingNormal(ns, h.ng, h.ngDotWo);
+        h.n = facingShadingNormal(ns, h.ng, h.wo, h.ngDotWo);
         const Model model(h);
         const V offset = load(in.offset, i);
         const M live = loadMask(in.live, i);

@@ -103,6 +103,9 @@ HWY_INLINE V3 gmax(V3 a, V3 b) {
 HWY_INLINE V maxComponent(V3 v) {
     return gmax(v.x, gmax(v.y, v.z));
 }
+HWY_INLINE V clamp01(V x) { // glm::clamp(x, 0, 1)
+    return gmin(gmax(x, hn::Zero(D())), hn::Set(D(), 1.0f));
+}
 HWY_INLINE V sign(M nonNegative) { // x >= 0 ? 1 : -1
     return hn::IfThenElse(nonNegative, hn::Set(D(), 1.0f), hn::Set(D(), -1.0f));
 }
@@ -116,12 +119,42 @@ HWY_INLINE V powerHeuristic(V pdfThis, V pdfOther) {
     const V w = hn::Div(hn::Set(D(), 1.0f), hn::Add(hn::Set(D(), 1.0f), hn::Mul(r, r)));
     return hn::IfThenZeroElse(hn::Le(pdfThis, hn::Zero(D())), w);
 }
-// Twin of facingShadingNormal (shared/sampling.h), given dot(ng, wo).
-HWY_INLINE V3 facingShadingNormal(V3 ns, V3 ng, V ngDotWo) {
-    const V side = sign(hn::Ge(ngDotWo, hn::Zero(D())));
+// Twin of facingShadingNormal (shared/sampling.h), given dot(ng, wo): every branch computed, the
+// scalar code's early returns as selects in the same order.
+HWY_INLINE V3 facingShadingNormal(V3 ns, V3 ng, V3 wo, V ngDotWo) {
+    const D d;
+    const V zero = hn::Zero(d), one = hn::Set(d, 1.0f), two = hn::Set(d, 2.0f);
+    const V side = sign(hn::Ge(ngDotWo, zero));
     const V3 n = mul(ns, side);
     const V3 g = mul(ng, side);
-    return select(hn::Gt(dot(n, g), hn::Zero(D())), n, g);
+    const V nz = dot(n, g);
+    const V wz = dot(wo, g);
+    const V clearance = gmin(hn::Mul(hn::Set(d, 0.9f), wz), hn::Set(d, 0.01f));
+    const M clears = hn::Ge(hn::Sub(hn::Mul(hn::Mul(two, dot(wo, n)), nz), wz), clearance);
+    const V3 xt = sub(n, mul(g, nz));
+    const V xl = hn::Sqrt(dot(xt, xt));
+    const V3 x = div(xt, xl);
+    const V wx = dot(wo, x);
+    const V a = hn::Add(hn::Mul(wx, wx), hn::Mul(wz, wz));
+    const V root =
+        hn::Sqrt(gmax(hn::Mul(hn::Mul(wx, wx), hn::Sub(a, hn::Mul(clearance, clearance))), zero));
+    const V mid = hn::Add(hn::Mul(wz, clearance), a);
+    const V twoA = hn::Mul(two, a);
+    const V cLow = hn::Sqrt(clamp01(hn::Div(hn::Sub(mid, root), twoA)));
+    const V cHigh = hn::Sqrt(clamp01(hn::Div(hn::Add(mid, root), twoA)));
+    const V sLow = hn::Sqrt(gmax(hn::Sub(one, hn::Mul(cLow, cLow)), zero));
+    const V sHigh = hn::Sqrt(gmax(hn::Sub(one, hn::Mul(cHigh, cHigh)), zero));
+    const V enough = hn::Mul(hn::Set(d, 0.9f), clearance);
+    auto height = [&](V c, V s) {
+        return hn::Sub(hn::Mul(hn::Mul(two, c), hn::Add(hn::Mul(s, wx), hn::Mul(c, wz))), wz);
+    };
+    const M useLow = hn::And(hn::Gt(cLow, nz), hn::Ge(height(cLow, sLow), enough));
+    const M useHigh = hn::And(hn::Gt(cHigh, nz), hn::Ge(height(cHigh, sHigh), enough));
+    V3 bent = select(useHigh, add(mul(x, sHigh), mul(g, cHigh)), g);
+    bent = select(useLow, add(mul(x, sLow), mul(g, cLow)), bent);
+    const M degenerate = hn::Not(hn::And(hn::Gt(xl, zero), hn::Gt(a, zero)));
+    const V3 valid = select(clears, n, select(degenerate, g, bent));
+    return select(hn::Gt(nz, zero), valid, g);
 }
 // Twin of offsetOrigin (shared/offset.h).
 HWY_INLINE V3 offsetOrigin(V3 p, V3 ng, V offset, V3 dir) {
@@ -237,9 +270,6 @@ HWY_INLINE V3 normalize(V3 v) {
 }
 HWY_INLINE M selectMask(M m, M a, M b) { // m ? a : b
     return hn::Or(hn::And(m, a), hn::AndNot(m, b));
-}
-HWY_INLINE V clamp01(V x) { // glm::clamp(x, 0, 1)
-    return gmin(gmax(x, hn::Zero(D())), hn::Set(D(), 1.0f));
 }
 // The scalar code's libm cos and sin, lane by lane: Highway's polynomials round differently.
 HWY_INLINE void cosSin(V phi, V& c, V& s) {

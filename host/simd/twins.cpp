@@ -61,7 +61,7 @@ FrameArgs frameArgs(const TwinLanes& in, int ngRow, int nsRow, int woRow, size_t
     a.ng = load3(in, ngRow, i);
     a.wo = load3(in, woRow, i);
     a.ngDotWo = dot(a.ng, a.wo);
-    a.frame = shadingFrame(facingShadingNormal(load3(in, nsRow, i), a.ng, a.ngDotWo));
+    a.frame = shadingFrame(facingShadingNormal(load3(in, nsRow, i), a.ng, a.wo, a.ngDotWo));
     return a;
 }
 
@@ -170,9 +170,8 @@ void runVector(Twin twin, const TwinLanes& in, size_t i, TwinResults& out) {
     case Twin::powerHeuristic: // pdfThis f0, pdfOther f1 -> f0
         return store(powerHeuristic(f(0), f(1)), out.f[0], i);
     case Twin::facingShadingNormal: { // ns f0-2, ng f3-5, wo f6-8 -> f0-2
-        const V3 ng = load3(in, 3, i);
-        return store3(facingShadingNormal(load3(in, 0, i), ng, dot(ng, load3(in, 6, i))), out, 0,
-                      i);
+        const V3 ng = load3(in, 3, i), wo = load3(in, 6, i);
+        return store3(facingShadingNormal(load3(in, 0, i), ng, wo, dot(ng, wo)), out, 0, i);
     }
     case Twin::sinQuarterPi: // x f0 -> f0
         return store(sinQuarterPi(f(0)), out.f[0], i);
@@ -201,8 +200,9 @@ void runVector(Twin twin, const TwinLanes& in, size_t i, TwinResults& out) {
         return store(emitterSolidAnglePdf(f(0), f(1), f(2), f(3)), out.f[0], i);
     case Twin::lambertEval: { // albedo f0-2, ng f3-5, ns f6-8, wo f9-11, wi f12-14 -> f0-2, pdf f3
         const V3 ng = load3(in, 3, i);
-        const V ngDotWo = dot(ng, load3(in, 9, i));
-        const V3 n = facingShadingNormal(load3(in, 6, i), ng, ngDotWo);
+        const V3 wo = load3(in, 9, i);
+        const V ngDotWo = dot(ng, wo);
+        const V3 n = facingShadingNormal(load3(in, 6, i), ng, wo, ngDotWo);
         V pdf;
         store3(lambertEval(load3(in, 0, i), ng, ngDotWo, n, load3(in, 12, i), pdf), out, 0, i);
         return store(pdf, out.f[3], i);

@@ -97,14 +97,51 @@ SHARED_FN float quantizePdf(float pdf) {
     return uintBitsToFloat(floatBitsToUint(pdf) & 0xFFFF0000u);
 }
 
-// The shading normal turned to the side of the geometric normal that wo is on.
+// The shading normal turned to the side of the geometric normal that wo is on, and made valid
+// for shading there: where wo's mirror reflection about it would point below the geometric
+// surface (or not clear it by min(0.9 cos θo, 0.01)), as a normal map or interpolated normals do
+// on the rims of bumps and at silhouettes, it is bent toward the geometric normal, in the plane
+// of the two, just far enough that the reflection clears it; an unbent normal leaves wo below
+// its own hemisphere and the surface black where light reaches it. Cycles and pbrt-v4 make the
+// same correction. A normal that needs none comes back unchanged, bit for bit.
 // SIMD twin: host/simd/simd_math-inl.h
 SHARED_FN vec3 facingShadingNormal(vec3 ns, vec3 ng, vec3 wo) {
     float side = dot(ng, wo) >= 0.0f ? 1.0f : -1.0f;
     vec3 n = ns * side;
+    vec3 g = ng * side;
+    float nz = dot(n, g);
     // A shading normal on the far side of the geometric one (bad vertex normals) is replaced by
     // the geometric normal, so cosines stay non-negative.
-    return dot(n, ng * side) > 0.0f ? n : ng * side;
+    if (!(nz > 0.0f)) return g;
+    float wz = dot(wo, g);
+    float clearance = min(0.9f * wz, 0.01f);
+    // The reflection's height above the surface: dot(2 dot(wo, n) n - wo, g).
+    if (2.0f * dot(wo, n) * nz - wz >= clearance) return n;
+    // n' = s x + c g, x the unit direction of n's tangential part. Its reflection's height
+    // 2 c (s wx + c wz) - wz equals the clearance where C = c^2 solves
+    // a C^2 - (a + wz clearance) C + (wz + clearance)^2 / 4 = 0, a = wx^2 + wz^2.
+    vec3 xt = n - g * nz;
+    float xl = sqrt(dot(xt, xt));
+    if (!(xl > 0.0f)) return g;
+    vec3 x = xt / xl;
+    float wx = dot(wo, x);
+    float a = wx * wx + wz * wz;
+    if (!(a > 0.0f)) return g;
+    float root = sqrt(max(wx * wx * (a - clearance * clearance), 0.0f));
+    float mid = wz * clearance + a;
+    // The least bend that clears: the smaller root beyond n's own C, else the larger, else g.
+    // Squaring admits a root of the mirrored tilt (-s); its reflection clears by
+    // clearance + 4 c s wx, so it is taken only where that is within 10 % of the clearance.
+    float cLow = sqrt(clamp((mid - root) / (2.0f * a), 0.0f, 1.0f));
+    float cHigh = sqrt(clamp((mid + root) / (2.0f * a), 0.0f, 1.0f));
+    float sLow = sqrt(max(1.0f - cLow * cLow, 0.0f));
+    float sHigh = sqrt(max(1.0f - cHigh * cHigh, 0.0f));
+    float enough = 0.9f * clearance;
+    bool useLow = cLow > nz && 2.0f * cLow * (sLow * wx + cLow * wz) - wz >= enough;
+    bool useHigh = cHigh > nz && 2.0f * cHigh * (sHigh * wx + cHigh * wz) - wz >= enough;
+    if (useLow) return x * sLow + g * cLow;
+    if (useHigh) return x * sHigh + g * cHigh;
+    return g;
 }
 
 // SIMD twin: host/simd/simd_math-inl.h

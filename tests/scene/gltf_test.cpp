@@ -732,6 +732,54 @@ TEST(Gltf, NormalTexturesTiltTheShadingNormalInTheTextureFrame) {
     }
 }
 
+// Shading normals bent valid (shared/sampling.h): a large quad whose normals all lean 60 degrees
+// toward +x, seen from the -x side 70 degrees off its normal, so that the view direction is below
+// every unbent shading normal's hemisphere, under a sun straight above. Unbent, the
+// metallic-roughness BSDF is 0 there and the image black; bent, every pixel is lit, on every
+// backend.
+TEST(Gltf, NormalsTurnedAwayFromTheViewerLeaveNoPixelBlack) {
+    TempDir dir;
+    GltfBuilder b;
+    b.doc["materials"] = json::array({material(vec3(0.8f), 0.0f, 0.5f)});
+    const int pos =
+        b.accessor<float>({-20, -20, 0, 20, -20, 0, 20, 20, 0, -20, 20, 0}, 5126, "VEC3");
+    const vec3 lean = glm::normalize(vec3(std::sin(1.0472f), 0.0f, std::cos(1.0472f)));
+    std::vector<float> normals;
+    for (int i = 0; i < 4; ++i)
+        normals.insert(normals.end(), {lean.x, lean.y, lean.z});
+    const int nor = b.accessor<float>(normals, 5126, "VEC3");
+    const int idx = b.accessor<uint16_t>({0, 1, 2, 0, 2, 3}, 5123, "SCALAR");
+    const json prim = {
+        {"attributes", {{"POSITION", pos}, {"NORMAL", nor}}}, {"indices", idx}, {"material", 0}};
+    b.doc["extensionsUsed"] = {"KHR_lights_punctual"};
+    b.doc["extensions"]["KHR_lights_punctual"]["lights"] =
+        json::array({{{"type", "directional"}, {"intensity", 5.0}}});
+    b.doc["cameras"] =
+        json::array({{{"type", "perspective"},
+                      {"perspective", {{"yfov", 0.2}, {"aspectRatio", 1.0}, {"znear", 0.1}}}}});
+    // The camera's -Z turned 70 degrees about +y toward +x, 3 units back from the origin.
+    const float t = -1.2217f; // -70 degrees
+    const vec3 view(std::sin(1.2217f), 0.0f, -std::cos(1.2217f));
+    b.scene({b.node({{"mesh", b.mesh(prim)}}),
+             b.node({{"camera", 0},
+                     {"rotation", {0.0, std::sin(t / 2), 0.0, std::cos(t / 2)}},
+                     {"translation", {-3 * view.x, 0.0, -3 * view.z}}}),
+             b.node({{"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}})});
+    Scene scene = loadScene(b.embedded(dir, "leaning.gltf"));
+    scene.image.width = scene.image.height = 16;
+    for (BackendKind backend : {BackendKind::Reference, BackendKind::Cpu, BackendKind::Vulkan}) {
+        SCOPED_TRACE(backendName(backend));
+        RenderConfig cfg;
+        cfg.backend = backend;
+        cfg.spp = 1;
+        const std::vector<float> img = render(scene, cfg)->film->image();
+        float darkest = 1e30f;
+        for (size_t p = 0; p < img.size(); p += 3)
+            darkest = std::min(darkest, img[p] + img[p + 1] + img[p + 2]);
+        EXPECT_GT(darkest, 0.0f);
+    }
+}
+
 } // namespace
 } // namespace spw::test
 
