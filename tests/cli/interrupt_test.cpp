@@ -149,7 +149,7 @@ TEST(Interrupt, TargetErrorStopsWhereTheErrorCsvCrossesIt) {
 }
 
 // A render of one iteration has no error estimate (two half buffers need two iterations): its
-// --error-csv cells are empty, and the render says so and why it stopped, once; a render of two
+// --error-csv cells are empty, and the render says so and why it stopped; a render of two
 // iterations has an estimate and says nothing of it.
 TEST(Interrupt, AnErrorCsvWithoutAnEstimateSaysWhyTheRenderStopped) {
     TempDir dir;
