@@ -1,5 +1,7 @@
 #include "embree_backend/cutouts.h"
 
+#include "shared/rng.h"
+
 namespace spw {
 
 Cutouts::Cutouts(const Scene& scene, const TextureResolver& textures)
@@ -12,7 +14,15 @@ bool Cutouts::filters(uint mesh) const {
     return scene_.shaders[size_t(scene_.meshes[mesh].shader)].cutout.enabled;
 }
 
-bool Cutouts::keeps(uint meshIndex, uint prim, float u, float v) const {
+float Cutouts::stochasticNumber(uint mesh, uint prim, vec3 org, vec3 dir) {
+    const uvec4 a = pcg4d(uvec4(floatBitsToUint(org.x), floatBitsToUint(org.y),
+                                floatBitsToUint(org.z), floatBitsToUint(dir.x)));
+    const uvec4 b = pcg4d(
+        uvec4(floatBitsToUint(dir.y) ^ a.x, floatBitsToUint(dir.z) ^ a.y, prim ^ a.z, mesh ^ a.w));
+    return uintToUnit(b.x);
+}
+
+bool Cutouts::keeps(uint meshIndex, uint prim, float u, float v, vec3 org, vec3 dir) const {
     const Mesh& mesh = scene_.meshes[meshIndex];
     const Cutout& c = scene_.shaders[size_t(mesh.shader)].cutout;
     float alpha = c.alpha;
@@ -22,6 +32,7 @@ bool Cutouts::keeps(uint meshIndex, uint prim, float u, float v) const {
         textures_.values(c.texture, 1, &uv, nullptr, &value);
         alpha *= value.x;
     }
+    if (c.stochastic) return stochasticNumber(meshIndex, prim, org, dir) < alpha;
     return alpha >= c.cutoff;
 }
 

@@ -22,7 +22,11 @@ void filterHits(const RTCFilterFunctionNArguments* args) {
         const uint mesh = RTCHitN_geomID(args->hit, args->N, i);
         const uint prim = RTCHitN_primID(args->hit, args->N, i);
         const float u = RTCHitN_u(args->hit, args->N, i), v = RTCHitN_v(args->hit, args->N, i);
-        if (!filter->keeps(mesh, prim, u, v)) args->valid[i] = 0;
+        const vec3 org(RTCRayN_org_x(args->ray, args->N, i), RTCRayN_org_y(args->ray, args->N, i),
+                       RTCRayN_org_z(args->ray, args->N, i));
+        const vec3 dir(RTCRayN_dir_x(args->ray, args->N, i), RTCRayN_dir_y(args->ray, args->N, i),
+                       RTCRayN_dir_z(args->ray, args->N, i));
+        if (!filter->keeps(mesh, prim, u, v, org, dir)) args->valid[i] = 0;
     }
 }
 } // namespace

@@ -15,16 +15,18 @@ struct RTCSceneTy;
 
 namespace spw {
 
-// Which candidate hits count, for meshes with holes in them (an alpha cut-out): Embree asks
-// `keeps` for each hit it finds on a mesh that `filters`, and traversal goes on past those it
-// does not keep, for closest hits and shadow rays alike. Meshes that do not filter get no
-// filter function, and cost nothing.
+// Which candidate hits count, for meshes with holes in them (an alpha cut-out, or alpha blending
+// as stochastic transparency): Embree asks `keeps` for each hit it finds on a mesh that
+// `filters`, and traversal goes on past those it does not keep, for closest hits and shadow rays
+// alike. Meshes that do not filter get no filter function, and cost nothing.
 class HitFilter {
   public:
     virtual ~HitFilter() = default;
     virtual bool filters(uint mesh) const = 0;
-    // Thread-safe: Embree calls it from every thread that traces.
-    virtual bool keeps(uint mesh, uint prim, float u, float v) const = 0;
+    // Whether the hit at Embree's barycentrics (u, v) of triangle `prim` counts, for the ray from
+    // `org` along `dir` (as traced: the same ray always gets the same answer). Thread-safe:
+    // Embree calls it from every thread that traces.
+    virtual bool keeps(uint mesh, uint prim, float u, float v, vec3 org, vec3 dir) const = 0;
 };
 
 class EmbreeScene {

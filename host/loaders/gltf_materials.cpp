@@ -60,7 +60,9 @@ int GltfReader::shaderFor(int material, const std::string& at) {
         if (scene_.shaders.size() >= size_t(kMaxShaders))
             fail(at, "more than " + std::to_string(kMaxShaders) + " materials");
         shaderOf_[key] = int(scene_.shaders.size());
+        uvSetsRead_.clear();
         scene_.shaders.push_back(material < 0 ? defaultShader() : readMaterial(material));
+        uvSetOf_[shaderOf_[key]] = material < 0 ? 0 : chooseUvSet(material);
     }
     return shaderOf_[key];
 }
@@ -82,9 +84,7 @@ Shader GltfReader::readMaterial(int index) {
     s.roughness = float(unit(pbr.roughnessFactor, at + "/pbrMetallicRoughness/roughnessFactor"));
     s.params.alpha = gltfAlpha(s.roughness);
     readImages(mat, s, at, name);
-    if (mat.alphaMode == "BLEND")
-        warn(name + ": alphaMode BLEND is not rendered (it is drawn opaque)");
-    else if (mat.alphaMode != "OPAQUE" && mat.alphaMode != "MASK")
+    if (mat.alphaMode != "OPAQUE" && mat.alphaMode != "MASK" && mat.alphaMode != "BLEND")
         fail(at + "/alphaMode", "must be OPAQUE, MASK or BLEND");
     readEmission(mat, s, at, name);
     if (mat.doubleSided) s.params.flags |= kShaderTwoSided;
@@ -95,7 +95,7 @@ void GltfReader::readImages(const tinygltf::Material& mat, Shader& s, const std:
                             const std::string& name) {
     const tinygltf::PbrMetallicRoughness& pbr = mat.pbrMetallicRoughness;
     if (pbr.baseColorTexture.index >= 0) baseColourTexture(pbr.baseColorTexture, s, at, name);
-    if (mat.alphaMode == "MASK") readCutout(mat, s, at, name);
+    if (mat.alphaMode == "MASK" || mat.alphaMode == "BLEND") readCutout(mat, s, at, name);
     if (pbr.metallicRoughnessTexture.index >= 0) {
         Texture mr = imageTexture(pbr.metallicRoughnessTexture,
                                   at + "/pbrMetallicRoughness/metallicRoughnessTexture",
@@ -170,6 +170,7 @@ void GltfReader::readCutout(const tinygltf::Material& mat, Shader& s, const std:
     const tinygltf::PbrMetallicRoughness& pbr = mat.pbrMetallicRoughness;
     Cutout& c = s.cutout;
     c.alpha = float(unit(pbr.baseColorFactor[3], at + "/pbrMetallicRoughness/baseColorFactor"));
+    c.stochastic = mat.alphaMode == "BLEND";
     c.cutoff = float(mat.alphaCutoff);
     if (!(c.cutoff >= 0.0f) || !std::isfinite(mat.alphaCutoff))
         fail(at + "/alphaCutoff", "must be a non-negative number");
@@ -182,15 +183,16 @@ void GltfReader::readCutout(const tinygltf::Material& mat, Shader& s, const std:
         c.texture = int(scene_.textures.size());
         scene_.textures.push_back(alpha);
     }
-    c.enabled = c.texture >= 0 || c.alpha < c.cutoff;
+    // A factor that decides alone: MASK's at least the cutoff, or BLEND's 1, is no cut-out.
+    c.enabled = c.texture >= 0 || (c.stochastic ? c.alpha < 1.0f : c.alpha < c.cutoff);
 }
 
 template <class Info>
 Texture GltfReader::imageTexture(const Info& info, const std::string& where,
                                  const std::string& what) {
     const int index = info.index;
-    if (info.texCoord != 0)
-        warn(what + "'s texCoord " + std::to_string(info.texCoord) + " is read as TEXCOORD_0");
+    if (info.texCoord < 0 || info.texCoord > kMaxUvSet)
+        fail(where + "/texCoord", "must be an integer in [0, " + std::to_string(kMaxUvSet) + "]");
     if (index >= int(model_.textures.size()))
         fail(where, "names texture " + std::to_string(index) + " of " +
                         std::to_string(model_.textures.size()));
@@ -235,7 +237,8 @@ Texture GltfReader::imageTexture(const Info& info, const std::string& where,
         !why.empty())
         fail(imageAt, why);
     in->close();
-    readTextureTransform(info, where, picture);
+    const int transformSet = readTextureTransform(info, where, picture);
+    uvSetsRead_.push_back(transformSet >= 0 ? transformSet : info.texCoord);
     if (const int sampler = model_.textures[size_t(index)].sampler; sampler >= 0) {
         if (sampler >= int(model_.samplers.size()))
             fail("/textures/" + std::to_string(index) + "/sampler",
@@ -278,10 +281,9 @@ void GltfReader::readSampler(const tinygltf::Sampler& s, const std::string& at,
 }
 
 template <class Info>
-void GltfReader::readTextureTransform(const Info& info, const std::string& where,
-                                      Texture& picture) {
+int GltfReader::readTextureTransform(const Info& info, const std::string& where, Texture& picture) {
     const auto e = info.extensions.find("KHR_texture_transform");
-    if (e == info.extensions.end()) return;
+    if (e == info.extensions.end()) return -1;
     const std::string at = where + "/extensions/KHR_texture_transform";
     auto numbers = [&](const char* key, std::vector<double> fallback) {
         if (!e->second.Has(key)) return fallback;
@@ -300,7 +302,14 @@ void GltfReader::readTextureTransform(const Info& info, const std::string& where
     const std::vector<double> offset = numbers("offset", {0.0, 0.0});
     const double rotation = numbers("rotation", {0.0})[0];
     const std::vector<double> scale = numbers("scale", {1.0, 1.0});
-    if (e->second.Has("texCoord")) warn("KHR_texture_transform's texCoord is read as TEXCOORD_0");
+    int set = -1;
+    if (e->second.Has("texCoord")) {
+        const tinygltf::Value& v = e->second.Get("texCoord");
+        const double n = v.IsNumber() ? v.GetNumberAsDouble() : -1.0;
+        if (!(n >= 0.0 && n <= kMaxUvSet) || n != std::floor(n))
+            fail(at + "/texCoord", "must be an integer in [0, " + std::to_string(kMaxUvSet) + "]");
+        set = int(n);
+    }
     const double c = std::cos(rotation), sn = std::sin(rotation);
     // Column by column, as the extension's GLSL writes them.
     const glm::dmat3 t(1, 0, 0, 0, 1, 0, offset[0], offset[1], 1);
@@ -310,6 +319,21 @@ void GltfReader::readTextureTransform(const Info& info, const std::string& where
     picture.uvTransformed = true;
     picture.uvTransform = mat3(flip * t * r * sc * flip);
     picture.footprintScale = float(std::max({std::fabs(scale[0]), std::fabs(scale[1]), 1e-6}));
+    return set;
+}
+
+int GltfReader::chooseUvSet(int material) {
+    if (uvSetsRead_.empty()) return 0;
+    const int chosen = uvSetsRead_.front();
+    for (int set : uvSetsRead_)
+        if (set != chosen) {
+            warn("material " + std::to_string(material) + "'s images name TEXCOORD_" +
+                 std::to_string(chosen) + " and TEXCOORD_" + std::to_string(set) +
+                 ": all are read through TEXCOORD_" + std::to_string(chosen) +
+                 ", the first one's (a mesh carries one set)");
+            break;
+        }
+    return chosen;
 }
 
 } // namespace spw

@@ -216,12 +216,21 @@ void GltfReader::readNormals(const tinygltf::Primitive& prim, const glm::dmat4& 
 }
 
 void GltfReader::readTextureCoordinates(const tinygltf::Primitive& prim, size_t vertices,
-                                        const std::string& at, Mesh& m) const {
-    const auto t = prim.attributes.find("TEXCOORD_0");
-    if (t == prim.attributes.end()) return;
-    const std::vector<double> uv = readAccessor(t->second, 2, at + "/attributes/TEXCOORD_0");
-    if (uv.size() != 2 * vertices)
-        fail(at + "/attributes/TEXCOORD_0", "has another count than POSITION");
+                                        const std::string& at, Mesh& m) {
+    const auto set = uvSetOf_.find(m.shader);
+    const std::string attribute =
+        "TEXCOORD_" + std::to_string(set == uvSetOf_.end() ? 0 : set->second);
+    const auto t = prim.attributes.find(attribute);
+    if (t == prim.attributes.end()) {
+        const Shader& shader = scene_.shaders[size_t(m.shader)];
+        if (shader.looksUpTextures() || shader.cutout.texture >= 0 || shader.emissionTexture >= 0)
+            warn("a primitive whose material has images has no " + attribute +
+                 ": they are read at (0, 0) there");
+        return;
+    }
+    const std::string where = at + "/attributes/" + attribute;
+    const std::vector<double> uv = readAccessor(t->second, 2, where);
+    if (uv.size() != 2 * vertices) fail(where, "has another count than POSITION");
     m.uvs.resize(vertices);
     for (size_t i = 0; i < vertices; ++i) {
         m.uvs[i] = vec2(float(uv[2 * i]), float(1.0 - uv[2 * i + 1]));

@@ -98,9 +98,10 @@ class GltfReader {
     void readNormals(const tinygltf::Primitive& prim, const glm::dmat4& world, size_t vertices,
                      const std::string& at, Mesh& m);
 
-    // TEXCOORD_0, its v turned to run up: glTF's v runs down the image, Spillway's (OBJ's) up.
+    // TEXCOORD_n, n the set the mesh's material reads (uvSetOf_), its v turned to run up: glTF's v
+    // runs down the image, Spillway's (OBJ's) up.
     void readTextureCoordinates(const tinygltf::Primitive& prim, size_t vertices,
-                                const std::string& at, Mesh& m) const;
+                                const std::string& at, Mesh& m);
 
     // COLOR_0 (RGB, or RGBA whose alpha is not read): per-vertex factors of the base colour,
     // clamped to [0, 1]. Not read where a YAML shader overrides the file's materials.
@@ -142,12 +143,14 @@ class GltfReader {
 
     // alphaMode MASK: a cut-out where baseColorFactor's alpha times the base colour image's
     // alpha channel (1 where it has none) is below alphaCutoff. A factor that decides alone is
-    // no cut-out at all (at least the cutoff) or hides the whole surface.
+    // no cut-out at all (at least the cutoff) or hides the whole surface. BLEND: that alpha as
+    // stochastic transparency (Cutout::stochastic).
     void readCutout(const tinygltf::Material& mat, Shader& s, const std::string& at,
                     const std::string& name);
 
     // A texture reference's image, as a Standard texture with its KHR_texture_transform: read
     // from memory where the file embeds it (checked readable now), else from beside the file.
+    // The coordinate set it names (texCoord, or the transform's override) joins uvSetsRead_.
     template <class Info> // tinygltf::TextureInfo, NormalTextureInfo
     Texture imageTexture(const Info& info, const std::string& where, const std::string& what);
 
@@ -162,8 +165,17 @@ class GltfReader {
 
     // KHR_texture_transform on a texture reference: T(offset) R(rotation) S(scale) of glTF's
     // texture coordinates, written for Spillway's (v = 1 - glTF's v) as F M F, F that flip.
+    // Returns the extension's texCoord override, or -1.
     template <class Info>
-    void readTextureTransform(const Info& info, const std::string& where, Texture& picture);
+    int readTextureTransform(const Info& info, const std::string& where, Texture& picture);
+
+    // The texture coordinate set material `material`'s images read, from uvSetsRead_ once they
+    // are all read: the one they name; where they name several, the first one's, the base
+    // colour's where it has one (warned).
+    int chooseUvSet(int material);
+
+    // The highest TEXCOORD_n a texture may name (Blender writes at most 8 sets).
+    static constexpr int kMaxUvSet = 255;
 
     // --- lights ----------------------------------------------------------------------------
 
@@ -182,6 +194,11 @@ class GltfReader {
     std::set<std::string> warned_;
     std::set<int> onPath_;
     std::vector<int> shaderOf_;
+    // Per shader made from the file: the TEXCOORD_n its meshes' texture coordinates are read from.
+    // A mesh carries one set, and every image of its material is looked up in it.
+    std::map<int, int> uvSetOf_;
+    // The sets the images of the material being read name, the base colour's first.
+    std::vector<int> uvSetsRead_;
     glm::dvec3 lo_{0.0}, hi_{0.0}; // the bounds of every position and point light read
     bool bounded_ = false;
     bool cameraFound_ = false, cameraSeen_ = false;

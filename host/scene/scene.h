@@ -157,9 +157,11 @@ inline uint wrapMode(Texture::Wrap wrap) {
 // An alpha cut-out (glTF's alphaMode MASK): the surface is there only where its alpha, `alpha`
 // times the first channel of the texture tree `texture` (or alone, -1), is at least `cutoff`.
 // Elsewhere rays pass through it, camera, bounce and shadow rays alike (the BVH's hit filter,
-// embree_backend/cutouts.h).
+// embree_backend/cutouts.h). Stochastic (glTF's alphaMode BLEND): each ray that meets it sees it
+// with probability alpha, and passes through it otherwise.
 struct Cutout {
     bool enabled = false;
+    bool stochastic = false;
     float alpha = 1.0f;
     int texture = -1;
     float cutoff = 0.5f;
