@@ -64,7 +64,7 @@ layout(set = 0, binding = 0) uniform usamplerBuffer shaderTable; // 3 texels per
 layout(set = 0, binding = 1) uniform usamplerBuffer emitterTable; // 5 texels per Emitter
 layout(set = 0, binding = 2) uniform usamplerBuffer emitterCdf;
 layout(set = 0, binding = 3) uniform usamplerBuffer lightData;
-layout(set = 0, binding = 4) uniform usamplerBuffer inputs; // 7 texels per ShadeInput
+layout(set = 0, binding = 4) uniform usamplerBuffer inputs; // 8 texels per ShadeInput
 layout(std430, set = 0, binding = 5) writeonly buffer Results { uvec4 results[]; }; // 7 per ShadeResult
 layout(scalar, push_constant) uniform Push { ShadePush pc; };
 
@@ -115,10 +115,10 @@ Emitter kernelEmitter(uint i) {
 
 // Layout twin of the C++ ShadeInput (shared/shade_io.h): tests/vk/kernel_layout_test.cpp checks it field by field.
 ShadeInput loadInput(uint i) {
-    uint t = 7u * i;
-    uvec4 w[7] = uvec4[7](fetch(inputs, t), fetch(inputs, t + 1u), fetch(inputs, t + 2u),
+    uint t = 8u * i;
+    uvec4 w[8] = uvec4[8](fetch(inputs, t), fetch(inputs, t + 1u), fetch(inputs, t + 2u),
                           fetch(inputs, t + 3u), fetch(inputs, t + 4u), fetch(inputs, t + 5u),
-                          fetch(inputs, t + 6u));
+                          fetch(inputs, t + 6u), fetch(inputs, t + 7u));
     ShadeInput r;
     r.hit.p = uintBitsToFloat(w[0].xyz);
     r.hit.t = uintBitsToFloat(w[0].w);
@@ -129,13 +129,19 @@ ShadeInput loadInput(uint i) {
     r.hit.albedo = uintBitsToFloat(w[3].xyz);
     r.hit.offset = uintBitsToFloat(w[3].w);
     r.hit.material = w[4].x;
-    r.path.beta = uintBitsToFloat(w[4].yzw);
-    r.path.prevPdf = uintBitsToFloat(w[5].x);
-    r.path.pathId = w[5].y;
-    r.path.bounce = w[5].z;
-    r.path.flags = w[5].w;
-    r.path.cone = w[6].x;
-    r.rayDir = uintBitsToFloat(w[6].yzw);
+    r.hit.lift = uintBitsToFloat(w[4].y);
+    r.path.beta.xy = uintBitsToFloat(w[4].zw);
+    r.path.beta.z = uintBitsToFloat(w[5].x);
+    r.path.prevPdf = uintBitsToFloat(w[5].y);
+    r.path.pathId = w[5].z;
+    r.path.bounce = w[5].w;
+    r.path.flags = w[6].x;
+    r.path.cone = w[6].y;
+    r.rayDir.xy = uintBitsToFloat(w[6].zw);
+    r.rayDir.z = uintBitsToFloat(w[7].x);
+    r.pad0 = w[7].y;
+    r.pad1 = w[7].z;
+    r.pad2 = w[7].w;
     return r;
 }
 

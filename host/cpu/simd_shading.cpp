@@ -39,7 +39,7 @@ struct RandomLanes {
 // A kernel's inputs for up to kBlock hits of one surface model.
 struct SurfaceLanes {
     Vec3s p, ng, ns, albedo, wo, beta; // the hit, -rayDir, the path's throughput
-    Floats offset;
+    Floats offset, lift;
     Floats alpha, ior, metallic; // the shader's GGX width, index of refraction and metalness
     Uints live;                  // bounce < max depth: the path goes on from here
     Uints roulette;              // bounce >= min depth
@@ -92,7 +92,8 @@ void MakeRandomNumbers(simd_shading::RandomLanes& lanes, size_t count, uint samp
 struct HitVector {
     V3 ng, albedo, wo;
     V ngDotWo, alpha, ior, metallic;
-    V3 n; // facingShadingNormal
+    V3 ns; // the interpolated shading normal
+    V3 n;  // facingShadingNormal
 };
 
 // Each model's eval, sample and delta test on a vector of hits, as the twins of its registry
@@ -153,6 +154,28 @@ struct MetallicRoughnessLanesModel {
     }
 };
 
+// Twin of terminatorEval (shared/path.h) for the lanes `candidates` selects (those whose BSDF
+// gave nothing toward wi): fcos and toward replaced where it applies.
+template <class Model>
+void terminatorLanes(const HitVector& h, V3 wi, V lift, M candidates, V3& fcos, V3& toward) {
+    const D d;
+    const V zero = hn::Zero(d);
+    M terminator = hn::And(candidates, hn::Gt(hn::Mul(h.ngDotWo, lift), zero));
+    terminator = hn::AndNot(hn::Gt(hn::Mul(h.ngDotWo, dot(h.ng, wi)), zero), terminator);
+    terminator =
+        hn::And(terminator, hn::And(hn::Gt(dot(h.ns, h.wo), zero), hn::Gt(dot(h.ns, wi), zero)));
+    if (hn::AllFalse(d, terminator)) return;
+    HitVector smooth = h; // the interpolated normal as the geometric one
+    smooth.ng = h.ns;
+    smooth.ngDotWo = dot(h.ns, h.wo);
+    smooth.n = facingShadingNormal(h.ns, h.ns, h.wo, smooth.ngDotWo);
+    const Model smoothModel(smooth);
+    V unusedPdf;
+    const V3 smoothFcos = smoothModel.eval(smooth, wi, unusedPdf);
+    fcos = select(terminator, smoothFcos, fcos);
+    toward = select(hn::And(terminator, hn::Gt(maxComponent(smoothFcos), zero)), h.wo, wi);
+}
+
 // Step 2 of shadeSurface, next-event estimation toward a point of the picked triangle
 // (sampleEmitter), for the lanes `shadowing` selects; the mask of those that send a shadow ray.
 template <class Model>
@@ -171,20 +194,29 @@ M shadowLanes(const simd_shading::SurfaceLanes& in, size_t i, const HitVector& h
     const V pdf = emitterSolidAnglePdf(load(in.ePickPdf, i), load(in.eArea, i), dist, cosLight);
     const V offsetQ = surfaceOffset(q, e0, add(e0, e1), add(e0, e2), eNormal);
     const V tmax = shadowRayTmax(dist, offset, offsetQ, cosLight);
+
     shadowing = hn::And(shadowing, hn::And(hn::Gt(dist, zero), hn::Gt(pdf, zero)));
 
     V bsdfPdf;
-    const V3 fcos = model.eval(h, wi, bsdfPdf);
+    V3 fcos = model.eval(h, wi, bsdfPdf);
+    // Where the BSDF gives nothing: terminatorEval, and a pdf of 0.
+    const M none = hn::Not(hn::Gt(maxComponent(fcos), zero));
+    bsdfPdf = hn::IfThenZeroElse(none, bsdfPdf);
+    const V lift = load(in.lift, i);
+    V3 toward = wi;
+    terminatorLanes<Model>(h, wi, lift, hn::And(shadowing, none), fcos, toward);
     shadowing = hn::And(shadowing, hn::Gt(maxComponent(fcos), zero));
 
     const V w = mis ? powerHeuristic(pdf, quantizePdf(bsdfPdf)) : hn::Set(d, 1.0f);
     const V3 radiance = load(in.eRadiance, i);
-    store(shadowing, offsetOrigin(p, h.ng, offset, wi), out.shadowOrigin, i);
+    const V lifted = shadowLift(h.ng, lift, toward, tmax);
+    const V liftedTmax = hn::Sub(tmax, hn::Mul(hn::Set(d, 2.0f), lifted));
+    store(shadowing, offsetOrigin(p, h.ng, hn::Add(offset, lifted), toward), out.shadowOrigin, i);
     store(shadowing, wi, out.shadowDir, i);
-    store(hn::IfThenElseZero(shadowing, tmax), out.shadowTmax, i);
+    store(hn::IfThenElseZero(shadowing, liftedTmax), out.shadowTmax, i);
     store(shadowing, mul(mul(mul(beta, fcos), radiance), hn::Div(w, pdf)), out.shadowContribution,
           i);
-    return hn::And(shadowing, hn::Gt(tmax, zero));
+    return hn::And(shadowing, hn::Gt(liftedTmax, zero));
 }
 
 // Steps 2 and 3 of shadeSurface for lanes [0, count) of one model's hits, count a multiple of
@@ -201,6 +233,7 @@ void shadeLanes(const simd_shading::SurfaceLanes& in, size_t count, bool nee, bo
         h.ng = load(in.ng, i), h.albedo = load(in.albedo, i), h.wo = load(in.wo, i);
         h.alpha = load(in.alpha, i), h.ior = load(in.ior, i), h.metallic = load(in.metallic, i);
         h.ngDotWo = dot(h.ng, h.wo);
+        h.ns = ns;
         h.n = facingShadingNormal(ns, h.ng, h.wo, h.ngDotWo);
         const Model model(h);
         const V offset = load(in.offset, i);
@@ -311,6 +344,7 @@ void fillLane(const SceneView& scene, const RenderParams& rp, const ShadeInput& 
     set(lanes.wo, k, wo);
     set(lanes.beta, k, st.beta);
     lanes.offset.v[k] = hit.offset;
+    lanes.lift.v[k] = hit.lift;
     const ShaderParams sh = shaderAtHit(scene.shaders[hit.shader], hit);
     lanes.alpha.v[k] = sh.alpha;
     lanes.ior.v[k] = sh.ior;

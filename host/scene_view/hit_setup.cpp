@@ -42,6 +42,19 @@ void HitSetup::surfaceHit(uint meshIndex, uint prim, float u, float v, float t,
     hit.albedo = vec3(0.0f);
     hit.offset = surfaceOffset(hit.p, p0, p1, p2, hit.ng);
     hit.material = 0u;
+    hit.lift = smoothLift(mesh, tri, u, v, hit.p, hit.ng);
+}
+
+float HitSetup::smoothLift(const Mesh& mesh, uvec3 tri, float u, float v, vec3 p, vec3 ng) {
+    if (mesh.normals.empty()) return 0.0f;
+    // Each vertex's tangent plane lifts p onto it where p lies below it.
+    auto toPlane = [&](uint i) {
+        const vec3 n = mesh.normals[i];
+        return n * std::max(0.0f, glm::dot(mesh.positions[i] - p, n));
+    };
+    const vec3 up = (1.0f - u - v) * toPlane(tri.x) + u * toPlane(tri.y) + v * toPlane(tri.z);
+    const float lift = glm::dot(up, ng);
+    return std::isfinite(lift) ? lift : 0.0f;
 }
 
 void HitSetup::setUpHit(const HitRecord& h, vec3 dir, uint cone, const TextureResolver& textures,
@@ -199,6 +212,8 @@ void HitSetup::setUpHits(size_t n, const HitRecord* const* hits, const vec3* dir
         hit.albedo = vec3(0.0f);
         hit.offset = l.offset.v[j];
         hit.material = 0u;
+        hit.lift = smoothLift(src_.meshes[h.mesh], src_.meshes[h.mesh].triangles[h.prim], h.u, h.v,
+                              hit.p, hit.ng);
         uv[j] = vec2(l.uv.x.v[j], l.uv.y.v[j]);
         footprint[j] = l.footprint.v[j];
     }

@@ -83,6 +83,11 @@ class HitSetup {
         }
     }
 
+    // SurfaceHit::lift at p, barycentrics (u, v) of triangle `tri` (unit geometric normal ng):
+    // the smooth surface's height over the triangle (shared/offset.h's shadowLift), 0 where the
+    // mesh has no vertex normals.
+    static float smoothLift(const Mesh& mesh, uvec3 tri, float u, float v, vec3 p, vec3 ng);
+
   private:
     // World-space hit for (mesh, triangle, Embree's u, v) at distance t; albedo left at 0.
     void surfaceHit(uint meshIndex, uint prim, float u, float v, float t, SurfaceHit& hit) const;

@@ -161,6 +161,12 @@ HWY_INLINE V3 offsetOrigin(V3 p, V3 ng, V offset, V3 dir) {
     const V side = sign(hn::Ge(dot(ng, dir), hn::Zero(D())));
     return add(p, mul(ng, hn::Mul(side, offset)));
 }
+// Twin of shadowLift (shared/offset.h).
+HWY_INLINE V shadowLift(V3 ng, V lift, V3 dir, V tmax) {
+    const V zero = hn::Zero(D());
+    const M up = hn::And(hn::Gt(hn::Mul(dot(ng, dir), lift), zero), hn::Gt(tmax, zero));
+    return hn::IfThenElseZero(up, gmin(hn::Abs(lift), hn::Mul(hn::Set(D(), 0.25f), tmax)));
+}
 // Twin of surfaceOffset (shared/offset.h).
 HWY_INLINE V surfaceOffset(V3 p, V3 v0, V3 v1, V3 v2, V3 n) {
     const V3 m = gmax(gmax(abs(v0), abs(v1)), gmax(abs(v2), abs(p)));

@@ -190,6 +190,8 @@ void runVector(Twin twin, const TwinLanes& in, size_t i, TwinResults& out) {
                       i);
     case Twin::shadowRayTmax: // dist f0, offsetP f1, offsetQ f2, cosQ f3 -> f0
         return store(shadowRayTmax(f(0), f(1), f(2), f(3)), out.f[0], i);
+    case Twin::shadowLift: // ng f0-2, lift f3, dir f4-6, tmax f7 -> f0
+        return store(shadowLift(load3(in, 0, i), f(3), load3(in, 4, i), f(7)), out.f[0], i);
     case Twin::emitterPoint: // p0 f0-2, e1 f3-5, e2 f6-8, u f9-10 -> f0-2
         return store3(emitterPoint(load3(in, 0, i), load3(in, 3, i), load3(in, 6, i), f(9), f(10)),
                       out, 0, i);

@@ -25,6 +25,7 @@
     X(surfaceOffset, "offset.h")                                                                   \
     X(offsetOrigin, "offset.h")                                                                    \
     X(shadowRayTmax, "offset.h")                                                                   \
+    X(shadowLift, "offset.h")                                                                      \
     X(emitterPoint, "light_sample.h")                                                              \
     X(emitterCosine, "light_sample.h")                                                             \
     X(emitterSolidAnglePdf, "light_sample.h")                                                      \

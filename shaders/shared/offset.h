@@ -62,5 +62,20 @@ SHARED_FN float shadowRayTmax(float dist, float offsetP, float offsetQ, float co
     return dist * (1.0f - kOffsetRelative) - (offsetP + offsetQ) / cosQ;
 }
 
+// The shadow terminator of a smooth-shaded mesh (Hanika 2021, "Hacking the Shadow Terminator",
+// as Cycles ships it): where the vertex normals say the surface curves, the true surface lies
+// above the flat triangle that was hit, and a shadow ray from the triangle toward a grazing light
+// is caught by the neighbouring triangles, the terminator drawn in facets. SurfaceHit::lift is
+// the height of the smooth surface over the triangle at p: each vertex's tangent plane, where p
+// lies below it, lifts p onto it, and the lifts are interpolated with p's barycentrics. A
+// shadow ray that leaves toward that side starts this much higher (at most a quarter of the way
+// to the light, tmax), one on the other side not at all. The lift is not applied to
+// continuation rays: one that left a concave region from above its triangles could escape
+// geometry that should have caught it.
+// SIMD twin: host/simd/simd_math-inl.h
+SHARED_FN float shadowLift(vec3 ng, float lift, vec3 dir, float tmax) {
+    return dot(ng, dir) * lift > 0.0f && tmax > 0.0f ? min(abs(lift), 0.25f * tmax) : 0.0f;
+}
+
 SHARED_END
 #endif

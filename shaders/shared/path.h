@@ -68,6 +68,26 @@ SHARED_FN void addEmission(SCENE_PARAM RenderParams rp, SurfaceHit hit, vec3 wo,
     if (w > 0.0f) r.flags |= kShadeEmitted;
 }
 
+// Next-event estimation toward a light that the triangle's plane hides but the smooth surface its
+// vertex normals describe does not: the light below the triangle on the viewer's side, above
+// the interpolated normal, at a hit lifted toward the viewer (SurfaceHit::lift, shared/offset.h).
+// The BSDF there as if the interpolated normal were the geometric one, and `toward` set to wo:
+// the side the shadow ray leaves from, lifted onto the smooth surface, from where it clears the
+// facets next to it on a convex mesh and is caught by them on a concave one (which has no lift).
+// Zero elsewhere, `toward` left as it was. The pdf is 0: BSDF sampling never leaves below the
+// triangle, so these directions are found by light sampling alone, at MIS weight 1.
+// host/cpu/simd_shading.cpp's shadowLanes does the same SIMD-wide.
+SHARED_FN vec3 terminatorEval(ShaderParams sh, SurfaceHit hit, vec3 wo, vec3 wi,
+                              INOUT(vec3) toward) {
+    float side = dot(hit.ng, wo);
+    if (!(side * hit.lift > 0.0f) || side * dot(hit.ng, wi) > 0.0f) return vec3(0.0f);
+    if (!(dot(hit.ns, wo) > 0.0f) || !(dot(hit.ns, wi) > 0.0f)) return vec3(0.0f);
+    float pdf;
+    vec3 fcos = bsdfEval(sh, hit.albedo, hit.ns, hit.ns, wo, wi, pdf);
+    if (maxComponent(fcos) > 0.0f) toward = wo;
+    return fcos;
+}
+
 // Whether the path goes on from a hit of shader sh: it samples a light and its BSDF.
 SHARED_FN bool shadeGoesOn(RenderParams rp, ShaderParams sh, PathState st) {
     return st.bounce < rp.maxDepth && sh.model != kModelNull;
@@ -105,14 +125,22 @@ SHARED_FN void shadeSurfaceWith(SCENE_PARAM RenderParams rp, SurfaceHit hit, vec
         if (ls.pdf > 0.0f) {
             float bsdfPdf;
             vec3 fcos = bsdfEval(sh, hit.albedo, hit.ng, hit.ns, wo, ls.wi, bsdfPdf);
+            vec3 toward = ls.wi; // the side of the surface the shadow ray leaves from
+            if (!(maxComponent(fcos) > 0.0f)) {
+                fcos = terminatorEval(sh, hit, wo, ls.wi, toward);
+                bsdfPdf = 0.0f;
+            }
             if (maxComponent(fcos) > 0.0f) {
                 // A delta light (a point, a direction): BSDF sampling cannot find it, no MIS.
                 float w = rp.strategy == kStrategyMis && !emitterIsDelta(e.type)
                               ? powerHeuristic(ls.pdf, quantizePdf(bsdfPdf))
                               : 1.0f;
-                r.shadowOrigin = offsetOrigin(hit.p, hit.ng, hit.offset, ls.wi);
+                // Lifted, the origin comes nearer the light by up to `lift` along the ray and
+                // moves as far across it: the ray stops twice that much sooner.
+                float lift = shadowLift(hit.ng, hit.lift, toward, ls.tmax);
+                r.shadowOrigin = offsetOrigin(hit.p, hit.ng, hit.offset + lift, toward);
                 r.shadowDir = ls.wi;
-                r.shadowTmax = ls.tmax;
+                r.shadowTmax = ls.tmax - 2.0f * lift;
                 r.shadowContribution = st.beta * fcos * ls.radiance * (w / ls.pdf);
                 if (r.shadowTmax > 0.0f) r.flags |= kShadeShadow;
             }

@@ -81,6 +81,9 @@ struct SurfaceHit {
     uint material; // with kShaderHitParams: the metallic (low 16 bits) and perceptual roughness
                    // (high) that the host's texture lookup gave the hit, as unorm16 (bsdf.h's
                    // shaderAtHit); 0 otherwise
+    float lift;    // how far above its flat triangle the smooth surface its vertex normals
+                   // describe lies at p, along ng (negative: below), for shadow rays leaving on
+                   // that side (shared/offset.h's shadowLift); 0 without vertex normals
 };
 const uint kNoEmitter = 0xFFFFFFFFu;
 

@@ -118,6 +118,8 @@ std::vector<ShadeInput> randomHits(std::mt19937& rng, const Fixture& f, size_t n
         h.albedo = vec3(u(rng), u(rng), u(rng));
         h.offset = 1e-6f * (1.0f + u(rng));
         h.material = uint(rng()); // metallic and roughness, where the shader takes them per hit
+        // Lifted toward either side (a smooth-shaded mesh), or not at all.
+        h.lift = u(rng) < 0.4f ? 0.0f : 0.05f * (u(rng) - 0.3f);
         in.rayDir = unitVector(rng);
         PathState& st = in.path;
         st.beta = u(rng) < 0.05f ? vec3(0.0f) : vec3(u(rng), u(rng), u(rng)) * 2.0f;

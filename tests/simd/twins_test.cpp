@@ -207,6 +207,11 @@ const std::map<Twin, ScalarSide>& scalarSides() {
           [](const Inputs& in, size_t k, Expected& e) {
               e.put(shadowRayTmax(in.f(0, k), in.f(1, k), in.f(2, k), in.f(3, k)));
           }}},
+        {Twin::shadowLift,
+         {[](Inputs& in) { in.setDirection(0), in.setDirection(4); },
+          [](const Inputs& in, size_t k, Expected& e) {
+              e.put(shadowLift(in.get3(0, k), in.f(3, k), in.get3(4, k), in.f(7, k)));
+          }}},
         {Twin::emitterPoint,
          {[](Inputs& in) { in.setUnit(9), in.setUnit(10); },
           [](const Inputs& in, size_t k, Expected& e) {
