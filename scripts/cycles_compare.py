@@ -187,9 +187,10 @@ def png(width, height, channels, pixel):
 
 def write_glb(path, meshes, materials, camera_z=4.5, yfov=0.6, images=(), sun=None,
               extensions=()):
-    """meshes: (positions, normals, indices, uvs or None, material) each; a perspective camera
-    on +Z; images: PNG files' bytes, texture i reading image i; sun: a directional light's
-    direction of travel and illuminance (lux), or none; extensions: names the materials use."""
+    """meshes: (positions, normals, indices, uvs, material) each, uvs None, one set, or a tuple
+    of sets (TEXCOORD_0, TEXCOORD_1, ...); a perspective camera on +Z; images: PNG files' bytes,
+    texture i reading image i; sun: a directional light's direction of travel and illuminance
+    (lux), or none; extensions: names the materials use."""
     doc = {"asset": {"version": "2.0"}, "scene": 0, "materials": materials, "meshes": [],
            "nodes": [], "accessors": [], "bufferViews": []}
     if extensions:
@@ -218,8 +219,8 @@ def write_glb(path, meshes, materials, camera_z=4.5, yfov=0.6, images=(), sun=No
         hi = [max(pos[k::3]) for k in range(3)]
         attributes = {"POSITION": view(pos, "f", n, 3, 5126, {"min": lo, "max": hi}),
                       "NORMAL": view(nor, "f", n, 3, 5126)}
-        if uv:
-            attributes["TEXCOORD_0"] = view(uv, "f", n, 2, 5126)
+        for k, st in enumerate(uv if isinstance(uv, tuple) else (uv,) if uv else ()):
+            attributes["TEXCOORD_%d" % k] = view(st, "f", n, 2, 5126)
         i = view(idx, "I", len(idx), 1, 5125)
         doc["meshes"].append({"primitives": [{"attributes": attributes, "indices": i,
                                               "material": mat}]})
@@ -319,7 +320,29 @@ def make_test_files(out):
     write_glb(os.path.join(out, "emissive.glb"),
               [s + (0,), f + (1,), panel() + (2,)], list(files["rough-plastic.glb"]) + [glowing],
               images=[emission_image()], extensions=["KHR_materials_emissive_strength"])
-    return sorted(os.path.join(out, n) for n in list(files) + ["textured.glb", "emissive.glb"])
+    # The checker (8 x 8 squares) on a panel behind the sphere through its second texture
+    # coordinate set, the first one another mapping (a quarter of the image, turned): read
+    # through TEXCOORD_0, the panel would show 2 x 2 large squares. No floor, as above.
+    pos, nor, idx, whole = panel()
+    quarter = [c for u, v in zip(whole[0::2], whole[1::2]) for c in (0.25 * v, 0.25 * u)]
+    second = material((1.0, 1.0, 1.0), 0.0, 0.5)
+    second["pbrMetallicRoughness"]["baseColorTexture"] = {"index": 0, "texCoord": 1}
+    write_glb(os.path.join(out, "uv-sets.glb"),
+              [s + (0,), (pos, nor, idx, (quarter, whole), 1)],
+              [files["rough-plastic.glb"][0], second], images=textured_images()[:1])
+    # A 16-segment sphere with smooth normals under a sun from the side, across its facets: the
+    # terminator.
+    write_glb(os.path.join(out, "terminator.glb"), [sphere(8, 16) + (0,)],
+              [material((0.8, 0.8, 0.8), 0.0, 0.4)], sun=((-1.0, -0.15, -0.1), 3.0 * 683))
+    # A blue BLEND panel of alpha 0.4 in front of the sphere, over its lower half.
+    veil = material((0.1, 0.3, 0.9), 0.0, 0.7)
+    veil["pbrMetallicRoughness"]["baseColorFactor"][3] = 0.4
+    veil["alphaMode"] = "BLEND"
+    write_glb(os.path.join(out, "blend.glb"),
+              [s + (0,), f + (1,), panel(-1.6, 1.6, -1.2, 0.2, 1.4) + (2,)],
+              list(files["rough-plastic.glb"]) + [veil])
+    return sorted(os.path.join(out, n) for n in list(files) + [
+        "textured.glb", "emissive.glb", "uv-sets.glb", "terminator.glb", "blend.glb"])
 
 
 # The suite's bound (docs/scene-format.md, "glTF files", says why): relMSE and each channel's
