@@ -47,6 +47,7 @@ bool ReferenceRenderer::renderIteration(uint iteration, Film& film) {
                             SurfaceHit hit;
                             ctx_.hitSetup.setUpHit(h, dir, st.cone, ctx_.textures,
                                                    st.bounce < rp.maxDepth, hit);
+                            if (ctx_.aovs && st.bounce == 0) ctx_.aovs->record(st.pathId, hit);
                             ShadeResult res;
                             shadeSurface(view, rp, hit, dir, st, res);
                             if (res.flags & kShadeEmitted)

@@ -31,6 +31,9 @@ namespace {
 // share its cores, unless --threads says otherwise; where mpirun bound a rank to fewer cores than
 // its share (one core each, its default for two ranks), those.
 void fitToRank(RenderOptions& o, Ranks* ranks, bool writes) {
+    if (ranks && ranks->size() > 1 && o.config.aovs != 0)
+        throw UsageError("--aov does not go with more than one MPI rank yet: the ranks do not "
+                         "share the passes");
     if (ranks && o.preview && writes)
         std::fprintf(stderr, "spillway: --preview shows rank 0's film, which holds every "
                              "rank's samples after each iteration\n");
@@ -196,6 +199,27 @@ void explainMissingEstimate(const RenderResult& result) {
                  result.stats.iterations, why.c_str());
 }
 
+// The image's R, G and B, then the passes' channels (AovFilm::channelNames).
+void writeImageWithPasses(OutputFile& file, const std::string& path, const Film& film,
+                          const AovFilm& aovs) {
+    const std::vector<std::string> names = aovs.channelNames();
+    const size_t extra = names.size(), channels = 3 + extra;
+    std::vector<float> rgb, passes;
+    writeImageRows(
+        file, path, film.width(), film.height(),
+        [&](int y0, int y1, float* out) {
+            const size_t pixels = size_t(film.width()) * size_t(y1 - y0);
+            rgb.resize(pixels * 3), passes.resize(pixels * extra);
+            film.imageRows(y0, y1, rgb.data());
+            aovs.rows(y0, y1, passes.data());
+            for (size_t i = 0; i < pixels; ++i) {
+                std::copy_n(&rgb[i * 3], 3, out + i * channels);
+                std::copy_n(&passes[i * extra], extra, out + i * channels + 3);
+            }
+        },
+        names);
+}
+
 // Every output is written whole, and flushed, before any is given its name: a failure in any of
 // them leaves none (host/image/output_file.h).
 void writeOutputs(const RenderOptions& o, const Scene& scene, RenderResult& result,
@@ -204,8 +228,11 @@ void writeOutputs(const RenderOptions& o, const Scene& scene, RenderResult& resu
     {
         StageTimer t(result.stats.stages, "write image");
         const Film& film = *result.film;
-        writeImageRows(image, o.output, scene.image.width, scene.image.height,
-                       [&](int y0, int y1, float* rgb) { film.imageRows(y0, y1, rgb); });
+        if (result.aovs)
+            writeImageWithPasses(image, o.output, film, *result.aovs);
+        else
+            writeImageRows(image, o.output, scene.image.width, scene.image.height,
+                           [&](int y0, int y1, float* rgb) { film.imageRows(y0, y1, rgb); });
         image.flush();
     }
     std::unique_ptr<OutputFile> errorMap;

@@ -1,6 +1,7 @@
 #include "host/app/render_options.h"
 
 #include "host/app/usage_error.h"
+#include "host/image/aov_film.h"
 #include "host/image/image_io.h"
 #include "host/image/output_file.h"
 
@@ -148,6 +149,17 @@ const std::vector<CliOption> kOwnOptions = {
      "at the end, the per-pixel relMSE estimate from two half buffers, per channel (the "
      "terms --error-csv averages): where the noise is",
      0, 0, [](O& r, const C&, const S& v) { r.errorMapPath = v; }},
+    {"--aov", nullptr, "PASSES", Section::Render,
+     "render passes as layers of the output EXR, named as Cycles names them: any of albedo "
+     "(\"Denoising Albedo\"), normal (\"Normal\"), depth (\"Depth\"), comma-separated",
+     0, 0,
+     [](O& r, const C& o, const S& v) {
+         try {
+             r.config.aovs = parseAovList(v);
+         } catch (const std::invalid_argument& e) {
+             throw UsageError(std::string(o.name) + " " + v + ": " + e.what());
+         }
+     }},
     {"--reference", nullptr, "REF.exr", Section::Render, "the reference image for --error-csv", 0,
      0, [](O& r, const C&, const S& v) { r.referencePath = v; }},
     {"--time-limit", nullptr, "SECONDS", Section::Render,
@@ -274,6 +286,14 @@ void checkRelations(RenderOptions& r) {
         !(r.errorMapPath.size() > 4 && r.errorMapPath.substr(r.errorMapPath.size() - 4) == ".exr"))
         throw UsageError("--error-map '" + r.errorMapPath +
                          "' must end in .exr: it holds linear values, not colours");
+    if (r.config.aovs != 0) {
+        if (std::filesystem::path(r.output).extension() != ".exr")
+            throw UsageError("--aov writes layers of an EXR: the output '" + r.output +
+                             "' must end in .exr");
+        if (!r.checkpointPath.empty() || !r.resumePath.empty() || !r.partialPath.empty())
+            throw UsageError("--aov does not go with --checkpoint, --resume or --partial yet: "
+                             "checkpoints do not keep the passes");
+    }
     if (!r.referencePath.empty() && r.errorCsvPath.empty())
         throw UsageError("--reference goes with --error-csv");
     if (!r.partialPath.empty() && !r.config.sampleRange)

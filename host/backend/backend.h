@@ -4,6 +4,7 @@
 
 #include "host/backend/render_config.h"
 #include "host/backend/stats.h"
+#include "host/image/aov_film.h"
 #include "host/image/film.h"
 #include "host/scene/camera.h"
 #include "host/scene/scene.h"
@@ -26,6 +27,7 @@ struct RenderContext {
     RenderParams params; // the render-wide values; each backend sets `iteration` in its own copy
     int threads;         // resolved thread count
     RenderStats& stats;
+    AovFilm* aovs = nullptr; // where camera rays' first hits go, with --aov (else none)
 };
 
 // Whether a stop was asked for (RenderConfig::stop, set by a signal handler): backends look at

@@ -120,6 +120,8 @@ struct RenderConfig {
     // A partial render: only samples [first, second) of the spp (iteration boundaries).
     std::optional<std::pair<int, int>> sampleRange;
     TextureFilter textureFilter = TextureFilter::Cone;
+    // Render passes beside the image (host/image/aov_film.h's kAov* bits; 0: none).
+    unsigned aovs = 0;
 };
 
 } // namespace spw

@@ -57,12 +57,21 @@ std::vector<unsigned char> encode(const std::string& path, const OIIO::ImageSpec
 
 namespace {
 
-// The spec Spillway writes `path` with: linear float EXR or 8-bit sRGB PNG.
-OIIO::ImageSpec outputSpec(const std::string& path, int width, int height) {
+// The spec Spillway writes `path` with: linear float EXR or 8-bit sRGB PNG; an EXR with `extra`
+// channels after R, G and B.
+OIIO::ImageSpec outputSpec(const std::string& path, int width, int height,
+                           const std::vector<std::string>& extra = {}) {
     if (!isSupportedOutput(path))
         throw std::runtime_error("cannot write '" + path + "': use .exr or .png");
     const bool png = extension(path) == ".png";
-    OIIO::ImageSpec spec(width, height, 3, png ? OIIO::TypeDesc::UINT8 : OIIO::TypeDesc::FLOAT);
+    if (png && !extra.empty())
+        throw std::runtime_error("cannot write '" + path + "': only an EXR holds more channels");
+    OIIO::ImageSpec spec(width, height, 3 + int(extra.size()),
+                         png ? OIIO::TypeDesc::UINT8 : OIIO::TypeDesc::FLOAT);
+    if (!extra.empty()) {
+        spec.channelnames = {"R", "G", "B"};
+        spec.channelnames.insert(spec.channelnames.end(), extra.begin(), extra.end());
+    }
     spec.attribute("oiio:ColorSpace", png ? "sRGB" : "Linear");
     spec.attribute("Software", "Spillway");
     // OpenEXR's default, zip, packs a rendered float image 5 % smaller than RLE, at 3x the time:
@@ -123,12 +132,16 @@ std::vector<unsigned char> encodeImage(const std::string& path, const ImageRGB& 
 }
 
 void writeImageRows(OutputFile& file, const std::string& path, int width, int height,
-                    const ImageRows& rows) {
-    const OIIO::ImageSpec spec = outputSpec(path, width, height);
+                    const ImageRows& rows, const std::vector<std::string>& extra) {
+    const OIIO::ImageSpec spec = outputSpec(path, width, height, extra);
+    const size_t channels = size_t(spec.nchannels);
     if (!file.seekable()) { // a FIFO: encoded in memory, then written in order
-        ImageRGB image{width, height, std::vector<float>(size_t(width) * height * 3)};
-        rows(0, height, image.rgb.data());
-        const std::vector<unsigned char> bytes = encodeImage(path, image);
+        std::vector<float> all(size_t(width) * size_t(height) * channels);
+        rows(0, height, all.data());
+        const std::vector<unsigned char> bytes =
+            spec.format == OIIO::TypeDesc::UINT8
+                ? encode(path, spec, OIIO::TypeDesc::UINT8, toSrgb8(all.data(), all.size()).data())
+                : encode(path, spec, OIIO::TypeDesc::FLOAT, all.data());
         file.write(bytes.data(), bytes.size());
         return;
     }
@@ -136,13 +149,14 @@ void writeImageRows(OutputFile& file, const std::string& path, int width, int he
     auto out = OIIO::ImageOutput::create(path, &proxy);
     if (!out) throw std::runtime_error("cannot write '" + path + "': " + OIIO::geterror());
     // Blocks of about 4 MiB of floats: enough lines for every thread of the EXR writer.
-    const int block = std::min(height, std::max(16, int((size_t(4) << 20) / (size_t(width) * 12))));
-    std::vector<float> rgb(size_t(width) * size_t(block) * 3);
+    const int block =
+        std::min(height, std::max(16, int((size_t(4) << 20) / (size_t(width) * 4 * channels))));
+    std::vector<float> rgb(size_t(width) * size_t(block) * channels);
     bool ok = out->open(path, spec);
     for (int y0 = 0; ok && y0 < height; y0 += block) {
         const int y1 = std::min(height, y0 + block);
         rows(y0, y1, rgb.data());
-        const size_t values = size_t(width) * size_t(y1 - y0) * 3;
+        const size_t values = size_t(width) * size_t(y1 - y0) * channels;
         ok = spec.format == OIIO::TypeDesc::UINT8
                  ? out->write_scanlines(y0, y1, 0, OIIO::TypeDesc::UINT8,
                                         toSrgb8(rgb.data(), values).data())

@@ -255,6 +255,9 @@ void setUpChunk(const RenderContext& ctx, const std::vector<RayState>& rays,
         }
         a = b;
     }
+    if (ctx.aovs) // the camera rays' first hits, for the render passes
+        for (size_t i = 0; i < n; ++i)
+            if (in[i].path.bounce == 0) ctx.aovs->record(in[i].path.pathId, in[i].hit);
 }
 
 void setUpHits(const RenderContext& ctx, const std::vector<RayState>& rays,

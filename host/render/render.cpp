@@ -250,8 +250,12 @@ void RenderSession::build() {
     params.sampling = dimensionSampler(scene_.sampler);
     stats_.extra["sampler"] = samplerName(scene_.sampler);
 
+    if (config_.aovs != 0)
+        result_->aovs = std::make_unique<AovFilm>(
+            scene_.image.width, scene_.image.height, spi_, config_.aovs,
+            glm::normalize(vec3(scene_.camera.cameraToWorld * vec4(0.0f, 0.0f, -1.0f, 0.0f))));
     ctx_.emplace(RenderContext{scene_, config_, *lights_, *embree_, *hitSetup_, *textures_,
-                               *camera_, params, threads_, stats_});
+                               *camera_, params, threads_, stats_, result_->aovs.get()});
     result_->film = std::make_unique<Film>(
         scene_.image.width, scene_.image.height, scene_.filter, lights_->brightestEmission(),
         int(params.samplesPerIteration),
@@ -324,6 +328,7 @@ const char* RenderSession::iterate(const ProgressCallback& onIteration) {
         {
             StageTimer t(stats_.stages, "accumulate");
             film.beginIteration();
+            if (result_->aovs) result_->aovs->beginIteration();
         }
         bool whole = backend_->renderIteration(uint(done_), film);
         embree_->checkError("tracing");
@@ -340,6 +345,7 @@ const char* RenderSession::iterate(const ProgressCallback& onIteration) {
         {
             StageTimer t(stats_.stages, "accumulate");
             film.endIteration();
+            if (result_->aovs) result_->aovs->endIteration();
         }
         textures_->noteCacheUse();
         renderSeconds_ +=

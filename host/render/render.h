@@ -4,6 +4,7 @@
 
 #include "host/backend/render_config.h"
 #include "host/backend/stats.h"
+#include "host/image/aov_film.h"
 #include "host/image/film.h"
 #include "host/render/checkpoint.h"
 #include "host/render/ranks.h"
@@ -21,6 +22,7 @@ namespace spw {
 struct RenderResult {
     std::unique_ptr<Film> film;
     RenderStats stats;
+    std::unique_ptr<AovFilm> aovs; // with RenderConfig::aovs, the passes
 };
 
 // Called after every iteration with (iterations done, iterations in all, the film).
