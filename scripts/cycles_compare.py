@@ -327,6 +327,8 @@ def make_test_files(out):
     quarter = [c for u, v in zip(whole[0::2], whole[1::2]) for c in (0.25 * v, 0.25 * u)]
     second = material((1.0, 1.0, 1.0), 0.0, 0.5)
     second["pbrMetallicRoughness"]["baseColorTexture"] = {"index": 0, "texCoord": 1}
+    second_uv0 = material((1.0, 1.0, 1.0), 0.0, 0.5)
+    second_uv0["pbrMetallicRoughness"]["baseColorTexture"] = {"index": 0}
     write_glb(os.path.join(out, "uv-sets.glb"),
               [s + (0,), (pos, nor, idx, (quarter, whole), 1)],
               [files["rough-plastic.glb"][0], second], images=textured_images()[:1])
@@ -341,8 +343,17 @@ def make_test_files(out):
     write_glb(os.path.join(out, "blend.glb"),
               [s + (0,), f + (1,), panel(-1.6, 1.6, -1.2, 0.2, 1.4) + (2,)],
               list(files["rough-plastic.glb"]) + [veil])
+    # A smooth glass sphere (KHR_materials_transmission 1, KHR_materials_ior 1.5) before the
+    # checker panel: refraction, and the panel seen upside down through it.
+    glass = material((1.0, 1.0, 1.0), 0.0, 0.0)
+    glass["extensions"] = {"KHR_materials_transmission": {"transmissionFactor": 1.0},
+                           "KHR_materials_ior": {"ior": 1.5}}
+    write_glb(os.path.join(out, "glass.glb"), [s + (0,), (pos, nor, idx, whole, 1)],
+              [glass, second_uv0], images=textured_images()[:1],
+              extensions=["KHR_materials_transmission", "KHR_materials_ior"])
     return sorted(os.path.join(out, n) for n in list(files) + [
-        "textured.glb", "emissive.glb", "uv-sets.glb", "terminator.glb", "blend.glb"])
+        "textured.glb", "emissive.glb", "uv-sets.glb", "terminator.glb", "blend.glb",
+        "glass.glb"])
 
 
 # The suite's bound (docs/scene-format.md, "glTF files", says why): relMSE and each channel's

@@ -21,12 +21,20 @@
 #include <map>
 #include <memory>
 #include <set>
+#include <sstream>
 
 namespace spw {
 
 namespace fs = std::filesystem;
 
 namespace {
+// x as the shortest decimal that reads back as it (1.01, not 1.010000).
+std::string number(double x) {
+    std::ostringstream out;
+    out << x;
+    return out.str();
+}
+
 // glTF 2.0's image formats, from an image's first bytes: ".png", ".jpg", or "" for anything else.
 std::string imageFormat(const std::string& head) {
     if (head.size() >= 8 && head.compare(0, 8, "\x89PNG\r\n\x1a\n", 8) == 0) return ".png";
@@ -84,6 +92,7 @@ Shader GltfReader::readMaterial(int index) {
     s.roughness = float(unit(pbr.roughnessFactor, at + "/pbrMetallicRoughness/roughnessFactor"));
     s.params.alpha = gltfAlpha(s.roughness);
     readImages(mat, s, at, name);
+    readTransmission(mat, s, at, name);
     if (mat.alphaMode != "OPAQUE" && mat.alphaMode != "MASK" && mat.alphaMode != "BLEND")
         fail(at + "/alphaMode", "must be OPAQUE, MASK or BLEND");
     readEmission(mat, s, at, name);
@@ -117,6 +126,60 @@ void GltfReader::readImages(const tinygltf::Material& mat, Shader& s, const std:
     }
     if (mat.occlusionTexture.index >= 0)
         warn(name + ": its occlusionTexture is ignored (a path tracer finds occlusion itself)");
+}
+
+// A number in [lo, hi] at `key` of extension `ext`, or `fallback` where it is absent.
+double GltfReader::extensionNumber(const tinygltf::Value& ext, const char* key, double fallback,
+                                   double lo, double hi, const std::string& at) const {
+    if (!ext.Has(key)) return fallback;
+    const tinygltf::Value& v = ext.Get(key);
+    const double x = v.IsNumber() ? v.GetNumberAsDouble() : NAN;
+    if (!(x >= lo && x <= hi))
+        fail(at + "/" + key, "must be a number in [" + number(lo) + ", " + number(hi) + "]");
+    return x;
+}
+
+void GltfReader::readTransmission(const tinygltf::Material& mat, Shader& s, const std::string& at,
+                                  const std::string& name) {
+    const auto iorExt = mat.extensions.find("KHR_materials_ior");
+    double ior = 1.5;
+    if (iorExt != mat.extensions.end()) {
+        ior = extensionNumber(iorExt->second, "ior", 1.5, 0.0, 10.0,
+                              at + "/extensions/KHR_materials_ior");
+        if (ior > 0.0 && ior < 1.0)
+            fail(at + "/extensions/KHR_materials_ior/ior", "must be 0 or at least 1");
+    }
+    const auto t = mat.extensions.find("KHR_materials_transmission");
+    const double factor = t == mat.extensions.end()
+                              ? 0.0
+                              : extensionNumber(t->second, "transmissionFactor", 0.0, 0.0, 1.0,
+                                                at + "/extensions/KHR_materials_transmission");
+    if (t != mat.extensions.end() && t->second.Has("transmissionTexture"))
+        warn(name + ": its transmissionTexture is not rendered (the factor alone is)");
+    if (factor == 0.0) {
+        if (iorExt != mat.extensions.end())
+            warn(name + ": KHR_materials_ior is rendered only with transmission (its reflection "
+                        "keeps glTF's F0 of 0.04)");
+        return;
+    }
+    if (factor < 1.0 || s.params.metallic > 0.0f || s.metallicRoughnessTexture >= 0) {
+        warn(name + ": transmission is rendered only at transmissionFactor 1 on a dielectric "
+                    "(metallicFactor 0, no metallic-roughness image): drawn opaque");
+        return;
+    }
+    if (s.texture >= 0 || s.params.colour != vec3(1.0f))
+        warn(name + ": glass is rendered without a tint: its base colour is not");
+    if (ior == 0.0) warn(name + ": KHR_materials_ior's ior 0 is rendered as 1.5");
+    if (ior > 0.0 && ior < kMinGlassIor)
+        warn(name + ": an ior below " + number(kMinGlassIor) + " is rendered as " +
+             number(kMinGlassIor));
+    s.typeName = "Dielectric";
+    s.params.model = kModelDielectric;
+    s.params.ior = float(ior == 0.0 ? 1.5 : std::max(ior, kMinGlassIor));
+    s.params.alpha = s.roughness * s.roughness; // below kGgxSmoothAlpha: smooth glass
+    s.params.flags &= ~(kShaderTextured | kShaderHitParams);
+    s.texture = -1;
+    s.metallicRoughnessTexture = -1;
 }
 
 void GltfReader::readEmission(const tinygltf::Material& mat, Shader& s, const std::string& at,

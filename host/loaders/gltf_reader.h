@@ -127,6 +127,18 @@ class GltfReader {
     void readImages(const tinygltf::Material& mat, Shader& s, const std::string& at,
                     const std::string& name);
 
+    // KHR_materials_transmission with KHR_materials_ior: a material that transmits all the light
+    // (transmissionFactor 1) and is no metal is glass, a Dielectric of that ior (1.5) and GGX
+    // alpha roughness^2 (smooth below kGgxSmoothAlpha), as Blender's importer and Cycles render
+    // it: a refracting solid, not the specification's thin wall, and untinted. Anything else is
+    // warned about and drawn opaque.
+    void readTransmission(const tinygltf::Material& mat, Shader& s, const std::string& at,
+                          const std::string& name);
+    double extensionNumber(const tinygltf::Value& ext, const char* key, double fallback, double lo,
+                           double hi, const std::string& at) const;
+    // The Dielectric model's least index of refraction.
+    static constexpr double kMinGlassIor = 1.01;
+
     // emissiveFactor times KHR_materials_emissive_strength's strength, times emissiveTexture's
     // image (sRGB) where the material has one and the factor is not black.
     void readEmission(const tinygltf::Material& mat, Shader& s, const std::string& at,
