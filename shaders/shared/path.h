@@ -93,6 +93,37 @@ SHARED_FN bool shadeGoesOn(RenderParams rp, ShaderParams sh, PathState st) {
     return st.bounce < rp.maxDepth && sh.model != kModelNull;
 }
 
+// Step 2 of shadeSurface: one emitter picked by power (uLight.x), one point on it or direction
+// to it (uLight.yz), and the shadow ray toward it with its pending contribution (r.shadow*,
+// kShadeShadow in r.flags when there is one to trace).
+SHARED_FN void addShadowRay(SCENE_PARAM RenderParams rp, ShaderParams sh, SurfaceHit hit, vec3 wo,
+                            PathState st, vec4 uLight, INOUT(ShadeResult) r) {
+    uint ei = pickEmitter(SCENE_ARG rp.emitterCount, uLight.x);
+    Emitter e = EMITTER(ei);
+    LightSample ls = sampleEmitter(SCENE_ARG rp, e, hit, vec2(uLight.y, uLight.z));
+    if (!(ls.pdf > 0.0f)) return;
+    float bsdfPdf;
+    vec3 fcos = bsdfEval(sh, hit.albedo, hit.ng, hit.ns, wo, ls.wi, bsdfPdf);
+    vec3 toward = ls.wi; // the side of the surface the shadow ray leaves from
+    if (!(maxComponent(fcos) > 0.0f)) {
+        fcos = terminatorEval(sh, hit, wo, ls.wi, toward);
+        bsdfPdf = 0.0f;
+    }
+    if (!(maxComponent(fcos) > 0.0f)) return;
+    // A delta light (a point, a direction): BSDF sampling cannot find it, no MIS.
+    float w = rp.strategy == kStrategyMis && !emitterIsDelta(e.type)
+                  ? powerHeuristic(ls.pdf, quantizePdf(bsdfPdf))
+                  : 1.0f;
+    // Lifted, the origin comes nearer the light by up to `lift` along the ray and moves as far
+    // across it: the ray stops twice that much sooner.
+    float lift = shadowLift(hit.ng, hit.lift, toward, ls.tmax);
+    r.shadowOrigin = offsetOrigin(hit.p, hit.ng, hit.offset + lift, toward);
+    r.shadowDir = ls.wi;
+    r.shadowTmax = ls.tmax - 2.0f * lift;
+    r.shadowContribution = st.beta * fcos * ls.radiance * (w / ls.pdf);
+    if (r.shadowTmax > 0.0f) r.flags |= kShadeShadow;
+}
+
 // shadeSurface with the path's random numbers for this bounce given: uLight = rand4(kDimLight),
 // uBsdf = rand4(kDimBsdf) (read only where shadeGoesOn), so that a caller can make them many at
 // a time (host/pipeline/simd_shading.cpp).
@@ -116,36 +147,9 @@ SHARED_FN void shadeSurfaceWith(SCENE_PARAM RenderParams rp, SurfaceHit hit, vec
 
     if (!shadeGoesOn(rp, sh, st)) return;
 
-    // 2. Next-event estimation: one emitter picked by power, one point on it (or direction to
-    //    it). A BSDF of delta lobes only can never reach the sampled point: no shadow ray.
-    if (rp.emitterCount > 0u && rp.strategy != kStrategyBsdf && !bsdfIsDelta(sh)) {
-        uint ei = pickEmitter(SCENE_ARG rp.emitterCount, uLight.x);
-        Emitter e = EMITTER(ei);
-        LightSample ls = sampleEmitter(SCENE_ARG rp, e, hit, vec2(uLight.y, uLight.z));
-        if (ls.pdf > 0.0f) {
-            float bsdfPdf;
-            vec3 fcos = bsdfEval(sh, hit.albedo, hit.ng, hit.ns, wo, ls.wi, bsdfPdf);
-            vec3 toward = ls.wi; // the side of the surface the shadow ray leaves from
-            if (!(maxComponent(fcos) > 0.0f)) {
-                fcos = terminatorEval(sh, hit, wo, ls.wi, toward);
-                bsdfPdf = 0.0f;
-            }
-            if (maxComponent(fcos) > 0.0f) {
-                // A delta light (a point, a direction): BSDF sampling cannot find it, no MIS.
-                float w = rp.strategy == kStrategyMis && !emitterIsDelta(e.type)
-                              ? powerHeuristic(ls.pdf, quantizePdf(bsdfPdf))
-                              : 1.0f;
-                // Lifted, the origin comes nearer the light by up to `lift` along the ray and
-                // moves as far across it: the ray stops twice that much sooner.
-                float lift = shadowLift(hit.ng, hit.lift, toward, ls.tmax);
-                r.shadowOrigin = offsetOrigin(hit.p, hit.ng, hit.offset + lift, toward);
-                r.shadowDir = ls.wi;
-                r.shadowTmax = ls.tmax - 2.0f * lift;
-                r.shadowContribution = st.beta * fcos * ls.radiance * (w / ls.pdf);
-                if (r.shadowTmax > 0.0f) r.flags |= kShadeShadow;
-            }
-        }
-    }
+    // 2. Next-event estimation. A BSDF of delta lobes only can never reach a sampled point.
+    if (rp.emitterCount > 0u && rp.strategy != kStrategyBsdf && !bsdfIsDelta(sh))
+        addShadowRay(SCENE_ARG rp, sh, hit, wo, st, uLight, r);
 
     // 3. Continuation: sample the BSDF, then Russian roulette once min depth bounces are done.
     vec3 wi;
