@@ -168,7 +168,7 @@ void GltfReader::readTransmission(const tinygltf::Material& mat, Shader& s, cons
         return;
     }
     if (s.texture >= 0 || s.params.colour != vec3(1.0f))
-        warn(name + ": glass is rendered without a tint: its base colour is not");
+        warn(name + ": glass takes no tint: its base colour is not rendered");
     if (ior == 0.0) warn(name + ": KHR_materials_ior's ior 0 is rendered as 1.5");
     if (ior > 0.0 && ior < kMinGlassIor)
         warn(name + ": an ior below " + number(kMinGlassIor) + " is rendered as " +
