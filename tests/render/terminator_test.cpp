@@ -47,9 +47,11 @@ json uvSphere(GltfBuilder& b, int segments) {
 
 // The sphere, `segments` around, scaled by `scale` and moved `away` along x, seen from +z
 // filling a 48 x 48 image, lit only by a sun travelling along -x: its terminator runs down the
-// middle of the image. Direct light only (one bounce), 4 spp.
+// middle of the image. With `panel`, lit instead by an emissive square far off along the sun's
+// way (triangles: the cpu backend's SIMD shading takes them). Direct light only (one bounce),
+// 4 spp.
 std::vector<float> litSphere(const TempDir& dir, int segments, double scale, double away,
-                             BackendKind backend) {
+                             BackendKind backend, bool panel = false) {
     GltfBuilder b;
     b.doc["materials"] = json::array({material(vec3(0.8f), 0.0f, 1.0f)});
     b.doc["extensionsUsed"] = {"KHR_lights_punctual"};
@@ -62,12 +64,33 @@ std::vector<float> litSphere(const TempDir& dir, int segments, double scale, dou
     // facets' edges rather than along them.
     const vec3 from(0, 0, -1), to = glm::normalize(vec3(-1.0f, -0.15f, -0.1f));
     const vec4 sunTurn = glm::normalize(vec4(glm::cross(from, to), 1.0f + glm::dot(from, to)));
-    b.scene({b.node({{"mesh", b.mesh(uvSphere(b, segments))},
-                     {"scale", {scale, scale, scale}},
-                     {"translation", {away, 0.0, 0.0}}}),
-             b.node({{"camera", 0}, {"translation", {away, 0.0, 4.5 * scale}}}),
-             b.node({{"rotation", {sunTurn.x, sunTurn.y, sunTurn.z, sunTurn.w}},
-                     {"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}})});
+    std::vector<int> nodes = {b.node({{"mesh", b.mesh(uvSphere(b, segments))},
+                                      {"scale", {scale, scale, scale}},
+                                      {"translation", {away, 0.0, 0.0}}}),
+                              b.node({{"camera", 0}, {"translation", {away, 0.0, 4.5 * scale}}})};
+    if (panel) {
+        // A 4 x 4 square 40 away, its front (+Z) turned to face along the sun's way.
+        b.doc["materials"].push_back(material(vec3(0.0f), 0.0f, 1.0f, vec3(1.0f)));
+        const vec3 up(0, 0, 1);
+        const vec4 turn = glm::normalize(vec4(glm::cross(up, to), 1.0f + glm::dot(up, to)));
+        const vec3 centre = -40.0f * to;
+        // The unit quaternion `turn` applied to the square's centre offset (2, 2, 0).
+        const vec3 q(turn.x, turn.y, turn.z), v(2.0f, 2.0f, 0.0f);
+        const vec3 turned =
+            v + 2.0f * turn.w * glm::cross(q, v) + 2.0f * glm::cross(q, glm::cross(q, v));
+        const vec3 corner = centre - turned;
+        nodes.push_back(b.node(
+            {{"mesh", b.mesh(b.quad(1))},
+             {"rotation", {turn.x, turn.y, turn.z, turn.w}},
+             {"scale", {4.0 * scale, 4.0 * scale, 4.0 * scale}},
+             {"translation", {away + corner.x * scale, corner.y * scale, corner.z * scale}}}));
+        b.doc.erase("extensions");
+        b.doc.erase("extensionsUsed");
+    } else {
+        nodes.push_back(b.node({{"rotation", {sunTurn.x, sunTurn.y, sunTurn.z, sunTurn.w}},
+                                {"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}}));
+    }
+    b.scene(nodes);
     Scene scene = loadScene(b.embedded(dir, "sphere.gltf"));
     scene.image.width = scene.image.height = 48;
     scene.settings.maxDepth = 1;
@@ -85,19 +108,23 @@ bool inside(int x, int y) {
 }
 
 // The least and the greatest ratio of `coarse` to `fine` over the pixels inside() that `fine`
-// lights. Without the lift, the coarse sphere's facets next to the terminator face away from
-// the sun while their vertex normals do not, and come out black: a least ratio of 0.
+// lights (a lit half disc: at least 300 of them, checked here). Without the lift, the coarse
+// sphere's facets next to the terminator face away from the sun while their vertex normals do not,
+// and come out black: a least ratio of 0.
 std::pair<double, double> ratioRange(const std::vector<float>& coarse,
                                      const std::vector<float>& fine) {
     const float brightest = *std::max_element(fine.begin(), fine.end());
     double lo = HUGE_VAL, hi = 0.0;
+    int lit = 0;
     for (int y = 0; y < 48; ++y)
         for (int x = 0; x < 48; ++x) {
             const size_t i = size_t(y * 48 + x) * 3 + 1;
             if (!inside(x, y) || !(fine[i] > 0.05f * brightest)) continue;
             lo = std::min(lo, double(coarse[i] / fine[i]));
             hi = std::max(hi, double(coarse[i] / fine[i]));
+            ++lit;
         }
+    EXPECT_GE(lit, 300);
     return {lo, hi};
 }
 
@@ -121,6 +148,15 @@ TEST(Terminator, ALowPolySphereIsShadedAsTheSmoothSphere) {
     for (const auto& [scale, away] : {std::pair{1e-4, 0.0}, {1e4, 0.0}, {1.0, 1e5}}) {
         SCOPED_TRACE(std::to_string(scale) + " at " + std::to_string(away));
         expectSmooth(litSphere(dir, 16, scale, away, BackendKind::Cpu));
+    }
+    // Lit by a distant emissive square, through the SIMD shading's twin of the same arithmetic.
+    const std::vector<float> finePanel =
+        litSphere(dir, 256, 1.0, 0.0, BackendKind::Reference, true);
+    for (BackendKind backend : {BackendKind::Reference, BackendKind::Cpu}) {
+        SCOPED_TRACE(backendName(backend) + std::string(", the square"));
+        const auto [lo, hi] = ratioRange(litSphere(dir, 16, 1.0, 0.0, backend, true), finePanel);
+        EXPECT_GT(lo, 0.9);
+        EXPECT_LT(hi, 1.1);
     }
 }
 
