@@ -128,14 +128,15 @@ void GltfReader::readImages(const tinygltf::Material& mat, Shader& s, const std:
         warn(name + ": its occlusionTexture is ignored (a path tracer finds occlusion itself)");
 }
 
-// A number in [lo, hi] at `key` of extension `ext`, or `fallback` where it is absent.
 double GltfReader::extensionNumber(const tinygltf::Value& ext, const char* key, double fallback,
                                    double lo, double hi, const std::string& at) const {
     if (!ext.Has(key)) return fallback;
     const tinygltf::Value& v = ext.Get(key);
     const double x = v.IsNumber() ? v.GetNumberAsDouble() : NAN;
-    if (!(x >= lo && x <= hi))
-        fail(at + "/" + key, "must be a number in [" + number(lo) + ", " + number(hi) + "]");
+    if (!(x >= lo && x <= hi) || !std::isfinite(x))
+        fail(at + "/" + key, std::isfinite(hi)
+                                 ? "must be a number in [" + number(lo) + ", " + number(hi) + "]"
+                                 : "must be a finite number of at least " + number(lo));
     return x;
 }
 
@@ -184,15 +185,12 @@ void GltfReader::readTransmission(const tinygltf::Material& mat, Shader& s, cons
 
 void GltfReader::readEmission(const tinygltf::Material& mat, Shader& s, const std::string& at,
                               const std::string& name) {
-    double strength = 1.0;
-    if (const auto e = mat.extensions.find("KHR_materials_emissive_strength");
-        e != mat.extensions.end() && e->second.Has("emissiveStrength")) {
-        const tinygltf::Value& v = e->second.Get("emissiveStrength");
-        strength = v.IsNumber() ? v.GetNumberAsDouble() : -1.0;
-        if (!(strength >= 0.0) || !std::isfinite(strength))
-            fail(at + "/extensions/KHR_materials_emissive_strength/emissiveStrength",
-                 "must be a non-negative number");
-    }
+    const auto e = mat.extensions.find("KHR_materials_emissive_strength");
+    const double strength =
+        e == mat.extensions.end()
+            ? 1.0
+            : extensionNumber(e->second, "emissiveStrength", 1.0, 0.0, HUGE_VAL,
+                              at + "/extensions/KHR_materials_emissive_strength");
     if (mat.emissiveFactor.size() != 3) fail(at + "/emissiveFactor", "needs 3 numbers");
     for (int k = 0; k < 3; ++k) {
         const double e = unit(mat.emissiveFactor[size_t(k)], at + "/emissiveFactor") * strength;

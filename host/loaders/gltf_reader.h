@@ -134,6 +134,8 @@ class GltfReader {
     // warned about and drawn opaque.
     void readTransmission(const tinygltf::Material& mat, Shader& s, const std::string& at,
                           const std::string& name);
+    // The number at `key` of extension object `ext` (its JSON pointer `at`), or `fallback` where
+    // it is absent; refused unless it is a finite number in [lo, hi] (hi may be HUGE_VAL).
     double extensionNumber(const tinygltf::Value& ext, const char* key, double fallback, double lo,
                            double hi, const std::string& at) const;
     // The Dielectric model's least index of refraction.

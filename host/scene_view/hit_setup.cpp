@@ -203,17 +203,17 @@ void HitSetup::setUpHits(size_t n, const HitRecord* const* hits, const vec3* dir
     for (size_t j = 0; j < n; ++j) {
         const HitRecord& h = *hits[j];
         SurfaceHit& hit = *out[j];
+        const Mesh& mesh = src_.meshes[h.mesh];
         hit.p = lane(l.p, j);
         hit.t = h.t;
         hit.ng = lane(l.ng, j);
-        hit.shader = uint(src_.meshes[h.mesh].shader);
+        hit.shader = uint(mesh.shader);
         hit.ns = lane(l.ns, j);
         hit.emitter = lights_.emitterOf(h.mesh, h.prim);
         hit.albedo = vec3(0.0f);
         hit.offset = l.offset.v[j];
         hit.material = 0u;
-        hit.lift = smoothLift(src_.meshes[h.mesh], src_.meshes[h.mesh].triangles[h.prim], h.u, h.v,
-                              hit.p, hit.ng);
+        hit.lift = smoothLift(mesh, mesh.triangles[h.prim], h.u, h.v, hit.p, hit.ng);
         uv[j] = vec2(l.uv.x.v[j], l.uv.y.v[j]);
         footprint[j] = l.footprint.v[j];
     }

@@ -262,15 +262,27 @@ TEST(Gltf, SamplerWrapModesRepeatClampOrMirror) {
     EXPECT_GT(mirror[15], 2.0); // mostly beyond 1.5: red
 }
 
-// A white floor (4 x 4) lit by a directional light slanting down, seen from above; and, unless
-// `veil` is null, a unit quad of material `veil` between them (z = 1), which hides part of the
-// floor from the camera and shadows another part. `image`: the veil's base colour image.
+// A white floor lit by a directional light slanting down, seen from above; and, unless `veil` is
+// null, a quad of material `veil` between them (z = 1). `image`: the veil's base colour image.
+// The default layout (a 4 x 4 floor, a unit veil) hides part of the floor from the camera and
+// shadows another part; wideVeil() covers the whole view and the whole floor.
+struct VeilLayout {
+    double floorSize = 4, floorCorner = -1.5, veilSize = 1, veilCorner = 0;
+    double yfov = 0.6, cameraXY = 0.5;
+    int maxDepth = 0, spp = 4; // maxDepth 0: the file's default
+};
+VeilLayout wideVeil(int spp) {
+    VeilLayout l;
+    l.floorSize = 8, l.floorCorner = -4, l.veilSize = 20, l.veilCorner = -10;
+    l.yfov = 0.4, l.cameraXY = 0, l.maxDepth = 1, l.spp = spp;
+    return l;
+}
 struct Veiled {
     std::vector<float> image;
     nlohmann::json stats;
 };
 Veiled renderVeiled(const TempDir& dir, const json& veil, BackendKind backend,
-                    const std::string& image = "") {
+                    const std::string& image = "", const VeilLayout& l = {}) {
     GltfBuilder b;
     b.doc["materials"] = json::array({material(vec3(0.8f), 0.0f, 1.0f)});
     b.doc["extensionsUsed"] = {"KHR_lights_punctual"};
@@ -278,11 +290,12 @@ Veiled renderVeiled(const TempDir& dir, const json& veil, BackendKind backend,
         json::array({{{"type", "directional"}, {"intensity", 2000.0}}});
     b.doc["cameras"] =
         json::array({{{"type", "perspective"},
-                      {"perspective", {{"yfov", 0.6}, {"aspectRatio", 1.0}, {"znear", 0.1}}}}});
+                      {"perspective", {{"yfov", l.yfov}, {"aspectRatio", 1.0}, {"znear", 0.1}}}}});
     std::vector<int> nodes = {
-        b.node(
-            {{"mesh", b.mesh(b.quad(0))}, {"scale", {4, 4, 4}}, {"translation", {-1.5, -1.5, 0}}}),
-        b.node({{"camera", 0}, {"translation", {0.5, 0.5, 5}}}),
+        b.node({{"mesh", b.mesh(b.quad(0))},
+                {"scale", {l.floorSize, l.floorSize, l.floorSize}},
+                {"translation", {l.floorCorner, l.floorCorner, 0}}}),
+        b.node({{"camera", 0}, {"translation", {l.cameraXY, l.cameraXY, 5}}}),
         // Down, slanting toward +x: the veil's shadow lies half a unit aside, partly in view.
         b.node({{"rotation", {0, -0.2297529, 0, 0.9732489}},
                 {"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}})};
@@ -292,14 +305,18 @@ Veiled renderVeiled(const TempDir& dir, const json& veil, BackendKind backend,
             b.doc["textures"] = json::array({{{"source", 0}}});
             b.doc["images"] = json::array({{{"uri", image}}});
         }
-        nodes.push_back(b.node({{"mesh", b.mesh(b.quad(1))}, {"translation", {0, 0, 1}}}));
+        nodes.push_back(b.node({{"mesh", b.mesh(b.quad(1))},
+                                {"scale", {l.veilSize, l.veilSize, l.veilSize}},
+                                {"translation", {l.veilCorner, l.veilCorner, 1}}}));
     }
     b.scene(nodes);
     Scene scene = loadScene(b.embedded(dir, "veiled.gltf"));
+    EXPECT_TRUE(scene.warnings.empty()) << scene.warnings.at(0);
     scene.image.width = scene.image.height = 24;
+    if (l.maxDepth > 0) scene.settings.maxDepth = l.maxDepth;
     RenderConfig cfg;
     cfg.backend = backend;
-    cfg.spp = 4;
+    cfg.spp = l.spp;
     const std::unique_ptr<RenderResult> r = render(scene, cfg);
     return {r->film->image(), r->stats.extra};
 }
@@ -389,47 +406,13 @@ TEST(Gltf, AlphaMaskCutsHolesForCameraBounceAndShadowRays) {
 namespace spw::test {
 namespace {
 
-// A white floor lit only by a sun slanting down through a veil of material `veil` that covers
-// the whole view and the whole floor (unless `veil` is null), direct light only (one bounce):
-// with a BLEND veil of alpha a, each pixel is in expectation a times the opaque veil's radiance
-// plus (1 - a)^2 times the bare floor's, the camera ray passing the veil with probability 1 - a
-// and then the floor's shadow ray with 1 - a again. `image`: the veil's base colour image. The
-// image's mean, 24 x 24 at `spp`.
+// The mean of the wide veil's image (wideVeil, direct light only): with a BLEND veil of alpha a,
+// each pixel is in expectation a times the opaque veil's radiance plus (1 - a)^2 times the bare
+// floor's, the camera ray passing the veil with probability 1 - a and then the floor's shadow ray
+// with 1 - a again.
 double veiledFloorMean(const TempDir& dir, const json& veil, BackendKind backend, int spp,
                        const std::string& image = "") {
-    GltfBuilder b;
-    b.doc["materials"] = json::array({material(vec3(0.8f), 0.0f, 1.0f)});
-    b.doc["extensionsUsed"] = {"KHR_lights_punctual"};
-    b.doc["extensions"]["KHR_lights_punctual"]["lights"] =
-        json::array({{{"type", "directional"}, {"intensity", 2000.0}}});
-    b.doc["cameras"] =
-        json::array({{{"type", "perspective"},
-                      {"perspective", {{"yfov", 0.4}, {"aspectRatio", 1.0}, {"znear", 0.1}}}}});
-    std::vector<int> nodes = {
-        b.node({{"mesh", b.mesh(b.quad(0))}, {"scale", {8, 8, 8}}, {"translation", {-4, -4, 0}}}),
-        b.node({{"camera", 0}, {"translation", {0, 0, 5}}}),
-        b.node({{"rotation", {0, -0.2297529, 0, 0.9732489}},
-                {"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}})};
-    if (!veil.is_null()) {
-        b.doc["materials"].push_back(veil);
-        if (!image.empty()) {
-            b.doc["textures"] = json::array({{{"source", 0}}});
-            b.doc["images"] = json::array({{{"uri", image}}});
-        }
-        nodes.push_back(b.node({{"mesh", b.mesh(b.quad(1))},
-                                {"scale", {20, 20, 20}},
-                                {"translation", {-10, -10, 1}}}));
-    }
-    b.scene(nodes);
-    Scene scene = loadScene(b.embedded(dir, "veiled-floor.gltf"));
-    EXPECT_TRUE(scene.warnings.empty()) << scene.warnings.at(0);
-    scene.image.width = scene.image.height = 24;
-    scene.settings.maxDepth = 1;
-    RenderConfig cfg;
-    cfg.backend = backend;
-    cfg.spp = spp;
-    const std::vector<float> img = render(scene, cfg)->film->image();
-    return mean(img);
+    return mean(renderVeiled(dir, veil, backend, image, wideVeil(spp)).image);
 }
 
 // alphaMode BLEND: stochastic transparency, the expected image the blend. A veil of alpha 0.3,
