@@ -45,6 +45,12 @@ are noisy; ratios travel, absolute seconds do not).
                                16x16 (the fixed costs), in bytes per pixel; the seconds to write
                                the 16-Mpixel EXR; render and wall seconds. Best of N, alternating.
                                Writes out/bench/large.json.
+  scripts/bench.py cycles      time to Cycles' error at 256 spp on five kinds of scene (the Cornell
+                               box, a glossy box lit by a small light, a textured glTF file, 128
+                               lamps, an environment map with a sun), each renderer against its
+                               own 4096-spp reference: scripts/cycles_bench.py says how.
+                               --backends cpu,reference (default), --scenes NAME,... (default
+                               all), --quick (tiny, for the suite). Writes out/bench/cycles.json.
   scripts/bench.py all         reference and pipeline (default)
 
 Options: --repeat N (best of N, default 3; production: 1), --spillway PATH (default
@@ -404,7 +410,8 @@ def bench_large(spillway, repeat, baseline):
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("what", nargs="?", default="all",
-                    choices=["reference", "pipeline", "production", "incore", "mpi", "large", "all"])
+                    choices=["reference", "pipeline", "production", "incore", "mpi", "large", "cycles",
+                             "all"])
     ap.add_argument("--repeat", type=int)
     ap.add_argument("--depths", default="1,2,3")
     ap.add_argument("--exponents", default="8,11,14,17")
@@ -415,7 +422,14 @@ def main():
     ap.add_argument("--threads-per-rank", type=int, default=0,
                     help="mpi: threads of each rank (default: --threads / ranks)")
     ap.add_argument("--threads", type=int, default=2, help="mpi: threads of the single process")
+    ap.add_argument("--backends", default="cpu,reference", help="cycles: Spillway's backends")
+    ap.add_argument("--scenes", default="", help="cycles: the scenes to run (default all)")
+    ap.add_argument("--quick", action="store_true", help="cycles: tiny images, to check it runs")
     a = ap.parse_args()
+    if a.what == "cycles":
+        import cycles_bench
+        sys.exit(cycles_bench.main(a.spillway, a.backends.split(","), a.quick, a.repeat or 1,
+                                   [s for s in a.scenes.split(",") if s]))
     if a.what == "production":
         bench_production(a.spillway, a.repeat or 1, [int(d) for d in a.depths.split(",")],
                          [int(e) for e in a.exponents.split(",")], a.scene_args.split())

@@ -34,7 +34,7 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
 # Run inside Blender (blender -b --python-expr): import, match the settings, render an EXR.
 BLENDER_SCRIPT = r"""
-import sys, json, bpy
+import sys, json, math, time, bpy
 import numpy as np
 if not hasattr(np, "bool"):
     np.bool = bool  # Blender 3.4's glTF importer on NumPy 1.24 and later
@@ -51,12 +51,14 @@ cam.sensor_fit = "HORIZONTAL"
 cam.angle_x = args["fov_x"]
 scene.render.engine = "CYCLES"
 scene.cycles.device = "CPU"
-scene.cycles.samples = args["spp"]
 scene.cycles.use_adaptive_sampling = False
 scene.cycles.use_denoising = False
 scene.cycles.max_bounces = 16
 for kind in ("diffuse", "glossy", "transmission", "volume", "transparent"):
     setattr(scene.cycles, kind + "_bounces", 16)
+if args.get("threads"):
+    scene.render.threads_mode = "FIXED"
+    scene.render.threads = args["threads"]
 scene.cycles.sample_clamp_direct = 0.0
 scene.cycles.sample_clamp_indirect = 0.0
 scene.cycles.caustics_reflective = True
@@ -71,16 +73,36 @@ scene.view_settings.view_transform = "Standard"
 scene.view_settings.look = "None"
 scene.view_settings.exposure = 0.0
 scene.view_settings.gamma = 1.0
-if not args["lit"]:
-    world = bpy.data.worlds.new("white")
-    world.use_nodes = True
-    world.node_tree.nodes["Background"].inputs["Color"].default_value = (1, 1, 1, 1)
-    world.node_tree.nodes["Background"].inputs["Strength"].default_value = 1.0
-    scene.world = world
+world = bpy.data.worlds.new("world")
+world.use_nodes = True
+background = world.node_tree.nodes["Background"]
+background.inputs["Color"].default_value = (0, 0, 0, 1) if args["lit"] else (1, 1, 1, 1)
+if args.get("environment"):
+    # Spillway's lat-long map looks along glTF's -Z (Blender's +Y) at its centre, where
+    # Blender's looks along +X: turned a quarter about Blender's up axis.
+    nodes, links = world.node_tree.nodes, world.node_tree.links
+    coords, mapping = nodes.new("ShaderNodeTexCoord"), nodes.new("ShaderNodeMapping")
+    mapping.inputs["Rotation"].default_value = (0.0, 0.0, args.get("environment_turn", -math.pi / 2))
+    texture = nodes.new("ShaderNodeTexEnvironment")
+    texture.image = bpy.data.images.load(args["environment"])
+    links.new(coords.outputs["Generated"], mapping.inputs["Vector"])
+    links.new(mapping.outputs["Vector"], texture.inputs["Vector"])
+    links.new(texture.outputs["Color"], background.inputs["Color"])
+scene.world = world
 scene.render.image_settings.file_format = "OPEN_EXR"
 scene.render.image_settings.color_depth = "32"
-scene.render.filepath = args["out"]
-bpy.ops.render.render(write_still=True)
+# Each render in turn (samples, seed, output), timed from the call to the image written.
+seconds = []
+for r in args["renders"]:
+    scene.cycles.samples = r["spp"]
+    scene.cycles.seed = r.get("seed", 0)
+    scene.render.filepath = r["out"]
+    start = time.perf_counter()
+    bpy.ops.render.render(write_still=True)
+    seconds.append(time.perf_counter() - start)
+if args.get("seconds"):
+    with open(args["seconds"], "w") as f:
+        json.dump(seconds, f)
 """
 
 
@@ -125,9 +147,25 @@ def compare(spillway, file, spp, width, out):
          "--quiet", "-o", ours, "--stats", stats])
     with open(stats) as f:
         s = json.load(f)
-    fov_x = horizontal_fov(file)
-    args = {"file": os.path.abspath(file), "spp": spp, "width": s["width"], "height": s["height"],
-            "fov_x": fov_x, "out": os.path.abspath(theirs), "lit": lit(file)}
+    render_in_cycles(file, s["width"], s["height"], [{"spp": spp, "out": os.path.abspath(theirs)}])
+    if not os.path.exists(theirs):
+        sys.exit("Blender wrote no image (%s)" % theirs)
+    r = run([spillway, "compare", ours, theirs, "--json"])
+    metrics = json.loads(r.stdout)
+    a, b = metrics["mean_a"], metrics["mean_b"]
+    ratios = [x / y if y > 0 else float("inf") for x, y in zip(a, b)]
+    return metrics, ratios
+
+
+def render_in_cycles(file, width, height, renders, environment=None, threads=None, seconds=None):
+    """Renders glTF FILE in Blender's Cycles with the settings above, once for each of `renders`
+    ({"spp", "out", "seed" (0)}), in one Blender process. environment: an equirectangular image
+    that lights the scene (as Spillway's Environment light does); threads: Cycles' (default:
+    every core); seconds: a JSON file that gets each render's seconds."""
+    args = {"file": os.path.abspath(file), "width": width, "height": height,
+            "fov_x": horizontal_fov(file), "lit": lit(file) or environment is not None,
+            "renders": renders, "threads": threads, "seconds": seconds,
+            "environment": os.path.abspath(environment) if environment else None}
     blender = shutil.which("blender")
     if not blender:
         sys.exit("blender is not installed (Debian: apt-get install blender)")
@@ -136,13 +174,6 @@ def compare(spillway, file, spp, width, out):
     env["PATH"] = "/usr/bin:/bin:" + env.get("PATH", "")
     run([blender, "-b", "--factory-startup", "--python-exit-code", "1", "--python-expr",
          BLENDER_SCRIPT, "--", json.dumps(args)], env=env)
-    if not os.path.exists(theirs):
-        sys.exit("Blender wrote no image (%s)" % theirs)
-    r = run([spillway, "compare", ours, theirs, "--json"])
-    metrics = json.loads(r.stdout)
-    a, b = metrics["mean_a"], metrics["mean_b"]
-    ratios = [x / y if y > 0 else float("inf") for x, y in zip(a, b)]
-    return metrics, ratios
 
 
 # --- test files: glTF written here, each with a camera ---------------------------------------
@@ -186,11 +217,11 @@ def png(width, height, channels, pixel):
 
 
 def write_glb(path, meshes, materials, camera_z=4.5, yfov=0.6, images=(), sun=None,
-              extensions=()):
+              extensions=(), aspect=4 / 3):
     """meshes: (positions, normals, indices, uvs, material) each, uvs None, one set, or a tuple
     of sets (TEXCOORD_0, TEXCOORD_1, ...); a perspective camera on +Z; images: PNG files' bytes,
     texture i reading image i; sun: a directional light's direction of travel and illuminance
-    (lux), or none; extensions: names the materials use."""
+    (lux), or none; extensions: names the materials use; aspect: the camera's width / height."""
     doc = {"asset": {"version": "2.0"}, "scene": 0, "materials": materials, "meshes": [],
            "nodes": [], "accessors": [], "bufferViews": []}
     if extensions:
@@ -241,7 +272,7 @@ def write_glb(path, meshes, materials, camera_z=4.5, yfov=0.6, images=(), sun=No
         doc["nodes"].append({"rotation": [axis[0] / norm, axis[1] / norm, 0.0, w / norm],
                              "extensions": {"KHR_lights_punctual": {"light": 0}}})
     doc["cameras"] = [{"type": "perspective",
-                       "perspective": {"yfov": yfov, "aspectRatio": 4 / 3, "znear": 0.05}}]
+                       "perspective": {"yfov": yfov, "aspectRatio": aspect, "znear": 0.05}}]
     doc["nodes"].append({"camera": 0, "translation": [0, 0.3, camera_z]})
     doc["scenes"] = [{"nodes": list(range(len(doc["nodes"])))}]
     doc["buffers"] = [{"byteLength": len(blob)}]

@@ -1,0 +1,354 @@
+"""`scripts/bench.py cycles`: the time Spillway needs to reach the error Cycles reaches at 256
+samples a pixel, on five kinds of scene users bring, each renderer judged against its own
+reference image (their BRDFs differ; on the Cornell box, where they nearly agree, Spillway is
+also judged against Cycles' reference).
+
+For each scene the script writes a glTF file (and, for the environment-lit one, a lat-long
+map and a YAML scene that places the file under it), then
+  - Cycles (Blender's glTF importer, scripts/cycles_compare.py's matched settings, 2 threads)
+    renders it at --cycles-spp (256) and at 16, 32, ... below, and once at --reference-spp
+    (4096) with another seed: its reference;
+  - each Spillway backend (--backends, default cpu and reference; default settings: the
+    Sobol sampler a glTF file gets, 2 threads) renders its own reference at --reference-spp
+    with another seed, and then 4, 8, 16, ... samples a pixel until its relMSE against that
+    reference is below the one Cycles reached at --cycles-spp.
+The time to reach that error is interpolated between the two bracketing renders (log time
+against log error); a render's time is Spillway's whole process (loading the scene included)
+and Cycles' render call (Blender's start and the import left out). The table prints, per
+scene: Cycles' seconds and relMSE at 256 spp, and per backend the samples and seconds it took
+and the ratio to Cycles' seconds. Writes out/bench/cycles.json.
+
+--quick renders small images and few samples: it checks that the comparison runs (the
+suite's Bench.CyclesQuickRuns), its figures mean nothing.
+"""
+import json
+import math
+import os
+import random
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import cycles_compare as cc  # noqa: E402
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+THREADS = 2
+
+
+# --- scenes -----------------------------------------------------------------------------------
+
+def obj_triangles(path):
+    """The triangles of a (polygon) OBJ file, as lists of three vertices."""
+    verts, tris = [], []
+    with open(path) as f:
+        for line in f:
+            t = line.split()
+            if t and t[0] == "v":
+                verts.append(tuple(float(x) for x in t[1:4]))
+            elif t and t[0] == "f":
+                face = [verts[int(x.split("/")[0]) - 1] for x in t[1:]]
+                tris += [(face[0], face[k], face[k + 1]) for k in range(1, len(face) - 1)]
+    return tris
+
+
+def flat_mesh(tris, material):
+    """A glTF mesh of flat-shaded triangles (each its own three vertices)."""
+    pos, nor = [], []
+    for a, b, c in tris:
+        e1 = [b[k] - a[k] for k in range(3)]
+        e2 = [c[k] - a[k] for k in range(3)]
+        n = [e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2],
+             e1[0] * e2[1] - e1[1] * e2[0]]
+        length = math.sqrt(sum(x * x for x in n)) or 1.0
+        for p in (a, b, c):
+            pos += p
+            nor += [x / length for x in n]
+    return pos, nor, list(range(len(pos) // 3)), None, material
+
+
+def quad(centre, half_x, half_z, material, facing=-1.0):
+    """A horizontal square light facing down (facing -1) or up, as two triangles."""
+    x, y, z = centre
+    a, b = (x - half_x, y, z - half_z), (x + half_x, y, z - half_z)
+    c, d = (x + half_x, y, z + half_z), (x - half_x, y, z + half_z)
+    return flat_mesh([(a, b, c), (a, c, d)] if facing < 0 else [(a, c, b), (a, d, c)], material)
+
+
+def emissive(colour, strength):
+    m = cc.material((0.0, 0.0, 0.0), 0.0, 1.0)
+    peak = max(colour)
+    m["emissiveFactor"] = [c / peak for c in colour]
+    m["extensions"] = {"KHR_materials_emissive_strength": {"emissiveStrength": strength * peak}}
+    m["doubleSided"] = True  # as Cycles' emission, which leaves both faces
+    return m
+
+
+def cornell(path, light_scale, blocks_material):
+    """The Cornell box (scenes/cornell-box), metres, turned to face the glTF camera on +Z: its
+    ceiling light scaled by light_scale in each direction, radiance 1 / light_scale^2 times, the
+    same power."""
+    def place(p):  # the scene's camera at (278, 273, -800) mm comes to (0, 0.3, 0.8) m
+        return ((278.0 - p[0]) / 1000, (p[1] - 273.0) / 1000 + 0.3, -p[2] / 1000)
+
+    folder = os.path.join(ROOT, "scenes", "cornell-box")
+    materials = [cc.material(c, 0.0, 1.0) for c in
+                 ((0.725, 0.71, 0.68), (0.63, 0.065, 0.05), (0.14, 0.45, 0.091))]
+    materials += [blocks_material, emissive((17, 12, 4), 1.0 / light_scale ** 2)]
+    meshes = [flat_mesh([tuple(place(p) for p in t) for t in obj_triangles(os.path.join(folder, f))], m)
+              for f, m in (("white.obj", 0), ("red.obj", 1), ("green.obj", 2), ("blocks.obj", 3))]
+    centre = place((278.0, 548.7, 279.5))
+    meshes.append(quad(centre, 0.065 * light_scale, 0.0525 * light_scale, 4))
+    fov_x = math.radians(39.3)
+    cc.write_glb(path, meshes, materials, camera_z=0.8, yfov=fov_x, aspect=1.0,
+                 extensions=["KHR_materials_emissive_strength"])
+
+
+def many_lights(path, count=128):
+    """Spheres on a floor before a wall, lit by `count` small square lamps of many colours and
+    powers (a 40:1 range) at many heights: a glTF file's dozens of lamps and emissive meshes."""
+    rng = random.Random(7)
+    s = cc.sphere()
+    materials = [cc.material((0.6, 0.6, 0.6), 0.0, 0.8), cc.material((0.9, 0.6, 0.3), 1.0, 0.35),
+                 cc.material((0.3, 0.5, 0.8), 0.0, 0.3)]
+    meshes = [cc.floor(8.0) + (0,), cc.panel(-4.0, 4.0, -1.0, 3.0, -2.5) + (0,)]
+    for k, (x, z, r) in enumerate(((-1.2, -0.6, 0.5), (0.1, 0.3, 0.45), (1.3, -0.9, 0.55))):
+        meshes.append(([c * r + o for c, o in zip(s[0], [x, -1.0 + r, z] * (len(s[0]) // 3))],
+                       s[1], s[2], None, 1 + k % 2))
+    for _ in range(count):
+        colour = [rng.uniform(0.2, 1.0) for _ in range(3)]
+        materials.append(emissive(colour, rng.choice((2.0, 8.0, 80.0)) * rng.uniform(0.5, 1.0)))
+        centre = (rng.uniform(-3.5, 3.5), rng.uniform(-0.5, 2.5), rng.uniform(-2.3, 2.0))
+        meshes.append(quad(centre, 0.04, 0.04, len(materials) - 1))
+    cc.write_glb(path, meshes, materials, camera_z=5.5, yfov=0.7,
+                 extensions=["KHR_materials_emissive_strength"])
+
+
+def textured(path):
+    """Textured spheres (base colour, metallic-roughness and normal images) on a checker floor
+    before a checker wall, under a sun and a wide emissive panel overhead: image lookups on
+    every bounce and light bouncing between the objects."""
+    s = cc.sphere()
+    images = cc.textured_images()
+    textured_material = cc.material((1.0, 1.0, 1.0), 1.0, 1.0)
+    textured_material["pbrMetallicRoughness"]["baseColorTexture"] = {"index": 0}
+    textured_material["pbrMetallicRoughness"]["metallicRoughnessTexture"] = {"index": 1}
+    textured_material["normalTexture"] = {"index": 2}
+    checker = cc.material((0.8, 0.8, 0.8), 0.0, 0.7)
+    checker["pbrMetallicRoughness"]["baseColorTexture"] = {"index": 0}
+    materials = [textured_material, checker, emissive((1.0, 0.95, 0.9), 1.5)]
+    size = 4.0
+    floor = ([-size, -1.0, -size, size, -1.0, -size, size, -1.0, size, -size, -1.0, size],
+             [0, 1, 0] * 4, [0, 2, 1, 0, 3, 2], [0, 0, 4, 0, 4, 4, 0, 4], 1)
+    meshes = [floor, cc.panel(-4.0, 4.0, -1.0, 3.0, -2.5) + (1,)]
+    for x, z, r in ((-1.3, -0.4, 0.6), (0.2, 0.3, 0.5), (1.5, -0.7, 0.7)):
+        meshes.append(([c * r + o for c, o in zip(s[0], [x, -1.0 + r, z] * (len(s[0]) // 3))],
+                       s[1], s[2], s[3], 0))
+    meshes.append(quad((0.0, 3.0, 0.0), 2.0, 1.5, 2))
+    cc.write_glb(path, meshes, materials, camera_z=5.5, yfov=0.7, images=images,
+                 sun=((0.5, -0.7, -0.5), 2.0 * 683), extensions=["KHR_materials_emissive_strength"])
+
+
+def write_hdr(path, width, height, texel):
+    """A Radiance RGBE image (flat scanlines), texel(x, y) -> linear RGB."""
+    rows = bytearray()
+    for y in range(height):
+        for x in range(width):
+            rgb = texel(x, y)
+            peak = max(rgb)
+            if peak < 1e-32:
+                rows += b"\0\0\0\0"
+                continue
+            mantissa, exponent = math.frexp(peak)
+            scale = mantissa * 256.0 / peak
+            rows += bytes([min(255, int(c * scale)) for c in rgb] + [exponent + 128])
+    with open(path, "wb") as f:
+        f.write(b"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y %d +X %d\n" % (height, width))
+        f.write(bytes(rows))
+
+
+def sky(x, y, width, height):
+    """A blue sky brightening to the horizon, a dim brown ground, and a sun 2 degrees across at
+    35 degrees of elevation, off to the camera's right, 4000 times the sky's radiance."""
+    theta = math.pi * (y + 0.5) / height  # from straight up
+    phi = 2 * math.pi * (x + 0.5) / width
+    sun_theta, sun_phi = math.radians(55), math.radians(230)
+    cos_angle = (math.cos(theta) * math.cos(sun_theta) +
+                 math.sin(theta) * math.sin(sun_theta) * math.cos(phi - sun_phi))
+    if cos_angle > math.cos(math.radians(1.0)):
+        return (4000.0, 3600.0, 3000.0)
+    if theta > math.pi / 2:
+        return (0.12, 0.09, 0.06)
+    t = theta / (math.pi / 2)
+    return (0.25 + 0.6 * t, 0.45 + 0.45 * t, 1.0)
+
+
+def environment_lit(folder, quick):
+    """Spheres on a floor under a sky with a sun (a lat-long map): a glTF file for Cycles, and
+    the YAML scene Spillway renders, which places it under the map with the file's camera."""
+    glb, hdr, yaml = (os.path.join(folder, n) for n in ("outdoor.glb", "sky.hdr", "outdoor.yaml"))
+    s = cc.sphere()
+    materials = [cc.material((0.5, 0.5, 0.5), 0.0, 0.9), cc.material((0.95, 0.64, 0.54), 1.0, 0.3),
+                 cc.material((0.8, 0.3, 0.2), 0.0, 0.4)]
+    meshes = [cc.floor(12.0) + (0,)]
+    for k, (x, z, r) in enumerate(((-1.3, -0.5, 0.6), (0.2, 0.2, 0.5), (1.4, -0.6, 0.7))):
+        meshes.append(([c * r + o for c, o in zip(s[0], [x, -1.0 + r, z] * (len(s[0]) // 3))],
+                       s[1], s[2], None, 1 + k % 2))
+    cc.write_glb(glb, meshes, materials, camera_z=5.0, yfov=0.6)
+    width = 128 if quick else 512
+    write_hdr(hdr, width, width // 2, lambda x, y: sky(x, y, width, width // 2))
+    fov_x = math.degrees(cc.horizontal_fov(glb))
+    with open(yaml, "w") as f:
+        f.write("image: {width: 640, height: 480, sample base: 1, iterations: 1}\n"
+                "camera:\n  type: PinHole\n"
+                "  look at: {eye: [0, 0.3, 5.0], target: [0, 0.3, 0], up: [0, 1, 0]}\n"
+                "  fov: %.6f\n"
+                "sampler: {type: Sobol}\n"
+                "shaders: []\n"
+                "objects:\n  - {type: Gltf, filename: outdoor.glb}\n"
+                "light: {type: Environment, filename: sky.hdr}\n" % fov_x)
+    return glb, yaml, hdr
+
+
+def make_scenes(folder, quick):
+    """[(name, glTF file for Cycles, file for Spillway, environment map or None)]."""
+    os.makedirs(folder, exist_ok=True)
+    p = lambda n: os.path.join(folder, n)  # noqa: E731
+    cornell(p("cornell.glb"), 1.0, cc.material((0.725, 0.71, 0.68), 0.0, 1.0))
+    cornell(p("glossy-small-light.glb"), 0.1, cc.material((0.95, 0.64, 0.54), 1.0, 0.28))
+    textured(p("textured.glb"))
+    many_lights(p("many-lights.glb"))
+    glb, yaml, hdr = environment_lit(folder, quick)
+    return [("cornell", p("cornell.glb"), p("cornell.glb"), None),
+            ("glossy-small-light", p("glossy-small-light.glb"), p("glossy-small-light.glb"), None),
+            ("textured", p("textured.glb"), p("textured.glb"), None),
+            ("many-lights", p("many-lights.glb"), p("many-lights.glb"), None),
+            ("environment", glb, yaml, hdr)]
+
+
+# --- renders ----------------------------------------------------------------------------------
+
+def relmse(spillway, image, reference):
+    r = subprocess.run([spillway, "compare", image, reference, "--json"], capture_output=True,
+                       text=True, check=True)
+    return json.loads(r.stdout)["relmse"]
+
+
+def spillway_render(spillway, backend, file, width, spp, seed, out):
+    """Seconds of the whole process (best of the repeats), and the image written."""
+    cmd = [spillway, "render", file, "--backend", backend, "--width", str(width), "--spp",
+           str(spp), "--seed", str(seed), "--threads", str(THREADS), "--quiet", "-o", out]
+    start = time.perf_counter()
+    r = subprocess.run(cmd, capture_output=True, text=True)
+    seconds = time.perf_counter() - start
+    if r.returncode != 0:
+        sys.exit("%s failed (%d): %s" % (" ".join(cmd), r.returncode, r.stderr[-2000:]))
+    return seconds
+
+
+def cycles_renders(glb, env, width, height, levels, ref_spp, folder):
+    """Cycles at each of `levels` (seed 0) and its reference (seed 1): {spp: (seconds, image)},
+    and the reference's path."""
+    renders = [{"spp": n, "seed": 0, "out": os.path.join(folder, "cycles-%d.exr" % n)}
+               for n in levels]
+    ref = os.path.join(folder, "cycles-reference.exr")
+    renders.append({"spp": ref_spp, "seed": 1, "out": ref})
+    seconds_file = os.path.join(folder, "cycles-seconds.json")
+    cc.render_in_cycles(glb, width, height, renders, environment=env, threads=THREADS,
+                        seconds=seconds_file)
+    with open(seconds_file) as f:
+        seconds = json.load(f)
+    return {r["spp"]: (t, r["out"]) for r, t in zip(renders[:-1], seconds)}, ref
+
+
+def interpolate_time(points, target):
+    """The seconds at which error reaches `target`, from (spp, seconds, error) in increasing
+    spp: log-log between the first render at or below the target and the one before it."""
+    for k, (spp, seconds, error) in enumerate(points):
+        if error > target:
+            continue
+        if k == 0 or error == target:
+            return seconds, spp
+        s0, t0, e0 = points[k - 1]
+        f = math.log(e0 / target) / math.log(e0 / error) if e0 > error else 1.0
+        return math.exp(math.log(t0) + f * (math.log(seconds) - math.log(t0))), \
+            math.exp(math.log(s0) + f * (math.log(spp) - math.log(s0)))
+    return None, None
+
+
+def bench_scene(spillway, backends, scene, width, cycles_spp, ref_spp, repeat, max_spp, folder):
+    name, glb, ours, env = scene
+    work = os.path.join(folder, name)
+    os.makedirs(work, exist_ok=True)
+    height = int(round(width / (1.0 if name.startswith(("cornell", "glossy")) else 4 / 3)))
+    levels = [n for n in (16, 32, 64, 128) if n < cycles_spp] + [cycles_spp]
+    cycles, cycles_ref = cycles_renders(glb, env, width, height, levels, ref_spp, work)
+    target = relmse(spillway, cycles[cycles_spp][1], cycles_ref)
+    row = {"scene": name, "width": width, "height": height, "cycles_spp": cycles_spp,
+           "cycles_seconds": cycles[cycles_spp][0], "cycles_relmse": target,
+           "cycles_curve": [(n, cycles[n][0], relmse(spillway, cycles[n][1], cycles_ref))
+                            for n in levels], "backends": {}}
+    for backend in backends:
+        ref = os.path.join(work, "%s-reference.exr" % backend)
+        spillway_render(spillway, backend, ours, width, ref_spp, 1, ref)
+        points, spp = [], 4
+        while spp <= max_spp:
+            out = os.path.join(work, "%s-%d.exr" % (backend, spp))
+            seconds = min(spillway_render(spillway, backend, ours, width, spp, 0, out)
+                          for _ in range(repeat))
+            points.append((spp, seconds, relmse(spillway, out, ref)))
+            if points[-1][2] <= target:
+                break
+            spp *= 2
+        seconds, at_spp = interpolate_time(points, target)
+        b = {"curve": points, "seconds": seconds, "spp": at_spp,
+             "ratio": seconds / row["cycles_seconds"] if seconds else None,
+             "against_cycles_reference": relmse(spillway, ref, cycles_ref)}
+        if name == "cornell":
+            # The same error against Cycles' reference (the BRDFs nearly agree here).
+            b["curve_against_cycles"] = [(n, t, relmse(spillway, os.path.join(
+                work, "%s-%d.exr" % (backend, n)), cycles_ref)) for n, t, _ in points]
+        row["backends"][backend] = b
+    return row
+
+
+def print_row(row):
+    print("%-19s Cycles %4d spp %7.2f s relMSE %.3g" % (
+        row["scene"], row["cycles_spp"], row["cycles_seconds"], row["cycles_relmse"]))
+    for backend, b in row["backends"].items():
+        if b["seconds"] is None:
+            print("  %-10s did not reach it by %d spp (relMSE %.3g)" % (
+                backend, b["curve"][-1][0], b["curve"][-1][2]))
+            continue
+        print("  %-10s %6.0f spp %7.2f s  %.2fx Cycles' time   (its reference vs Cycles': "
+              "relMSE %.3g)" % (backend, b["spp"], b["seconds"], b["ratio"],
+                                b["against_cycles_reference"]))
+    sys.stdout.flush()
+
+
+def main(spillway, backends, quick, repeat, scenes=None):
+    width, cycles_spp, ref_spp, max_spp = (32, 16, 64, 256) if quick else (128, 256, 4096, 8192)
+    folder = tempfile.mkdtemp(prefix="bench-cycles-") if quick else \
+        os.path.join(ROOT, "out", "bench", "cycles")
+    rows = []
+    for scene in make_scenes(os.path.join(folder, "scenes"), quick):
+        if scenes and scene[0] not in scenes:
+            continue
+        rows.append(bench_scene(spillway, backends, scene, width, cycles_spp, ref_spp, repeat,
+                                max_spp, folder))
+        print_row(rows[-1])
+    if not quick:
+        with open(os.path.join(ROOT, "out", "bench", "cycles.json"), "w") as f:
+            json.dump(rows, f, indent=2)
+    else:
+        shutil.rmtree(folder)
+    # Every scene measured: each render's seconds and error positive and finite.
+    def measured(points):
+        return all(0 < t < math.inf and 0 < e < math.inf for _, t, e in points)
+    bad = [r["scene"] for r in rows if not (measured(r["cycles_curve"]) and all(
+        measured(b["curve"]) for b in r["backends"].values()))]
+    if bad:
+        print("FAIL: no usable measurement on %s" % ", ".join(bad))
+    return 1 if bad else 0
