@@ -360,16 +360,17 @@ void fillLane(const SceneView& scene, const RenderParams& rp, const ShadeInput& 
 void pickLaneEmitter(const SceneView& scene, const RenderParams& rp, bool nee, SurfaceLanes& lanes,
                      size_t k) {
     static const Emitter kNone{};
-    const Emitter& e =
-        nee && lanes.live.v[k] != 0u
-            ? scene.emitters[pickEmitter(scene, rp.emitterCount, lanes.random.uLightX.v[k])]
-            : kNone;
+    float pickPdf = 0.0f;
+    const uint picked = nee && lanes.live.v[k] != 0u ? pickLight(scene, rp, get(lanes.p, k),
+                                                                 lanes.random.uLightX.v[k], pickPdf)
+                                                     : kNoEmitter;
+    const Emitter& e = picked != kNoEmitter ? scene.emitters[picked] : kNone;
     set(lanes.e0, k, e.p0);
     set(lanes.e1, k, e.e1);
     set(lanes.e2, k, e.e2);
     set(lanes.eNormal, k, e.normal);
     set(lanes.eRadiance, k, e.radiance);
-    lanes.ePickPdf.v[k] = e.pickPdf;
+    lanes.ePickPdf.v[k] = pickPdf;
     lanes.eArea.v[k] = e.area;
     lanes.eTwoSided.v[k] = mask(e.twoSided != 0u);
 }

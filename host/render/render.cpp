@@ -244,6 +244,8 @@ void RenderSession::build() {
     params.threshold = scene_.settings.threshold;
     params.strategy = config_.strategy;
     params.emitterCount = lights_->sampledEmitters();
+    params.treeEmitters = lights_->treeEmitters();
+    stats_.extra["light_tree_emitters"] = double(lights_->treeEmitters());
     params.environment = lights_->environment();
     params.envWidth = lights_->environmentWidth();
     params.envHeight = lights_->environmentHeight();

@@ -1,5 +1,7 @@
 #include "host/scene_view/lights.h"
 
+#include "host/scene_view/light_tree.h"
+
 #include "host/scene/emitter_kinds.h"
 #include "host/textures/textures.h"
 
@@ -59,13 +61,18 @@ SceneLights::SceneLights(const Scene& scene, const TextureResolver* textures) {
     for (size_t m = 0; m < scene.meshes.size(); ++m)
         addTriangles(scene, m, textures, powers);
 
+    // The lights with a place first, behind the triangles: the light tree's emitters lead the
+    // table (shared/light_tree.h).
     const double radius = sceneRadius(scene);
-    for (const PunctualLight& p : scene.punctualLights)
-        addPunctual(p, radius, powers);
+    for (bool placed : {true, false})
+        for (const PunctualLight& p : scene.punctualLights)
+            if (((emitterKind(p.kind)->flags & kLightTakesPosition) != 0) == placed)
+                addPunctual(p, radius, powers);
 
     if (scene.environment) buildEnvironment(*scene.environment, radius, powers);
     placeEmissionMaps();
     buildCdf(powers, scene.meshes.size());
+    buildTree();
 
     // An environment stays visible to escaping rays even where next-event estimation never
     // picks it (a scene with no geometry has no power to give it).
@@ -95,6 +102,17 @@ void SceneLights::placeEmissionMaps() {
     maps_.clear();
 }
 
+// The light tree over the leading emitters with a place, where it picks differently from the
+// CDF (two or more emitters, not all with the same bounds).
+void SceneLights::buildTree() {
+    uint count = 0;
+    while (count < sampled_ && inLightTree(emitters_[count]))
+        ++count;
+    if (!lightTreeChangesPicks(emitters_, count)) return;
+    treeEmitters_ = count;
+    appendLightTree(emitters_, count, table_);
+}
+
 // Every emitter's pickPdf and the CDF, from their powers; without any power, no emitter.
 void SceneLights::buildCdf(const std::vector<double>& powers, size_t meshes) {
     double totalPower = 0.0;
@@ -105,9 +123,10 @@ void SceneLights::buildCdf(const std::vector<double>& powers, size_t meshes) {
         for (size_t i = 0; i < emitters_.size(); ++i) {
             running += powers[i];
             emitters_[i].pickPdf = float(powers[i] / totalPower);
-            cdf_.push_back(float(running / totalPower));
+            table_.push_back(float(running / totalPower));
         }
-        cdf_.back() = 1.0f;
+        table_.back() = 1.0f;
+        sampled_ = uint(table_.size());
     } else {
         emitters_.clear(); // nothing emits: nothing to sample
         emitterBase_.assign(meshes, -1);
@@ -315,8 +334,8 @@ SceneView SceneLights::view() const {
     SceneView v;
     v.shaders = shaders_.data();
     v.emitters = emitters_.data();
-    v.emitterCdf = cdf_.data();
-    v.emitterCount = uint(cdf_.size());
+    v.emitterCdf = table_.data();
+    v.emitterCount = sampled_;
     v.lightData = lightData_.empty() ? nullptr : lightData_.data();
     return v;
 }

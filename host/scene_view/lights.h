@@ -1,9 +1,9 @@
 // What shading reads of the scene besides the hit: the shader table, and the lights. Every
 // triangle of a mesh whose shader emits is an emitter, and so is every punctual light and the
 // environment; next-event estimation picks one with probability proportional to its power (the
-// CDF), and the film's fixed-point scale reads the brightest emission. Built from the Scene alone,
-// apart from the BVH (embree_backend/), as pbrt-v4 builds its lights and light sampler apart from
-// the aggregate.
+// CDF), or through the light tree among those with a place (light_tree.h), and the film's
+// fixed-point scale reads the brightest emission. Built from the Scene alone, apart from the BVH
+// (embree_backend/), as pbrt-v4 builds its lights and light sampler apart from the aggregate.
 #pragma once
 
 #include "host/scene/scene.h"
@@ -27,7 +27,12 @@ class SceneLights {
     const std::vector<Emitter>& emitters() const { return emitters_; }
     // How many emitters next-event estimation picks from (the CDF's length): every emitter but
     // an environment that has no power to be picked by (no geometry to light).
-    uint sampledEmitters() const { return uint(cdf_.size()); }
+    uint sampledEmitters() const { return sampled_; }
+    // How many emitters, from the first, the light tree holds (0: the scene has no tree).
+    uint treeEmitters() const { return treeEmitters_; }
+    // What the kernels read as the emitter CDF (SceneView::emitterCdf): the CDF, then the
+    // light tree (shared/light_tree.h).
+    const std::vector<float>& emitterTable() const { return table_; }
     // The environment's emitter index, or kNoEmitter; its map's size (0 x 0: constant).
     uint environment() const { return environment_; }
     uint environmentWidth() const { return envWidth_; }
@@ -60,13 +65,16 @@ class SceneLights {
                           const EmissionImage& image, Emitter& e);
     void placeEmissionMaps();
     void buildCdf(const std::vector<double>& powers, size_t meshes);
+    void buildTree();
     void addPunctual(const PunctualLight& p, double radius, std::vector<double>& powers);
     void buildEnvironment(const Environment& env, double radius, std::vector<double>& powers);
     double buildEnvironmentMap(const Environment& env, float& brightest);
 
     std::vector<ShaderParams> shaders_;
     std::vector<Emitter> emitters_;
-    std::vector<float> cdf_;
+    std::vector<float> table_; // the CDF (sampled_ entries), then the light tree
+    uint sampled_ = 0;
+    uint treeEmitters_ = 0;
     std::vector<int> emitterBase_; // per mesh: index of its first emitter, or -1
     float brightest_ = 0.0f;
     uint environment_ = kNoEmitter;

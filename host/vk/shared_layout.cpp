@@ -16,7 +16,7 @@ static_assert(offsetof(Emitter, normal) == 48 && offsetof(Emitter, type) == 60 &
               "Emitter layout");
 static_assert(sizeof(SurfaceHit) == 72, "SurfaceHit layout changed");
 static_assert(sizeof(PathState) == 32, "PathState layout changed");
-static_assert(sizeof(RenderParams) == 48, "RenderParams layout changed");
+static_assert(sizeof(RenderParams) == 52, "RenderParams layout changed");
 // What the shading kernels read and write (shaders/shared/shade_io.h, shaders/shade_kernel.glsl).
 static_assert(offsetof(SurfaceHit, shader) == 28 && offsetof(SurfaceHit, emitter) == 44 &&
                   offsetof(SurfaceHit, albedo) == 48 && offsetof(SurfaceHit, material) == 64 &&
@@ -32,8 +32,8 @@ static_assert(offsetof(ShadeResult, emitted) == 4 && offsetof(ShadeResult, shado
 static_assert(sizeof(ShadeInput) == 128, "ShadeInput layout changed");
 static_assert(offsetof(ShadeInput, path) == 72 && offsetof(ShadeInput, rayDir) == 104,
               "ShadeInput layout");
-static_assert(sizeof(ShadePush) == 64 && offsetof(ShadePush, offset) == 48 &&
-                  offsetof(ShadePush, count) == 52,
+static_assert(sizeof(ShadePush) == 64 && offsetof(ShadePush, offset) == 52 &&
+                  offsetof(ShadePush, count) == 56,
               "ShadePush layout changed");
 static_assert(sizeof(ShadePush) <= 128,
               "push constants beyond the 128 bytes every device guarantees");

@@ -125,7 +125,8 @@ std::unique_ptr<HostArray> VulkanShading::uploadTable(const void* data, size_t b
     return a;
 }
 
-// The scene's tables, uploaded once: shaders, emitters, the emitters' CDF, the environment.
+// The scene's tables, uploaded once: shaders, emitters, the emitters' CDF and light tree, the
+// environment.
 void VulkanShading::uploadTables(const RenderContext& ctx) {
     const auto start = std::chrono::steady_clock::now();
     const SceneView view = ctx.lights.view();
@@ -136,8 +137,8 @@ void VulkanShading::uploadTables(const RenderContext& ctx) {
                                kTexelBytes, "shader");
     emitterTable_ = uploadTable(view.emitters, lights.emitters().size() * sizeof(Emitter),
                                 kTexelBytes, "emitter");
-    emitterCdf_ = uploadTable(view.emitterCdf, view.emitterCount * sizeof(float), sizeof(float),
-                              "emitter CDF");
+    emitterCdf_ = uploadTable(view.emitterCdf, lights.emitterTable().size() * sizeof(float),
+                              sizeof(float), "emitter CDF and light tree");
     // The environment's map and CDFs and the emission maps; without them, 16 bytes are bound.
     environment_ = uploadTable(lights.lightData().data(), lights.lightData().size() * sizeof(float),
                                sizeof(float), "light data");

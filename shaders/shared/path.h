@@ -61,6 +61,8 @@ SHARED_FN void addEmission(SCENE_PARAM RenderParams rp, SurfaceHit hit, vec3 wo,
     bool sampledByBsdf = st.bounce > 0u && (st.flags & kPathSpecular) == 0u;
     if (sampledByBsdf && rp.strategy == kStrategyLight) w = 0.0f;
     if (sampledByBsdf && rp.strategy == kStrategyMis) {
+        // The pick probability from the ray's origin, the previous vertex.
+        e.pickPdf = lightPickPdf(SCENE_ARG rp, hit.emitter, hit.p + hit.t * wo);
         float lightPdf = emitterSolidAnglePdf(e, hit.t, cosLight);
         w = powerHeuristic(st.prevPdf, lightPdf);
     }
@@ -93,13 +95,16 @@ SHARED_FN bool shadeGoesOn(RenderParams rp, ShaderParams sh, PathState st) {
     return st.bounce < rp.maxDepth && sh.model != kModelNull;
 }
 
-// Step 2 of shadeSurface: one emitter picked by power (uLight.x), one point on it or direction
+// Step 2 of shadeSurface: one emitter picked (pickLight, uLight.x), one point on it or direction
 // to it (uLight.yz), and the shadow ray toward it with its pending contribution (r.shadow*,
 // kShadeShadow in r.flags when there is one to trace).
 SHARED_FN void addShadowRay(SCENE_PARAM RenderParams rp, ShaderParams sh, SurfaceHit hit, vec3 wo,
                             PathState st, vec4 uLight, INOUT(ShadeResult) r) {
-    uint ei = pickEmitter(SCENE_ARG rp.emitterCount, uLight.x);
+    float pickPdf;
+    uint ei = pickLight(SCENE_ARG rp, hit.p, uLight.x, pickPdf);
+    if (ei == kNoEmitter) return;
     Emitter e = EMITTER(ei);
+    e.pickPdf = pickPdf;
     LightSample ls = sampleEmitter(SCENE_ARG rp, e, hit, vec2(uLight.y, uLight.z));
     if (!(ls.pdf > 0.0f)) return;
     float bsdfPdf;

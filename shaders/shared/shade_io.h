@@ -31,7 +31,6 @@ struct ShadePush {
     uint offset; // first record of the range within the bound window
     uint count;  // records in the range
     uint pad0;
-    uint pad1;
 };
 
 SHARED_END

@@ -116,6 +116,8 @@ struct RenderParams {
     uint environment; // the environment's emitter index, or kNoEmitter
     uint envWidth;    // its lat-long map's size in texels; 0 x 0 for a constant environment
     uint envHeight;
+    uint treeEmitters; // emitters 0 .. treeEmitters - 1 are picked through the light tree
+                       // (shared/light_tree.h); 0: no tree
 };
 
 const uint kShadeEmitted = 1u;
