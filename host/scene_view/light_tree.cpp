@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 
 namespace spw {
 namespace {
@@ -92,11 +93,27 @@ Bounds unite(const Bounds& a, const Bounds& b) {
     return u;
 }
 
+bool sameBounds(const Bounds& a, const Bounds& b) {
+    return a.lo == b.lo && a.hi == b.hi && a.axis == b.axis && a.thetaO == b.thetaO &&
+           a.thetaE == b.thetaE && a.twoSided == b.twoSided;
+}
+
+// The most emitters a leaf holds (all with the same bounds).
+constexpr size_t kMaxLeafEmitters = 8;
+
 struct Builder {
     const std::vector<Bounds>& leaves;
     std::vector<uint> order; // emitter indices, partitioned as the build goes
     std::vector<Bounds> nodes;
-    std::vector<uint> links, parents, leafOf;
+    std::vector<uint> links, parents, counts, leafOf;
+
+    // Whether order[begin, end) is one leaf: one emitter, or a few the tree cannot tell apart.
+    bool leafOfOne(size_t begin, size_t end) const {
+        if (end - begin > kMaxLeafEmitters) return false;
+        for (size_t i = begin + 1; i < end; ++i)
+            if (!sameBounds(leaves[order[i]], leaves[order[begin]])) return false;
+        return true;
+    }
 
     // The node over order[begin, end), and its subtree after it; returns its index.
     uint build(size_t begin, size_t end, uint parent) {
@@ -104,11 +121,16 @@ struct Builder {
         nodes.emplace_back();
         links.push_back(0u);
         parents.push_back(parent);
-        if (end - begin == 1) {
-            const uint e = order[begin];
-            nodes[node] = leaves[e];
-            links[node] = kTreeLeaf | (leaves[e].twoSided ? kTreeTwoSided : 0u) | e;
-            leafOf[e] = node;
+        counts.push_back(0u);
+        if (leafOfOne(begin, end)) {
+            Bounds merged;
+            for (size_t i = begin; i < end; ++i) {
+                merged = unite(merged, leaves[order[i]]);
+                leafOf[order[i]] = node;
+            }
+            nodes[node] = merged;
+            links[node] = kTreeLeaf | (merged.twoSided ? kTreeTwoSided : 0u) | uint(begin);
+            counts[node] = uint(end - begin);
             return node;
         }
         dvec3 lo(std::numeric_limits<double>::max()), hi(-lo);
@@ -151,12 +173,8 @@ bool inLightTree(const Emitter& e) {
 bool lightTreeChangesPicks(const std::vector<Emitter>& emitters, uint count) {
     if (count < 2) return false;
     const Bounds first = emitterBounds(emitters[0]);
-    for (uint i = 1; i < count; ++i) {
-        const Bounds b = emitterBounds(emitters[i]);
-        if (b.lo != first.lo || b.hi != first.hi || b.axis != first.axis ||
-            b.thetaO != first.thetaO || b.thetaE != first.thetaE || b.twoSided != first.twoSided)
-            return true;
-    }
+    for (uint i = 1; i < count; ++i)
+        if (!sameBounds(emitterBounds(emitters[i]), first)) return true;
     return false;
 }
 
@@ -164,12 +182,15 @@ void appendLightTree(const std::vector<Emitter>& emitters, uint count, std::vect
     std::vector<Bounds> leaves;
     for (uint i = 0; i < count; ++i)
         leaves.push_back(emitterBounds(emitters[i]));
-    Builder b{leaves, {}, {}, {}, {}, std::vector<uint>(count, 0u)};
+    Builder b{leaves, {}, {}, {}, {}, {}, std::vector<uint>(count, 0u)};
     for (uint i = 0; i < count; ++i)
         b.order.push_back(i);
     b.build(0, count, kTreeRoot);
     for (uint node : b.leafOf)
         table.push_back(bits(node));
+    for (uint e : b.order)
+        table.insert(table.end(), {bits(e), emitters[e].pickPdf});
+    const size_t start = table.size();
     for (size_t n = 0; n < b.nodes.size(); ++n) {
         const Bounds& nb = b.nodes[n];
         const dvec3 centre = 0.5 * (nb.lo + nb.hi);
@@ -177,11 +198,14 @@ void appendLightTree(const std::vector<Emitter>& emitters, uint count, std::vect
         // Rounded up, so that the float sphere still holds every emitter.
         const float r =
             radius > 0.0 ? std::nextafter(float(radius * (1.0 + 1e-6)), INFINITY) : 0.0f;
-        table.insert(table.end(), {float(centre.x), float(centre.y), float(centre.z), r,
-                                   float(nb.axis.x), float(nb.axis.y), float(nb.axis.z),
-                                   float(std::cos(nb.thetaO)), float(std::cos(nb.thetaE)),
-                                   float(nb.power), bits(b.links[n]), bits(b.parents[n])});
+        table.insert(table.end(),
+                     {float(centre.x), float(centre.y), float(centre.z), r, float(nb.axis.x),
+                      float(nb.axis.y), float(nb.axis.z), float(std::cos(nb.thetaO)),
+                      float(std::sin(nb.thetaO)), float(std::cos(nb.thetaE)), float(nb.power),
+                      bits(b.links[n]), bits(b.parents[n]), bits(b.counts[n]), 0.0f, 0.0f});
     }
+    if (table.size() - start != b.nodes.size() * kTreeNodeWords)
+        throw std::logic_error("light tree: a node's words are not kTreeNodeWords");
 }
 
 } // namespace spw

@@ -19,9 +19,9 @@ bool inLightTree(const Emitter& e);
 bool lightTreeChangesPicks(const std::vector<Emitter>& emitters, uint count);
 
 // Appends to `table` the words of shared/light_tree.h for emitters [0, count) (each inLightTree,
-// its pickPdf its share of the power): each emitter's leaf, then the nodes. Splits at the
-// median of the emitters' centres along the widest axis, so the tree is balanced: a depth of
-// log2(count) rounded up.
+// its pickPdf its share of the power): each emitter's leaf, the leaves' members, then the nodes.
+// Splits at the median of the emitters' centres along the widest axis, so the tree is balanced: a
+// depth of log2(count) rounded up.
 void appendLightTree(const std::vector<Emitter>& emitters, uint count, std::vector<float>& table);
 
 } // namespace spw
