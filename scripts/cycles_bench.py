@@ -15,8 +15,9 @@ map and a YAML scene that places the file under it), then
 The time to reach that error is interpolated between the two bracketing renders (log time
 against log error); a render's time is Spillway's whole process (loading the scene included)
 and Cycles' render call (Blender's start and the import left out). The table prints, per
-scene: Cycles' seconds and relMSE at 256 spp, and per backend the samples and seconds it took
-and the ratio to Cycles' seconds. Writes out/bench/cycles.json.
+scene: Cycles' seconds and relMSE at 256 spp, and per backend the samples and seconds it took,
+the ratio to Cycles' seconds, and that ratio less Spillway's process start (`spillway
+--version`: loading its shared libraries), which Cycles' figure does not pay. Writes out/bench/cycles.json.
 
 --quick renders small images and few samples: it checks that the comparison runs (the
 suite's Bench.CyclesQuickRuns), its figures mean nothing.
@@ -248,6 +249,16 @@ def spillway_render(spillway, backend, file, width, spp, seed, out):
     return seconds
 
 
+def start_seconds(spillway):
+    """The least of three `spillway --version` runs: the process's start (loading its shared
+    libraries), which every render's time includes."""
+    def once():
+        start = time.perf_counter()
+        subprocess.run([spillway, "--version"], capture_output=True, check=True)
+        return time.perf_counter() - start
+    return min(once() for _ in range(3))
+
+
 def cycles_renders(glb, env, width, height, levels, ref_spp, folder):
     """Cycles at each of `levels` (seed 0) and its reference (seed 1): {spp: (seconds, image)},
     and the reference's path."""
@@ -303,8 +314,10 @@ def bench_scene(spillway, backends, scene, width, cycles_spp, ref_spp, repeat, m
                 break
             spp *= 2
         seconds, at_spp = interpolate_time(points, target)
-        b = {"curve": points, "seconds": seconds, "spp": at_spp,
+        start = start_seconds(spillway)
+        b = {"curve": points, "seconds": seconds, "spp": at_spp, "start_seconds": start,
              "ratio": seconds / row["cycles_seconds"] if seconds else None,
+             "ratio_without_start": (seconds - start) / row["cycles_seconds"] if seconds else None,
              "against_cycles_reference": relmse(spillway, ref, cycles_ref)}
         if name == "cornell":
             # The same error against Cycles' reference (the BRDFs nearly agree here).
@@ -322,9 +335,10 @@ def print_row(row):
             print("  %-10s did not reach it by %d spp (relMSE %.3g)" % (
                 backend, b["curve"][-1][0], b["curve"][-1][2]))
             continue
-        print("  %-10s %6.0f spp %7.2f s  %.2fx Cycles' time   (its reference vs Cycles': "
-              "relMSE %.3g)" % (backend, b["spp"], b["seconds"], b["ratio"],
-                                b["against_cycles_reference"]))
+        print("  %-10s %6.0f spp %7.2f s  %.2fx Cycles' time, %.2fx without the %.2f s process "
+              "start   (its reference vs Cycles': relMSE %.3g)" % (
+                  backend, b["spp"], b["seconds"], b["ratio"], b["ratio_without_start"],
+                  b["start_seconds"], b["against_cycles_reference"]))
     sys.stdout.flush()
 
 
