@@ -382,9 +382,18 @@ def make_test_files(out):
     write_glb(os.path.join(out, "glass.glb"), [s + (0,), (pos, nor, idx, whole, 1)],
               [glass, second_uv0], images=textured_images()[:1],
               extensions=["KHR_materials_transmission", "KHR_materials_ior"])
+    # A dark blue glossy plastic of ior 2 (F0 1/9, not glTF's 0.04) on the grey floor. Blender
+    # 3.4's importer reads the ior into the Principled BSDF's specular only beside
+    # KHR_materials_specular, here at its defaults (which change nothing in glTF).
+    shiny = material((0.05, 0.1, 0.4), 0.0, 0.25)
+    shiny["extensions"] = {"KHR_materials_ior": {"ior": 2.0},
+                           "KHR_materials_specular": {"specularFactor": 1.0,
+                                                      "specularColorFactor": [1.0, 1.0, 1.0]}}
+    write_glb(os.path.join(out, "ior.glb"), [s + (0,), f + (1,)], [shiny, grey],
+              extensions=["KHR_materials_ior", "KHR_materials_specular"])
     return sorted(os.path.join(out, n) for n in list(files) + [
         "textured.glb", "emissive.glb", "uv-sets.glb", "terminator.glb", "blend.glb",
-        "glass.glb"])
+        "glass.glb", "ior.glb"])
 
 
 # The suite's bound (docs/scene-format.md, "glTF files", says why): relMSE and each channel's

@@ -147,10 +147,11 @@ struct MetallicRoughnessLanesModel {
         : frame(shadingFrame(h.n)), alpha(gmax(h.alpha, hn::Set(D(), kGltfMinAlpha))) {}
     M delta(const HitVector&) const { return hn::FirstN(D(), 0); }
     V3 eval(const HitVector& h, V3 wi, V& pdf) const {
-        return gltfEval(h.albedo, h.metallic, alpha, h.ng, h.ngDotWo, frame, h.wo, wi, pdf);
+        return gltfEval(h.albedo, h.metallic, alpha, h.ior, h.ng, h.ngDotWo, frame, h.wo, wi, pdf);
     }
     BsdfSample sample(const HitVector& h, V ux, V uy, V uz) const {
-        return gltfSample(h.albedo, h.metallic, alpha, h.ng, h.ngDotWo, frame, h.wo, ux, uy, uz);
+        return gltfSample(h.albedo, h.metallic, alpha, h.ior, h.ng, h.ngDotWo, frame, h.wo, ux, uy,
+                          uz);
     }
 };
 
@@ -347,7 +348,8 @@ void fillLane(const SceneView& scene, const RenderParams& rp, const ShadeInput& 
     lanes.lift.v[k] = hit.lift;
     const ShaderParams sh = shaderAtHit(scene.shaders[hit.shader], hit);
     lanes.alpha.v[k] = sh.alpha;
-    lanes.ior.v[k] = sh.ior;
+    // MetallicRoughness reads its dielectric F0 where the Dielectric reads its ior.
+    lanes.ior.v[k] = sh.model == kModelMetallicRoughness ? gltfDielectricF0(sh.ior) : sh.ior;
     lanes.metallic.v[k] = sh.metallic;
     const bool live = st.bounce < rp.maxDepth;
     lanes.live.v[k] = mask(live);

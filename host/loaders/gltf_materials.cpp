@@ -157,12 +157,12 @@ void GltfReader::readTransmission(const tinygltf::Material& mat, Shader& s, cons
                                                 at + "/extensions/KHR_materials_transmission");
     if (t != mat.extensions.end() && t->second.Has("transmissionTexture"))
         warn(name + ": its transmissionTexture is not rendered (the factor alone is)");
-    if (factor == 0.0) {
-        if (iorExt != mat.extensions.end())
-            warn(name + ": KHR_materials_ior is rendered only with transmission (its reflection "
-                        "keeps glTF's F0 of 0.04)");
-        return;
-    }
+    // Opaque, the ior sets the dielectric reflection's F0 ((ior - 1) / (ior + 1))^2
+    // (shared/gltf.h's gltfDielectricF0); 0 keeps glTF's 0.04.
+    if (ior == 0.0 && iorExt != mat.extensions.end())
+        warn(name + ": KHR_materials_ior's ior 0 is rendered as 1.5");
+    s.params.ior = float(ior == 0.0 ? 1.5 : ior);
+    if (factor == 0.0) return;
     if (factor < 1.0 || s.params.metallic > 0.0f || s.metallicRoughnessTexture >= 0) {
         warn(name + ": transmission is rendered only at transmissionFactor 1 on a dielectric "
                     "(metallicFactor 0, no metallic-roughness image): drawn opaque");
@@ -170,7 +170,6 @@ void GltfReader::readTransmission(const tinygltf::Material& mat, Shader& s, cons
     }
     if (s.texture >= 0 || s.params.colour != vec3(1.0f))
         warn(name + ": glass takes no tint: its base colour is not rendered");
-    if (ior == 0.0) warn(name + ": KHR_materials_ior's ior 0 is rendered as 1.5");
     if (ior > 0.0 && ior < kMinGlassIor)
         warn(name + ": an ior below " + number(kMinGlassIor) + " is rendered as " +
              number(kMinGlassIor));

@@ -281,8 +281,8 @@ HWY_INLINE V gltfSpecularProbability(V3 f0, V3 cDiff, V cosO) {
     return hn::IfThenElse(hn::Gt(fd, hn::Zero(d)), p, one);
 }
 // Twin of gltfEval (shared/gltf.h), given dot(ng, wo) and shadingFrame's frame.
-HWY_INLINE V3 gltfEval(V3 colour, V metallic, V alpha, V3 ng, V ngDotWo, const Frame& f, V3 wo,
-                       V3 wi, V& pdf) {
+HWY_INLINE V3 gltfEval(V3 colour, V metallic, V alpha, V f0d, V3 ng, V ngDotWo, const Frame& f,
+                       V3 wo, V3 wi, V& pdf) {
     const D d;
     const V zero = hn::Zero(d), one = hn::Set(d, 1.0f), two = hn::Set(d, 2.0f);
     const V invPi = hn::Set(d, kInvPi);
@@ -293,7 +293,7 @@ HWY_INLINE V3 gltfEval(V3 colour, V metallic, V alpha, V3 ng, V ngDotWo, const F
                                           hn::Or(hn::Le(lo.z, zero), hn::Le(li.z, zero))),
                                    hn::Gt(len2, zero));
     h = mul(h, hn::Div(one, hn::Sqrt(len2)));
-    const V3 f0 = mix(hn::Set(d, kGltfDielectricF0), colour, metallic);
+    const V3 f0 = mix(f0d, colour, metallic);
     const V3 cDiff = mul(colour, hn::Sub(one, metallic));
     const V3 F = schlickFresnel(f0, dot(lo, h));
     const V ndf = ggxD(h, alpha);
@@ -310,12 +310,12 @@ HWY_INLINE V3 gltfEval(V3 colour, V metallic, V alpha, V3 ng, V ngDotWo, const F
     return select(evaluated, add(specular, diffuse), V3{zero, zero, zero});
 }
 // Twin of gltfSample (shared/gltf.h), given dot(ng, wo) and shadingFrame's frame.
-HWY_INLINE BsdfSample gltfSample(V3 colour, V metallic, V alpha, V3 ng, V ngDotWo, const Frame& f,
-                                 V3 wo, V ux, V uy, V uz) {
+HWY_INLINE BsdfSample gltfSample(V3 colour, V metallic, V alpha, V f0d, V3 ng, V ngDotWo,
+                                 const Frame& f, V3 wo, V ux, V uy, V uz) {
     const D d;
     const V zero = hn::Zero(d), one = hn::Set(d, 1.0f), two = hn::Set(d, 2.0f);
     const V3 lo = frameToLocal(f, wo);
-    const V3 f0 = mix(hn::Set(d, kGltfDielectricF0), colour, metallic);
+    const V3 f0 = mix(f0d, colour, metallic);
     const V3 cDiff = mul(colour, hn::Sub(one, metallic));
     const M specularLobe = hn::Lt(uz, gltfSpecularProbability(f0, cDiff, lo.z));
     BsdfSample s;
@@ -329,7 +329,7 @@ HWY_INLINE BsdfSample gltfSample(V3 colour, V metallic, V alpha, V3 ng, V ngDotW
     }
     s.ok = hn::And(s.ok, hn::Gt(li.z, zero));
     s.wi = frameToWorld(f, li);
-    const V3 fcos = gltfEval(colour, metallic, alpha, ng, ngDotWo, f, wo, s.wi, s.pdf);
+    const V3 fcos = gltfEval(colour, metallic, alpha, f0d, ng, ngDotWo, f, wo, s.wi, s.pdf);
     s.ok = hn::And(s.ok, hn::Gt(s.pdf, zero));
     s.weight = div(fcos, s.pdf);
     s.specular = hn::FirstN(d, 0);

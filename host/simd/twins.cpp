@@ -139,19 +139,19 @@ void runBsdfTwin(Twin twin, const TwinLanes& in, size_t i, TwinResults& out) {
     case Twin::gltfSpecularProbability: // f0 f0-2, cDiff f3-5, cosO f6 -> f0
         return store(gltfSpecularProbability(load3(in, 0, i), load3(in, 3, i), f(6)), out.f[0], i);
     case Twin::gltfEval: { // colour f0-2, metallic f3, alpha f4, ng f5-7, ns f8-10, wo f11-13,
-                           // wi f14-16 -> f0-2, pdf f3
+                           // wi f14-16, f0d f17 -> f0-2, pdf f3
         const FrameArgs a = frameArgs(in, 5, 8, 11, i);
         V pdf;
-        store3(gltfEval(load3(in, 0, i), f(3), f(4), a.ng, a.ngDotWo, a.frame, a.wo,
+        store3(gltfEval(load3(in, 0, i), f(3), f(4), f(17), a.ng, a.ngDotWo, a.frame, a.wo,
                         load3(in, 14, i), pdf),
                out, 0, i);
         return store(pdf, out.f[3], i);
     }
     case Twin::gltfSample: { // colour f0-2, metallic f3, alpha f4, ng f5-7, ns f8-10, wo f11-13,
-                             // u f14-16
+                             // u f14-16, f0d f17
         const FrameArgs a = frameArgs(in, 5, 8, 11, i);
-        return storeSample(gltfSample(load3(in, 0, i), f(3), f(4), a.ng, a.ngDotWo, a.frame, a.wo,
-                                      f(14), f(15), f(16)),
+        return storeSample(gltfSample(load3(in, 0, i), f(3), f(4), f(17), a.ng, a.ngDotWo, a.frame,
+                                      a.wo, f(14), f(15), f(16)),
                            out, i);
     }
     default:

@@ -74,7 +74,7 @@ inline constexpr TwinInfo kTwins[] = {
 // `specular` as masks u0 and u1, its out-parameters zero where it fails). twins.cpp says per twin
 // which rows it reads; `uniform` holds the arguments that are one value for every lane.
 struct TwinLanes {
-    Floats f[17];
+    Floats f[18];
     Uints u[5];
     std::uint32_t uniform[3];
 };

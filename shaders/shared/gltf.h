@@ -3,7 +3,9 @@
 //   parameters: colour [r, g, b] ([1, 1, 1]) or texture: the base colour; metallic (1) in
 //   [0, 1]; roughness (1) in [0, 1], the perceptual roughness: GGX alpha = roughness^2, at least
 //   kGltfMinAlpha. glTF's defaults (metallicFactor and roughnessFactor 1).
-//   c_diff = colour (1 - metallic), f0 = mix(0.04, colour, metallic),
+//   c_diff = colour (1 - metallic), f0 = mix(F0d, colour, metallic), F0d the dielectric's:
+//   ((ior - 1) / (ior + 1))^2 from the shader's ior (KHR_materials_ior), exactly glTF's 0.04 at
+//   ior 1.5 and wherever the ior is unset (below 1),
 //   F = f0 + (1 - f0) (1 - |wo.h|)^5 (Schlick, as conductor.h),
 //   f = (1 - F) c_diff / pi + F D G2 / (4 |co| |ci|)
 //   with GGX D and the height-correlated Smith G2 of ggx.h (the specification's V is
@@ -27,6 +29,15 @@ SHARED_BEGIN
 const float kGltfMinAlpha = 0.045f * 0.045f;
 const float kGltfDielectricF0 = 0.04f;
 
+// The dielectric part's F0 for an index of refraction (gltfDielectricF0(1.5) is kGltfDielectricF0
+// to the bit; an ior below 1, or NaN, is unset and takes it too). The cpu backend's SIMD shading
+// calls it per lane (host/cpu/simd_shading.cpp).
+SHARED_FN float gltfDielectricF0(float ior) {
+    if (!(ior >= 1.0f) || ior == 1.5f) return kGltfDielectricF0;
+    float r = (ior - 1.0f) / (ior + 1.0f);
+    return r * r;
+}
+
 // GGX alpha from glTF's perceptual roughness.
 SHARED_FN float gltfAlpha(float roughness) {
     return max(roughness * roughness, kGltfMinAlpha);
@@ -45,8 +56,8 @@ SHARED_FN float gltfSpecularProbability(vec3 f0, vec3 cDiff, float cosO) {
 }
 
 // SIMD twin: host/simd/simd_bsdf-inl.h
-SHARED_FN vec3 gltfEval(vec3 colour, float metallic, float alpha, vec3 ng, vec3 ns, vec3 wo,
-                        vec3 wi, OUT(float) pdf) {
+SHARED_FN vec3 gltfEval(vec3 colour, float metallic, float alpha, float f0d, vec3 ng, vec3 ns,
+                        vec3 wo, vec3 wi, OUT(float) pdf) {
     pdf = 0.0f;
     if (dot(ng, wo) * dot(ng, wi) <= 0.0f) return vec3(0.0f);
     Frame f = shadingFrame(ns, ng, wo);
@@ -57,7 +68,7 @@ SHARED_FN vec3 gltfEval(vec3 colour, float metallic, float alpha, vec3 ng, vec3 
     float len2 = dot(h, h);
     if (!(len2 > 0.0f)) return vec3(0.0f);
     h = h * inversesqrt(len2);
-    vec3 f0 = mix(vec3(kGltfDielectricF0), colour, metallic);
+    vec3 f0 = mix(vec3(f0d), colour, metallic);
     vec3 cDiff = colour * (1.0f - metallic);
     vec3 F = schlickFresnel(f0, dot(lo, h));
     float d = ggxD(h, alpha);
@@ -71,8 +82,8 @@ SHARED_FN vec3 gltfEval(vec3 colour, float metallic, float alpha, vec3 ng, vec3 
 }
 
 // SIMD twin: host/simd/simd_bsdf-inl.h
-SHARED_FN bool gltfSample(vec3 colour, float metallic, float alpha, vec3 ng, vec3 ns, vec3 wo,
-                          vec3 u, OUT(vec3) wi, OUT(vec3) weight, OUT(float) pdf,
+SHARED_FN bool gltfSample(vec3 colour, float metallic, float alpha, float f0d, vec3 ng, vec3 ns,
+                          vec3 wo, vec3 u, OUT(vec3) wi, OUT(vec3) weight, OUT(float) pdf,
                           OUT(bool) specular) {
     wi = vec3(0.0f);
     weight = vec3(0.0f);
@@ -81,7 +92,7 @@ SHARED_FN bool gltfSample(vec3 colour, float metallic, float alpha, vec3 ng, vec
     Frame f = shadingFrame(ns, ng, wo);
     vec3 lo = frameToLocal(f, wo);
     if (lo.z <= 0.0f) return false;
-    vec3 f0 = mix(vec3(kGltfDielectricF0), colour, metallic);
+    vec3 f0 = mix(vec3(f0d), colour, metallic);
     vec3 cDiff = colour * (1.0f - metallic);
     vec3 li;
     if (u.z < gltfSpecularProbability(f0, cDiff, lo.z)) {
@@ -94,7 +105,7 @@ SHARED_FN bool gltfSample(vec3 colour, float metallic, float alpha, vec3 ng, vec
     }
     if (li.z <= 0.0f) return false; // below the surface: absorbed
     wi = frameToWorld(f, li);
-    vec3 fcos = gltfEval(colour, metallic, alpha, ng, ns, wo, wi, pdf);
+    vec3 fcos = gltfEval(colour, metallic, alpha, f0d, ng, ns, wo, wi, pdf);
     if (!(pdf > 0.0f)) return false;
     weight = fcos / pdf;
     return true;
@@ -111,12 +122,13 @@ SHARED_FN float gltfBsdfConeSpread(ShaderParams sh) {
 }
 SHARED_FN vec3 gltfBsdfEval(ShaderParams sh, vec3 albedo, vec3 ng, vec3 ns, vec3 wo, vec3 wi,
                             OUT(float) pdf) {
-    return gltfEval(albedo, sh.metallic, max(sh.alpha, kGltfMinAlpha), ng, ns, wo, wi, pdf);
+    return gltfEval(albedo, sh.metallic, max(sh.alpha, kGltfMinAlpha), gltfDielectricF0(sh.ior), ng,
+                    ns, wo, wi, pdf);
 }
 SHARED_FN bool gltfBsdfSample(ShaderParams sh, vec3 albedo, vec3 ng, vec3 ns, vec3 wo, vec3 u,
                               OUT(vec3) wi, OUT(vec3) weight, OUT(float) pdf, OUT(bool) specular) {
-    return gltfSample(albedo, sh.metallic, max(sh.alpha, kGltfMinAlpha), ng, ns, wo, u, wi, weight,
-                      pdf, specular);
+    return gltfSample(albedo, sh.metallic, max(sh.alpha, kGltfMinAlpha), gltfDielectricF0(sh.ior),
+                      ng, ns, wo, u, wi, weight, pdf, specular);
 }
 
 SHARED_END

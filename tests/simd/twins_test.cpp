@@ -350,28 +350,29 @@ const std::map<Twin, ScalarSide>& scalarSides() {
          {[](Inputs& in) {
               in.setUnit(0), in.setUnit(1), in.setUnit(2), in.setMetallic(3), in.setAlpha(4);
               in.setNormals(5, 8), in.setAbove(11, 5), in.setAbove(14, 5);
+              in.setRange(17, 0.0f, 0.3f);
           },
           [](const Inputs& in, size_t k, Expected& e) {
               float pdf;
-              e.put(gltfEval(in.get3(0, k), in.f(3, k), in.f(4, k), in.get3(5, k), in.get3(8, k),
-                             in.get3(11, k), in.get3(14, k), pdf));
+              e.put(gltfEval(in.get3(0, k), in.f(3, k), in.f(4, k), in.f(17, k), in.get3(5, k),
+                             in.get3(8, k), in.get3(11, k), in.get3(14, k), pdf));
               e.put(pdf);
           }}},
         {Twin::gltfSample,
          {[](Inputs& in) {
               in.setUnit(0), in.setUnit(1), in.setUnit(2), in.setMetallic(3), in.setAlpha(4);
               in.setNormals(5, 8), in.setAbove(11, 5);
-              in.setUnit(14), in.setUnit(15), in.setUnit(16);
+              in.setUnit(14), in.setUnit(15), in.setUnit(16), in.setRange(17, 0.0f, 0.3f);
           },
           [](const Inputs& in, size_t k, Expected& e) {
               // Unwritten where the sample fails: putSample reads them only where it does not.
               vec3 wi(0.0f), weight(0.0f);
               float pdf = 0.0f;
               bool specular = false;
-              const bool ok =
-                  gltfSample(in.get3(0, k), in.f(3, k), in.f(4, k), in.get3(5, k), in.get3(8, k),
-                             in.get3(11, k), vec3(in.f(14, k), in.f(15, k), in.f(16, k)), wi,
-                             weight, pdf, specular);
+              const bool ok = gltfSample(in.get3(0, k), in.f(3, k), in.f(4, k), in.f(17, k),
+                                         in.get3(5, k), in.get3(8, k), in.get3(11, k),
+                                         vec3(in.f(14, k), in.f(15, k), in.f(16, k)), wi, weight,
+                                         pdf, specular);
               putSample(e, ok, specular, wi, weight, pdf);
           }}},
         {Twin::pcg4d,
