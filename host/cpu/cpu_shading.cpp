@@ -94,7 +94,7 @@ class CpuShading : public SlottedEngine {
 } // namespace
 
 bool usesSimdShading(const RenderContext& ctx) {
-    return ctx.config.pipeline.simdShading && simdShadingApplies(ctx.lights.view());
+    return ctx.config.pipeline.simdShading;
 }
 
 std::unique_ptr<ShadingEngine> makeCpuShading(const RenderContext& ctx) {

@@ -13,8 +13,8 @@ namespace spw {
 
 std::unique_ptr<ShadingEngine> makeCpuShading(const RenderContext& ctx);
 
-// Whether the cpu engine (and the fused stages) shade Lambert hits SIMD-wide: asked for
-// (PipelineConfig::simdShading) and possible for the scene (simdShadingApplies).
+// Whether the cpu engine (and the fused stages) shade hits SIMD-wide (PipelineConfig::simdShading;
+// every scene can).
 bool usesSimdShading(const RenderContext& ctx);
 
 } // namespace spw

@@ -3,7 +3,7 @@
 // itself through foreach_target.h) and picks the best the processor has at the first call.
 //
 // Each kernel is shadeSurface() (shared/path.h) for one surface model (shared/lambert.h,
-// conductor.h, dielectric.h, gltf.h) and triangle emitters: shadeLanes() is its control flow, and a
+// conductor.h, dielectric.h, gltf.h): shadeLanes() is its control flow, and a
 // small struct per model supplies bsdfEval, bsdfSample and bsdfIsDelta as the SIMD twins of the
 // model's shared functions (host/simd/simd_math-inl.h and simd_bsdf-inl.h, each checked against its
 // scalar function lane by lane).
@@ -47,6 +47,13 @@ struct SurfaceLanes {
     Vec3s e0, e1, e2, eNormal, eRadiance; // the picked emitter (a triangle)
     Floats ePickPdf, eArea;
     Uints eTwoSided;
+    // Where the picked emitter is not a triangle without an emission map (a punctual light,
+    // the environment, a mapped triangle), its light sample, made one lane at a time by
+    // sampleEmitter: eSampled set, the direction, the shadow ray's length, the pdf, whether it is
+    // a delta light, and in eRadiance the radiance it brings.
+    Uints eSampled, eDelta;
+    Vec3s sWi;
+    Floats sTmax, sPdf;
 };
 static_assert(sizeof(SurfaceLanes) % sizeof(Floats) == 0, "rows only");
 static_assert(sizeof(RandomLanes) % sizeof(Floats) == 0, "rows only");
@@ -190,13 +197,19 @@ M shadowLanes(const simd_shading::SurfaceLanes& in, size_t i, const HitVector& h
     const V3 q = emitterPoint(e0, e1, e2, load(in.random.uLightY, i), load(in.random.uLightZ, i));
     const V3 dq = sub(q, p);
     const V dist = hn::Sqrt(dot(dq, dq));
-    const V3 wi = div(dq, dist);
-    const V cosLight = emitterCosine(eNormal, loadMask(in.eTwoSided, i), neg(wi));
-    const V pdf = emitterSolidAnglePdf(load(in.ePickPdf, i), load(in.eArea, i), dist, cosLight);
+    const V3 toQ = div(dq, dist);
+    const V cosLight = emitterCosine(eNormal, loadMask(in.eTwoSided, i), neg(toQ));
+    const V trianglePdf =
+        emitterSolidAnglePdf(load(in.ePickPdf, i), load(in.eArea, i), dist, cosLight);
     const V offsetQ = surfaceOffset(q, e0, add(e0, e1), add(e0, e2), eNormal);
-    const V tmax = shadowRayTmax(dist, offset, offsetQ, cosLight);
+    // The lanes whose sample sampleEmitter made take it instead of the triangle's.
+    const M sampled = loadMask(in.eSampled, i);
+    const V3 wi = select(sampled, load(in.sWi, i), toQ);
+    const V pdf = hn::IfThenElse(sampled, load(in.sPdf, i), trianglePdf);
+    const V tmax =
+        hn::IfThenElse(sampled, load(in.sTmax, i), shadowRayTmax(dist, offset, offsetQ, cosLight));
 
-    shadowing = hn::And(shadowing, hn::And(hn::Gt(dist, zero), hn::Gt(pdf, zero)));
+    shadowing = hn::And(shadowing, hn::And(hn::Or(sampled, hn::Gt(dist, zero)), hn::Gt(pdf, zero)));
 
     V bsdfPdf;
     V3 fcos = model.eval(h, wi, bsdfPdf);
@@ -208,7 +221,9 @@ M shadowLanes(const simd_shading::SurfaceLanes& in, size_t i, const HitVector& h
     terminatorLanes<Model>(h, wi, lift, hn::And(shadowing, none), fcos, toward);
     shadowing = hn::And(shadowing, hn::Gt(maxComponent(fcos), zero));
 
-    const V w = mis ? powerHeuristic(pdf, quantizePdf(bsdfPdf)) : hn::Set(d, 1.0f);
+    // A delta light (a point, a direction): BSDF sampling cannot find it, no MIS.
+    const V w = hn::IfThenElse(loadMask(in.eDelta, i), hn::Set(d, 1.0f),
+                               mis ? powerHeuristic(pdf, quantizePdf(bsdfPdf)) : hn::Set(d, 1.0f));
     const V3 radiance = load(in.eRadiance, i);
     const V lifted = shadowLift(h.ng, lift, toward, tmax);
     const V liftedTmax = hn::Sub(tmax, hn::Mul(hn::Set(d, 2.0f), lifted));
@@ -358,15 +373,41 @@ void fillLane(const SceneView& scene, const RenderParams& rp, const ShadeInput& 
 }
 
 // Lane k's emitter, picked with the random number MakeRandomNumbers made (zeros where the path ends
-// here or nothing is sampled, so that the kernel reads defined values).
-void pickLaneEmitter(const SceneView& scene, const RenderParams& rp, bool nee, SurfaceLanes& lanes,
-                     size_t k) {
+// here or nothing is sampled, so that the kernel reads defined values); where it is not a
+// triangle without an emission map, its light sample from `hit`, made here.
+void pickLaneEmitter(const SceneView& scene, const RenderParams& rp, bool nee,
+                     const SurfaceHit& hit, SurfaceLanes& lanes, size_t k) {
     static const Emitter kNone{};
     float pickPdf = 0.0f;
     const uint picked = nee && lanes.live.v[k] != 0u ? pickLight(scene, rp, get(lanes.p, k),
                                                                  lanes.random.uLightX.v[k], pickPdf)
                                                      : kNoEmitter;
     const Emitter& e = picked != kNoEmitter ? scene.emitters[picked] : kNone;
+    const bool sampled =
+        picked != kNoEmitter && (e.type != kEmitterTriangle || e.map != kNoEmissionMap);
+    lanes.eSampled.v[k] = mask(sampled);
+    lanes.eDelta.v[k] = mask(sampled && emitterIsDelta(e.type));
+    if (sampled) {
+        Emitter withPdf = e;
+        withPdf.pickPdf = pickPdf;
+        const LightSample ls = sampleEmitter(
+            scene, rp, withPdf, hit, vec2(lanes.random.uLightY.v[k], lanes.random.uLightZ.v[k]));
+        set(lanes.sWi, k, ls.wi);
+        lanes.sTmax.v[k] = ls.tmax;
+        lanes.sPdf.v[k] = ls.pdf;
+        set(lanes.e0, k, vec3(0.0f));
+        set(lanes.e1, k, vec3(0.0f));
+        set(lanes.e2, k, vec3(0.0f));
+        set(lanes.eNormal, k, vec3(0.0f, 0.0f, 1.0f));
+        set(lanes.eRadiance, k, ls.radiance);
+        lanes.ePickPdf.v[k] = 0.0f;
+        lanes.eArea.v[k] = 1.0f;
+        lanes.eTwoSided.v[k] = 0u;
+        return;
+    }
+    set(lanes.sWi, k, vec3(0.0f, 0.0f, 1.0f));
+    lanes.sTmax.v[k] = 0.0f;
+    lanes.sPdf.v[k] = 0.0f;
     set(lanes.e0, k, e.p0);
     set(lanes.e1, k, e.e1);
     set(lanes.e2, k, e.e2);
@@ -420,13 +461,6 @@ const WideTwin kWideTwins[] = {
 static_assert(sizeof(kWideTwins) / sizeof(kWideTwins[0]) == kModelCount,
               "every registered surface model names its wide twin, or nullptr for none");
 
-bool simdShadingApplies(const SceneView& view) {
-    for (uint i = 0; i < view.emitterCount; ++i)
-        if (view.emitters[i].type != kEmitterTriangle || view.emitters[i].map != kNoEmissionMap)
-            return false;
-    return true;
-}
-
 namespace {
 // A block of hits per model with a kernel, filled as the hits come: runs of one shader where the
 // hits are sorted, interleaved models where they are not.
@@ -443,8 +477,8 @@ void shadeBlock(const SceneView& view, const RenderParams& rp, bool nee, bool mi
     const size_t end = wholeVectors(b.count);
     padLanes(b.lanes, b.count, end);
     HWY_DYNAMIC_DISPATCH(MakeRandomNumbers)(b.lanes.random, end, rp.sampling, rp.seed);
-    for (size_t k = 0; k < end; ++k)
-        pickLaneEmitter(view, rp, nee, b.lanes, k);
+    for (size_t k = 0; k < end; ++k) // padding lanes are lane 0's copies
+        pickLaneEmitter(view, rp, nee, in[b.hitOf[k < b.count ? k : 0]].hit, b.lanes, k);
     switch (model) {
     case kModelLambert:
         HWY_DYNAMIC_DISPATCH(ShadeLambertLanes)(b.lanes, end, nee, mis, rp.threshold, results);

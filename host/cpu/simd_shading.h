@@ -34,13 +34,11 @@ struct WideTwin {
 };
 extern const WideTwin kWideTwins[kModelCount];
 
-// Whether the kernels can shade this scene's hits: every emitter next-event estimation picks is
-// a triangle without an emission map (point lights, the environment and emission maps take
-// shadeSurface()).
-bool simdShadingApplies(const SceneView& view);
-
 // out[i] = shadeSurface(view, rp, in[i]) for i in [0, n); `simd` false shades every hit with
-// shadeSurface() (for scenes simdShadingApplies() refuses, and to compare).
+// shadeSurface() (--simd-shading off, and to compare). Light samples toward a triangle without
+// an emission map are made SIMD-wide; toward any other emitter (a punctual light, the
+// environment, a mapped triangle) one lane at a time by sampleEmitter, and the rest of
+// next-event estimation SIMD-wide again.
 void shadeHits(const SceneView& view, const RenderParams& rp, bool simd, const ShadeInput* in,
                size_t n, ShadeResult* out);
 

@@ -19,6 +19,7 @@
 #include <hwy/targets.h>
 #include <nlohmann/json.hpp>
 
+#include <cstdlib>
 #include <cstring>
 #include <map>
 #include <random>
@@ -48,7 +49,10 @@ vec3 unitVector(std::mt19937& rng) {
     return normalize(vec3(g(rng), g(rng), g(rng)));
 }
 
-Fixture makeFixture(std::mt19937& rng, int emitters) {
+// `emitters` emitters: triangles; with everyKind, in turn a triangle, a point light, a spot
+// light and a directional light, the last one the environment (constant), whose index the
+// caller gives RenderParams::environment.
+Fixture makeFixture(std::mt19937& rng, int emitters, bool everyKind = false) {
     Fixture f;
     std::uniform_real_distribution<float> u(0.0f, 1.0f);
     struct Model {
@@ -89,6 +93,17 @@ Fixture makeFixture(std::mt19937& rng, int emitters) {
         e.radiance = vec3(5.0f * u(rng), 4.0f, 3.0f * u(rng));
         e.pickPdf = 0.2f + u(rng);
         total += e.pickPdf;
+        const int kind = everyKind ? (i + 1 == emitters ? 4 : i % 4) : 0;
+        if (kind == 1 || kind == 2) { // a point light; a spot light shining down
+            e.type = kind == 1 ? kEmitterPoint : kEmitterSpot;
+            e.normal = normalize(vec3(u(rng) - 0.5f, -1.0f, u(rng) - 0.5f));
+            e.e1 = vec3(0.5f, 0.9f, 0.0f); // cos outer, cos inner
+        } else if (kind == 3) {            // a directional light shining down
+            e.type = kEmitterDirectional;
+            e.normal = normalize(vec3(u(rng) - 0.5f, -1.0f, u(rng) - 0.5f));
+        } else if (kind == 4) {
+            e.type = kEmitterEnvironment;
+        }
         f.emitters.push_back(e);
     }
     float sum = 0.0f;
@@ -202,18 +217,21 @@ TEST(SimdShading, EveryModelsHitsAreShadeSurfaceToTheBit) {
 
 void expectEveryModelsHitsAreShadeSurface() {
     std::mt19937 rng(2024);
-    for (int emitters : {3, 1, 0}) {
-        const Fixture f = makeFixture(rng, emitters);
-        ASSERT_TRUE(simdShadingApplies(f.view()));
+    for (int emitters : {3, 1, 0, -6}) { // -6: six of every kind
+        const bool everyKind = emitters < 0;
+        emitters = std::abs(emitters);
+        const Fixture f = makeFixture(rng, emitters, everyKind);
         // 2003 hits: blocks of one model's hits, some full (64), most ragged.
         const std::vector<ShadeInput> hits = randomHits(rng, f, 2003);
         for (uint strategy : {kStrategyMis, kStrategyLight, kStrategyBsdf})
             for (uint sampling : {kSamplerIndependent, kSamplerSobol}) {
-                const std::string what = std::to_string(emitters) + " emitters, strategy " +
+                const std::string what = std::to_string(emitters) + " emitters" +
+                                         (everyKind ? " of every kind" : "") + ", strategy " +
                                          std::to_string(strategy) + ", sampler " +
                                          std::to_string(sampling);
-                const FlagCounts c = compareWithShadeSurface(
-                    f.view(), params(strategy, sampling, uint(emitters)), hits, what.c_str());
+                RenderParams rp = params(strategy, sampling, uint(emitters));
+                if (everyKind) rp.environment = uint(emitters - 1);
+                const FlagCounts c = compareWithShadeSurface(f.view(), rp, hits, what.c_str());
                 // The comparison reached every outcome it can have here.
                 EXPECT_GT(c.next, 400u) << what;
                 EXPECT_GT(c.specular, 40u) << what;
@@ -261,15 +279,8 @@ TEST(SimdShading, Rand4ManyIsRand4ToTheBit) {
     hwy::SetSupportedTargetsForTest(0);
 }
 
-TEST(SimdShading, RunsInTheWidestInstructionSetAndOnlyWhereEveryLightIsATriangle) {
+TEST(SimdShading, RunsInTheWidestInstructionSet) {
     EXPECT_STRNE(simdTarget(), "");
-    std::mt19937 rng(5);
-    Fixture f = makeFixture(rng, 2);
-    EXPECT_TRUE(simdShadingApplies(f.view()));
-    f.emitters[1].type = kEmitterPoint;
-    EXPECT_FALSE(simdShadingApplies(f.view()));
-    f.emitters[1].type = kEmitterEnvironment;
-    EXPECT_FALSE(simdShadingApplies(f.view()));
 }
 
 // The registry's every model names its wide twin in this engine, or none, in the registry's
