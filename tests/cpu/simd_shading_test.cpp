@@ -49,12 +49,38 @@ vec3 unitVector(std::mt19937& rng) {
     return normalize(vec3(g(rng), g(rng), g(rng)));
 }
 
+// Emitter i of a fixture, its pickPdf unnormalised: kind 0 a triangle, 1 a point light, 2 a spot
+// light, 3 a directional light, 4 the environment (constant).
+Emitter randomEmitter(std::mt19937& rng, int i, int kind) {
+    std::uniform_real_distribution<float> u(0.0f, 1.0f);
+    Emitter e{};
+    e.type = kEmitterTriangle;
+    e.p0 = vec3(u(rng), 2.0f + u(rng), u(rng)) * 3.0f;
+    e.e1 = vec3(u(rng) - 0.5f, 0.1f * u(rng), u(rng) - 0.5f) * 2.0f;
+    e.e2 = vec3(u(rng) - 0.5f, 0.1f * u(rng), u(rng) - 0.5f) * 2.0f;
+    e.normal = normalize(cross(e.e1, e.e2));
+    e.area = 0.5f * length(cross(e.e1, e.e2));
+    e.twoSided = i % 2 == 0 ? 1u : 0u;
+    e.radiance = vec3(5.0f * u(rng), 4.0f, 3.0f * u(rng));
+    e.pickPdf = 0.2f + u(rng);
+    if (kind == 1 || kind == 2) { // a point light; a spot light shining down
+        e.type = kind == 1 ? kEmitterPoint : kEmitterSpot;
+        e.normal = normalize(vec3(u(rng) - 0.5f, -1.0f, u(rng) - 0.5f));
+        e.e1 = vec3(0.5f, 0.9f, 0.0f); // cos outer, cos inner
+    } else if (kind == 3) {            // a directional light shining down
+        e.type = kEmitterDirectional;
+        e.normal = normalize(vec3(u(rng) - 0.5f, -1.0f, u(rng) - 0.5f));
+    } else if (kind == 4) {
+        e.type = kEmitterEnvironment;
+    }
+    return e;
+}
+
 // `emitters` emitters: triangles; with everyKind, in turn a triangle, a point light, a spot
 // light and a directional light, the last one the environment (constant), whose index the
 // caller gives RenderParams::environment.
 Fixture makeFixture(std::mt19937& rng, int emitters, bool everyKind = false) {
     Fixture f;
-    std::uniform_real_distribution<float> u(0.0f, 1.0f);
     struct Model {
         uint model;
         float alpha, ior;
@@ -82,29 +108,11 @@ Fixture makeFixture(std::mt19937& rng, int emitters, bool everyKind = false) {
     }
     float total = 0.0f;
     for (int i = 0; i < emitters; ++i) {
-        Emitter e{};
-        e.type = kEmitterTriangle;
-        e.p0 = vec3(u(rng), 2.0f + u(rng), u(rng)) * 3.0f;
-        e.e1 = vec3(u(rng) - 0.5f, 0.1f * u(rng), u(rng) - 0.5f) * 2.0f;
-        e.e2 = vec3(u(rng) - 0.5f, 0.1f * u(rng), u(rng) - 0.5f) * 2.0f;
-        e.normal = normalize(cross(e.e1, e.e2));
-        e.area = 0.5f * length(cross(e.e1, e.e2));
-        e.twoSided = i % 2 == 0 ? 1u : 0u;
-        e.radiance = vec3(5.0f * u(rng), 4.0f, 3.0f * u(rng));
-        e.pickPdf = 0.2f + u(rng);
-        total += e.pickPdf;
-        const int kind = everyKind ? (i + 1 == emitters ? 4 : i % 4) : 0;
-        if (kind == 1 || kind == 2) { // a point light; a spot light shining down
-            e.type = kind == 1 ? kEmitterPoint : kEmitterSpot;
-            e.normal = normalize(vec3(u(rng) - 0.5f, -1.0f, u(rng) - 0.5f));
-            e.e1 = vec3(0.5f, 0.9f, 0.0f); // cos outer, cos inner
-        } else if (kind == 3) {            // a directional light shining down
-            e.type = kEmitterDirectional;
-            e.normal = normalize(vec3(u(rng) - 0.5f, -1.0f, u(rng) - 0.5f));
-        } else if (kind == 4) {
-            e.type = kEmitterEnvironment;
-        }
-        f.emitters.push_back(e);
+        f.emitters.push_back(randomEmitter(rng, i,
+                                           everyKind && i + 1 == emitters ? 4
+                                           : everyKind                    ? i % 4
+                                                                          : 0));
+        total += f.emitters.back().pickPdf;
     }
     float sum = 0.0f;
     for (Emitter& e : f.emitters) {
