@@ -391,15 +391,39 @@ def make_test_files(out):
                                                       "specularColorFactor": [1.0, 1.0, 1.0]}}
     write_glb(os.path.join(out, "ior.glb"), [s + (0,), f + (1,)], [shiny, grey],
               extensions=["KHR_materials_ior", "KHR_materials_specular"])
+    # Car paint: a red rough plastic under a smooth clear coat (KHR_materials_clearcoat), on
+    # the grey floor.
+    paint = material((0.6, 0.05, 0.05), 0.0, 0.5)
+    paint["extensions"] = {"KHR_materials_clearcoat": {"clearcoatFactor": 1.0,
+                                                       "clearcoatRoughnessFactor": 0.1}}
+    write_glb(os.path.join(out, "clearcoat.glb"), [s + (0,), f + (1,)], [paint, grey],
+              extensions=["KHR_materials_clearcoat"])
+    # The glass sphere before the checker, tinted by its base colour and absorbing inside
+    # (KHR_materials_volume): light through its centre crosses 2 units of it.
+    tinted = material((0.95, 0.85, 0.7), 0.0, 0.0)
+    tinted["extensions"] = dict(glass["extensions"])
+    tinted["extensions"]["KHR_materials_volume"] = {
+        "thicknessFactor": 1.0, "attenuationColor": [0.9, 0.75, 0.95],
+        "attenuationDistance": 1.0}
+    write_glb(os.path.join(out, "tinted-glass.glb"), [s + (0,), (pos, nor, idx, whole, 1)],
+              [tinted, second_uv0], images=textured_images()[:1],
+              extensions=["KHR_materials_transmission", "KHR_materials_ior",
+                          "KHR_materials_volume"])
     return sorted(os.path.join(out, n) for n in list(files) + [
         "textured.glb", "emissive.glb", "uv-sets.glb", "terminator.glb", "blend.glb",
-        "glass.glb", "ior.glb"])
+        "glass.glb", "ior.glb", "clearcoat.glb", "tinted-glass.glb"])
 
 
 # The suite's bound (docs/scene-format.md, "glTF files", says why): relMSE and each channel's
 # mean ratio, at 128 samples per pixel, 96 x 72 pixels.
 SELF_TEST_MAX_RELMSE = 0.015
 SELF_TEST_MAX_RATIO_ERROR = 0.07
+# Files whose models differ more, and by how much they may. clearcoat.glb: Blender 3.4's
+# Principled BSDF coats as Disney's model does (a GTR1 lobe at a quarter of the weight, the base
+# not dimmed), where glTF's coat is a full GGX dielectric layer that dims the base by what it
+# reflects: 0.018 measured, 0.012 with the coat dropped. The coat's own check is its closed form
+# on every backend (GltfClearcoat.*); this bound catches a coat that is far off.
+SELF_TEST_FILE_MAX_RELMSE = {"clearcoat.glb": 0.03}
 
 
 def self_test(spillway):
@@ -409,11 +433,12 @@ def self_test(spillway):
         for path in make_test_files(work):
             out = os.path.join(work, os.path.basename(path) + ".out")
             metrics, ratios = compare(spillway, path, 128, 96, out)
-            ok = metrics["relmse"] <= SELF_TEST_MAX_RELMSE and all(
+            bound = SELF_TEST_FILE_MAX_RELMSE.get(os.path.basename(path), SELF_TEST_MAX_RELMSE)
+            ok = metrics["relmse"] <= bound and all(
                 abs(r - 1.0) <= SELF_TEST_MAX_RATIO_ERROR for r in ratios)
             print("%s %s: relMSE %.4g (bound %g), mean ratio %s (bound 1 +- %g)" % (
                 "ok  " if ok else "FAIL", os.path.basename(path), metrics["relmse"],
-                SELF_TEST_MAX_RELMSE, ["%.3f" % r for r in ratios], SELF_TEST_MAX_RATIO_ERROR))
+                bound, ["%.3f" % r for r in ratios], SELF_TEST_MAX_RATIO_ERROR))
             failed += not ok
         return 1 if failed else 0
     finally:

@@ -140,10 +140,18 @@ struct DielectricLanesModel {
     explicit DielectricLanesModel(const HitVector& h) : frame(shadingFrame(h.n)) {}
     M delta(const HitVector& h) const { return ggxIsSmooth(h.alpha); }
     V3 eval(const HitVector& h, V3 wi, V& pdf) const {
-        return dielectricEval(h.ior, h.alpha, h.ng, h.ngDotWo, frame, h.wo, wi, pdf);
+        const V3 fcos = dielectricEval(h.ior, h.alpha, h.ng, h.ngDotWo, frame, h.wo, wi, pdf);
+        return select(refracts(h, wi), mul(fcos, h.albedo), fcos);
     }
     BsdfSample sample(const HitVector& h, V ux, V uy, V uz) const {
-        return dielectricSample(h.ior, h.alpha, h.ng, h.ngDotWo, frame, h.wo, ux, uy, uz);
+        BsdfSample s = dielectricSample(h.ior, h.alpha, h.ng, h.ngDotWo, frame, h.wo, ux, uy, uz);
+        s.weight = select(refracts(h, s.wi), mul(s.weight, h.albedo), s.weight);
+        return s;
+    }
+    // dielectricBsdfEval's and dielectricBsdfSample's test: wi on the other side of ng from wo,
+    // where the albedo tints.
+    static M refracts(const HitVector& h, V3 wi) {
+        return hn::Lt(hn::Mul(h.ngDotWo, dot(h.ng, wi)), hn::Zero(D()));
     }
 };
 
@@ -348,8 +356,9 @@ void setRandomLane(const RenderParams& rp, const PathState& st, simd_shading::Ra
 void fillLane(const SceneView& scene, const RenderParams& rp, const ShadeInput& in,
               SurfaceLanes& lanes, size_t k, ShadeResult& out) {
     const SurfaceHit& hit = in.hit;
-    const PathState& st = in.path;
     const vec3 wo = -in.rayDir;
+    const ShaderParams sh = shaderAtHit(scene.shaders[hit.shader], hit);
+    const PathState st = throughMedium(sh, hit, wo, in.path);
     out.flags = 0u;
     out.emitted = vec3(0.0f);
     addEmission(scene, rp, hit, wo, st, out);
@@ -361,7 +370,6 @@ void fillLane(const SceneView& scene, const RenderParams& rp, const ShadeInput& 
     set(lanes.beta, k, st.beta);
     lanes.offset.v[k] = hit.offset;
     lanes.lift.v[k] = hit.lift;
-    const ShaderParams sh = shaderAtHit(scene.shaders[hit.shader], hit);
     lanes.alpha.v[k] = sh.alpha;
     // MetallicRoughness reads its dielectric F0 where the Dielectric reads its ior.
     lanes.ior.v[k] = sh.model == kModelMetallicRoughness ? gltfDielectricF0(sh.ior) : sh.ior;
@@ -429,7 +437,7 @@ template <class Lanes> void padLanes(Lanes& lanes, size_t count, size_t end) {
 // The kernel's results for lane k into `out` (whose emission fillLane wrote).
 void takeLane(const ShaderParams& sh, const SurfaceResults& res, size_t k, const ShadeInput& in,
               ShadeResult& out) {
-    const PathState& st = in.path;
+    const PathState st = throughMedium(sh, in.hit, -in.rayDir, in.path); // as fillLane's
     out.shadowOrigin = get(res.shadowOrigin, k);
     out.shadowDir = get(res.shadowDir, k);
     out.shadowTmax = res.shadowTmax.v[k];
@@ -457,6 +465,7 @@ const WideTwin kWideTwins[] = {
     {kModelConductor, "ShadeConductorLanes"},
     {kModelDielectric, "ShadeDielectricLanes"},
     {kModelMetallicRoughness, "ShadeMetallicRoughnessLanes"},
+    {kModelCoatedMetallicRoughness, nullptr}, // shadeSurfaceWith, one hit at a time
 };
 static_assert(sizeof(kWideTwins) / sizeof(kWideTwins[0]) == kModelCount,
               "every registered surface model names its wide twin, or nullptr for none");

@@ -93,6 +93,8 @@ Shader GltfReader::readMaterial(int index) {
     s.params.alpha = gltfAlpha(s.roughness);
     readImages(mat, s, at, name);
     readTransmission(mat, s, at, name);
+    readVolume(mat, s, at, name);
+    readClearcoat(mat, s, at, name);
     if (mat.alphaMode != "OPAQUE" && mat.alphaMode != "MASK" && mat.alphaMode != "BLEND")
         fail(at + "/alphaMode", "must be OPAQUE, MASK or BLEND");
     readEmission(mat, s, at, name);
@@ -140,6 +142,14 @@ double GltfReader::extensionNumber(const tinygltf::Value& ext, const char* key, 
     return x;
 }
 
+double GltfReader::extensionNumber(const tinygltf::Value& values, int k,
+                                   const std::string& at) const {
+    const tinygltf::Value& v = values.Get(k);
+    const double x = v.IsNumber() ? v.GetNumberAsDouble() : NAN;
+    if (!(x >= 0.0 && x <= 1.0)) fail(at + "/" + std::to_string(k), "must be a number in [0, 1]");
+    return x;
+}
+
 void GltfReader::readTransmission(const tinygltf::Material& mat, Shader& s, const std::string& at,
                                   const std::string& name) {
     const auto iorExt = mat.extensions.find("KHR_materials_ior");
@@ -168,8 +178,6 @@ void GltfReader::readTransmission(const tinygltf::Material& mat, Shader& s, cons
                     "(metallicFactor 0, no metallic-roughness image): drawn opaque");
         return;
     }
-    if (s.texture >= 0 || s.params.colour != vec3(1.0f))
-        warn(name + ": glass takes no tint: its base colour is not rendered");
     if (ior > 0.0 && ior < kMinGlassIor)
         warn(name + ": an ior below " + number(kMinGlassIor) + " is rendered as " +
              number(kMinGlassIor));
@@ -177,9 +185,69 @@ void GltfReader::readTransmission(const tinygltf::Material& mat, Shader& s, cons
     s.params.model = kModelDielectric;
     s.params.ior = float(ior == 0.0 ? 1.5 : std::max(ior, kMinGlassIor));
     s.params.alpha = s.roughness * s.roughness; // below kGgxSmoothAlpha: smooth glass
-    s.params.flags &= ~(kShaderTextured | kShaderHitParams);
-    s.texture = -1;
+    // The base colour (its factor, image and vertex colours) tints what the glass refracts.
+    s.params.flags &= ~kShaderHitParams;
     s.metallicRoughnessTexture = -1;
+}
+
+void GltfReader::readVolume(const tinygltf::Material& mat, Shader& s, const std::string& at,
+                            const std::string& name) {
+    const auto v = mat.extensions.find("KHR_materials_volume");
+    if (v == mat.extensions.end()) return;
+    const std::string where = at + "/extensions/KHR_materials_volume";
+    const double thickness =
+        extensionNumber(v->second, "thicknessFactor", 0.0, 0.0, HUGE_VAL, where);
+    const double distance =
+        extensionNumber(v->second, "attenuationDistance", HUGE_VAL, 0.0, HUGE_VAL, where);
+    if (v->second.Has("attenuationDistance") && !(distance > 0.0))
+        fail(where + "/attenuationDistance", "must be a positive number");
+    vec3 colour(1.0f);
+    if (v->second.Has("attenuationColor")) {
+        const tinygltf::Value& c = v->second.Get("attenuationColor");
+        if (!c.IsArray() || c.ArrayLen() != 3)
+            fail(where + "/attenuationColor", "needs 3 numbers in [0, 1]");
+        for (int k = 0; k < 3; ++k)
+            colour[k] = float(extensionNumber(c, k, where + "/attenuationColor"));
+    }
+    if (v->second.Has("thicknessTexture"))
+        warn(name + ": its thicknessTexture is not read (the mesh's own thickness is rendered)");
+    if (s.params.model != kModelDielectric || !std::isfinite(distance) || colour == vec3(1.0f))
+        return; // nothing absorbs: the volume of an opaque material is never entered
+    if (thickness == 0.0) {
+        warn(name + ": KHR_materials_volume's thicknessFactor 0 makes it thin-walled: its "
+                    "attenuation is not rendered");
+        return;
+    }
+    // Beer-Lambert: attenuationColor is what is left after attenuationDistance.
+    for (int k = 0; k < 3; ++k)
+        s.params.absorption[k] = float(-std::log(std::max(double(colour[k]), 1e-30)) / distance);
+    if (!std::isfinite(maxComponent(s.params.absorption)))
+        fail(where + "/attenuationDistance", "gives an absorption beyond the float range");
+}
+
+void GltfReader::readClearcoat(const tinygltf::Material& mat, Shader& s, const std::string& at,
+                               const std::string& name) {
+    const auto c = mat.extensions.find("KHR_materials_clearcoat");
+    if (c == mat.extensions.end()) return;
+    const std::string where = at + "/extensions/KHR_materials_clearcoat";
+    const double factor = extensionNumber(c->second, "clearcoatFactor", 0.0, 0.0, 1.0, where);
+    const double roughness =
+        extensionNumber(c->second, "clearcoatRoughnessFactor", 0.0, 0.0, 1.0, where);
+    if (factor == 0.0) return;
+    if (s.params.model != kModelMetallicRoughness) {
+        warn(name + ": a clear coat on glass is not rendered");
+        return;
+    }
+    for (const char* image : {"clearcoatTexture", "clearcoatRoughnessTexture"})
+        if (c->second.Has(image))
+            warn(name + ": its " + image + " is not rendered (the factor alone is)");
+    if (c->second.Has("clearcoatNormalTexture"))
+        warn(name + ": its clearcoatNormalTexture is not rendered (the coat takes the base's "
+                    "shading normal)");
+    s.typeName = "CoatedMetallicRoughness";
+    s.params.model = kModelCoatedMetallicRoughness;
+    s.params.coat = float(factor);
+    s.params.coatAlpha = gltfAlpha(float(roughness));
 }
 
 void GltfReader::readEmission(const tinygltf::Material& mat, Shader& s, const std::string& at,

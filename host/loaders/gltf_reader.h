@@ -130,14 +130,26 @@ class GltfReader {
     // KHR_materials_transmission with KHR_materials_ior: a material that transmits all the light
     // (transmissionFactor 1) and is no metal is glass, a Dielectric of that ior (1.5) and GGX
     // alpha roughness^2 (smooth below kGgxSmoothAlpha), as Blender's importer and Cycles render
-    // it: a refracting solid, not the specification's thin wall, and untinted. Anything else is
-    // warned about and drawn opaque.
+    // it: a refracting solid, not the specification's thin wall, its base colour tinting what it
+    // refracts. Anything else is warned about and drawn opaque.
     void readTransmission(const tinygltf::Material& mat, Shader& s, const std::string& at,
                           const std::string& name);
+    // KHR_materials_volume on glass: attenuationColor left after attenuationDistance, as the
+    // medium's absorption coefficient -ln(colour) / distance (ShaderParams::absorption).
+    // thicknessFactor 0 (thin-walled) absorbs nothing, and says so.
+    void readVolume(const tinygltf::Material& mat, Shader& s, const std::string& at,
+                    const std::string& name);
+    // KHR_materials_clearcoat: a material with a coat of weight clearcoatFactor > 0 is a
+    // CoatedMetallicRoughness shader (shared/clearcoat.h), its coat's GGX alpha
+    // clearcoatRoughnessFactor^2; the coat's images are warned about and not rendered.
+    void readClearcoat(const tinygltf::Material& mat, Shader& s, const std::string& at,
+                       const std::string& name);
     // The number at `key` of extension object `ext` (its JSON pointer `at`), or `fallback` where
     // it is absent; refused unless it is a finite number in [lo, hi] (hi may be HUGE_VAL).
     double extensionNumber(const tinygltf::Value& ext, const char* key, double fallback, double lo,
                            double hi, const std::string& at) const;
+    // Element k of the array `values` (at JSON pointer `at`), refused unless a number in [0, 1].
+    double extensionNumber(const tinygltf::Value& values, int k, const std::string& at) const;
     // The Dielectric model's least index of refraction.
     static constexpr double kMinGlassIor = 1.01;
 

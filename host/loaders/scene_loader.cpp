@@ -294,7 +294,10 @@ void readShader(const Reader& rd, const YAML::Node& n, TextureReader& textures, 
                             {kTakesAlpha, "alpha"},
                             {kTakesIor, "ior"},
                             {kTakesMetallic, "metallic"},
-                            {kTakesRoughness, "roughness"}})
+                            {kTakesRoughness, "roughness"},
+                            {kTakesAbsorption, "absorption"},
+                            {kTakesCoat, "coat"},
+                            {kTakesCoat, "coat roughness"}})
         if (takes & bit) keys.push_back(key);
     rd.checkKeys(n, t + " shader", keys);
     if (t == "Emissive" && !n["emission"]) rd.fail(n, "Emissive shader needs 'emission'");
@@ -324,6 +327,13 @@ void readShader(const Reader& rd, const YAML::Node& n, TextureReader& textures, 
         p.metallic = n["metallic"] ? float(rd.number(n["metallic"], "metallic", 0.0, 1.0)) : 1.0f;
         p.alpha = gltfAlpha(n["roughness"] ? float(rd.number(n["roughness"], "roughness", 0.0, 1.0))
                                            : 1.0f);
+    }
+    if (n["absorption"]) p.absorption = rd.vec<3>(n["absorption"], "absorption", 0.0, 1e30);
+    if (takes & kTakesCoat) {
+        p.coat = n["coat"] ? float(rd.number(n["coat"], "coat", 0.0, 1.0)) : 1.0f;
+        p.coatAlpha = gltfAlpha(
+            n["coat roughness"] ? float(rd.number(n["coat roughness"], "coat roughness", 0.0, 1.0))
+                                : 0.0f);
     }
     if (n["emission"]) p.emission = rd.vec<3>(n["emission"], "emission", 0.0, kMaxRadiance);
     if (n["two sided"] && rd.boolean(n["two sided"], "two sided")) p.flags |= kShaderTwoSided;

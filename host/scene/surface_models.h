@@ -25,6 +25,9 @@ enum SurfaceParam : uint {
     kTakesMetallic = 1u << 5,    // metallic: glTF's metallic factor in [0, 1] (default 1)
     kTakesRoughness = 1u << 6,   // roughness: glTF's perceptual roughness in [0, 1] (default 1),
                                  // GGX alpha = roughness^2 (shared/gltf.h)
+    kTakesAbsorption = 1u << 7,  // absorption: [r, g, b], each >= 0, per unit length (default 0)
+    kTakesCoat = 1u << 8,        // coat (1) in [0, 1] and coat roughness (0) in [0, 1], the clear
+                                 // coat's weight and perceptual roughness (shared/clearcoat.h)
 };
 
 struct SurfaceModelInfo {

@@ -1,7 +1,10 @@
 // Dielectric: a refracting interface (glass, water), rough or smooth.
 //   parameters: ior (1.5): index of refraction behind the surface (the side its geometric normal
 //   points away from; the front is vacuum, index 1), in [1.01, 10]; alpha (0): GGX width, below
-//   kGgxSmoothAlpha (1e-4) the interface is smooth. No colour: nothing is absorbed.
+//   kGgxSmoothAlpha (1e-4) the interface is smooth; colour ([1, 1, 1]) or texture: the tint of
+//   the light it refracts (glTF's base colour on a transmissive material), each crossing
+//   multiplied by it, reflection untinted; absorption ([0, 0, 0]): the medium behind the surface
+//   absorbs sigma_a per unit length, Beer-Lambert (path.h's throughMedium).
 //   Fresnel: the exact unpolarised dielectric reflectance, 1 beyond the critical angle (total
 //   internal reflection).
 //   Rough: Walter, Marschner, Li & Torrance 2007, "Microfacet Models for Refraction through Rough
@@ -135,7 +138,8 @@ SHARED_FN bool dielectricSample(float ior, float alpha, vec3 ng, vec3 ns, vec3 w
     return pdf > 0.0f && denomG > 0.0f;
 }
 
-// The registry's interface (shared/bsdf.h dispatches here). No colour: albedo is not read.
+// The registry's interface (shared/bsdf.h dispatches here). The albedo (reflectance x colour or
+// texture) tints refraction; x 1 leaves an untinted interface's values as they are, to the bit.
 SHARED_FN bool dielectricBsdfIsDelta(ShaderParams sh) {
     return ggxIsSmooth(sh.alpha);
 }
@@ -145,14 +149,15 @@ SHARED_FN float dielectricBsdfConeSpread(ShaderParams sh) {
 }
 SHARED_FN vec3 dielectricBsdfEval(ShaderParams sh, vec3 albedo, vec3 ng, vec3 ns, vec3 wo, vec3 wi,
                                   OUT(float) pdf) {
-    UNUSED(albedo);
-    return dielectricEval(sh.ior, sh.alpha, ng, ns, wo, wi, pdf);
+    vec3 fcos = dielectricEval(sh.ior, sh.alpha, ng, ns, wo, wi, pdf);
+    return dot(ng, wo) * dot(ng, wi) < 0.0f ? fcos * albedo : fcos;
 }
 SHARED_FN bool dielectricBsdfSample(ShaderParams sh, vec3 albedo, vec3 ng, vec3 ns, vec3 wo, vec3 u,
                                     OUT(vec3) wi, OUT(vec3) weight, OUT(float) pdf,
                                     OUT(bool) specular) {
-    UNUSED(albedo);
-    return dielectricSample(sh.ior, sh.alpha, ng, ns, wo, u, wi, weight, pdf, specular);
+    if (!dielectricSample(sh.ior, sh.alpha, ng, ns, wo, u, wi, weight, pdf, specular)) return false;
+    if (dot(ng, wo) * dot(ng, wi) < 0.0f) weight = weight * albedo;
+    return true;
 }
 
 SHARED_END

@@ -90,6 +90,19 @@ SHARED_FN vec3 terminatorEval(ShaderParams sh, SurfaceHit hit, vec3 wo, vec3 wi,
     return fcos;
 }
 
+// The path's state at a hit, its throughput attenuated by the medium the ray crossed: a ray that
+// reaches a Dielectric from behind (the side its geometric normal points away from) travelled
+// hit.t inside that surface's medium, which passes exp(-absorption t) (Beer-Lambert). A medium
+// is known by the surface that bounds it: a surface inside it (nested media) is reached without
+// the attenuation. A clear medium (absorption 0) leaves beta as it was, to the bit.
+// host/cpu/simd_shading.cpp's fillLane calls it per lane.
+SHARED_FN PathState throughMedium(ShaderParams sh, SurfaceHit hit, vec3 wo, PathState st) {
+    if (sh.model == kModelDielectric && dot(hit.ng, wo) < 0.0f &&
+        maxComponent(sh.absorption) > 0.0f)
+        st.beta = st.beta * exp(-sh.absorption * hit.t);
+    return st;
+}
+
 // Whether the path goes on from a hit of shader sh: it samples a light and its BSDF.
 SHARED_FN bool shadeGoesOn(RenderParams rp, ShaderParams sh, PathState st) {
     return st.bounce < rp.maxDepth && sh.model != kModelNull;
@@ -142,10 +155,10 @@ SHARED_FN void shadeSurfaceWith(SCENE_PARAM RenderParams rp, SurfaceHit hit, vec
     r.shadowTmax = 0.0f;
     r.nextOrigin = vec3(0.0f);
     r.nextDir = vec3(0.0f);
-    r.next = st;
-
     ShaderParams sh = shaderAtHit(SHADER(hit.shader), hit);
     vec3 wo = -rayDir;
+    st = throughMedium(sh, hit, wo, st);
+    r.next = st;
 
     // 1. Emission seen by this ray, weighted against having sampled it from the previous vertex.
     addEmission(SCENE_ARG rp, hit, wo, st, r);

@@ -13,8 +13,8 @@
 // its kernel or its TEST(<Name>, ...) in tests/bsdf/<stem>_test.cpp. How to add one:
 // docs/adding-a-surface-model.md.
 //
-// X(Name, id, stem, PARAMS) — id counts up from 0 in this order; keep each entry on one line
-// (CMake parses them). PARAMS is read by the C++ loader only.
+// X(Name, id, stem, PARAMS) — id counts up from 0 in this order; keep each entry's
+// `X(Name, id, stem,` on one line (CMake parses them). PARAMS is read by the C++ loader only.
 #ifndef SPILLWAY_SHARED_SURFACE_MODELS_H
 #define SPILLWAY_SHARED_SURFACE_MODELS_H
 
@@ -22,7 +22,11 @@
     X(Null, 0u, null, kNoParams)                                                                   \
     X(Lambert, 1u, lambert, kTakesReflectance | kTakesColour | kTakesTexture)                      \
     X(Conductor, 2u, conductor, kTakesColour | kTakesTexture | kTakesAlpha)                        \
-    X(Dielectric, 3u, dielectric, kTakesIor | kTakesAlpha)                                         \
-    X(MetallicRoughness, 4u, gltf, kTakesColour | kTakesTexture | kTakesMetallic | kTakesRoughness)
+    X(Dielectric, 3u, dielectric,                                                                  \
+      kTakesIor | kTakesAlpha | kTakesColour | kTakesTexture | kTakesAbsorption)                   \
+    X(MetallicRoughness, 4u, gltf,                                                                 \
+      kTakesColour | kTakesTexture | kTakesMetallic | kTakesRoughness)                             \
+    X(CoatedMetallicRoughness, 5u, clearcoat,                                                      \
+      kTakesColour | kTakesTexture | kTakesMetallic | kTakesRoughness | kTakesCoat)
 
 #endif

@@ -29,9 +29,16 @@ struct ShaderParams {
     float reflectance; // albedo scale
     uint flags;        // kShader*
     float ior;         // Dielectric: index of refraction of the back (inside) of the surface
-    float alpha;    // Conductor, Dielectric, MetallicRoughness: GGX width; below kGgxSmoothAlpha a
-                    // delta lobe
-    float metallic; // MetallicRoughness: glTF's metallic factor
+    float alpha;     // Conductor, Dielectric, MetallicRoughness: GGX width; below kGgxSmoothAlpha a
+                     // delta lobe
+    float metallic;  // MetallicRoughness: glTF's metallic factor
+    vec3 absorption; // Dielectric: the absorption coefficient of the medium behind the surface,
+                     // per unit length (Beer-Lambert); 0: clear
+    float coat;      // CoatedMetallicRoughness: the clear coat's weight in [0, 1]
+    float coatAlpha; // CoatedMetallicRoughness: the coat's GGX width
+    uint pad0;
+    uint pad1;
+    uint pad2;
 };
 
 // What next-event estimation picks, with probability pickPdf, proportional to its power

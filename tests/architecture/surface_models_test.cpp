@@ -52,7 +52,10 @@ TEST(SurfaceModels, TheLoaderTakesEachModelWithExactlyItsRegisteredKeys) {
         {kTakesAlpha, "alpha: 0.5"},
         {kTakesIor, "ior: 1.33"},
         {kTakesMetallic, "metallic: 0.5"},
-        {kTakesRoughness, "roughness: 0.5"}};
+        {kTakesRoughness, "roughness: 0.5"},
+        {kTakesAbsorption, "absorption: [0.1, 0.2, 0.3]"},
+        {kTakesCoat, "coat: 0.5"},
+        {kTakesCoat, "coat roughness: 0.5"}};
     TempDir dir;
     for (const SurfaceModelInfo& m : kSurfaceModels) {
         const std::string type = std::string("type: ") + m.name;

@@ -1,0 +1,118 @@
+// CoatedMetallicRoughness: glTF's metallic-roughness material (shared/gltf.h) under a clear coat,
+// as KHR_materials_clearcoat defines it (the extension's specification, "Clearcoat" and
+// "Implementation").
+//   parameters: those of MetallicRoughness (colour or texture, metallic, roughness, ior), and
+//   coat (1) in [0, 1], the coat's weight; coat roughness (0) in [0, 1], its perceptual
+//   roughness (GGX alpha = coat roughness^2, at least kGltfMinAlpha).
+//   The coat is a dielectric of ior 1.5 (F0 = 0.04) over the base, sharing its shading normal:
+//     Fc = coat (0.04 + 0.96 (1 - |n.wo|)^5)
+//     f = (1 - Fc) f_base + Fc D_c G2_c / (4 |co| |ci|)
+//   the specification's fresnel_coat: the coat's Fresnel term is taken once, from the view
+//   direction, and the base is dimmed by what the coat reflects. The coat lobe is GGX with the
+//   height-correlated Smith G2 (ggx.h), as the base's specular lobe.
+//   Sampling: the coat's lobe through GGX's visible normals with probability pCoat, the base's
+//   own sampling (gltfSample) otherwise; pdf = the mixture's, weight = fcos / pdf. pCoat = Fc /
+//   (Fc + (1 - Fc) a), a the base's lobes' weights seen from wo (as gltfSpecularProbability
+//   reckons them), within [0.1, 0.9] while the coat has weight.
+//   Not rendered: the coat's own normal map (clearcoatNormalTexture), which the glTF loader
+//   warns about; the coat dims nothing the surface emits.
+#ifndef SPILLWAY_SHARED_CLEARCOAT_H
+#define SPILLWAY_SHARED_CLEARCOAT_H
+#include "gltf.h"
+
+SHARED_BEGIN
+
+// The coat's reflectance seen from wo at cosine cosO to the shading normal, times its weight.
+SHARED_FN float gltfCoatFresnel(float coat, float cosO) {
+    return coat * schlickFresnel(vec3(kGltfDielectricF0), cosO).x;
+}
+
+// The probability of sampling the coat's lobe: its reflectance fc against the base's lobes'.
+SHARED_FN float gltfCoatProbability(vec3 colour, float metallic, float f0d, float fc, float cosO) {
+    if (!(fc > 0.0f)) return 0.0f;
+    vec3 f0 = mix(vec3(f0d), colour, metallic);
+    vec3 F = schlickFresnel(f0, cosO);
+    vec3 d = colour * (1.0f - metallic) * (vec3(1.0f) - F);
+    float base = (F.x + F.y + F.z + d.x + d.y + d.z) / 3.0f;
+    return clamp(fc / (fc + (1.0f - fc) * base), 0.1f, 0.9f);
+}
+
+SHARED_FN vec3 gltfCoatEval(vec3 colour, float metallic, float alpha, float f0d, float coat,
+                            float coatAlpha, vec3 ng, vec3 ns, vec3 wo, vec3 wi, OUT(float) pdf) {
+    float basePdf;
+    vec3 base = gltfEval(colour, metallic, alpha, f0d, ng, ns, wo, wi, basePdf);
+    pdf = 0.0f;
+    if (dot(ng, wo) * dot(ng, wi) <= 0.0f) return vec3(0.0f);
+    Frame f = shadingFrame(ns, ng, wo);
+    vec3 lo = frameToLocal(f, wo);
+    vec3 li = frameToLocal(f, wi);
+    if (lo.z <= 0.0f || li.z <= 0.0f) return vec3(0.0f);
+    vec3 h = lo + li;
+    float len2 = dot(h, h);
+    if (!(len2 > 0.0f)) return vec3(0.0f);
+    h = h * inversesqrt(len2);
+    float fc = gltfCoatFresnel(coat, lo.z);
+    float d = ggxD(h, coatAlpha);
+    float denom = ggxG2Denominator(lo, li, coatAlpha);
+    float layer = denom > 0.0f ? fc * d * li.z / (2.0f * denom) : 0.0f;
+    float pCoat = gltfCoatProbability(colour, metallic, f0d, fc, lo.z);
+    pdf = pCoat * (d / (2.0f * (lo.z + ggxA(lo, coatAlpha)))) + (1.0f - pCoat) * basePdf;
+    return base * (1.0f - fc) + vec3(layer);
+}
+
+SHARED_FN bool gltfCoatSample(vec3 colour, float metallic, float alpha, float f0d, float coat,
+                              float coatAlpha, vec3 ng, vec3 ns, vec3 wo, vec3 u, OUT(vec3) wi,
+                              OUT(vec3) weight, OUT(float) pdf, OUT(bool) specular) {
+    wi = vec3(0.0f);
+    weight = vec3(0.0f);
+    pdf = 0.0f;
+    specular = false;
+    Frame f = shadingFrame(ns, ng, wo);
+    vec3 lo = frameToLocal(f, wo);
+    if (lo.z <= 0.0f) return false;
+    float fc = gltfCoatFresnel(coat, lo.z);
+    float pCoat = gltfCoatProbability(colour, metallic, f0d, fc, lo.z);
+    if (u.z < pCoat) {
+        vec3 h = ggxSampleVisibleNormal(lo, coatAlpha, vec2(u.x, u.y));
+        float oh = dot(lo, h);
+        if (oh <= 0.0f) return false;
+        vec3 li = 2.0f * oh * h - lo;
+        if (li.z <= 0.0f) return false;
+        wi = frameToWorld(f, li);
+    } else {
+        vec3 baseWeight;
+        float basePdf;
+        vec3 v = vec3(u.x, u.y, (u.z - pCoat) / (1.0f - pCoat));
+        if (!gltfSample(colour, metallic, alpha, f0d, ng, ns, wo, v, wi, baseWeight, basePdf,
+                        specular))
+            return false;
+    }
+    vec3 fcos = gltfCoatEval(colour, metallic, alpha, f0d, coat, coatAlpha, ng, ns, wo, wi, pdf);
+    if (!(pdf > 0.0f)) return false;
+    weight = fcos / pdf;
+    return true;
+}
+
+// The registry's interface (shared/bsdf.h dispatches here).
+SHARED_FN bool clearcoatBsdfIsDelta(ShaderParams sh) {
+    UNUSED(sh);
+    return false;
+}
+SHARED_FN float clearcoatBsdfConeSpread(ShaderParams sh) {
+    return gltfBsdfConeSpread(sh);
+}
+SHARED_FN vec3 clearcoatBsdfEval(ShaderParams sh, vec3 albedo, vec3 ng, vec3 ns, vec3 wo, vec3 wi,
+                                 OUT(float) pdf) {
+    return gltfCoatEval(albedo, sh.metallic, max(sh.alpha, kGltfMinAlpha), gltfDielectricF0(sh.ior),
+                        sh.coat, max(sh.coatAlpha, kGltfMinAlpha), ng, ns, wo, wi, pdf);
+}
+SHARED_FN bool clearcoatBsdfSample(ShaderParams sh, vec3 albedo, vec3 ng, vec3 ns, vec3 wo, vec3 u,
+                                   OUT(vec3) wi, OUT(vec3) weight, OUT(float) pdf,
+                                   OUT(bool) specular) {
+    return gltfCoatSample(albedo, sh.metallic, max(sh.alpha, kGltfMinAlpha),
+                          gltfDielectricF0(sh.ior), sh.coat, max(sh.coatAlpha, kGltfMinAlpha), ng,
+                          ns, wo, u, wi, weight, pdf, specular);
+}
+
+SHARED_END
+#endif
