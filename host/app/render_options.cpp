@@ -202,8 +202,9 @@ const std::vector<CliOption> kOwnOptions = {
          r.config.textureFilter = choice(o, v, parseTextureFilter);
      }},
     {"--spill-dir", nullptr, "DIR", Section::Pipeline,
-     "where spilled batches go (default: the system temp folder)", 0, 0,
-     [](O& r, const C&, const S& v) { r.config.pipeline.spillDir = v; }},
+     "where spilled batches and tiled copies of large textures go, as unnamed files (default: "
+     "the system temp folder)",
+     0, 0, [](O& r, const C&, const S& v) { r.config.pipeline.spillDir = v; }},
     {"--ray-sort", nullptr, "MODE", Section::Pipeline,
      "auto (sort only where it measures faster), morton, median or off", 0, 0,
      [](O& r, const C& o, const S& v) {

@@ -48,12 +48,15 @@ void TextureCounters::merge(const TextureCounters& o) {
     filesReopened += o.filesReopened;
     cacheMisses += o.cacheMisses;
     peakCacheBytes = std::max(peakCacheBytes, o.peakCacheBytes);
+    tiledCopies += o.tiledCopies;
+    tiledCopyBytes += o.tiledCopyBytes;
 }
 
 bool TextureCounters::operator==(const TextureCounters& o) const {
     return lookups == o.lookups && tilesRead == o.tilesRead && bytesRead == o.bytesRead &&
            filesOpened == o.filesOpened && filesReopened == o.filesReopened &&
-           cacheMisses == o.cacheMisses && peakCacheBytes == o.peakCacheBytes;
+           cacheMisses == o.cacheMisses && peakCacheBytes == o.peakCacheBytes &&
+           tiledCopies == o.tiledCopies && tiledCopyBytes == o.tiledCopyBytes;
 }
 
 namespace {
@@ -89,6 +92,8 @@ nlohmann::json texturesJson(const TextureCounters& t, std::uint64_t rays) {
             {"files_reopened", t.filesReopened},
             {"cache_misses", t.cacheMisses},
             {"peak_cache_bytes", t.peakCacheBytes},
+            {"tiled_copies", t.tiledCopies},
+            {"tiled_copy_bytes", t.tiledCopyBytes},
             {"per_ray",
              {{"lookups", perRay(t.lookups)},
               {"tiles_read", perRay(t.tilesRead)},
@@ -104,6 +109,8 @@ TextureCounters readTextures(const nlohmann::json& j) {
     t.filesReopened = j.at("files_reopened").get<std::uint64_t>();
     t.cacheMisses = j.at("cache_misses").get<std::uint64_t>();
     t.peakCacheBytes = j.at("peak_cache_bytes").get<std::uint64_t>();
+    t.tiledCopies = j.value("tiled_copies", std::uint64_t(0));
+    t.tiledCopyBytes = j.value("tiled_copy_bytes", std::uint64_t(0));
     return t;
 }
 

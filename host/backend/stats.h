@@ -61,7 +61,8 @@ struct TextureCounters {
     std::uint64_t lookups = 0, tilesRead = 0, bytesRead = 0, filesOpened = 0, filesReopened = 0,
                   cacheMisses = 0;
     std::uint64_t peakCacheBytes = 0;
-    void merge(const TextureCounters& o); // sums; the cache's peak is the largest
+    std::uint64_t tiledCopies = 0, tiledCopyBytes = 0; // textures/tiled_copy.h
+    void merge(const TextureCounters& o);              // sums; the cache's peak is the largest
     bool operator==(const TextureCounters& o) const;
 };
 

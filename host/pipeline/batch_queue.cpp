@@ -1,5 +1,7 @@
 #include "host/pipeline/batch_queue.h"
 
+#include "host/image/scratch_file.h"
+
 #include <algorithm>
 #include <cerrno>
 #include <cstdlib>
@@ -26,12 +28,7 @@ BatchQueue::~BatchQueue() {
 
 SpillFile& BatchQueue::spill() {
     if (!spill_) {
-        // The system temp folder as std::filesystem::temp_directory_path() finds it, but without
-        // its check that the folder exists: that is the spill file's to report, if it is needed.
-        std::string dir = spillDir_;
-        for (const char* var : {"TMPDIR", "TMP", "TEMP", "TEMPDIR"})
-            if (dir.empty() && std::getenv(var) && *std::getenv(var)) dir = std::getenv(var);
-        spill_ = std::make_unique<SpillFile>(dir.empty() ? "/tmp" : dir);
+        spill_ = std::make_unique<SpillFile>(scratchFolder(spillDir_));
     }
     return *spill_;
 }

@@ -1,5 +1,7 @@
 #include "host/pipeline/spill_file.h"
 
+#include "host/image/scratch_file.h"
+
 #include <algorithm>
 #include <cerrno>
 #include <cstdlib>
@@ -12,22 +14,7 @@
 
 namespace spw {
 
-SpillFile::SpillFile(const std::string& dir) : dir_(dir) {
-#ifdef O_TMPFILE
-    fd_ = ::open(dir.c_str(), O_TMPFILE | O_RDWR | O_CLOEXEC, 0600);
-#endif
-    if (fd_ < 0) {
-        // No O_TMPFILE here: make a named file and unlink it before anything else happens.
-        std::string templ = dir + "/spillway-spill-XXXXXX";
-        std::vector<char> name(templ.begin(), templ.end());
-        name.push_back('\0');
-        fd_ = ::mkostemp(name.data(), O_CLOEXEC);
-        if (fd_ >= 0) ::unlink(name.data());
-    }
-    if (fd_ < 0)
-        throw std::runtime_error("cannot create a spill file in '" + dir +
-                                 "': " + std::strerror(errno));
-}
+SpillFile::SpillFile(const std::string& dir) : dir_(dir), fd_(openScratchFile(dir, "spill")) {}
 
 SpillFile::~SpillFile() {
     if (fd_ >= 0) ::close(fd_);

@@ -36,6 +36,8 @@ TextureCounters textureCounters(const TextureResolver& textures) {
     c.filesReopened = t.filesReopened;
     c.cacheMisses = t.cacheMisses;
     c.peakCacheBytes = t.peakCacheBytes;
+    c.tiledCopies = t.tiledCopies;
+    c.tiledCopyBytes = t.tiledCopyBytes;
     return c;
 }
 
@@ -223,7 +225,10 @@ void RenderSession::chooseBackend() {
 // backend.
 void RenderSession::build() {
     textures_.emplace(scene_, scene_.settings.textureCacheMiB,
-                      config_.textureFilter == TextureFilter::Cone, config_.pipeline.simdShading);
+                      config_.textureFilter == TextureFilter::Cone, config_.pipeline.simdShading,
+                      config_.pipeline.spillDir);
+    if (const double s = textures_->statistics().tiledCopySeconds; s > 0.0)
+        stats_.stages.add("tile textures", s);
     lights_.emplace(scene_, &*textures_);
     if (lights_->emissionImages() > 0) stats_.extra["emission_maps"] = lights_->emissionImages();
     cutouts_.emplace(scene_, *textures_);

@@ -5,6 +5,7 @@
 #pragma once
 
 #include "host/textures/textures.h"
+#include "host/textures/tiled_copy.h"
 #include "host/textures/wide_texels.h"
 
 #include <OpenImageIO/filesystem.h>
@@ -14,6 +15,7 @@
 
 #include <array>
 #include <atomic>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <string>
@@ -43,6 +45,15 @@ struct TextureResolver::Impl {
         size_t firstHeld = 0;      // its levels' slots in ThreadState::held
     };
     std::vector<Image> images; // parallel to Scene::textures (only Standard entries are used)
+    // Tiled copies of large untiled images (tiled_copy.h), by file and encoding, and the folder
+    // they go to.
+    std::map<std::string, std::unique_ptr<TiledCopy>> copies;
+    std::string scratch;
+    double tiledCopySeconds = 0.0;
+    // The cache's handle of the tiled copy of Standard texture t's image `name`, whose first
+    // level is `spec`, made on first use. Throws where it cannot be made.
+    OIIO::ImageCache::ImageHandle* tiledCopy(const Texture& t, OIIO::ustring name,
+                                             const OIIO::ImageSpec& spec, bool srgb);
     // The first failed lookup, reported after the iteration (a lookup cannot throw mid-batch).
     std::atomic<bool> failed{false};
     std::mutex errorMutex;

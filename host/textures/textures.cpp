@@ -1,7 +1,9 @@
 #include "host/textures/textures.h"
 
 #include "host/image/image_io.h"
+#include "host/image/scratch_file.h"
 #include "host/textures/texel_reader.h"
+#include "host/textures/tiled_copy.h"
 #include "host/textures/wide_texels.h"
 
 #include "shared/texture_wrap.h"
@@ -16,6 +18,7 @@
 #include <algorithm>
 #include <array>
 #include <atomic>
+#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -50,9 +53,11 @@ void visit(const Scene& scene, int t, std::vector<int>& slotOf, std::vector<int>
 }
 
 // Opens a Standard texture's image in the cache (an embedded one through a proxy it keeps):
-// its channels, encoding and MIP levels. Throws where the image cannot be read.
+// its channels, encoding and MIP levels; a large untiled one through its tiled copy
+// (tiled_copy.h) unless it is read whole (an emission map). Throws where the image cannot be
+// read.
 void openImage(const Scene& scene, TextureResolver::Impl& impl, const Texture& t,
-               TextureResolver::Impl::Image& img) {
+               TextureResolver::Impl::Image& img, bool readWhole) {
     // A file must be a regular file before the cache opens it: a FIFO would block the render.
     std::error_code ec;
     if (!t.bytes && !std::filesystem::is_regular_file(t.path, ec))
@@ -90,6 +95,19 @@ void openImage(const Scene& scene, TextureResolver::Impl& impl, const Texture& t
     img.eightBit = spec->format == OIIO::TypeDesc::UINT8;
     std::string cs = spec->get_string_attribute("oiio:ColorSpace");
     img.srgb = !t.linear && (cs == "sRGB" || (cs.empty() && spec->format == OIIO::TypeDesc::UINT8));
+    const int levels = impl.cache->imagespec(img.handle, nullptr, 0, 1) ? 2 : 1;
+    if (!readWhole && needsTiledCopy(*spec, levels)) {
+        try {
+            img.handle = impl.tiledCopy(t, name, *spec, img.srgb);
+        } catch (const TiledCopy::ReadError& e) {
+            throw SceneError(scene.file, t.line,
+                             "texture file '" + t.path + "' cannot be read: " + e.what());
+        }
+        spec = img.handle ? impl.cache->imagespec(img.handle, nullptr, 0, 0) : nullptr;
+        if (!spec)
+            throw std::runtime_error("cannot read the tiled copy of texture '" + t.path +
+                                     "': " + impl.cache->geterror());
+    }
     img.finest = float(std::max(spec->width, spec->height));
     // Its MIP levels, as many as the file has (an image without them is its own only level).
     for (int level = 0; level < int(kMaxLevels); ++level) {
@@ -102,7 +120,39 @@ void openImage(const Scene& scene, TextureResolver::Impl& impl, const Texture& t
 
 } // namespace
 
-TextureResolver::TextureResolver(const Scene& scene, double cacheMiB, bool filtered, bool wide)
+OIIO::ImageCache::ImageHandle* TextureResolver::Impl::tiledCopy(const Texture& t,
+                                                                OIIO::ustring name,
+                                                                const OIIO::ImageSpec& spec,
+                                                                bool srgb) {
+    // One copy per image and encoding; an alpha-only lookup (channel 3) takes either, as the
+    // alpha is averaged alike in both.
+    const std::string key = name.string() + (srgb ? "\n1" : "\n0");
+    auto found = copies.find(key);
+    if (found == copies.end() && t.channel == 3)
+        found = copies.find(name.string() + (srgb ? "\n0" : "\n1"));
+    if (found == copies.end()) {
+        const auto start = std::chrono::steady_clock::now();
+        OIIO::ImageSpec config;
+        std::unique_ptr<OIIO::Filesystem::IOMemReader> reader;
+        if (t.bytes) { // embedded: read from memory, as the cache does
+            reader = std::make_unique<OIIO::Filesystem::IOMemReader>(
+                const_cast<char*>(t.bytes->data()), t.bytes->size());
+            void* ptr = reader.get();
+            config.attribute("oiio:ioproxy", OIIO::TypeDesc::PTR, &ptr);
+        }
+        auto copy =
+            std::make_unique<TiledCopy>(t.path, t.bytes ? &config : nullptr, spec, srgb, scratch);
+        found = copies.emplace(key, std::move(copy)).first;
+        tiledCopySeconds +=
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        // The source, opened for its header alone, is closed again: its pixels are the copy's.
+        if (!t.bytes) cache->invalidate(name);
+    }
+    return cache->get_image_handle(OIIO::ustring(found->second->path()));
+}
+
+TextureResolver::TextureResolver(const Scene& scene, double cacheMiB, bool filtered, bool wide,
+                                 const std::string& scratch)
     : scene_(scene), wide_(wide) {
     programs_.resize(scene.textures.size());
     auto compile = [&](int root) {
@@ -133,6 +183,7 @@ TextureResolver::TextureResolver(const Scene& scene, double cacheMiB, bool filte
     impl_ = std::make_unique<Impl>();
     impl_->filtered = filtered;
     impl_->wide = wide;
+    impl_->scratch = scratchFolder(scratch);
     impl_->cache = OIIO::ImageCache::create(false);
     impl_->cache->attribute("max_memory_MB", float(cacheMiB));
     // Colours as the file stores them: OpenImageIO would premultiply a PNG's colour by its alpha
@@ -147,11 +198,15 @@ TextureResolver::TextureResolver(const Scene& scene, double cacheMiB, bool filte
         "max_open_files",
         int(std::clamp<rlim_t>(rlim_t(standard) + 16, 100, std::max<rlim_t>(allowed, 100))));
     impl_->images.resize(scene.textures.size());
+    // Emission maps are read whole, once (finestLevel): they need no tiled copy.
+    std::vector<bool> readWhole(scene.textures.size(), false);
+    for (const Shader& sh : scene.shaders)
+        if (sh.emissionTexture >= 0) readWhole[size_t(sh.emissionTexture)] = true;
     for (size_t i = 0; i < scene.textures.size(); ++i) {
         const Texture& t = scene.textures[i];
         if (t.type != TextureType::Standard) continue;
         Impl::Image& img = impl_->images[i];
-        openImage(scene, *impl_, t, img);
+        openImage(scene, *impl_, t, img, readWhole[i]);
         img.firstHeld = impl_->heldSlots;
         impl_->heldSlots += img.levels.size();
     }
@@ -203,6 +258,10 @@ TextureStatistics TextureResolver::statistics() const {
     s.filesReopened = s.filesOpened > unique ? s.filesOpened - unique : 0;
     s.cacheMisses = count("stat:find_tile_cache_misses");
     s.peakCacheBytes = impl_->peakCacheBytes.load();
+    s.tiledCopies = impl_->copies.size();
+    for (const auto& copy : impl_->copies)
+        s.tiledCopyBytes += copy.second->bytes();
+    s.tiledCopySeconds = impl_->tiledCopySeconds;
     return s;
 }
 

@@ -16,6 +16,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <string>
 #include <vector>
 
 namespace spw {
@@ -29,6 +30,9 @@ struct TextureStatistics {
     std::uint64_t filesReopened = 0;  // opens beyond the first of each file
     std::uint64_t cacheMisses = 0;    // tile lookups that missed the cache
     std::uint64_t peakCacheBytes = 0; // the tile cache's largest size seen (noteCacheUse)
+    std::uint64_t tiledCopies = 0;    // large untiled images given tiled copies (tiled_copy.h)
+    std::uint64_t tiledCopyBytes = 0; // the pixel bytes written to them
+    double tiledCopySeconds = 0.0;    // the time making them took
 };
 
 class TextureResolver {
@@ -37,8 +41,10 @@ class TextureResolver {
     // lookups take their footprint (MIP levels, trilinear); otherwise the finest level always.
     // wide: albedos() filters runs of lookups in 8-bit images and blends Layered textures
     // SIMD-wide (wide_texels.h); false, one lookup at a time. The values are the same to the
-    // bit.
-    TextureResolver(const Scene& scene, double cacheMiB, bool filtered = true, bool wide = true);
+    // bit. scratch: the folder for tiled copies of large untiled images (tiled_copy.h), as
+    // --spill-dir names it (empty: the system temp folder, image/scratch_file.h).
+    TextureResolver(const Scene& scene, double cacheMiB, bool filtered = true, bool wide = true,
+                    const std::string& scratch = "");
     ~TextureResolver();
     TextureResolver(const TextureResolver&) = delete;
     TextureResolver& operator=(const TextureResolver&) = delete;

@@ -1,0 +1,174 @@
+// Tiled copies of large untiled images (host/textures/tiled_copy.h): a PNG over 16 MiB decoded
+// is read through a 64 x 64-tiled, MIP-mapped copy in an unnamed scratch file. Its finest level
+// is the image bit for bit; its coarser levels are averaged in linear light; a render is the
+// same image under a texture cache far smaller than the image, which the cache then keeps to;
+// no file is left in the scratch folder; a folder where no file can be made is an error naming
+// it, a truncated image a scene error naming the file. Images under the threshold are read as
+// they always were, with no copy.
+#include "host/image/image_io.h"
+#include "host/loaders/scene_loader.h"
+#include "host/render/render.h"
+#include "host/textures/textures.h"
+#include "host/textures/tiled_copy.h"
+#include "test_util.h"
+
+#include <OpenImageIO/imageio.h>
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <random>
+#include <stdexcept>
+
+namespace spw::test {
+namespace {
+
+// 2400 x 2400 RGB, 8-bit: 17.3 MB decoded, over kTiledCopyMinBytes. Red is a checker of 0 and
+// 255 a texel square; green and blue are pseudo-random.
+constexpr int kSide = 2400;
+
+std::vector<unsigned char> writeLargePng(const std::string& path) {
+    std::vector<unsigned char> px(size_t(kSide) * kSide * 3);
+    std::mt19937 rng(11);
+    for (int y = 0; y < kSide; ++y)
+        for (int x = 0; x < kSide; ++x) {
+            unsigned char* p = &px[(size_t(y) * kSide + size_t(x)) * 3];
+            p[0] = (x + y) % 2 ? 255 : 0;
+            p[1] = static_cast<unsigned char>(rng());
+            p[2] = static_cast<unsigned char>(rng());
+        }
+    auto out = OIIO::ImageOutput::create(path);
+    EXPECT_TRUE(out && out->open(path, OIIO::ImageSpec(kSide, kSide, 3, OIIO::TypeDesc::UINT8)));
+    EXPECT_TRUE(out->write_image(OIIO::TypeDesc::UINT8, px.data()));
+    EXPECT_TRUE(out->close());
+    return px;
+}
+
+// A plane filling the view of a camera above it, textured by `image`.
+std::string planeScene(const TempDir& dir, const std::string& image) {
+    dir.write("plane.obj", "v -0.5 -0.5 -0.5\nv -0.5 -0.5 0.5\nv 0.5 -0.5 0.5\nv 0.5 -0.5 -0.5\n"
+                           "vt 0 0\nvt 0 1\nvt 1 1\nvt 1 0\nf 1/1 2/2 3/3\nf 1/1 3/3 4/4\n");
+    return dir.write("t.yaml",
+                     "image: {width: 32, height: 32, sample base: 4, iterations: 1}\n"
+                     "settings: {max depth: 1}\n"
+                     "camera: {look at: {eye: [0, 0.5, 0], target: [0, -0.5, 0], up: [0, 0, -1]}, "
+                     "fov: 40}\n"
+                     "shader: {type: Lambert, texture: {type: Standard, string: " +
+                         image +
+                         "}}\n"
+                         "object: {filename: plane.obj}\n"
+                         "light: {type: Environment, colour: [1, 1, 1]}\n");
+}
+
+TEST(TiledCopy, TheFinestLevelIsTheImageBitForBitAndCoarserLevelsAverageInLinearLight) {
+    TempDir dir;
+    const std::vector<unsigned char> px = writeLargePng(dir.file("large.png"));
+    const Scene scene = loadScene(planeScene(dir, "large.png"));
+    const TextureResolver textures(scene, 64.0, true, true, dir.path());
+    const TextureStatistics s = textures.statistics();
+    EXPECT_EQ(s.tiledCopies, 1u);
+    // Every level, 2400 down to 1: 4/3 of the finest within the levels' rounding.
+    EXPECT_GT(s.tiledCopyBytes, px.size() * 4 / 3 - px.size() / 100);
+    EXPECT_LT(s.tiledCopyBytes, px.size() * 4 / 3 + px.size() / 100);
+    // At the finest level every lookup is the one the same pixels give read as they are (here
+    // from a TIFF of 64 x 64 tiles, one level, which needs no copy), to the bit.
+    {
+        auto out = OIIO::ImageOutput::create("tif");
+        OIIO::ImageSpec spec(kSide, kSide, 3, OIIO::TypeDesc::UINT8);
+        spec.tile_width = spec.tile_height = 64;
+        ASSERT_TRUE(out && out->open(dir.file("tiled.tif"), spec));
+        ASSERT_TRUE(out->write_image(OIIO::TypeDesc::UINT8, px.data()));
+        ASSERT_TRUE(out->close());
+    }
+    const Scene direct = loadScene(planeScene(dir, "tiled.tif"));
+    const TextureResolver reference(direct, 64.0, true, true, dir.path());
+    EXPECT_EQ(reference.statistics().tiledCopies, 0u);
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<float> u(-0.5f, 1.5f);
+    for (int i = 0; i < 5000; ++i) {
+        const vec2 uv(u(rng), u(rng));
+        ASSERT_EQ(textures.albedo(scene.shaders[0], uv, 0.0f),
+                  reference.albedo(direct.shaders[0], uv, 0.0f))
+            << uv.x << ", " << uv.y;
+    }
+    // A footprint of the whole image reads the coarsest levels: the red checker of 0 and 1
+    // averages to 0.5 in linear light (0.216 had the sRGB codes been averaged), within the
+    // 8-bit rounding of the levels between.
+    const vec3 coarse = textures.albedo(scene.shaders[0], vec2(0.3f, 0.6f), 4.0f);
+    EXPECT_NEAR(coarse.x, 0.5f, 0.01f);
+    textures.checkErrors();
+}
+
+TEST(TiledCopy, ARenderIsTheSameUnderACacheFarSmallerThanTheImageAndLeavesNoFile) {
+    TempDir dir, scratch;
+    writeLargePng(dir.file("large.png"));
+    Scene scene = loadScene(planeScene(dir, "large.png"));
+    std::vector<float> images[2];
+    std::uint64_t peaks[2];
+    const double budgets[2] = {1024.0, 1.0};
+    for (int i = 0; i < 2; ++i) {
+        scene.settings.textureCacheMiB = budgets[i];
+        RenderConfig cfg;
+        cfg.backend = BackendKind::Cpu;
+        cfg.pipeline.spillDir = scratch.path();
+        const auto result = render(scene, cfg);
+        images[i] = result->film->image();
+        const nlohmann::json t = result->stats.toJson()["textures"];
+        EXPECT_EQ(t["tiled_copies"], 1);
+        peaks[i] = t["peak_cache_bytes"].get<std::uint64_t>();
+        EXPECT_GT(result->stats.stages.get("tile textures"), 0.0);
+        // The copy is an unnamed file: nothing in the folder, during the render or after it.
+        EXPECT_TRUE(std::filesystem::is_empty(scratch.path()));
+    }
+    EXPECT_EQ(images[0], images[1]);
+    // 17 MB decoded, read through a 1 MiB cache: the cache stays within a few tiles of it.
+    EXPECT_LT(peaks[1], std::uint64_t(2) << 20);
+}
+
+TEST(TiledCopy, AFolderWhereNoFileCanBeMadeIsAnErrorNamingIt) {
+    TempDir dir;
+    writeLargePng(dir.file("large.png"));
+    const Scene scene = loadScene(planeScene(dir, "large.png"));
+    try {
+        const TextureResolver textures(scene, 64.0, true, true, dir.file("no-such-folder"));
+        ADD_FAILURE() << "no error";
+    } catch (const std::runtime_error& e) {
+        EXPECT_NE(std::string(e.what()).find("cannot create a texture tile file in '" +
+                                             dir.file("no-such-folder") + "'"),
+                  std::string::npos)
+            << e.what();
+    }
+}
+
+// A large image whose pixels stop short of its header's size is a scene error naming the
+// texture file (exit 2), found when the copy reads it, as a lookup would have found it.
+TEST(TiledCopy, ATruncatedImageIsASceneErrorNamingIt) {
+    TempDir dir;
+    writeLargePng(dir.file("large.png"));
+    std::filesystem::resize_file(dir.file("large.png"),
+                                 std::filesystem::file_size(dir.file("large.png")) / 2);
+    const Scene scene = loadScene(planeScene(dir, "large.png"));
+    try {
+        const TextureResolver textures(scene, 64.0, true, true, dir.path());
+        ADD_FAILURE() << "no error";
+    } catch (const SceneError& e) {
+        EXPECT_NE(std::string(e.what()).find("texture file '" + dir.file("large.png") +
+                                             "' cannot be read"),
+                  std::string::npos)
+            << e.what();
+    }
+}
+
+TEST(TiledCopy, ImagesUnderTheThresholdAreReadAsTheyAre) {
+    OIIO::ImageSpec small(2048, 2048, 4, OIIO::TypeDesc::UINT8); // 16 MiB exactly
+    small.tile_width = small.tile_height = 2048;
+    EXPECT_FALSE(needsTiledCopy(small, 1));
+    OIIO::ImageSpec large(2049, 2048, 4, OIIO::TypeDesc::UINT8);
+    large.tile_width = 2049, large.tile_height = 2048;
+    EXPECT_TRUE(needsTiledCopy(large, 1));
+    EXPECT_FALSE(needsTiledCopy(large, 2)); // MIP-mapped: made to be read so
+    large.tile_width = large.tile_height = 64;
+    EXPECT_FALSE(needsTiledCopy(large, 1)); // tiled
+}
+
+} // namespace
+} // namespace spw::test
