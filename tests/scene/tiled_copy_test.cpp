@@ -15,6 +15,17 @@
 #include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
 
+#if defined(__SANITIZE_ADDRESS__)
+#define SPILLWAY_LSAN 1
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define SPILLWAY_LSAN 1
+#endif
+#endif
+#if SPILLWAY_LSAN
+#include <sanitizer/lsan_interface.h>
+#endif
+
 #include <filesystem>
 #include <random>
 #include <stdexcept>
@@ -22,8 +33,21 @@
 namespace spw::test {
 namespace {
 
-// 2400 x 2400 RGB, 8-bit: 17.3 MB decoded, over kTiledCopyMinBytes. Red is a checker of 0 and
-// 255 a texel square; green and blue are pseudo-random.
+// LeakSanitizer ignores what is allocated while one lives (in the sanitized build).
+struct LeakCheckPause {
+#if SPILLWAY_LSAN
+    LeakCheckPause() {
+        __lsan_disable();
+    }
+    ~LeakCheckPause() {
+        __lsan_enable();
+    }
+#endif
+};
+
+// 2400 x 2400 RGB, 8-bit, untiled, in the format `path` names: 17.3 MB decoded, over
+// kTiledCopyMinBytes. Red is a checker of 0 and 255 a texel square; green and blue are
+// pseudo-random.
 constexpr int kSide = 2400;
 
 std::vector<unsigned char> writeLargePng(const std::string& path) {
@@ -147,6 +171,10 @@ TEST(TiledCopy, ATruncatedImageIsASceneErrorNamingIt) {
     std::filesystem::resize_file(dir.file("large.png"),
                                  std::filesystem::file_size(dir.file("large.png")) / 2);
     const Scene scene = loadScene(planeScene(dir, "large.png"));
+    // OpenImageIO 2.4's PNG reader leaks a string when libpng gives up on a truncated file
+    // (tests/fuzz/lsan.supp names it, but only the slow unwinder reaches its frames): what it
+    // allocates while reading is not LeakSanitizer's to report here.
+    [[maybe_unused]] LeakCheckPause pause;
     try {
         const TextureResolver textures(scene, 64.0, true, true, dir.path());
         ADD_FAILURE() << "no error";
