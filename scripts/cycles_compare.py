@@ -391,6 +391,13 @@ def make_test_files(out):
                                                       "specularColorFactor": [1.0, 1.0, 1.0]}}
     write_glb(os.path.join(out, "ior.glb"), [s + (0,), f + (1,)], [shiny, grey],
               extensions=["KHR_materials_ior", "KHR_materials_specular"])
+    # A dark blue glossy plastic whose KHR_materials_specular raises its F0 to 0.1 (2.5 x glTF's
+    # 0.04), as Blender 3.4's exporter writes a Principled BSDF's specular of 1.25: its importer
+    # reads the colour's luminance back into that specular (and ignores specularFactor, left 1).
+    bright = material((0.05, 0.1, 0.4), 0.0, 0.25)
+    bright["extensions"] = {"KHR_materials_specular": {"specularColorFactor": [2.5, 2.5, 2.5]}}
+    write_glb(os.path.join(out, "specular.glb"), [s + (0,), f + (1,)], [bright, grey],
+              extensions=["KHR_materials_specular"])
     # Car paint: a red rough plastic under a smooth clear coat (KHR_materials_clearcoat), on
     # the grey floor.
     paint = material((0.6, 0.05, 0.05), 0.0, 0.5)
@@ -411,7 +418,7 @@ def make_test_files(out):
                           "KHR_materials_volume"])
     return sorted(os.path.join(out, n) for n in list(files) + [
         "textured.glb", "emissive.glb", "uv-sets.glb", "terminator.glb", "blend.glb",
-        "glass.glb", "ior.glb", "clearcoat.glb", "tinted-glass.glb"])
+        "glass.glb", "ior.glb", "specular.glb", "clearcoat.glb", "tinted-glass.glb"])
 
 
 # The suite's bound (docs/scene-format.md, "glTF files", says why): relMSE and each channel's

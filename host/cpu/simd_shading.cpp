@@ -41,6 +41,8 @@ struct SurfaceLanes {
     Vec3s p, ng, ns, albedo, wo, beta; // the hit, -rayDir, the path's throughput
     Floats offset, lift;
     Floats alpha, ior, metallic; // the shader's GGX width, index of refraction and metalness
+    Vec3s f0d;                   // MetallicRoughness: the dielectric part's F0 colour
+    Floats f90d;                 // and its F90 (shared/gltf.h); zeros for other models
     Uints live;                  // bounce < max depth: the path goes on from here
     Uints roulette;              // bounce >= min depth
     RandomLanes random;
@@ -99,6 +101,8 @@ void MakeRandomNumbers(simd_shading::RandomLanes& lanes, size_t count, uint samp
 struct HitVector {
     V3 ng, albedo, wo;
     V ngDotWo, alpha, ior, metallic;
+    V3 f0d; // MetallicRoughness: the dielectric part's F0 colour and F90
+    V f90d;
     V3 ns; // the interpolated shading normal
     V3 n;  // facingShadingNormal
 };
@@ -162,11 +166,12 @@ struct MetallicRoughnessLanesModel {
         : frame(shadingFrame(h.n)), alpha(gmax(h.alpha, hn::Set(D(), kGltfMinAlpha))) {}
     M delta(const HitVector&) const { return hn::FirstN(D(), 0); }
     V3 eval(const HitVector& h, V3 wi, V& pdf) const {
-        return gltfEval(h.albedo, h.metallic, alpha, h.ior, h.ng, h.ngDotWo, frame, h.wo, wi, pdf);
+        return gltfEval(h.albedo, h.metallic, alpha, h.f0d, h.f90d, h.ng, h.ngDotWo, frame, h.wo,
+                        wi, pdf);
     }
     BsdfSample sample(const HitVector& h, V ux, V uy, V uz) const {
-        return gltfSample(h.albedo, h.metallic, alpha, h.ior, h.ng, h.ngDotWo, frame, h.wo, ux, uy,
-                          uz);
+        return gltfSample(h.albedo, h.metallic, alpha, h.f0d, h.f90d, h.ng, h.ngDotWo, frame, h.wo,
+                          ux, uy, uz);
     }
 };
 
@@ -256,6 +261,7 @@ void shadeLanes(const simd_shading::SurfaceLanes& in, size_t count, bool nee, bo
         const V3 p = load(in.p, i), ns = load(in.ns, i), beta = load(in.beta, i);
         h.ng = load(in.ng, i), h.albedo = load(in.albedo, i), h.wo = load(in.wo, i);
         h.alpha = load(in.alpha, i), h.ior = load(in.ior, i), h.metallic = load(in.metallic, i);
+        h.f0d = load(in.f0d, i), h.f90d = load(in.f90d, i);
         h.ngDotWo = dot(h.ng, h.wo);
         h.ns = ns;
         h.n = facingShadingNormal(ns, h.ng, h.wo, h.ngDotWo);
@@ -371,8 +377,10 @@ void fillLane(const SceneView& scene, const RenderParams& rp, const ShadeInput& 
     lanes.offset.v[k] = hit.offset;
     lanes.lift.v[k] = hit.lift;
     lanes.alpha.v[k] = sh.alpha;
-    // MetallicRoughness reads its dielectric F0 where the Dielectric reads its ior.
-    lanes.ior.v[k] = sh.model == kModelMetallicRoughness ? gltfDielectricF0(sh.ior) : sh.ior;
+    lanes.ior.v[k] = sh.ior;
+    const bool gltf = sh.model == kModelMetallicRoughness;
+    set(lanes.f0d, k, gltf ? gltfDielectricF0Colour(sh) : vec3(0.0f));
+    lanes.f90d.v[k] = gltf ? gltfDielectricF90(sh) : 0.0f;
     lanes.metallic.v[k] = sh.metallic;
     const bool live = st.bounce < rp.maxDepth;
     lanes.live.v[k] = mask(live);

@@ -95,6 +95,7 @@ Shader GltfReader::readMaterial(int index) {
     readTransmission(mat, s, at, name);
     readVolume(mat, s, at, name);
     readClearcoat(mat, s, at, name);
+    readSpecular(mat, s, at, name);
     if (mat.alphaMode != "OPAQUE" && mat.alphaMode != "MASK" && mat.alphaMode != "BLEND")
         fail(at + "/alphaMode", "must be OPAQUE, MASK or BLEND");
     readEmission(mat, s, at, name);
@@ -142,11 +143,14 @@ double GltfReader::extensionNumber(const tinygltf::Value& ext, const char* key, 
     return x;
 }
 
-double GltfReader::extensionNumber(const tinygltf::Value& values, int k,
+double GltfReader::extensionNumber(const tinygltf::Value& values, int k, double lo, double hi,
                                    const std::string& at) const {
     const tinygltf::Value& v = values.Get(k);
     const double x = v.IsNumber() ? v.GetNumberAsDouble() : NAN;
-    if (!(x >= 0.0 && x <= 1.0)) fail(at + "/" + std::to_string(k), "must be a number in [0, 1]");
+    if (!(x >= lo && x <= hi) || !std::isfinite(x))
+        fail(at + "/" + std::to_string(k),
+             std::isfinite(hi) ? "must be a number in [" + number(lo) + ", " + number(hi) + "]"
+                               : "must be a finite number of at least " + number(lo));
     return x;
 }
 
@@ -207,7 +211,7 @@ void GltfReader::readVolume(const tinygltf::Material& mat, Shader& s, const std:
         if (!c.IsArray() || c.ArrayLen() != 3)
             fail(where + "/attenuationColor", "needs 3 numbers in [0, 1]");
         for (int k = 0; k < 3; ++k)
-            colour[k] = float(extensionNumber(c, k, where + "/attenuationColor"));
+            colour[k] = float(extensionNumber(c, k, 0.0, 1.0, where + "/attenuationColor"));
     }
     if (v->second.Has("thicknessTexture"))
         warn(name + ": its thicknessTexture is not read (the mesh's own thickness is rendered)");
@@ -248,6 +252,35 @@ void GltfReader::readClearcoat(const tinygltf::Material& mat, Shader& s, const s
     s.params.model = kModelCoatedMetallicRoughness;
     s.params.coat = float(factor);
     s.params.coatAlpha = gltfAlpha(float(roughness));
+}
+
+void GltfReader::readSpecular(const tinygltf::Material& mat, Shader& s, const std::string& at,
+                              const std::string& name) {
+    const auto e = mat.extensions.find("KHR_materials_specular");
+    if (e == mat.extensions.end()) return;
+    const std::string where = at + "/extensions/KHR_materials_specular";
+    const double factor = extensionNumber(e->second, "specularFactor", 1.0, 0.0, 1.0, where);
+    vec3 colour(1.0f);
+    if (e->second.Has("specularColorFactor")) {
+        const tinygltf::Value& c = e->second.Get("specularColorFactor");
+        if (!c.IsArray() || c.ArrayLen() != 3)
+            fail(where + "/specularColorFactor", "needs 3 numbers of at least 0");
+        for (int k = 0; k < 3; ++k)
+            colour[k] = float(std::min(
+                extensionNumber(c, k, 0.0, HUGE_VAL, where + "/specularColorFactor"), 1e3));
+    }
+    for (const char* image : {"specularTexture", "specularColorTexture"})
+        if (e->second.Has(image))
+            warn(name + ": its " + image + " is not rendered (the factor alone is)");
+    if (factor == 1.0 && colour == vec3(1.0f)) return; // the defaults: glTF's own reflection
+    if (s.params.model == kModelDielectric) {
+        warn(name + ": KHR_materials_specular on glass is not rendered (its reflection follows "
+                    "the ior alone)");
+        return;
+    }
+    s.params.flags |= kShaderSpecular;
+    s.params.specular = float(factor);
+    s.params.specularColour = colour;
 }
 
 void GltfReader::readEmission(const tinygltf::Material& mat, Shader& s, const std::string& at,

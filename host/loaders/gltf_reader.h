@@ -142,14 +142,19 @@ class GltfReader {
     // KHR_materials_clearcoat: a material with a coat of weight clearcoatFactor > 0 is a
     // CoatedMetallicRoughness shader (shared/clearcoat.h), its coat's GGX alpha
     // clearcoatRoughnessFactor^2; the coat's images are warned about and not rendered.
+    // KHR_materials_specular: the dielectric reflection's weight and F0 colour (factors only).
+    void readSpecular(const tinygltf::Material& mat, Shader& s, const std::string& at,
+                      const std::string& name);
     void readClearcoat(const tinygltf::Material& mat, Shader& s, const std::string& at,
                        const std::string& name);
     // The number at `key` of extension object `ext` (its JSON pointer `at`), or `fallback` where
     // it is absent; refused unless it is a finite number in [lo, hi] (hi may be HUGE_VAL).
     double extensionNumber(const tinygltf::Value& ext, const char* key, double fallback, double lo,
                            double hi, const std::string& at) const;
-    // Element k of the array `values` (at JSON pointer `at`), refused unless a number in [0, 1].
-    double extensionNumber(const tinygltf::Value& values, int k, const std::string& at) const;
+    // Element k of the array `values` (at JSON pointer `at`), refused unless a finite number in
+    // [lo, hi].
+    double extensionNumber(const tinygltf::Value& values, int k, double lo, double hi,
+                           const std::string& at) const;
     // The Dielectric model's least index of refraction.
     static constexpr double kMinGlassIor = 1.01;
 

@@ -28,6 +28,9 @@ enum SurfaceParam : uint {
     kTakesAbsorption = 1u << 7,  // absorption: [r, g, b], each >= 0, per unit length (default 0)
     kTakesCoat = 1u << 8,        // coat (1) in [0, 1] and coat roughness (0) in [0, 1], the clear
                                  // coat's weight and perceptual roughness (shared/clearcoat.h)
+    kTakesSpecular = 1u << 9,    // specular (1) in [0, 1] and specular colour [r, g, b] (each in
+                                 // [0, 1000], default [1, 1, 1]): the dielectric reflection's
+                                 // weight and F0 colour (KHR_materials_specular, shared/gltf.h)
 };
 
 struct SurfaceModelInfo {

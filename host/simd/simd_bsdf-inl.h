@@ -267,22 +267,40 @@ HWY_INLINE V3 mix(V a, V3 b, V t) {
     return {hn::Add(at, hn::Mul(b.x, t)), hn::Add(at, hn::Mul(b.y, t)),
             hn::Add(at, hn::Mul(b.z, t))};
 }
+// glm's mix(a, b, t) of two vec3: a (1 - t) + b t.
+HWY_INLINE V3 mix(V3 a, V3 b, V t) {
+    const V s = hn::Sub(hn::Set(D(), 1.0f), t);
+    return {hn::Add(hn::Mul(a.x, s), hn::Mul(b.x, t)), hn::Add(hn::Mul(a.y, s), hn::Mul(b.y, t)),
+            hn::Add(hn::Mul(a.z, s), hn::Mul(b.z, t))};
+}
+// Twin of gltfFresnel (shared/gltf.h).
+HWY_INLINE V3 gltfFresnel(V3 f0, V f90, V cosTheta) {
+    const V one = hn::Set(D(), 1.0f);
+    const V m = clamp01(hn::Sub(one, cosTheta));
+    const V m2 = hn::Mul(m, m);
+    return add(f0, mul(sub(V3{f90, f90, f90}, f0), hn::Mul(hn::Mul(m2, m2), m)));
+}
+// gltfF90 (shared/gltf.h): 1 - (1 - f90d) (1 - metallic).
+HWY_INLINE V gltfF90(V f90d, V metallic) {
+    const V one = hn::Set(D(), 1.0f);
+    return hn::Sub(one, hn::Mul(hn::Sub(one, f90d), hn::Sub(one, metallic)));
+}
 HWY_INLINE V mean(V3 v) {
     return hn::Div(hn::Add(hn::Add(v.x, v.y), v.z), hn::Set(D(), 3.0f));
 }
 // Twin of gltfSpecularProbability (shared/gltf.h).
-HWY_INLINE V gltfSpecularProbability(V3 f0, V3 cDiff, V cosO) {
+HWY_INLINE V gltfSpecularProbability(V3 f0, V f90, V3 cDiff, V cosO) {
     const D d;
     const V one = hn::Set(d, 1.0f);
-    const V3 F = schlickFresnel(f0, cosO);
+    const V3 F = gltfFresnel(f0, f90, cosO);
     const V fs = mean(F);
     const V fd = mean(mul(cDiff, sub(V3{one, one, one}, F)));
     const V p = gmin(gmax(hn::Div(fs, hn::Add(fs, fd)), hn::Set(d, 0.25f)), hn::Set(d, 0.9f));
     return hn::IfThenElse(hn::Gt(fd, hn::Zero(d)), p, one);
 }
 // Twin of gltfEval (shared/gltf.h), given dot(ng, wo) and shadingFrame's frame.
-HWY_INLINE V3 gltfEval(V3 colour, V metallic, V alpha, V f0d, V3 ng, V ngDotWo, const Frame& f,
-                       V3 wo, V3 wi, V& pdf) {
+HWY_INLINE V3 gltfEval(V3 colour, V metallic, V alpha, V3 f0d, V f90d, V3 ng, V ngDotWo,
+                       const Frame& f, V3 wo, V3 wi, V& pdf) {
     const D d;
     const V zero = hn::Zero(d), one = hn::Set(d, 1.0f), two = hn::Set(d, 2.0f);
     const V invPi = hn::Set(d, kInvPi);
@@ -294,15 +312,16 @@ HWY_INLINE V3 gltfEval(V3 colour, V metallic, V alpha, V f0d, V3 ng, V ngDotWo, 
                                    hn::Gt(len2, zero));
     h = mul(h, hn::Div(one, hn::Sqrt(len2)));
     const V3 f0 = mix(f0d, colour, metallic);
+    const V f90 = gltfF90(f90d, metallic);
     const V3 cDiff = mul(colour, hn::Sub(one, metallic));
-    const V3 F = schlickFresnel(f0, dot(lo, h));
+    const V3 F = gltfFresnel(f0, f90, dot(lo, h));
     const V ndf = ggxD(h, alpha);
     const V denom = ggxG2Denominator(lo, li, alpha);
     const V3 specular =
         select(hn::Gt(denom, zero), mul(F, hn::Div(hn::Mul(ndf, li.z), hn::Mul(two, denom))),
                V3{zero, zero, zero});
     const V3 diffuse = mul(mul(sub(V3{one, one, one}, F), cDiff), hn::Mul(li.z, invPi));
-    const V pSpecular = gltfSpecularProbability(f0, cDiff, lo.z);
+    const V pSpecular = gltfSpecularProbability(f0, f90, cDiff, lo.z);
     const V specularPdf = hn::Div(ndf, hn::Mul(two, hn::Add(lo.z, ggxA(lo, alpha))));
     pdf = hn::IfThenElseZero(evaluated,
                              hn::Add(hn::Mul(pSpecular, specularPdf),
@@ -310,14 +329,15 @@ HWY_INLINE V3 gltfEval(V3 colour, V metallic, V alpha, V f0d, V3 ng, V ngDotWo, 
     return select(evaluated, add(specular, diffuse), V3{zero, zero, zero});
 }
 // Twin of gltfSample (shared/gltf.h), given dot(ng, wo) and shadingFrame's frame.
-HWY_INLINE BsdfSample gltfSample(V3 colour, V metallic, V alpha, V f0d, V3 ng, V ngDotWo,
+HWY_INLINE BsdfSample gltfSample(V3 colour, V metallic, V alpha, V3 f0d, V f90d, V3 ng, V ngDotWo,
                                  const Frame& f, V3 wo, V ux, V uy, V uz) {
     const D d;
     const V zero = hn::Zero(d), one = hn::Set(d, 1.0f), two = hn::Set(d, 2.0f);
     const V3 lo = frameToLocal(f, wo);
     const V3 f0 = mix(f0d, colour, metallic);
     const V3 cDiff = mul(colour, hn::Sub(one, metallic));
-    const M specularLobe = hn::Lt(uz, gltfSpecularProbability(f0, cDiff, lo.z));
+    const M specularLobe =
+        hn::Lt(uz, gltfSpecularProbability(f0, gltfF90(f90d, metallic), cDiff, lo.z));
     BsdfSample s;
     s.ok = hn::Gt(lo.z, zero);
     V3 li = sampleCosineHemisphere(ux, uy);
@@ -329,7 +349,7 @@ HWY_INLINE BsdfSample gltfSample(V3 colour, V metallic, V alpha, V f0d, V3 ng, V
     }
     s.ok = hn::And(s.ok, hn::Gt(li.z, zero));
     s.wi = frameToWorld(f, li);
-    const V3 fcos = gltfEval(colour, metallic, alpha, f0d, ng, ngDotWo, f, wo, s.wi, s.pdf);
+    const V3 fcos = gltfEval(colour, metallic, alpha, f0d, f90d, ng, ngDotWo, f, wo, s.wi, s.pdf);
     s.ok = hn::And(s.ok, hn::Gt(s.pdf, zero));
     s.weight = div(fcos, s.pdf);
     s.specular = hn::FirstN(d, 0);

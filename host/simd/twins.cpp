@@ -136,22 +136,25 @@ void runBsdfTwin(Twin twin, const TwinLanes& in, size_t i, TwinResults& out) {
             dielectricSample(f(0), f(1), a.ng, a.ngDotWo, a.frame, a.wo, f(11), f(12), f(13)), out,
             i);
     }
-    case Twin::gltfSpecularProbability: // f0 f0-2, cDiff f3-5, cosO f6 -> f0
-        return store(gltfSpecularProbability(load3(in, 0, i), load3(in, 3, i), f(6)), out.f[0], i);
+    case Twin::gltfFresnel: // f0 f0-2, f90 f3, cosTheta f4 -> f0-2
+        return store3(gltfFresnel(load3(in, 0, i), f(3), f(4)), out, 0, i);
+    case Twin::gltfSpecularProbability: // f0 f0-2, cDiff f3-5, cosO f6, f90 f7 -> f0
+        return store(gltfSpecularProbability(load3(in, 0, i), f(7), load3(in, 3, i), f(6)),
+                     out.f[0], i);
     case Twin::gltfEval: { // colour f0-2, metallic f3, alpha f4, ng f5-7, ns f8-10, wo f11-13,
-                           // wi f14-16, f0d f17 -> f0-2, pdf f3
+                           // wi f14-16, f0d f17-19, f90d f20 -> f0-2, pdf f3
         const FrameArgs a = frameArgs(in, 5, 8, 11, i);
         V pdf;
-        store3(gltfEval(load3(in, 0, i), f(3), f(4), f(17), a.ng, a.ngDotWo, a.frame, a.wo,
-                        load3(in, 14, i), pdf),
+        store3(gltfEval(load3(in, 0, i), f(3), f(4), load3(in, 17, i), f(20), a.ng, a.ngDotWo,
+                        a.frame, a.wo, load3(in, 14, i), pdf),
                out, 0, i);
         return store(pdf, out.f[3], i);
     }
     case Twin::gltfSample: { // colour f0-2, metallic f3, alpha f4, ng f5-7, ns f8-10, wo f11-13,
-                             // u f14-16, f0d f17
+                             // u f14-16, f0d f17-19, f90d f20
         const FrameArgs a = frameArgs(in, 5, 8, 11, i);
-        return storeSample(gltfSample(load3(in, 0, i), f(3), f(4), f(17), a.ng, a.ngDotWo, a.frame,
-                                      a.wo, f(14), f(15), f(16)),
+        return storeSample(gltfSample(load3(in, 0, i), f(3), f(4), load3(in, 17, i), f(20), a.ng,
+                                      a.ngDotWo, a.frame, a.wo, f(14), f(15), f(16)),
                            out, i);
     }
     default:

@@ -40,6 +40,7 @@
     X(fresnelDielectric, "dielectric.h")                                                           \
     X(dielectricEval, "dielectric.h")                                                              \
     X(dielectricSample, "dielectric.h")                                                            \
+    X(gltfFresnel, "gltf.h")                                                                       \
     X(gltfSpecularProbability, "gltf.h")                                                           \
     X(gltfEval, "gltf.h")                                                                          \
     X(gltfSample, "gltf.h")                                                                        \
@@ -74,7 +75,7 @@ inline constexpr TwinInfo kTwins[] = {
 // `specular` as masks u0 and u1, its out-parameters zero where it fails). twins.cpp says per twin
 // which rows it reads; `uniform` holds the arguments that are one value for every lane.
 struct TwinLanes {
-    Floats f[18];
+    Floats f[21];
     Uints u[5];
     std::uint32_t uniform[3];
 };

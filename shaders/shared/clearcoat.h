@@ -1,7 +1,8 @@
 // CoatedMetallicRoughness: glTF's metallic-roughness material (shared/gltf.h) under a clear coat,
 // as KHR_materials_clearcoat defines it (the extension's specification, "Clearcoat" and
 // "Implementation").
-//   parameters: those of MetallicRoughness (colour or texture, metallic, roughness, ior), and
+//   parameters: those of MetallicRoughness (colour or texture, metallic, roughness, ior,
+//   specular, specular colour), and
 //   coat (1) in [0, 1], the coat's weight; coat roughness (0) in [0, 1], its perceptual
 //   roughness (GGX alpha = coat roughness^2, at least kGltfMinAlpha).
 //   The coat is a dielectric of ior 1.5 (F0 = 0.04) over the base, sharing its shading normal:
@@ -28,19 +29,20 @@ SHARED_FN float gltfCoatFresnel(float coat, float cosO) {
 }
 
 // The probability of sampling the coat's lobe: its reflectance fc against the base's lobes'.
-SHARED_FN float gltfCoatProbability(vec3 colour, float metallic, float f0d, float fc, float cosO) {
+SHARED_FN float gltfCoatProbability(vec3 colour, float metallic, vec3 f0d, float f90d, float fc,
+                                    float cosO) {
     if (!(fc > 0.0f)) return 0.0f;
-    vec3 f0 = mix(vec3(f0d), colour, metallic);
-    vec3 F = schlickFresnel(f0, cosO);
+    vec3 F = gltfFresnel(gltfF0(f0d, colour, metallic), gltfF90(f90d, metallic), cosO);
     vec3 d = colour * (1.0f - metallic) * (vec3(1.0f) - F);
     float base = (F.x + F.y + F.z + d.x + d.y + d.z) / 3.0f;
     return clamp(fc / (fc + (1.0f - fc) * base), 0.1f, 0.9f);
 }
 
-SHARED_FN vec3 gltfCoatEval(vec3 colour, float metallic, float alpha, float f0d, float coat,
-                            float coatAlpha, vec3 ng, vec3 ns, vec3 wo, vec3 wi, OUT(float) pdf) {
+SHARED_FN vec3 gltfCoatEval(vec3 colour, float metallic, float alpha, vec3 f0d, float f90d,
+                            float coat, float coatAlpha, vec3 ng, vec3 ns, vec3 wo, vec3 wi,
+                            OUT(float) pdf) {
     float basePdf;
-    vec3 base = gltfEval(colour, metallic, alpha, f0d, ng, ns, wo, wi, basePdf);
+    vec3 base = gltfEval(colour, metallic, alpha, f0d, f90d, ng, ns, wo, wi, basePdf);
     pdf = 0.0f;
     if (dot(ng, wo) * dot(ng, wi) <= 0.0f) return vec3(0.0f);
     Frame f = shadingFrame(ns, ng, wo);
@@ -55,14 +57,14 @@ SHARED_FN vec3 gltfCoatEval(vec3 colour, float metallic, float alpha, float f0d,
     float d = ggxD(h, coatAlpha);
     float denom = ggxG2Denominator(lo, li, coatAlpha);
     float layer = denom > 0.0f ? fc * d * li.z / (2.0f * denom) : 0.0f;
-    float pCoat = gltfCoatProbability(colour, metallic, f0d, fc, lo.z);
+    float pCoat = gltfCoatProbability(colour, metallic, f0d, f90d, fc, lo.z);
     pdf = pCoat * (d / (2.0f * (lo.z + ggxA(lo, coatAlpha)))) + (1.0f - pCoat) * basePdf;
     return base * (1.0f - fc) + vec3(layer);
 }
 
-SHARED_FN bool gltfCoatSample(vec3 colour, float metallic, float alpha, float f0d, float coat,
-                              float coatAlpha, vec3 ng, vec3 ns, vec3 wo, vec3 u, OUT(vec3) wi,
-                              OUT(vec3) weight, OUT(float) pdf, OUT(bool) specular) {
+SHARED_FN bool gltfCoatSample(vec3 colour, float metallic, float alpha, vec3 f0d, float f90d,
+                              float coat, float coatAlpha, vec3 ng, vec3 ns, vec3 wo, vec3 u,
+                              OUT(vec3) wi, OUT(vec3) weight, OUT(float) pdf, OUT(bool) specular) {
     wi = vec3(0.0f);
     weight = vec3(0.0f);
     pdf = 0.0f;
@@ -71,7 +73,7 @@ SHARED_FN bool gltfCoatSample(vec3 colour, float metallic, float alpha, float f0
     vec3 lo = frameToLocal(f, wo);
     if (lo.z <= 0.0f) return false;
     float fc = gltfCoatFresnel(coat, lo.z);
-    float pCoat = gltfCoatProbability(colour, metallic, f0d, fc, lo.z);
+    float pCoat = gltfCoatProbability(colour, metallic, f0d, f90d, fc, lo.z);
     if (u.z < pCoat) {
         vec3 h = ggxSampleVisibleNormal(lo, coatAlpha, vec2(u.x, u.y));
         float oh = dot(lo, h);
@@ -83,11 +85,12 @@ SHARED_FN bool gltfCoatSample(vec3 colour, float metallic, float alpha, float f0
         vec3 baseWeight;
         float basePdf;
         vec3 v = vec3(u.x, u.y, (u.z - pCoat) / (1.0f - pCoat));
-        if (!gltfSample(colour, metallic, alpha, f0d, ng, ns, wo, v, wi, baseWeight, basePdf,
+        if (!gltfSample(colour, metallic, alpha, f0d, f90d, ng, ns, wo, v, wi, baseWeight, basePdf,
                         specular))
             return false;
     }
-    vec3 fcos = gltfCoatEval(colour, metallic, alpha, f0d, coat, coatAlpha, ng, ns, wo, wi, pdf);
+    vec3 fcos =
+        gltfCoatEval(colour, metallic, alpha, f0d, f90d, coat, coatAlpha, ng, ns, wo, wi, pdf);
     if (!(pdf > 0.0f)) return false;
     weight = fcos / pdf;
     return true;
@@ -103,15 +106,17 @@ SHARED_FN float clearcoatBsdfConeSpread(ShaderParams sh) {
 }
 SHARED_FN vec3 clearcoatBsdfEval(ShaderParams sh, vec3 albedo, vec3 ng, vec3 ns, vec3 wo, vec3 wi,
                                  OUT(float) pdf) {
-    return gltfCoatEval(albedo, sh.metallic, max(sh.alpha, kGltfMinAlpha), gltfDielectricF0(sh.ior),
-                        sh.coat, max(sh.coatAlpha, kGltfMinAlpha), ng, ns, wo, wi, pdf);
+    return gltfCoatEval(albedo, sh.metallic, max(sh.alpha, kGltfMinAlpha),
+                        gltfDielectricF0Colour(sh), gltfDielectricF90(sh), sh.coat,
+                        max(sh.coatAlpha, kGltfMinAlpha), ng, ns, wo, wi, pdf);
 }
 SHARED_FN bool clearcoatBsdfSample(ShaderParams sh, vec3 albedo, vec3 ng, vec3 ns, vec3 wo, vec3 u,
                                    OUT(vec3) wi, OUT(vec3) weight, OUT(float) pdf,
                                    OUT(bool) specular) {
     return gltfCoatSample(albedo, sh.metallic, max(sh.alpha, kGltfMinAlpha),
-                          gltfDielectricF0(sh.ior), sh.coat, max(sh.coatAlpha, kGltfMinAlpha), ng,
-                          ns, wo, u, wi, weight, pdf, specular);
+                          gltfDielectricF0Colour(sh), gltfDielectricF90(sh), sh.coat,
+                          max(sh.coatAlpha, kGltfMinAlpha), ng, ns, wo, u, wi, weight, pdf,
+                          specular);
 }
 
 SHARED_END

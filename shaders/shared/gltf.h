@@ -2,11 +2,16 @@
 // appendix B, "BRDF implementation"), reflection only.
 //   parameters: colour [r, g, b] ([1, 1, 1]) or texture: the base colour; metallic (1) in
 //   [0, 1]; roughness (1) in [0, 1], the perceptual roughness: GGX alpha = roughness^2, at least
-//   kGltfMinAlpha. glTF's defaults (metallicFactor and roughnessFactor 1).
-//   c_diff = colour (1 - metallic), f0 = mix(F0d, colour, metallic), F0d the dielectric's:
-//   ((ior - 1) / (ior + 1))^2 from the shader's ior (KHR_materials_ior), exactly glTF's 0.04 at
-//   ior 1.5 and wherever the ior is unset (below 1),
-//   F = f0 + (1 - f0) (1 - |wo.h|)^5 (Schlick, as conductor.h),
+//   kGltfMinAlpha; ior (1.5); specular (1) in [0, 1] and specular colour [r, g, b] ([1, 1, 1]),
+//   each at least 0 (KHR_materials_specular). glTF's defaults (metallicFactor and roughnessFactor
+//   1).
+//   c_diff = colour (1 - metallic), f0 = mix(F0d, colour, metallic), f90 = mix(F90d, 1, metallic),
+//   the dielectric's F0d = min(((ior - 1) / (ior + 1))^2 specularColour, 1) specular and
+//   F90d = specular: ((ior - 1) / (ior + 1))^2 from the shader's ior (KHR_materials_ior), exactly
+//   glTF's 0.04 at ior 1.5 and wherever the ior is unset (below 1); specular and specularColour
+//   KHR_materials_specular's weight and F0 colour (1 and (1, 1, 1) without kShaderSpecular, where
+//   F0d is the ior's F0 and F90d 1, to the bit), as that extension's implementation section has it,
+//   F = f0 + (f90 - f0) (1 - |wo.h|)^5 (Schlick, as conductor.h, with glTF's f90),
 //   f = (1 - F) c_diff / pi + F D G2 / (4 |co| |ci|)
 //   with GGX D and the height-correlated Smith G2 of ggx.h (the specification's V is
 //   G2 / (4 |co| |ci|)). The diffuse term takes (1 - F) with the half vector's F, as the
@@ -14,7 +19,7 @@
 //   Sampling: the specular lobe through GGX's visible normals (as conductor.h) with probability
 //   pSpecular, the diffuse one cosine-weighted otherwise; pdf = the mixture's, weight = fcos /
 //   pdf. pSpecular = Fs / (Fs + Fd) from the lobes' weights seen from wo (Fs = mean of
-//   F(f0, cos wo), Fd = mean of c_diff (1 - F(f0, cos wo))), within [0.25, 0.9] while there is a
+//   F(cos wo), Fd = mean of c_diff (1 - F(cos wo))), within [0.25, 0.9] while there is a
 //   diffuse lobe (so neither lobe is starved), 1 without one (a pure metal).
 //   alpha is floored at kGltfMinAlpha = 0.045^2 (Filament's floor on perceptual roughness): a
 //   roughness of 0 is a very narrow GGX lobe, never a delta lobe mixed with a diffuse one.
@@ -38,6 +43,34 @@ SHARED_FN float gltfDielectricF0(float ior) {
     return r * r;
 }
 
+// The dielectric part's F0 colour and F90 (KHR_materials_specular's weight): without
+// kShaderSpecular, the ior's F0 and 1.
+SHARED_FN vec3 gltfDielectricF0Colour(ShaderParams sh) {
+    float f0 = gltfDielectricF0(sh.ior);
+    if ((sh.flags & kShaderSpecular) == 0u) return vec3(f0);
+    return min(f0 * sh.specularColour, vec3(1.0f)) * sh.specular;
+}
+SHARED_FN float gltfDielectricF90(ShaderParams sh) {
+    return (sh.flags & kShaderSpecular) != 0u ? sh.specular : 1.0f;
+}
+
+// Schlick's Fresnel with glTF's f90: f0 + (f90 - f0) (1 - cosTheta)^5 (schlickFresnel at f90 1,
+// to the bit).
+// SIMD twin: host/simd/simd_bsdf-inl.h
+SHARED_FN vec3 gltfFresnel(vec3 f0, float f90, float cosTheta) {
+    float m = clamp(1.0f - cosTheta, 0.0f, 1.0f);
+    float m2 = m * m;
+    return f0 + (vec3(f90) - f0) * (m2 * m2 * m);
+}
+
+// f0 and f90 of the dielectric part (f0d, f90d) mixed with the metal's (colour, 1) by metallic.
+SHARED_FN vec3 gltfF0(vec3 f0d, vec3 colour, float metallic) {
+    return mix(f0d, colour, metallic);
+}
+SHARED_FN float gltfF90(float f90d, float metallic) {
+    return 1.0f - (1.0f - f90d) * (1.0f - metallic);
+}
+
 // GGX alpha from glTF's perceptual roughness.
 SHARED_FN float gltfAlpha(float roughness) {
     return max(roughness * roughness, kGltfMinAlpha);
@@ -46,8 +79,8 @@ SHARED_FN float gltfAlpha(float roughness) {
 // The probability of sampling the specular lobe, seen from wo at cosine cosO to the shading
 // normal.
 // SIMD twin: host/simd/simd_bsdf-inl.h
-SHARED_FN float gltfSpecularProbability(vec3 f0, vec3 cDiff, float cosO) {
-    vec3 F = schlickFresnel(f0, cosO);
+SHARED_FN float gltfSpecularProbability(vec3 f0, float f90, vec3 cDiff, float cosO) {
+    vec3 F = gltfFresnel(f0, f90, cosO);
     float fs = (F.x + F.y + F.z) / 3.0f;
     vec3 d = cDiff * (vec3(1.0f) - F);
     float fd = (d.x + d.y + d.z) / 3.0f;
@@ -56,8 +89,8 @@ SHARED_FN float gltfSpecularProbability(vec3 f0, vec3 cDiff, float cosO) {
 }
 
 // SIMD twin: host/simd/simd_bsdf-inl.h
-SHARED_FN vec3 gltfEval(vec3 colour, float metallic, float alpha, float f0d, vec3 ng, vec3 ns,
-                        vec3 wo, vec3 wi, OUT(float) pdf) {
+SHARED_FN vec3 gltfEval(vec3 colour, float metallic, float alpha, vec3 f0d, float f90d, vec3 ng,
+                        vec3 ns, vec3 wo, vec3 wi, OUT(float) pdf) {
     pdf = 0.0f;
     if (dot(ng, wo) * dot(ng, wi) <= 0.0f) return vec3(0.0f);
     Frame f = shadingFrame(ns, ng, wo);
@@ -68,22 +101,23 @@ SHARED_FN vec3 gltfEval(vec3 colour, float metallic, float alpha, float f0d, vec
     float len2 = dot(h, h);
     if (!(len2 > 0.0f)) return vec3(0.0f);
     h = h * inversesqrt(len2);
-    vec3 f0 = mix(vec3(f0d), colour, metallic);
+    vec3 f0 = gltfF0(f0d, colour, metallic);
+    float f90 = gltfF90(f90d, metallic);
     vec3 cDiff = colour * (1.0f - metallic);
-    vec3 F = schlickFresnel(f0, dot(lo, h));
+    vec3 F = gltfFresnel(f0, f90, dot(lo, h));
     float d = ggxD(h, alpha);
     float denom = ggxG2Denominator(lo, li, alpha);
     vec3 specular = denom > 0.0f ? F * (d * li.z / (2.0f * denom)) : vec3(0.0f);
     vec3 diffuse = (vec3(1.0f) - F) * cDiff * (li.z * kInvPi);
-    float pSpecular = gltfSpecularProbability(f0, cDiff, lo.z);
+    float pSpecular = gltfSpecularProbability(f0, f90, cDiff, lo.z);
     pdf =
         pSpecular * (d / (2.0f * (lo.z + ggxA(lo, alpha)))) + (1.0f - pSpecular) * (li.z * kInvPi);
     return specular + diffuse;
 }
 
 // SIMD twin: host/simd/simd_bsdf-inl.h
-SHARED_FN bool gltfSample(vec3 colour, float metallic, float alpha, float f0d, vec3 ng, vec3 ns,
-                          vec3 wo, vec3 u, OUT(vec3) wi, OUT(vec3) weight, OUT(float) pdf,
+SHARED_FN bool gltfSample(vec3 colour, float metallic, float alpha, vec3 f0d, float f90d, vec3 ng,
+                          vec3 ns, vec3 wo, vec3 u, OUT(vec3) wi, OUT(vec3) weight, OUT(float) pdf,
                           OUT(bool) specular) {
     wi = vec3(0.0f);
     weight = vec3(0.0f);
@@ -92,10 +126,10 @@ SHARED_FN bool gltfSample(vec3 colour, float metallic, float alpha, float f0d, v
     Frame f = shadingFrame(ns, ng, wo);
     vec3 lo = frameToLocal(f, wo);
     if (lo.z <= 0.0f) return false;
-    vec3 f0 = mix(vec3(f0d), colour, metallic);
+    vec3 f0 = gltfF0(f0d, colour, metallic);
     vec3 cDiff = colour * (1.0f - metallic);
     vec3 li;
-    if (u.z < gltfSpecularProbability(f0, cDiff, lo.z)) {
+    if (u.z < gltfSpecularProbability(f0, gltfF90(f90d, metallic), cDiff, lo.z)) {
         vec3 h = ggxSampleVisibleNormal(lo, alpha, vec2(u.x, u.y));
         float oh = dot(lo, h);
         if (oh <= 0.0f) return false;
@@ -105,7 +139,7 @@ SHARED_FN bool gltfSample(vec3 colour, float metallic, float alpha, float f0d, v
     }
     if (li.z <= 0.0f) return false; // below the surface: absorbed
     wi = frameToWorld(f, li);
-    vec3 fcos = gltfEval(colour, metallic, alpha, f0d, ng, ns, wo, wi, pdf);
+    vec3 fcos = gltfEval(colour, metallic, alpha, f0d, f90d, ng, ns, wo, wi, pdf);
     if (!(pdf > 0.0f)) return false;
     weight = fcos / pdf;
     return true;
@@ -122,13 +156,13 @@ SHARED_FN float gltfBsdfConeSpread(ShaderParams sh) {
 }
 SHARED_FN vec3 gltfBsdfEval(ShaderParams sh, vec3 albedo, vec3 ng, vec3 ns, vec3 wo, vec3 wi,
                             OUT(float) pdf) {
-    return gltfEval(albedo, sh.metallic, max(sh.alpha, kGltfMinAlpha), gltfDielectricF0(sh.ior), ng,
-                    ns, wo, wi, pdf);
+    return gltfEval(albedo, sh.metallic, max(sh.alpha, kGltfMinAlpha), gltfDielectricF0Colour(sh),
+                    gltfDielectricF90(sh), ng, ns, wo, wi, pdf);
 }
 SHARED_FN bool gltfBsdfSample(ShaderParams sh, vec3 albedo, vec3 ng, vec3 ns, vec3 wo, vec3 u,
                               OUT(vec3) wi, OUT(vec3) weight, OUT(float) pdf, OUT(bool) specular) {
-    return gltfSample(albedo, sh.metallic, max(sh.alpha, kGltfMinAlpha), gltfDielectricF0(sh.ior),
-                      ng, ns, wo, u, wi, weight, pdf, specular);
+    return gltfSample(albedo, sh.metallic, max(sh.alpha, kGltfMinAlpha), gltfDielectricF0Colour(sh),
+                      gltfDielectricF90(sh), ng, ns, wo, u, wi, weight, pdf, specular);
 }
 
 SHARED_END

@@ -25,8 +25,9 @@
     X(Dielectric, 3u, dielectric,                                                                  \
       kTakesIor | kTakesAlpha | kTakesColour | kTakesTexture | kTakesAbsorption)                   \
     X(MetallicRoughness, 4u, gltf,                                                                 \
-      kTakesColour | kTakesTexture | kTakesMetallic | kTakesRoughness)                             \
+      kTakesColour | kTakesTexture | kTakesMetallic | kTakesRoughness | kTakesSpecular)            \
     X(CoatedMetallicRoughness, 5u, clearcoat,                                                      \
-      kTakesColour | kTakesTexture | kTakesMetallic | kTakesRoughness | kTakesCoat)
+      kTakesColour | kTakesTexture | kTakesMetallic | kTakesRoughness | kTakesCoat |               \
+          kTakesSpecular)
 
 #endif

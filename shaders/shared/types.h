@@ -21,6 +21,8 @@ const uint kModelCount = 0u SPW_SURFACE_MODELS(SPW_MODEL_ONE);
 const uint kShaderTwoSided = 1u;  // emits from both faces
 const uint kShaderTextured = 2u;  // albedo comes from a texture tree, resolved on the host
 const uint kShaderHitParams = 4u; // metallic and roughness come from the hit (SurfaceHit.material)
+const uint kShaderSpecular = 8u;  // MetallicRoughness models: the dielectric reflection takes
+                                  // specular and specularColour (KHR_materials_specular)
 
 struct ShaderParams {
     vec3 emission;     // radiance leaving the front face (both with kShaderTwoSided)
@@ -36,6 +38,11 @@ struct ShaderParams {
                      // per unit length (Beer-Lambert); 0: clear
     float coat;      // CoatedMetallicRoughness: the clear coat's weight in [0, 1]
     float coatAlpha; // CoatedMetallicRoughness: the coat's GGX width
+    // MetallicRoughness models, with kShaderSpecular: the dielectric reflection's F0 colour
+    // factor and its weight (KHR_materials_specular's specularColorFactor and specularFactor);
+    // without the flag, (1, 1, 1) and 1.
+    vec3 specularColour;
+    float specular;
     uint pad0;
     uint pad1;
     uint pad2;

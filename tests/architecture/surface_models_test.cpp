@@ -55,7 +55,9 @@ TEST(SurfaceModels, TheLoaderTakesEachModelWithExactlyItsRegisteredKeys) {
         {kTakesRoughness, "roughness: 0.5"},
         {kTakesAbsorption, "absorption: [0.1, 0.2, 0.3]"},
         {kTakesCoat, "coat: 0.5"},
-        {kTakesCoat, "coat roughness: 0.5"}};
+        {kTakesCoat, "coat roughness: 0.5"},
+        {kTakesSpecular, "specular: 0.5"},
+        {kTakesSpecular, "specular colour: [2, 1, 0.5]"}};
     TempDir dir;
     for (const SurfaceModelInfo& m : kSurfaceModels) {
         const std::string type = std::string("type: ") + m.name;
@@ -91,6 +93,15 @@ TEST(SurfaceModels, MetallicRoughnessTakesGltfFactorsAndDefaults) {
     EXPECT_EQ(load(", roughness: 0").alpha, kGltfMinAlpha);
     EXPECT_THROW(load(", roughness: 1.5"), SceneError);
     EXPECT_THROW(load(", alpha: 0.5"), SceneError);
+    // KHR_materials_specular's weight and F0 colour: set only where a key is given.
+    EXPECT_EQ(plain.flags & kShaderSpecular, 0u);
+    const ShaderParams specular = load(", specular: 0.5, specular colour: [2, 1, 0.5]");
+    EXPECT_NE(specular.flags & kShaderSpecular, 0u);
+    EXPECT_EQ(specular.specular, 0.5f);
+    EXPECT_EQ(specular.specularColour, vec3(2.0f, 1.0f, 0.5f));
+    const ShaderParams colourOnly = load(", specular colour: [0.5, 0.5, 0.5]");
+    EXPECT_EQ(colourOnly.specular, 1.0f);
+    EXPECT_EQ(load(", specular: 0").specularColour, vec3(1.0f));
 }
 
 } // namespace

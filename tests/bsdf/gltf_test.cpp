@@ -1,7 +1,9 @@
 // MetallicRoughness (shared/gltf.h), glTF 2.0's metallic-roughness material: its sampling
 // against its pdf (chi-square) from dielectric to metal, smooth to rough, at normal, oblique and
 // grazing incidence; the pdf and f |cos| integrated by quadrature; a pure metal is the Conductor
-// bit for bit; energy in a white furnace; closed forms at the narrow-lobe limit.
+// bit for bit; energy in a white furnace; closed forms at the narrow-lobe limit; and
+// KHR_materials_specular's weight and F0 colour (kShaderSpecular): sampled as the pdf says, their
+// defaults glTF's own material to the bit, their F0 at the narrow-lobe limit.
 #include "bsdf_test_util.h"
 
 #include "shared/gltf.h"
@@ -95,6 +97,73 @@ TEST(MetallicRoughness, WhiteFurnaceAndTheNarrowLobeLimits) {
     BsdfUnderTest black = metallicRoughness(0.0f, 0.0f, 0.0);
     black.albedo = vec3(0.0f);
     EXPECT_NEAR(testSampling(black, lobes(black), 50000, 23).fcosIntegral, 0.04, 1e-3);
+}
+
+// metallicRoughness with KHR_materials_specular's weight and F0 colour.
+BsdfUnderTest withSpecular(BsdfUnderTest m, float weight, vec3 colour) {
+    m.sh.flags |= kShaderSpecular;
+    m.sh.specular = weight;
+    m.sh.specularColour = colour;
+    return m;
+}
+
+TEST(MetallicRoughness, WithSpecularSampledDirectionsFollowThePdf) {
+    const float weights[] = {0.0f, 0.4f};
+    const float metallics[] = {0.0f, 0.5f};
+    const float roughnesses[] = {0.2f, 0.7f};
+    const double thetas[] = {0.0, 60.0};
+    const int tests =
+        int(std::size(weights) * std::size(metallics) * std::size(roughnesses) * std::size(thetas));
+    for (float w : weights)
+        for (float metallic : metallics)
+            for (float roughness : roughnesses)
+                for (double theta : thetas) {
+                    const BsdfUnderTest m = withSpecular(
+                        metallicRoughness(metallic, roughness, theta), w, vec3(2.5f, 1.0f, 0.2f));
+                    char name[128];
+                    std::snprintf(name, sizeof name,
+                                  "specular %g, metallic %g, roughness %g, theta %g", w, metallic,
+                                  roughness, theta);
+                    expectSamplingMatchesPdf(
+                        testSampling(m, lobes(m), 200000, 900 + uint(theta + 10 * roughness + w)),
+                        tests, name);
+                }
+}
+
+// specular 1 and colour (1, 1, 1) are glTF's material without the extension, to the bit, in eval
+// and in sample; and a black dielectric reflects min(0.04 c, 1) w at normal incidence (the
+// channels' mean, as testSampling integrates it), nothing at w = 0.
+TEST(MetallicRoughness, SpecularDefaultsChangeNothingAndItsF0IsTheReflectance) {
+    Uniform u(31);
+    for (float metallic : {0.0f, 0.4f, 1.0f})
+        for (double theta : {0.0, 50.0, 88.0}) {
+            const BsdfUnderTest plain = metallicRoughness(metallic, 0.4f, theta);
+            const BsdfUnderTest flagged = withSpecular(plain, 1.0f, vec3(1.0f));
+            for (int k = 0; k < 300; ++k) {
+                const vec3 wi = glm::normalize(u.next3() - vec3(0.5f));
+                float pdfA, pdfB;
+                ASSERT_EQ(bsdfEval(plain.sh, plain.albedo, plain.ng, plain.ns, plain.wo, wi, pdfA),
+                          bsdfEval(flagged.sh, flagged.albedo, flagged.ng, flagged.ns, flagged.wo,
+                                   wi, pdfB));
+                ASSERT_EQ(pdfA, pdfB);
+                const vec3 r = u.next3();
+                vec3 wiA, wiB, wA, wB;
+                bool sA, sB;
+                const bool okA = bsdfSample(plain.sh, plain.albedo, plain.ng, plain.ns, plain.wo, r,
+                                            wiA, wA, pdfA, sA);
+                const bool okB = bsdfSample(flagged.sh, flagged.albedo, flagged.ng, flagged.ns,
+                                            flagged.wo, r, wiB, wB, pdfB, sB);
+                ASSERT_EQ(okA, okB);
+                if (okA) ASSERT_TRUE(wiA == wiB && wA == wB && pdfA == pdfB);
+            }
+        }
+    BsdfUnderTest black =
+        withSpecular(metallicRoughness(0.0f, 0.0f, 0.0), 0.5f, vec3(2.0f, 1.0f, 0.25f));
+    black.albedo = vec3(0.0f);
+    EXPECT_NEAR(testSampling(black, lobes(black), 50000, 32).fcosIntegral,
+                0.5 * (0.08 + 0.04 + 0.01) / 3.0, 1e-3);
+    black.sh.specular = 0.0f;
+    EXPECT_EQ(testSampling(black, lobes(black), 50000, 33).fcosIntegral, 0.0);
 }
 
 } // namespace

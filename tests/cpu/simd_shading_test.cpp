@@ -99,7 +99,9 @@ Fixture makeFixture(std::mt19937& rng, int emitters, bool everyKind = false) {
           Model{kModelDielectric, 0.0f, 1.33f}, Model{kModelMetallicRoughness, 0.3f, 1.5f, 0.5f},
           Model{kModelMetallicRoughness, 0.0f, 1.5f, 0.0f},
           Model{kModelMetallicRoughness, 0.6f, 1.5f, 1.0f},
-          Model{kModelMetallicRoughness, 0.6f, 1.5f, 1.0f, kShaderHitParams}}) {
+          Model{kModelMetallicRoughness, 0.6f, 1.5f, 1.0f, kShaderHitParams},
+          Model{kModelMetallicRoughness, 0.3f, 1.7f, 0.3f, kShaderSpecular},
+          Model{kModelCoatedMetallicRoughness, 0.3f, 1.5f, 0.2f, kShaderSpecular}}) {
         ShaderParams sh{};
         sh.model = m.model;
         sh.colour = vec3(0.8f);
@@ -111,6 +113,8 @@ Fixture makeFixture(std::mt19937& rng, int emitters, bool everyKind = false) {
         sh.absorption = m.absorption;
         sh.coat = 0.7f;
         sh.coatAlpha = 0.01f;
+        sh.specular = 0.6f; // read with kShaderSpecular only
+        sh.specularColour = vec3(1.8f, 1.0f, 0.3f);
         f.shaders.push_back(sh);
     }
     float total = 0.0f;

@@ -7,6 +7,8 @@
 //   * KHR_materials_ior on an opaque material sets its dielectric reflection's F0;
 //   * KHR_materials_clearcoat: a coat of weight c reflects 0.04 c at normal incidence over
 //     the base, which gets the rest;
+//   * KHR_materials_specular: the dielectric reflection's F0 is min(F0(ior) specularColorFactor,
+//     1) specularFactor;
 // and what is not rendered is warned about, and malformed values are refused naming where.
 #include "host/loaders/scene_loader.h"
 #include "scene/gltf_builder.h"
@@ -50,7 +52,8 @@ std::string sphereFile(const TempDir& dir, const json& mat) {
     GltfBuilder b;
     b.doc["materials"] = json::array({mat});
     b.doc["extensionsUsed"] = {"KHR_materials_transmission", "KHR_materials_ior",
-                               "KHR_materials_volume", "KHR_materials_clearcoat"};
+                               "KHR_materials_volume", "KHR_materials_clearcoat",
+                               "KHR_materials_specular"};
     b.doc["cameras"] =
         json::array({{{"type", "perspective"},
                       {"perspective", {{"yfov", 0.6}, {"aspectRatio", 1.0}, {"znear", 0.1}}}}});
@@ -78,6 +81,14 @@ json coated(double coat, double roughness) {
     json m = material(vec3(0.0f), 0.0f, 0.0f);
     m["extensions"]["KHR_materials_clearcoat"] = {{"clearcoatFactor", coat},
                                                   {"clearcoatRoughnessFactor", roughness}};
+    return m;
+}
+
+// A black smooth dielectric with KHR_materials_specular's weight and F0 colour.
+json specular(double weight, std::vector<double> colour) {
+    json m = material(vec3(0.0f), 0.0f, 0.0f);
+    m["extensions"]["KHR_materials_specular"] = {{"specularFactor", weight},
+                                                 {"specularColorFactor", colour}};
     return m;
 }
 
@@ -178,6 +189,14 @@ TEST(GltfGlass, WhatIsNotRenderedIsWarnedAndBadValuesRefused) {
     json iorOnly = material(vec3(1.0f), 0.0f, 0.5f);
     iorOnly["extensions"]["KHR_materials_ior"]["ior"] = 1.7;
     EXPECT_EQ(warnings(iorOnly).second, ""); // an opaque material's F0 (GltfIor.*)
+    json specularImages = specular(0.5, {1.0, 1.0, 1.0});
+    specularImages["extensions"]["KHR_materials_specular"]["specularColorTexture"] = {{"index", 0}};
+    EXPECT_NE(warnings(specularImages).second.find("specularColorTexture is not rendered"),
+              std::string::npos);
+    json specularGlass = glass(1.0, 1.5);
+    specularGlass["extensions"]["KHR_materials_specular"]["specularFactor"] = 0.5;
+    EXPECT_NE(warnings(specularGlass).second.find("KHR_materials_specular on glass"),
+              std::string::npos);
     const struct {
         json mat;
         std::string message;
@@ -197,6 +216,12 @@ TEST(GltfGlass, WhatIsNotRenderedIsWarnedAndBadValuesRefused) {
         {coated(2.0, 0.0), "KHR_materials_clearcoat/clearcoatFactor: must be a number in [0, 1]"},
         {coated(1.0, -0.5),
          "KHR_materials_clearcoat/clearcoatRoughnessFactor: must be a number in [0, 1]"},
+        {specular(1.5, {1.0, 1.0, 1.0}),
+         "KHR_materials_specular/specularFactor: must be a number in [0, 1]"},
+        {specular(1.0, {1.0, -1.0, 1.0}),
+         "KHR_materials_specular/specularColorFactor/1: must be a finite number of at least 0"},
+        {specular(1.0, {1.0, 1.0}),
+         "KHR_materials_specular/specularColorFactor: needs 3 numbers of at least 0"},
     };
     for (const auto& c : bad) {
         try {
@@ -285,6 +310,39 @@ TEST(GltfClearcoat, ACoatReflectsItsWeightTimesItsF0OverTheBase) {
                     << "coat " << coat << ", roughness " << roughness;
             });
         }
+}
+
+// KHR_materials_specular on a black smooth dielectric, in a white furnace: at the centre of the
+// view the sphere reflects its F0, min(0.04 c, 1) w per channel for specularColorFactor c and
+// specularFactor w: 0.5 (0.08, 0.04, 0.01) for c = (2, 1, 0.25), w = 0.5; nothing at w = 0 (a
+// purely diffuse, black material); and 1 where 0.04 c passes 1 (F0 1 is a mirror of the
+// environment, whatever the angle: the whole image is 1). The defaults (w 1, c 1) leave glTF's
+// own material, without kShaderSpecular. On every backend.
+TEST(GltfSpecular, TheWeightAndColourSetTheReflectionAtNormalIncidence) {
+    TempDir dir;
+    const Scene plain = loadScene(sphereFile(dir, specular(1.0, {1.0, 1.0, 1.0})));
+    EXPECT_EQ(plain.shaders.at(0).params.flags & kShaderSpecular, 0u);
+    const struct {
+        double weight;
+        std::vector<double> colour;
+        vec3 expected;
+    } cases[] = {{0.5, {2.0, 1.0, 0.25}, vec3(0.04f, 0.02f, 0.005f)},
+                 {0.0, {1.0, 1.0, 1.0}, vec3(0.0f)},
+                 {1.0, {40.0, 40.0, 40.0}, vec3(1.0f)}};
+    for (const auto& c : cases) {
+        const Scene scene = loadScene(sphereFile(dir, specular(c.weight, c.colour)));
+        const ShaderParams& sh = scene.shaders.at(0).params;
+        ASSERT_EQ(sh.model, kModelMetallicRoughness);
+        EXPECT_NE(sh.flags & kShaderSpecular, 0u);
+        EXPECT_EQ(sh.specular, float(c.weight));
+        EXPECT_TRUE(scene.warnings.empty()) << scene.warnings.at(0);
+        onEveryBackend(scene, [&](const std::vector<float>& img) {
+            const vec3 v = centre(img);
+            for (int k = 0; k < 3; ++k)
+                EXPECT_NEAR(v[k], c.expected[k], 0.03 * c.expected[k] + 1e-4)
+                    << "channel " << k << ", weight " << c.weight;
+        });
+    }
 }
 
 } // namespace

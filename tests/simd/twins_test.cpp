@@ -94,6 +94,22 @@ struct Inputs {
         for (float& m : lanes.f[row].v)
             m = rng() % 4 == 0 ? 0.0f : rng() % 3 == 0 ? 1.0f : unit();
     }
+    // glTF's F90: 1 (no KHR_materials_specular), 0 and between.
+    void setF90(int row) {
+        for (float& x : lanes.f[row].v)
+            x = rng() % 3 == 0 ? 1.0f : rng() % 4 == 0 ? 0.0f : unit();
+    }
+    // The dielectric part's F0 colour (rows row to row + 2) and F90 (row + 3): an ior's grey F0
+    // with F90 1, as without KHR_materials_specular, or a coloured F0 times a weight.
+    void setDielectricF0(int row) {
+        for (size_t k = 0; k < kLanes; ++k) {
+            const float f0 = 0.3f * unit();
+            const bool plain = rng() % 2 == 0;
+            const float w = plain ? 1.0f : unit();
+            set3(row, k, plain ? vec3(f0) : w * min(vec3(unit(), unit(), unit()), vec3(1.0f)));
+            lanes.f[row + 3].v[k] = w;
+        }
+    }
     void setRange(int row, float lo, float hi) {
         for (float& x : lanes.f[row].v)
             x = std::uniform_real_distribution<float>(lo, hi)(rng);
@@ -336,41 +352,49 @@ const std::map<Twin, ScalarSide>& scalarSides() {
                   vec3(in.f(11, k), in.f(12, k), in.f(13, k)), wi, weight, pdf, specular);
               putSample(e, ok, specular, wi, weight, pdf);
           }}},
+        {Twin::gltfFresnel,
+         {[](Inputs& in) {
+              in.setUnit(0), in.setUnit(1), in.setUnit(2), in.setF90(3);
+              in.setRange(4, -0.2f, 1.2f);
+          },
+          [](const Inputs& in, size_t k, Expected& e) {
+              e.put(gltfFresnel(in.get3(0, k), in.f(3, k), in.f(4, k)));
+          }}},
         {Twin::gltfSpecularProbability,
          {[](Inputs& in) {
               for (int row = 0; row < 6; ++row)
                   in.setUnit(row);
-              in.setRange(6, 0.0f, 1.0f);
+              in.setRange(6, 0.0f, 1.0f), in.setF90(7);
               in.lanes.f[3].v[0] = in.lanes.f[4].v[0] = in.lanes.f[5].v[0] = 0.0f; // no diffuse
           },
           [](const Inputs& in, size_t k, Expected& e) {
-              e.put(gltfSpecularProbability(in.get3(0, k), in.get3(3, k), in.f(6, k)));
+              e.put(gltfSpecularProbability(in.get3(0, k), in.f(7, k), in.get3(3, k), in.f(6, k)));
           }}},
         {Twin::gltfEval,
          {[](Inputs& in) {
               in.setUnit(0), in.setUnit(1), in.setUnit(2), in.setMetallic(3), in.setAlpha(4);
               in.setNormals(5, 8), in.setAbove(11, 5), in.setAbove(14, 5);
-              in.setRange(17, 0.0f, 0.3f);
+              in.setDielectricF0(17);
           },
           [](const Inputs& in, size_t k, Expected& e) {
               float pdf;
-              e.put(gltfEval(in.get3(0, k), in.f(3, k), in.f(4, k), in.f(17, k), in.get3(5, k),
-                             in.get3(8, k), in.get3(11, k), in.get3(14, k), pdf));
+              e.put(gltfEval(in.get3(0, k), in.f(3, k), in.f(4, k), in.get3(17, k), in.f(20, k),
+                             in.get3(5, k), in.get3(8, k), in.get3(11, k), in.get3(14, k), pdf));
               e.put(pdf);
           }}},
         {Twin::gltfSample,
          {[](Inputs& in) {
               in.setUnit(0), in.setUnit(1), in.setUnit(2), in.setMetallic(3), in.setAlpha(4);
               in.setNormals(5, 8), in.setAbove(11, 5);
-              in.setUnit(14), in.setUnit(15), in.setUnit(16), in.setRange(17, 0.0f, 0.3f);
+              in.setUnit(14), in.setUnit(15), in.setUnit(16), in.setDielectricF0(17);
           },
           [](const Inputs& in, size_t k, Expected& e) {
               // Unwritten where the sample fails: putSample reads them only where it does not.
               vec3 wi(0.0f), weight(0.0f);
               float pdf = 0.0f;
               bool specular = false;
-              const bool ok = gltfSample(in.get3(0, k), in.f(3, k), in.f(4, k), in.f(17, k),
-                                         in.get3(5, k), in.get3(8, k), in.get3(11, k),
+              const bool ok = gltfSample(in.get3(0, k), in.f(3, k), in.f(4, k), in.get3(17, k),
+                                         in.f(20, k), in.get3(5, k), in.get3(8, k), in.get3(11, k),
                                          vec3(in.f(14, k), in.f(15, k), in.f(16, k)), wi, weight,
                                          pdf, specular);
               putSample(e, ok, specular, wi, weight, pdf);
