@@ -391,6 +391,14 @@ def make_test_files(out):
                                                       "specularColorFactor": [1.0, 1.0, 1.0]}}
     write_glb(os.path.join(out, "ior.glb"), [s + (0,), f + (1,)], [shiny, grey],
               extensions=["KHR_materials_ior", "KHR_materials_specular"])
+    # Half glass: the glass sphere transmitting half of the light over a pale green opaque base
+    # (KHR_materials_transmission 0.5), before the checker panel.
+    half = material((0.6, 0.9, 0.6), 0.0, 0.0)
+    half["extensions"] = {"KHR_materials_transmission": {"transmissionFactor": 0.5},
+                          "KHR_materials_ior": {"ior": 1.5}}
+    write_glb(os.path.join(out, "half-glass.glb"), [s + (0,), (pos, nor, idx, whole, 1)],
+              [half, second_uv0], images=textured_images()[:1],
+              extensions=["KHR_materials_transmission", "KHR_materials_ior"])
     # A dark blue glossy plastic whose KHR_materials_specular raises its F0 to 0.1 (2.5 x glTF's
     # 0.04), as Blender 3.4's exporter writes a Principled BSDF's specular of 1.25: its importer
     # reads the colour's luminance back into that specular (and ignores specularFactor, left 1).
@@ -418,7 +426,7 @@ def make_test_files(out):
                           "KHR_materials_volume"])
     return sorted(os.path.join(out, n) for n in list(files) + [
         "textured.glb", "emissive.glb", "uv-sets.glb", "terminator.glb", "blend.glb",
-        "glass.glb", "ior.glb", "specular.glb", "clearcoat.glb", "tinted-glass.glb"])
+        "glass.glb", "half-glass.glb", "ior.glb", "specular.glb", "clearcoat.glb", "tinted-glass.glb"])
 
 
 # The suite's bound (docs/scene-format.md, "glTF files", says why): relMSE and each channel's

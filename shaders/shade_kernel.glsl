@@ -89,7 +89,7 @@ ShaderParams kernelShader(uint i) {
     s.coatAlpha = uintBitsToFloat(w4.x);
     s.specularColour = uintBitsToFloat(w4.yzw);
     s.specular = uintBitsToFloat(w5.x);
-    s.pad0 = w5.y;
+    s.transmission = uintBitsToFloat(w5.y);
     s.pad1 = w5.z;
     s.pad2 = w5.w;
 #ifdef SPW_KERNEL_MODEL

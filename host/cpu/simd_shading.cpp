@@ -473,7 +473,8 @@ const WideTwin kWideTwins[] = {
     {kModelConductor, "ShadeConductorLanes"},
     {kModelDielectric, "ShadeDielectricLanes"},
     {kModelMetallicRoughness, "ShadeMetallicRoughnessLanes"},
-    {kModelCoatedMetallicRoughness, nullptr}, // shadeSurfaceWith, one hit at a time
+    {kModelCoatedMetallicRoughness, nullptr},       // shadeSurfaceWith, one hit at a time
+    {kModelTransmissiveMetallicRoughness, nullptr}, // as CoatedMetallicRoughness
 };
 static_assert(sizeof(kWideTwins) / sizeof(kWideTwins[0]) == kModelCount,
               "every registered surface model names its wide twin, or nullptr for none");

@@ -177,16 +177,18 @@ void GltfReader::readTransmission(const tinygltf::Material& mat, Shader& s, cons
         warn(name + ": KHR_materials_ior's ior 0 is rendered as 1.5");
     s.params.ior = float(ior == 0.0 ? 1.5 : ior);
     if (factor == 0.0) return;
-    if (factor < 1.0 || s.params.metallic > 0.0f || s.metallicRoughnessTexture >= 0) {
-        warn(name + ": transmission is rendered only at transmissionFactor 1 on a dielectric "
-                    "(metallicFactor 0, no metallic-roughness image): drawn opaque");
+    if (s.params.metallic > 0.0f || s.metallicRoughnessTexture >= 0) {
+        warn(name + ": transmission is rendered only on a dielectric (metallicFactor 0, no "
+                    "metallic-roughness image): drawn opaque");
         return;
     }
     if (ior > 0.0 && ior < kMinGlassIor)
         warn(name + ": an ior below " + number(kMinGlassIor) + " is rendered as " +
              number(kMinGlassIor));
-    s.typeName = "Dielectric";
-    s.params.model = kModelDielectric;
+    // Below 1, glass mixed with the opaque material (shared/transmission.h).
+    s.typeName = factor < 1.0 ? "TransmissiveMetallicRoughness" : "Dielectric";
+    s.params.model = factor < 1.0 ? kModelTransmissiveMetallicRoughness : kModelDielectric;
+    s.params.transmission = float(factor);
     s.params.ior = float(ior == 0.0 ? 1.5 : std::max(ior, kMinGlassIor));
     s.params.alpha = s.roughness * s.roughness; // below kGgxSmoothAlpha: smooth glass
     // The base colour (its factor, image and vertex colours) tints what the glass refracts.
@@ -215,7 +217,9 @@ void GltfReader::readVolume(const tinygltf::Material& mat, Shader& s, const std:
     }
     if (v->second.Has("thicknessTexture"))
         warn(name + ": its thicknessTexture is not read (the mesh's own thickness is rendered)");
-    if (s.params.model != kModelDielectric || !std::isfinite(distance) || colour == vec3(1.0f))
+    const bool transmits =
+        s.params.model == kModelDielectric || s.params.model == kModelTransmissiveMetallicRoughness;
+    if (!transmits || !std::isfinite(distance) || colour == vec3(1.0f))
         return; // nothing absorbs: the volume of an opaque material is never entered
     if (thickness == 0.0) {
         warn(name + ": KHR_materials_volume's thicknessFactor 0 makes it thin-walled: its "
@@ -273,7 +277,8 @@ void GltfReader::readSpecular(const tinygltf::Material& mat, Shader& s, const st
         if (e->second.Has(image))
             warn(name + ": its " + image + " is not rendered (the factor alone is)");
     if (factor == 1.0 && colour == vec3(1.0f)) return; // the defaults: glTF's own reflection
-    if (s.params.model == kModelDielectric) {
+    if (s.params.model == kModelDielectric ||
+        s.params.model == kModelTransmissiveMetallicRoughness) {
         warn(name + ": KHR_materials_specular on glass is not rendered (its reflection follows "
                     "the ior alone)");
         return;

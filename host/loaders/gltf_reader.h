@@ -131,12 +131,14 @@ class GltfReader {
     // (transmissionFactor 1) and is no metal is glass, a Dielectric of that ior (1.5) and GGX
     // alpha roughness^2 (smooth below kGgxSmoothAlpha), as Blender's importer and Cycles render
     // it: a refracting solid, not the specification's thin wall, its base colour tinting what it
-    // refracts. Anything else is warned about and drawn opaque.
+    // refracts. Transmitting part of it (0 < transmissionFactor < 1), a
+    // TransmissiveMetallicRoughness: that glass mixed with the opaque material by the factor
+    // (shared/transmission.h). On a metal it is warned about and drawn opaque.
     void readTransmission(const tinygltf::Material& mat, Shader& s, const std::string& at,
                           const std::string& name);
-    // KHR_materials_volume on glass: attenuationColor left after attenuationDistance, as the
-    // medium's absorption coefficient -ln(colour) / distance (ShaderParams::absorption).
-    // thicknessFactor 0 (thin-walled) absorbs nothing, and says so.
+    // KHR_materials_volume on glass, whole or partial: attenuationColor left after
+    // attenuationDistance, as the medium's absorption coefficient -ln(colour) / distance
+    // (ShaderParams::absorption). thicknessFactor 0 (thin-walled) absorbs nothing, and says so.
     void readVolume(const tinygltf::Material& mat, Shader& s, const std::string& at,
                     const std::string& name);
     // KHR_materials_clearcoat: a material with a coat of weight clearcoatFactor > 0 is a

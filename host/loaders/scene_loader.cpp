@@ -140,11 +140,18 @@ class TextureReader {
 // The metallic-roughness models' keys (shared/gltf.h, shared/clearcoat.h), and the Dielectric's
 // absorption.
 void readGltfParams(const Reader& rd, const YAML::Node& n, uint takes, ShaderParams& p) {
-    if (takes & kTakesMetallic) {
+    if (takes & kTakesMetallic)
         p.metallic = n["metallic"] ? float(rd.number(n["metallic"], "metallic", 0.0, 1.0)) : 1.0f;
-        p.alpha = gltfAlpha(n["roughness"] ? float(rd.number(n["roughness"], "roughness", 0.0, 1.0))
-                                           : 1.0f);
+    if (takes & kTakesRoughness) {
+        const float r =
+            n["roughness"] ? float(rd.number(n["roughness"], "roughness", 0.0, 1.0)) : 1.0f;
+        // The transmissive model's glass takes alpha as it is (smooth below kGgxSmoothAlpha).
+        p.alpha = takes & kTakesTransmission ? r * r : gltfAlpha(r);
     }
+    if (takes & kTakesTransmission)
+        p.transmission = n["transmission"]
+                             ? float(rd.number(n["transmission"], "transmission", 0.0, 1.0))
+                             : 1.0f;
     if (n["absorption"]) p.absorption = rd.vec<3>(n["absorption"], "absorption", 0.0, 1e30);
     if (takes & kTakesCoat) {
         p.coat = n["coat"] ? float(rd.number(n["coat"], "coat", 0.0, 1.0)) : 1.0f;
@@ -191,7 +198,8 @@ void readShader(const Reader& rd, const YAML::Node& n, TextureReader& textures, 
                             {kTakesCoat, "coat"},
                             {kTakesCoat, "coat roughness"},
                             {kTakesSpecular, "specular"},
-                            {kTakesSpecular, "specular colour"}})
+                            {kTakesSpecular, "specular colour"},
+                            {kTakesTransmission, "transmission"}})
         if (takes & bit) keys.push_back(key);
     rd.checkKeys(n, t + " shader", keys);
     if (t == "Emissive" && !n["emission"]) rd.fail(n, "Emissive shader needs 'emission'");

@@ -12,7 +12,8 @@ static_assert(offsetof(ShaderParams, model) == 12 && offsetof(ShaderParams, flag
                   offsetof(ShaderParams, absorption) == 48 && offsetof(ShaderParams, coat) == 60 &&
                   offsetof(ShaderParams, coatAlpha) == 64 &&
                   offsetof(ShaderParams, specularColour) == 68 &&
-                  offsetof(ShaderParams, specular) == 80,
+                  offsetof(ShaderParams, specular) == 80 &&
+                  offsetof(ShaderParams, transmission) == 84,
               "ShaderParams layout");
 static_assert(sizeof(Emitter) == 80, "Emitter layout changed");
 static_assert(offsetof(Emitter, normal) == 48 && offsetof(Emitter, type) == 60 &&

@@ -91,14 +91,13 @@ SHARED_FN vec3 terminatorEval(ShaderParams sh, SurfaceHit hit, vec3 wo, vec3 wi,
 }
 
 // The path's state at a hit, its throughput attenuated by the medium the ray crossed: a ray that
-// reaches a Dielectric from behind (the side its geometric normal points away from) travelled
-// hit.t inside that surface's medium, which passes exp(-absorption t) (Beer-Lambert). A medium
-// is known by the surface that bounds it: a surface inside it (nested media) is reached without
-// the attenuation. A clear medium (absorption 0) leaves beta as it was, to the bit.
-// host/cpu/simd_shading.cpp's fillLane calls it per lane.
+// reaches a surface with an absorption (a Dielectric, a TransmissiveMetallicRoughness) from behind
+// (the side its geometric normal points away from) travelled hit.t inside that surface's medium,
+// which passes exp(-absorption t) (Beer-Lambert). A medium is known by the surface that bounds it:
+// a surface inside it (nested media) is reached without the attenuation. A clear medium (absorption
+// 0) leaves beta as it was, to the bit. host/cpu/simd_shading.cpp's fillLane calls it per lane.
 SHARED_FN PathState throughMedium(ShaderParams sh, SurfaceHit hit, vec3 wo, PathState st) {
-    if (sh.model == kModelDielectric && dot(hit.ng, wo) < 0.0f &&
-        maxComponent(sh.absorption) > 0.0f)
+    if (dot(hit.ng, wo) < 0.0f && maxComponent(sh.absorption) > 0.0f)
         st.beta = st.beta * exp(-sh.absorption * hit.t);
     return st;
 }

@@ -28,6 +28,9 @@
       kTakesColour | kTakesTexture | kTakesMetallic | kTakesRoughness | kTakesSpecular)            \
     X(CoatedMetallicRoughness, 5u, clearcoat,                                                      \
       kTakesColour | kTakesTexture | kTakesMetallic | kTakesRoughness | kTakesCoat |               \
-          kTakesSpecular)
+          kTakesSpecular)                                                                          \
+    X(TransmissiveMetallicRoughness, 6u, transmission,                                             \
+      kTakesColour | kTakesTexture | kTakesRoughness | kTakesIor | kTakesAbsorption |              \
+          kTakesTransmission)
 
 #endif

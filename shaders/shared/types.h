@@ -43,7 +43,7 @@ struct ShaderParams {
     // without the flag, (1, 1, 1) and 1.
     vec3 specularColour;
     float specular;
-    uint pad0;
+    float transmission; // TransmissiveMetallicRoughness: the glass lobe's weight in [0, 1]
     uint pad1;
     uint pad2;
 };

@@ -57,7 +57,8 @@ TEST(SurfaceModels, TheLoaderTakesEachModelWithExactlyItsRegisteredKeys) {
         {kTakesCoat, "coat: 0.5"},
         {kTakesCoat, "coat roughness: 0.5"},
         {kTakesSpecular, "specular: 0.5"},
-        {kTakesSpecular, "specular colour: [2, 1, 0.5]"}};
+        {kTakesSpecular, "specular colour: [2, 1, 0.5]"},
+        {kTakesTransmission, "transmission: 0.5"}};
     TempDir dir;
     for (const SurfaceModelInfo& m : kSurfaceModels) {
         const std::string type = std::string("type: ") + m.name;
@@ -102,6 +103,26 @@ TEST(SurfaceModels, MetallicRoughnessTakesGltfFactorsAndDefaults) {
     const ShaderParams colourOnly = load(", specular colour: [0.5, 0.5, 0.5]");
     EXPECT_EQ(colourOnly.specular, 1.0f);
     EXPECT_EQ(load(", specular: 0").specularColour, vec3(1.0f));
+}
+
+// The transmissive model's roughness is its glass's: alpha = roughness^2 unfloored (smooth glass
+// at 0; the opaque part floors it itself); transmission defaults to 1.
+TEST(SurfaceModels, TransmissiveMetallicRoughnessTakesItsGlassAlphaAndTransmission) {
+    TempDir dir;
+    const auto load = [&](const std::string& keys) {
+        return loadScene(
+                   dir.write("s.yaml", shaderScene("type: TransmissiveMetallicRoughness" + keys)))
+            .shaders.at(0)
+            .params;
+    };
+    EXPECT_EQ(load("").transmission, 1.0f);
+    EXPECT_EQ(load("").alpha, 1.0f);
+    const ShaderParams set = load(", roughness: 0, transmission: 0.25, ior: 1.33");
+    EXPECT_EQ(set.alpha, 0.0f);
+    EXPECT_EQ(set.transmission, 0.25f);
+    EXPECT_EQ(set.ior, 1.33f);
+    EXPECT_THROW(load(", transmission: 1.5"), SceneError);
+    EXPECT_THROW(load(", metallic: 0.5"), SceneError);
 }
 
 } // namespace

@@ -574,6 +574,8 @@ const ErrorCase kErrorCases[] = {
     {"DielectricNegativeAbsorption", "shader:\n  type: Dielectric\n  absorption: [1, -1, 1]\n", 3,
      "absorption"},
     {"CoatAboveOne", "shader:\n  type: CoatedMetallicRoughness\n  coat: 1.5\n", 3, "coat"},
+    {"TransmissionBelowZero",
+     "shader:\n  type: TransmissiveMetallicRoughness\n  transmission: -0.5\n", 3, "transmission"},
     {"SpecularAboveOne", "shader:\n  type: MetallicRoughness\n  specular: 1.5\n", 3, "specular"},
     {"SpecularColourNegative",
      "shader:\n  type: MetallicRoughness\n  specular colour: [1, -1, 1]\n", 3, "specular colour"},

@@ -40,7 +40,7 @@ const Fields kShaderParams = {
     SPW_FIELD(ShaderParams, alpha),      SPW_FIELD(ShaderParams, metallic),
     SPW_FIELD(ShaderParams, absorption), SPW_FIELD(ShaderParams, coat),
     SPW_FIELD(ShaderParams, coatAlpha),  SPW_FIELD(ShaderParams, specularColour),
-    SPW_FIELD(ShaderParams, specular),   SPW_FIELD(ShaderParams, pad0),
+    SPW_FIELD(ShaderParams, specular),   SPW_FIELD(ShaderParams, transmission),
     SPW_FIELD(ShaderParams, pad1),       SPW_FIELD(ShaderParams, pad2)};
 const Fields kEmitter = {SPW_FIELD(Emitter, p0),       SPW_FIELD(Emitter, area),
                          SPW_FIELD(Emitter, e1),       SPW_FIELD(Emitter, pickPdf),
