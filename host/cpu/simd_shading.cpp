@@ -475,6 +475,7 @@ const WideTwin kWideTwins[] = {
     {kModelMetallicRoughness, "ShadeMetallicRoughnessLanes"},
     {kModelCoatedMetallicRoughness, nullptr},       // shadeSurfaceWith, one hit at a time
     {kModelTransmissiveMetallicRoughness, nullptr}, // as CoatedMetallicRoughness
+    {kModelSheenMetallicRoughness, nullptr},        // as CoatedMetallicRoughness
 };
 static_assert(sizeof(kWideTwins) / sizeof(kWideTwins[0]) == kModelCount,
               "every registered surface model names its wide twin, or nullptr for none");

@@ -30,9 +30,9 @@ namespace {
 
 // The extensions this loader honours: a file may require them.
 const std::set<std::string> kHonoured = {
-    "KHR_lights_punctual",  "KHR_materials_clearcoat", "KHR_materials_emissive_strength",
-    "KHR_materials_ior",    "KHR_materials_specular",  "KHR_materials_transmission",
-    "KHR_materials_volume", "KHR_texture_transform"};
+    "KHR_lights_punctual",        "KHR_materials_clearcoat", "KHR_materials_emissive_strength",
+    "KHR_materials_ior",          "KHR_materials_sheen",     "KHR_materials_specular",
+    "KHR_materials_transmission", "KHR_materials_volume",    "KHR_texture_transform"};
 
 // The image of a `spillway render model.glb` without an aspect ratio: 640 pixels wide.
 constexpr int kDefaultWidth = 640;

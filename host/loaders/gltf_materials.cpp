@@ -96,6 +96,7 @@ Shader GltfReader::readMaterial(int index) {
     readVolume(mat, s, at, name);
     readClearcoat(mat, s, at, name);
     readSpecular(mat, s, at, name);
+    readSheen(mat, s, at, name);
     if (mat.alphaMode != "OPAQUE" && mat.alphaMode != "MASK" && mat.alphaMode != "BLEND")
         fail(at + "/alphaMode", "must be OPAQUE, MASK or BLEND");
     readEmission(mat, s, at, name);
@@ -286,6 +287,37 @@ void GltfReader::readSpecular(const tinygltf::Material& mat, Shader& s, const st
     s.params.flags |= kShaderSpecular;
     s.params.specular = float(factor);
     s.params.specularColour = colour;
+}
+
+void GltfReader::readSheen(const tinygltf::Material& mat, Shader& s, const std::string& at,
+                           const std::string& name) {
+    const auto e = mat.extensions.find("KHR_materials_sheen");
+    if (e == mat.extensions.end()) return;
+    const std::string where = at + "/extensions/KHR_materials_sheen";
+    vec3 colour(0.0f);
+    if (e->second.Has("sheenColorFactor")) {
+        const tinygltf::Value& c = e->second.Get("sheenColorFactor");
+        if (!c.IsArray() || c.ArrayLen() != 3)
+            fail(where + "/sheenColorFactor", "needs 3 numbers in [0, 1]");
+        for (int k = 0; k < 3; ++k)
+            colour[k] = float(extensionNumber(c, k, 0.0, 1.0, where + "/sheenColorFactor"));
+    }
+    const double roughness =
+        extensionNumber(e->second, "sheenRoughnessFactor", 0.0, 0.0, 1.0, where);
+    for (const char* image : {"sheenColorTexture", "sheenRoughnessTexture"})
+        if (e->second.Has(image))
+            warn(name + ": its " + image + " is not rendered (the factor alone is)");
+    if (colour == vec3(0.0f)) return;
+    if (s.params.model != kModelMetallicRoughness) {
+        warn(name + ": a sheen on " +
+             (s.params.model == kModelCoatedMetallicRoughness ? "a clear coat" : "glass") +
+             " is not rendered");
+        return;
+    }
+    s.typeName = "SheenMetallicRoughness";
+    s.params.model = kModelSheenMetallicRoughness;
+    s.params.sheenColour = colour;
+    s.params.sheenRoughness = float(roughness);
 }
 
 void GltfReader::readEmission(const tinygltf::Material& mat, Shader& s, const std::string& at,

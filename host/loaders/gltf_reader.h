@@ -144,6 +144,10 @@ class GltfReader {
     // KHR_materials_clearcoat: a material with a coat of weight clearcoatFactor > 0 is a
     // CoatedMetallicRoughness shader (shared/clearcoat.h), its coat's GGX alpha
     // clearcoatRoughnessFactor^2; the coat's images are warned about and not rendered.
+    // KHR_materials_sheen: a material with a sheen of colour above 0 is a SheenMetallicRoughness
+    // shader (shared/sheen.h); the sheen's images are warned about and not rendered.
+    void readSheen(const tinygltf::Material& mat, Shader& s, const std::string& at,
+                   const std::string& name);
     // KHR_materials_specular: the dielectric reflection's weight and F0 colour (factors only).
     void readSpecular(const tinygltf::Material& mat, Shader& s, const std::string& at,
                       const std::string& name);

@@ -159,6 +159,13 @@ void readGltfParams(const Reader& rd, const YAML::Node& n, uint takes, ShaderPar
             n["coat roughness"] ? float(rd.number(n["coat roughness"], "coat roughness", 0.0, 1.0))
                                 : 0.0f);
     }
+    if (takes & kTakesSheen) {
+        p.sheenColour =
+            n["sheen colour"] ? rd.vec<3>(n["sheen colour"], "sheen colour", 0.0, 1.0) : vec3(1.0f);
+        p.sheenRoughness = n["sheen roughness"]
+                               ? float(rd.number(n["sheen roughness"], "sheen roughness", 0.0, 1.0))
+                               : 0.5f;
+    }
     if (n["specular"] || n["specular colour"]) {
         p.flags |= kShaderSpecular;
         p.specular = n["specular"] ? float(rd.number(n["specular"], "specular", 0.0, 1.0)) : 1.0f;
@@ -199,7 +206,9 @@ void readShader(const Reader& rd, const YAML::Node& n, TextureReader& textures, 
                             {kTakesCoat, "coat roughness"},
                             {kTakesSpecular, "specular"},
                             {kTakesSpecular, "specular colour"},
-                            {kTakesTransmission, "transmission"}})
+                            {kTakesTransmission, "transmission"},
+                            {kTakesSheen, "sheen colour"},
+                            {kTakesSheen, "sheen roughness"}})
         if (takes & bit) keys.push_back(key);
     rd.checkKeys(n, t + " shader", keys);
     if (t == "Emissive" && !n["emission"]) rd.fail(n, "Emissive shader needs 'emission'");

@@ -33,6 +33,8 @@ enum SurfaceParam : uint {
                                    // weight and F0 colour (KHR_materials_specular, shared/gltf.h)
     kTakesTransmission = 1u << 10, // transmission (1) in [0, 1]: the weight of the glass lobe
                                    // against the opaque one (shared/transmission.h)
+    kTakesSheen = 1u << 11,        // sheen colour [r, g, b] ([1, 1, 1], each in [0, 1]) and sheen
+                            // roughness (0.5) in [0, 1] (KHR_materials_sheen, shared/sheen.h)
 };
 
 struct SurfaceModelInfo {

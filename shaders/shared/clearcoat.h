@@ -32,9 +32,7 @@ SHARED_FN float gltfCoatFresnel(float coat, float cosO) {
 SHARED_FN float gltfCoatProbability(vec3 colour, float metallic, vec3 f0d, float f90d, float fc,
                                     float cosO) {
     if (!(fc > 0.0f)) return 0.0f;
-    vec3 F = gltfFresnel(gltfF0(f0d, colour, metallic), gltfF90(f90d, metallic), cosO);
-    vec3 d = colour * (1.0f - metallic) * (vec3(1.0f) - F);
-    float base = (F.x + F.y + F.z + d.x + d.y + d.z) / 3.0f;
+    float base = gltfLobesWeight(colour, metallic, f0d, f90d, cosO);
     return clamp(fc / (fc + (1.0f - fc) * base), 0.1f, 0.9f);
 }
 

@@ -71,6 +71,15 @@ SHARED_FN float gltfF90(float f90d, float metallic) {
     return 1.0f - (1.0f - f90d) * (1.0f - metallic);
 }
 
+// What the material's lobes reflect in all seen from wo at cosine cosO to the shading normal (the
+// channels' mean of F + c_diff (1 - F)): the weight a layer over it (a clear coat, a sheen)
+// samples its own lobe against.
+SHARED_FN float gltfLobesWeight(vec3 colour, float metallic, vec3 f0d, float f90d, float cosO) {
+    vec3 F = gltfFresnel(gltfF0(f0d, colour, metallic), gltfF90(f90d, metallic), cosO);
+    vec3 d = colour * (1.0f - metallic) * (vec3(1.0f) - F);
+    return (F.x + F.y + F.z + d.x + d.y + d.z) / 3.0f;
+}
+
 // GGX alpha from glTF's perceptual roughness.
 SHARED_FN float gltfAlpha(float roughness) {
     return max(roughness * roughness, kGltfMinAlpha);

@@ -31,6 +31,9 @@
           kTakesSpecular)                                                                          \
     X(TransmissiveMetallicRoughness, 6u, transmission,                                             \
       kTakesColour | kTakesTexture | kTakesRoughness | kTakesIor | kTakesAbsorption |              \
-          kTakesTransmission)
+          kTakesTransmission)                                                                      \
+    X(SheenMetallicRoughness, 7u, sheen,                                                           \
+      kTakesColour | kTakesTexture | kTakesMetallic | kTakesRoughness | kTakesSpecular |           \
+          kTakesSheen)
 
 #endif

@@ -43,9 +43,11 @@ struct ShaderParams {
     // without the flag, (1, 1, 1) and 1.
     vec3 specularColour;
     float specular;
-    float transmission; // TransmissiveMetallicRoughness: the glass lobe's weight in [0, 1]
+    float transmission;   // TransmissiveMetallicRoughness: the glass lobe's weight in [0, 1]
+    float sheenRoughness; // SheenMetallicRoughness: the sheen's perceptual roughness
+    uint pad0;
+    vec3 sheenColour; // SheenMetallicRoughness: the sheen's colour (KHR_materials_sheen)
     uint pad1;
-    uint pad2;
 };
 
 // What next-event estimation picks, with probability pickPdf, proportional to its power

@@ -58,7 +58,9 @@ TEST(SurfaceModels, TheLoaderTakesEachModelWithExactlyItsRegisteredKeys) {
         {kTakesCoat, "coat roughness: 0.5"},
         {kTakesSpecular, "specular: 0.5"},
         {kTakesSpecular, "specular colour: [2, 1, 0.5]"},
-        {kTakesTransmission, "transmission: 0.5"}};
+        {kTakesTransmission, "transmission: 0.5"},
+        {kTakesSheen, "sheen colour: [1, 0.5, 0.2]"},
+        {kTakesSheen, "sheen roughness: 0.3"}};
     TempDir dir;
     for (const SurfaceModelInfo& m : kSurfaceModels) {
         const std::string type = std::string("type: ") + m.name;

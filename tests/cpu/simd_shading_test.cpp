@@ -90,20 +90,26 @@ Fixture makeFixture(std::mt19937& rng, int emitters, bool everyKind = false) {
         vec3 absorption{0.0f}; // Dielectric: the medium behind it absorbs
     };
     for (Model m :
-         {Model{kModelLambert, 0.0f, 1.5f}, Model{kModelLambert, 0.0f, 1.5f},
-          Model{kModelConductor, 0.3f, 1.5f}, Model{kModelLambert, 0.0f, 1.5f},
-          Model{kModelNull, 0.0f, 1.5f}, Model{kModelConductor, 0.0f, 1.5f},
-          Model{kModelDielectric, 0.2f, 1.5f}, Model{kModelConductor, 1e-3f, 1.5f},
+         {Model{kModelLambert, 0.0f, 1.5f},
+          Model{kModelLambert, 0.0f, 1.5f},
+          Model{kModelConductor, 0.3f, 1.5f},
+          Model{kModelLambert, 0.0f, 1.5f},
+          Model{kModelNull, 0.0f, 1.5f},
+          Model{kModelConductor, 0.0f, 1.5f},
+          Model{kModelDielectric, 0.2f, 1.5f},
+          Model{kModelConductor, 1e-3f, 1.5f},
           Model{kModelDielectric, 0.0f, 1.5f, 1.0f, 0u, vec3(0.7f, 0.1f, 0.0f)},
           Model{kModelCoatedMetallicRoughness, 0.3f, 1.5f, 0.5f},
-          Model{kModelDielectric, 0.0f, 1.33f}, Model{kModelMetallicRoughness, 0.3f, 1.5f, 0.5f},
+          Model{kModelDielectric, 0.0f, 1.33f},
+          Model{kModelMetallicRoughness, 0.3f, 1.5f, 0.5f},
           Model{kModelMetallicRoughness, 0.0f, 1.5f, 0.0f},
           Model{kModelMetallicRoughness, 0.6f, 1.5f, 1.0f},
           Model{kModelMetallicRoughness, 0.6f, 1.5f, 1.0f, kShaderHitParams},
           Model{kModelMetallicRoughness, 0.3f, 1.7f, 0.3f, kShaderSpecular},
           Model{kModelCoatedMetallicRoughness, 0.3f, 1.5f, 0.2f, kShaderSpecular},
           Model{kModelTransmissiveMetallicRoughness, 0.0f, 1.5f, 0.0f, 0u, vec3(0.5f, 0.1f, 0.0f)},
-          Model{kModelTransmissiveMetallicRoughness, 0.2f, 1.3f}}) {
+          Model{kModelTransmissiveMetallicRoughness, 0.2f, 1.3f},
+          Model{kModelSheenMetallicRoughness, 0.3f, 1.5f, 0.2f}}) {
         ShaderParams sh{};
         sh.model = m.model;
         sh.colour = vec3(0.8f);
@@ -117,7 +123,9 @@ Fixture makeFixture(std::mt19937& rng, int emitters, bool everyKind = false) {
         sh.coatAlpha = 0.01f;
         sh.specular = 0.6f; // read with kShaderSpecular only
         sh.specularColour = vec3(1.8f, 1.0f, 0.3f);
-        sh.transmission = 0.4f; // read by TransmissiveMetallicRoughness only
+        sh.transmission = 0.4f;                  // read by TransmissiveMetallicRoughness only
+        sh.sheenColour = vec3(0.9f, 0.5f, 0.2f); // read by SheenMetallicRoughness only
+        sh.sheenRoughness = 0.4f;
         f.shaders.push_back(sh);
     }
     float total = 0.0f;
@@ -309,15 +317,16 @@ TEST(SimdShading, RunsInTheWidestInstructionSet) {
 // order; and the cpu backend's stats say which of the scene's models were shaded a run at a
 // time and which one hit at a time (scenes/every-model.yaml: Lambert, Conductor and Dielectric
 // wide; its quad light's emissive Null, which only passes the path on, not; CoatedMetallicRoughness
-// and TransmissiveMetallicRoughness have no twin yet, and are shaded one hit at a time), all of
-// them scalar with SIMD off.
+// TransmissiveMetallicRoughness and SheenMetallicRoughness have no twin yet, and are shaded one hit
+// at a time), all of them scalar with SIMD off.
 TEST(SimdShading, EveryModelNamesItsWideTwinAndTheStatsNameTheScalarOnes) {
     for (size_t i = 0; i < kSurfaceModelCount; ++i) {
         EXPECT_EQ(kWideTwins[i].model, kSurfaceModels[i].model) << kSurfaceModels[i].name;
         EXPECT_EQ(kWideTwins[i].kernel != nullptr,
                   kSurfaceModels[i].model != kModelNull &&
                       kSurfaceModels[i].model != kModelCoatedMetallicRoughness &&
-                      kSurfaceModels[i].model != kModelTransmissiveMetallicRoughness)
+                      kSurfaceModels[i].model != kModelTransmissiveMetallicRoughness &&
+                      kSurfaceModels[i].model != kModelSheenMetallicRoughness)
             << kSurfaceModels[i].name;
     }
     Scene scene = loadScene(test::sourceDir() + "/scenes/every-model.yaml");

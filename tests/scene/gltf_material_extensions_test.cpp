@@ -11,12 +11,15 @@
 //     the base, which gets the rest;
 //   * KHR_materials_specular: the dielectric reflection's F0 is min(F0(ior) specularColorFactor,
 //     1) specularFactor;
+//   * KHR_materials_sheen: over a base that reflects nothing, the sheen's colour times its
+//     lobe's albedo;
 // and what is not rendered is warned about, and malformed values are refused naming where.
 #include "host/loaders/scene_loader.h"
 #include "scene/gltf_builder.h"
 #include "test_util.h"
 
 #include "shared/gltf.h"
+#include "shared/sheen.h"
 #include "shared/types.h"
 
 #include <gtest/gtest.h>
@@ -54,8 +57,8 @@ std::string sphereFile(const TempDir& dir, const json& mat) {
     GltfBuilder b;
     b.doc["materials"] = json::array({mat});
     b.doc["extensionsUsed"] = {"KHR_materials_transmission", "KHR_materials_ior",
-                               "KHR_materials_volume", "KHR_materials_clearcoat",
-                               "KHR_materials_specular"};
+                               "KHR_materials_volume",       "KHR_materials_clearcoat",
+                               "KHR_materials_specular",     "KHR_materials_sheen"};
     b.doc["cameras"] =
         json::array({{{"type", "perspective"},
                       {"perspective", {{"yfov", 0.6}, {"aspectRatio", 1.0}, {"znear", 0.1}}}}});
@@ -91,6 +94,14 @@ json specular(double weight, std::vector<double> colour) {
     json m = material(vec3(0.0f), 0.0f, 0.0f);
     m["extensions"]["KHR_materials_specular"] = {{"specularFactor", weight},
                                                  {"specularColorFactor", colour}};
+    return m;
+}
+
+// A black dielectric whose reflection is off (KHR_materials_specular's weight 0) under a sheen.
+json sheen(std::vector<double> colour, double roughness) {
+    json m = specular(0.0, {1.0, 1.0, 1.0});
+    m["extensions"]["KHR_materials_sheen"] = {{"sheenColorFactor", colour},
+                                              {"sheenRoughnessFactor", roughness}};
     return m;
 }
 
@@ -215,6 +226,15 @@ TEST(GltfGlass, WhatIsNotRenderedIsWarnedAndBadValuesRefused) {
     specularImages["extensions"]["KHR_materials_specular"]["specularColorTexture"] = {{"index", 0}};
     EXPECT_NE(warnings(specularImages).second.find("specularColorTexture is not rendered"),
               std::string::npos);
+    json sheenGlass = glass(1.0, 1.5);
+    sheenGlass["extensions"]["KHR_materials_sheen"]["sheenColorFactor"] = {1.0, 1.0, 1.0};
+    EXPECT_NE(warnings(sheenGlass).second.find("a sheen on glass"), std::string::npos);
+    json sheenImages = material(vec3(0.5f), 0.0f, 0.5f);
+    sheenImages["extensions"]["KHR_materials_sheen"] = {{"sheenColorFactor", {1.0, 1.0, 1.0}},
+                                                        {"sheenRoughnessTexture", {{"index", 0}}}};
+    const auto sheenImage = warnings(sheenImages);
+    EXPECT_EQ(sheenImage.first, kModelSheenMetallicRoughness);
+    EXPECT_NE(sheenImage.second.find("sheenRoughnessTexture is not rendered"), std::string::npos);
     json specularGlass = glass(1.0, 1.5);
     specularGlass["extensions"]["KHR_materials_specular"]["specularFactor"] = 0.5;
     EXPECT_NE(warnings(specularGlass).second.find("KHR_materials_specular on glass"),
@@ -238,6 +258,10 @@ TEST(GltfGlass, WhatIsNotRenderedIsWarnedAndBadValuesRefused) {
         {coated(2.0, 0.0), "KHR_materials_clearcoat/clearcoatFactor: must be a number in [0, 1]"},
         {coated(1.0, -0.5),
          "KHR_materials_clearcoat/clearcoatRoughnessFactor: must be a number in [0, 1]"},
+        {sheen({1.0, 2.0, 1.0}, 0.5),
+         "KHR_materials_sheen/sheenColorFactor/1: must be a number in [0, 1]"},
+        {sheen({1.0, 1.0, 1.0}, -0.5),
+         "KHR_materials_sheen/sheenRoughnessFactor: must be a number in [0, 1]"},
         {specular(1.5, {1.0, 1.0, 1.0}),
          "KHR_materials_specular/specularFactor: must be a number in [0, 1]"},
         {specular(1.0, {1.0, -1.0, 1.0}),
@@ -396,6 +420,33 @@ TEST(GltfTransmission, PartialTransmissionMixesTheGlassWithTheOpaqueMaterial) {
                 },
                 256);
         }
+    }
+}
+
+// KHR_materials_sheen over a base that reflects nothing (a black dielectric, its reflection off),
+// in a white furnace: at the centre of the view (cos within 0.1 % of 1) the sphere reflects the
+// sheen's colour times its lobe's albedo E(1, roughness) (sheen_albedo.h, which
+// SheenMetallicRoughness.TheAlbedoTable… checks by quadrature), per channel. On every backend.
+TEST(GltfSheen, ASheenReflectsItsColourTimesItsAlbedo) {
+    TempDir dir;
+    const vec3 colour(1.0f, 0.5f, 0.25f);
+    for (double roughness : {0.5, 1.0}) {
+        const Scene scene =
+            loadScene(sphereFile(dir, sheen({colour.x, colour.y, colour.z}, roughness)));
+        const ShaderParams& sh = scene.shaders.at(0).params;
+        ASSERT_EQ(sh.model, kModelSheenMetallicRoughness);
+        EXPECT_EQ(sh.sheenColour, colour);
+        EXPECT_TRUE(scene.warnings.empty()) << scene.warnings.at(0);
+        const vec3 expected = colour * sheenAlbedo(1.0f, float(roughness));
+        onEveryBackend(
+            scene,
+            [&](const std::vector<float>& img) {
+                const vec3 v = centre(img);
+                for (int k = 0; k < 3; ++k)
+                    EXPECT_NEAR(v[k], expected[k], 0.03 * expected[k])
+                        << "channel " << k << ", roughness " << roughness;
+            },
+            256);
     }
 }
 

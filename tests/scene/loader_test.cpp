@@ -576,6 +576,8 @@ const ErrorCase kErrorCases[] = {
     {"CoatAboveOne", "shader:\n  type: CoatedMetallicRoughness\n  coat: 1.5\n", 3, "coat"},
     {"TransmissionBelowZero",
      "shader:\n  type: TransmissiveMetallicRoughness\n  transmission: -0.5\n", 3, "transmission"},
+    {"SheenColourAboveOne",
+     "shader:\n  type: SheenMetallicRoughness\n  sheen colour: [1, 1.5, 1]\n", 3, "sheen colour"},
     {"SpecularAboveOne", "shader:\n  type: MetallicRoughness\n  specular: 1.5\n", 3, "specular"},
     {"SpecularColourNegative",
      "shader:\n  type: MetallicRoughness\n  specular colour: [1, -1, 1]\n", 3, "specular colour"},

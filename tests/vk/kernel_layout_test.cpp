@@ -34,14 +34,15 @@ using Fields = std::map<std::string, Field>;
         }                                                                                          \
     }
 const Fields kShaderParams = {
-    SPW_FIELD(ShaderParams, emission),   SPW_FIELD(ShaderParams, model),
-    SPW_FIELD(ShaderParams, colour),     SPW_FIELD(ShaderParams, reflectance),
-    SPW_FIELD(ShaderParams, flags),      SPW_FIELD(ShaderParams, ior),
-    SPW_FIELD(ShaderParams, alpha),      SPW_FIELD(ShaderParams, metallic),
-    SPW_FIELD(ShaderParams, absorption), SPW_FIELD(ShaderParams, coat),
-    SPW_FIELD(ShaderParams, coatAlpha),  SPW_FIELD(ShaderParams, specularColour),
-    SPW_FIELD(ShaderParams, specular),   SPW_FIELD(ShaderParams, transmission),
-    SPW_FIELD(ShaderParams, pad1),       SPW_FIELD(ShaderParams, pad2)};
+    SPW_FIELD(ShaderParams, emission),    SPW_FIELD(ShaderParams, model),
+    SPW_FIELD(ShaderParams, colour),      SPW_FIELD(ShaderParams, reflectance),
+    SPW_FIELD(ShaderParams, flags),       SPW_FIELD(ShaderParams, ior),
+    SPW_FIELD(ShaderParams, alpha),       SPW_FIELD(ShaderParams, metallic),
+    SPW_FIELD(ShaderParams, absorption),  SPW_FIELD(ShaderParams, coat),
+    SPW_FIELD(ShaderParams, coatAlpha),   SPW_FIELD(ShaderParams, specularColour),
+    SPW_FIELD(ShaderParams, specular),    SPW_FIELD(ShaderParams, transmission),
+    SPW_FIELD(ShaderParams, sheenColour), SPW_FIELD(ShaderParams, sheenRoughness),
+    SPW_FIELD(ShaderParams, pad0),        SPW_FIELD(ShaderParams, pad1)};
 const Fields kEmitter = {SPW_FIELD(Emitter, p0),       SPW_FIELD(Emitter, area),
                          SPW_FIELD(Emitter, e1),       SPW_FIELD(Emitter, pickPdf),
                          SPW_FIELD(Emitter, e2),       SPW_FIELD(Emitter, twoSided),
