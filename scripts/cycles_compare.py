@@ -399,6 +399,23 @@ def make_test_files(out):
     write_glb(os.path.join(out, "half-glass.glb"), [s + (0,), (pos, nor, idx, whole, 1)],
               [half, second_uv0], images=textured_images()[:1],
               extensions=["KHR_materials_transmission", "KHR_materials_ior"])
+    # Striped glass: the half-glass sphere transmitting all of the light where its
+    # transmissionTexture's red channel is 1 and none where it is 0, in 8 stripes around it.
+    striped = material((0.6, 0.9, 0.6), 0.0, 0.0)
+    striped["extensions"] = {"KHR_materials_transmission": {"transmissionFactor": 1.0,
+                                                            "transmissionTexture": {"index": 1}},
+                             "KHR_materials_ior": {"ior": 1.5}}
+    stripes = png(64, 8, 3, lambda x, y: (255 if (x // 4) % 2 else 0, 0, 0))
+    write_glb(os.path.join(out, "striped-glass.glb"), [s + (0,), (pos, nor, idx, whole, 1)],
+              [striped, second_uv0], images=textured_images()[:1] + [stripes],
+              extensions=["KHR_materials_transmission", "KHR_materials_ior"])
+    # Metallic glass: transmission 1 on a half-metallic gold base, whose glass then weighs
+    # 1 - metallic = 0.5 (the specification's and Principled's), before the checker panel.
+    gilded = material((0.9, 0.75, 0.4), 0.5, 0.0)
+    gilded["extensions"] = dict(glass["extensions"])
+    write_glb(os.path.join(out, "metal-glass.glb"), [s + (0,), (pos, nor, idx, whole, 1)],
+              [gilded, second_uv0], images=textured_images()[:1],
+              extensions=["KHR_materials_transmission", "KHR_materials_ior"])
     # Velvet: a dark red rough plastic under a pale sheen (KHR_materials_sheen), on the grey floor.
     velvet = material((0.3, 0.02, 0.05), 0.0, 0.8)
     velvet["extensions"] = {"KHR_materials_sheen": {"sheenColorFactor": [0.9, 0.7, 0.7],
@@ -432,7 +449,8 @@ def make_test_files(out):
                           "KHR_materials_volume"])
     return sorted(os.path.join(out, n) for n in list(files) + [
         "textured.glb", "emissive.glb", "uv-sets.glb", "terminator.glb", "blend.glb",
-        "glass.glb", "half-glass.glb", "ior.glb", "specular.glb", "sheen.glb", "clearcoat.glb", "tinted-glass.glb"])
+        "glass.glb", "half-glass.glb", "ior.glb", "specular.glb", "sheen.glb", "clearcoat.glb", "tinted-glass.glb",
+        "striped-glass.glb", "metal-glass.glb"])
 
 
 # The suite's bound (docs/scene-format.md, "glTF files", says why): relMSE and each channel's
@@ -447,7 +465,12 @@ SELF_TEST_MAX_RATIO_ERROR = 0.07
 # sheen.glb: Blender 3.4's importer adds a Velvet BSDF (Cycles' Ashikhmin velvet, sigma the sheen
 # roughness) to the Principled BSDF, neither dimming the base nor following glTF's Charlie sheen:
 # 0.018 measured, 0.059 with the sheen dropped.
-SELF_TEST_FILE_MAX_RELMSE = {"clearcoat.glb": 0.03, "sheen.glb": 0.03}
+# metal-glass.glb: glTF makes the metallic share a pure conductor and the rest glass; Blender
+# 3.4's Principled BSDF, given the same metallic 0.5 and transmission 1, renders the sphere 6-12 %
+# darker per channel: 0.108 measured, 0.248 drawn opaque as before. Its own check is the closed
+# form on every backend (GltfTransmission.*).
+SELF_TEST_FILE_MAX_RELMSE = {"clearcoat.glb": 0.03, "sheen.glb": 0.03, "metal-glass.glb": 0.15}
+SELF_TEST_FILE_MAX_RATIO_ERROR = {"metal-glass.glb": 0.15}
 
 
 def self_test(spillway):
@@ -458,11 +481,12 @@ def self_test(spillway):
             out = os.path.join(work, os.path.basename(path) + ".out")
             metrics, ratios = compare(spillway, path, 128, 96, out)
             bound = SELF_TEST_FILE_MAX_RELMSE.get(os.path.basename(path), SELF_TEST_MAX_RELMSE)
-            ok = metrics["relmse"] <= bound and all(
-                abs(r - 1.0) <= SELF_TEST_MAX_RATIO_ERROR for r in ratios)
+            ratio_bound = SELF_TEST_FILE_MAX_RATIO_ERROR.get(os.path.basename(path),
+                                                             SELF_TEST_MAX_RATIO_ERROR)
+            ok = metrics["relmse"] <= bound and all(abs(r - 1.0) <= ratio_bound for r in ratios)
             print("%s %s: relMSE %.4g (bound %g), mean ratio %s (bound 1 +- %g)" % (
                 "ok  " if ok else "FAIL", os.path.basename(path), metrics["relmse"],
-                bound, ["%.3f" % r for r in ratios], SELF_TEST_MAX_RATIO_ERROR))
+                bound, ["%.3f" % r for r in ratios], ratio_bound))
             failed += not ok
         return 1 if failed else 0
     finally:

@@ -142,18 +142,15 @@ ShadeInput loadInput(uint i) {
     r.hit.offset = uintBitsToFloat(w[3].w);
     r.hit.material = w[4].x;
     r.hit.lift = uintBitsToFloat(w[4].y);
-    r.path.beta.xy = uintBitsToFloat(w[4].zw);
-    r.path.beta.z = uintBitsToFloat(w[5].x);
-    r.path.prevPdf = uintBitsToFloat(w[5].y);
-    r.path.pathId = w[5].z;
-    r.path.bounce = w[5].w;
-    r.path.flags = w[6].x;
-    r.path.cone = w[6].y;
-    r.rayDir.xy = uintBitsToFloat(w[6].zw);
-    r.rayDir.z = uintBitsToFloat(w[7].x);
-    r.pad0 = w[7].y;
-    r.pad1 = w[7].z;
-    r.pad2 = w[7].w;
+    r.hit.extension = w[4].zw;
+    r.path.beta = uintBitsToFloat(w[5].xyz);
+    r.path.prevPdf = uintBitsToFloat(w[5].w);
+    r.path.pathId = w[6].x;
+    r.path.bounce = w[6].y;
+    r.path.flags = w[6].z;
+    r.path.cone = w[6].w;
+    r.rayDir = uintBitsToFloat(w[7].xyz);
+    r.pad0 = w[7].w;
     return r;
 }
 

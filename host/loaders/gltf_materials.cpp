@@ -21,20 +21,12 @@
 #include <map>
 #include <memory>
 #include <set>
-#include <sstream>
 
 namespace spw {
 
 namespace fs = std::filesystem;
 
 namespace {
-// x as the shortest decimal that reads back as it (1.01, not 1.010000).
-std::string number(double x) {
-    std::ostringstream out;
-    out << x;
-    return out.str();
-}
-
 // glTF 2.0's image formats, from an image's first bytes: ".png", ".jpg", or "" for anything else.
 std::string imageFormat(const std::string& head) {
     if (head.size() >= 8 && head.compare(0, 8, "\x89PNG\r\n\x1a\n", 8) == 0) return ".png";
@@ -95,8 +87,8 @@ Shader GltfReader::readMaterial(int index) {
     readTransmission(mat, s, at, name);
     readVolume(mat, s, at, name);
     readClearcoat(mat, s, at, name);
-    readSpecular(mat, s, at, name);
     readSheen(mat, s, at, name);
+    readSpecular(mat, s, at, name); // after the models that take the extension's images
     if (mat.alphaMode != "OPAQUE" && mat.alphaMode != "MASK" && mat.alphaMode != "BLEND")
         fail(at + "/alphaMode", "must be OPAQUE, MASK or BLEND");
     readEmission(mat, s, at, name);
@@ -130,194 +122,6 @@ void GltfReader::readImages(const tinygltf::Material& mat, Shader& s, const std:
     }
     if (mat.occlusionTexture.index >= 0)
         warn(name + ": its occlusionTexture is ignored (a path tracer finds occlusion itself)");
-}
-
-double GltfReader::extensionNumber(const tinygltf::Value& ext, const char* key, double fallback,
-                                   double lo, double hi, const std::string& at) const {
-    if (!ext.Has(key)) return fallback;
-    const tinygltf::Value& v = ext.Get(key);
-    const double x = v.IsNumber() ? v.GetNumberAsDouble() : NAN;
-    if (!(x >= lo && x <= hi) || !std::isfinite(x))
-        fail(at + "/" + key, std::isfinite(hi)
-                                 ? "must be a number in [" + number(lo) + ", " + number(hi) + "]"
-                                 : "must be a finite number of at least " + number(lo));
-    return x;
-}
-
-double GltfReader::extensionNumber(const tinygltf::Value& values, int k, double lo, double hi,
-                                   const std::string& at) const {
-    const tinygltf::Value& v = values.Get(k);
-    const double x = v.IsNumber() ? v.GetNumberAsDouble() : NAN;
-    if (!(x >= lo && x <= hi) || !std::isfinite(x))
-        fail(at + "/" + std::to_string(k),
-             std::isfinite(hi) ? "must be a number in [" + number(lo) + ", " + number(hi) + "]"
-                               : "must be a finite number of at least " + number(lo));
-    return x;
-}
-
-void GltfReader::readTransmission(const tinygltf::Material& mat, Shader& s, const std::string& at,
-                                  const std::string& name) {
-    const auto iorExt = mat.extensions.find("KHR_materials_ior");
-    double ior = 1.5;
-    if (iorExt != mat.extensions.end()) {
-        ior = extensionNumber(iorExt->second, "ior", 1.5, 0.0, 10.0,
-                              at + "/extensions/KHR_materials_ior");
-        if (ior > 0.0 && ior < 1.0)
-            fail(at + "/extensions/KHR_materials_ior/ior", "must be 0 or at least 1");
-    }
-    const auto t = mat.extensions.find("KHR_materials_transmission");
-    const double factor = t == mat.extensions.end()
-                              ? 0.0
-                              : extensionNumber(t->second, "transmissionFactor", 0.0, 0.0, 1.0,
-                                                at + "/extensions/KHR_materials_transmission");
-    if (t != mat.extensions.end() && t->second.Has("transmissionTexture"))
-        warn(name + ": its transmissionTexture is not rendered (the factor alone is)");
-    // Opaque, the ior sets the dielectric reflection's F0 ((ior - 1) / (ior + 1))^2
-    // (shared/gltf.h's gltfDielectricF0); 0 keeps glTF's 0.04.
-    if (ior == 0.0 && iorExt != mat.extensions.end())
-        warn(name + ": KHR_materials_ior's ior 0 is rendered as 1.5");
-    s.params.ior = float(ior == 0.0 ? 1.5 : ior);
-    if (factor == 0.0) return;
-    if (s.params.metallic > 0.0f || s.metallicRoughnessTexture >= 0) {
-        warn(name + ": transmission is rendered only on a dielectric (metallicFactor 0, no "
-                    "metallic-roughness image): drawn opaque");
-        return;
-    }
-    if (ior > 0.0 && ior < kMinGlassIor)
-        warn(name + ": an ior below " + number(kMinGlassIor) + " is rendered as " +
-             number(kMinGlassIor));
-    // Below 1, glass mixed with the opaque material (shared/transmission.h).
-    s.typeName = factor < 1.0 ? "TransmissiveMetallicRoughness" : "Dielectric";
-    s.params.model = factor < 1.0 ? kModelTransmissiveMetallicRoughness : kModelDielectric;
-    s.params.transmission = float(factor);
-    s.params.ior = float(ior == 0.0 ? 1.5 : std::max(ior, kMinGlassIor));
-    s.params.alpha = s.roughness * s.roughness; // below kGgxSmoothAlpha: smooth glass
-    // The base colour (its factor, image and vertex colours) tints what the glass refracts.
-    s.params.flags &= ~kShaderHitParams;
-    s.metallicRoughnessTexture = -1;
-}
-
-void GltfReader::readVolume(const tinygltf::Material& mat, Shader& s, const std::string& at,
-                            const std::string& name) {
-    const auto v = mat.extensions.find("KHR_materials_volume");
-    if (v == mat.extensions.end()) return;
-    const std::string where = at + "/extensions/KHR_materials_volume";
-    const double thickness =
-        extensionNumber(v->second, "thicknessFactor", 0.0, 0.0, HUGE_VAL, where);
-    const double distance =
-        extensionNumber(v->second, "attenuationDistance", HUGE_VAL, 0.0, HUGE_VAL, where);
-    if (v->second.Has("attenuationDistance") && !(distance > 0.0))
-        fail(where + "/attenuationDistance", "must be a positive number");
-    vec3 colour(1.0f);
-    if (v->second.Has("attenuationColor")) {
-        const tinygltf::Value& c = v->second.Get("attenuationColor");
-        if (!c.IsArray() || c.ArrayLen() != 3)
-            fail(where + "/attenuationColor", "needs 3 numbers in [0, 1]");
-        for (int k = 0; k < 3; ++k)
-            colour[k] = float(extensionNumber(c, k, 0.0, 1.0, where + "/attenuationColor"));
-    }
-    if (v->second.Has("thicknessTexture"))
-        warn(name + ": its thicknessTexture is not read (the mesh's own thickness is rendered)");
-    const bool transmits =
-        s.params.model == kModelDielectric || s.params.model == kModelTransmissiveMetallicRoughness;
-    if (!transmits || !std::isfinite(distance) || colour == vec3(1.0f))
-        return; // nothing absorbs: the volume of an opaque material is never entered
-    if (thickness == 0.0) {
-        warn(name + ": KHR_materials_volume's thicknessFactor 0 makes it thin-walled: its "
-                    "attenuation is not rendered");
-        return;
-    }
-    // Beer-Lambert: attenuationColor is what is left after attenuationDistance.
-    for (int k = 0; k < 3; ++k)
-        s.params.absorption[k] = float(-std::log(std::max(double(colour[k]), 1e-30)) / distance);
-    if (!std::isfinite(maxComponent(s.params.absorption)))
-        fail(where + "/attenuationDistance", "gives an absorption beyond the float range");
-}
-
-void GltfReader::readClearcoat(const tinygltf::Material& mat, Shader& s, const std::string& at,
-                               const std::string& name) {
-    const auto c = mat.extensions.find("KHR_materials_clearcoat");
-    if (c == mat.extensions.end()) return;
-    const std::string where = at + "/extensions/KHR_materials_clearcoat";
-    const double factor = extensionNumber(c->second, "clearcoatFactor", 0.0, 0.0, 1.0, where);
-    const double roughness =
-        extensionNumber(c->second, "clearcoatRoughnessFactor", 0.0, 0.0, 1.0, where);
-    if (factor == 0.0) return;
-    if (s.params.model != kModelMetallicRoughness) {
-        warn(name + ": a clear coat on glass is not rendered");
-        return;
-    }
-    for (const char* image : {"clearcoatTexture", "clearcoatRoughnessTexture"})
-        if (c->second.Has(image))
-            warn(name + ": its " + image + " is not rendered (the factor alone is)");
-    if (c->second.Has("clearcoatNormalTexture"))
-        warn(name + ": its clearcoatNormalTexture is not rendered (the coat takes the base's "
-                    "shading normal)");
-    s.typeName = "CoatedMetallicRoughness";
-    s.params.model = kModelCoatedMetallicRoughness;
-    s.params.coat = float(factor);
-    s.params.coatAlpha = gltfAlpha(float(roughness));
-}
-
-void GltfReader::readSpecular(const tinygltf::Material& mat, Shader& s, const std::string& at,
-                              const std::string& name) {
-    const auto e = mat.extensions.find("KHR_materials_specular");
-    if (e == mat.extensions.end()) return;
-    const std::string where = at + "/extensions/KHR_materials_specular";
-    const double factor = extensionNumber(e->second, "specularFactor", 1.0, 0.0, 1.0, where);
-    vec3 colour(1.0f);
-    if (e->second.Has("specularColorFactor")) {
-        const tinygltf::Value& c = e->second.Get("specularColorFactor");
-        if (!c.IsArray() || c.ArrayLen() != 3)
-            fail(where + "/specularColorFactor", "needs 3 numbers of at least 0");
-        for (int k = 0; k < 3; ++k)
-            colour[k] = float(std::min(
-                extensionNumber(c, k, 0.0, HUGE_VAL, where + "/specularColorFactor"), 1e3));
-    }
-    for (const char* image : {"specularTexture", "specularColorTexture"})
-        if (e->second.Has(image))
-            warn(name + ": its " + image + " is not rendered (the factor alone is)");
-    if (factor == 1.0 && colour == vec3(1.0f)) return; // the defaults: glTF's own reflection
-    if (s.params.model == kModelDielectric ||
-        s.params.model == kModelTransmissiveMetallicRoughness) {
-        warn(name + ": KHR_materials_specular on glass is not rendered (its reflection follows "
-                    "the ior alone)");
-        return;
-    }
-    s.params.flags |= kShaderSpecular;
-    s.params.specular = float(factor);
-    s.params.specularColour = colour;
-}
-
-void GltfReader::readSheen(const tinygltf::Material& mat, Shader& s, const std::string& at,
-                           const std::string& name) {
-    const auto e = mat.extensions.find("KHR_materials_sheen");
-    if (e == mat.extensions.end()) return;
-    const std::string where = at + "/extensions/KHR_materials_sheen";
-    vec3 colour(0.0f);
-    if (e->second.Has("sheenColorFactor")) {
-        const tinygltf::Value& c = e->second.Get("sheenColorFactor");
-        if (!c.IsArray() || c.ArrayLen() != 3)
-            fail(where + "/sheenColorFactor", "needs 3 numbers in [0, 1]");
-        for (int k = 0; k < 3; ++k)
-            colour[k] = float(extensionNumber(c, k, 0.0, 1.0, where + "/sheenColorFactor"));
-    }
-    const double roughness =
-        extensionNumber(e->second, "sheenRoughnessFactor", 0.0, 0.0, 1.0, where);
-    for (const char* image : {"sheenColorTexture", "sheenRoughnessTexture"})
-        if (e->second.Has(image))
-            warn(name + ": its " + image + " is not rendered (the factor alone is)");
-    if (colour == vec3(0.0f)) return;
-    if (s.params.model != kModelMetallicRoughness) {
-        warn(name + ": a sheen on " +
-             (s.params.model == kModelCoatedMetallicRoughness ? "a clear coat" : "glass") +
-             " is not rendered");
-        return;
-    }
-    s.typeName = "SheenMetallicRoughness";
-    s.params.model = kModelSheenMetallicRoughness;
-    s.params.sheenColour = colour;
-    s.params.sheenRoughness = float(roughness);
 }
 
 void GltfReader::readEmission(const tinygltf::Material& mat, Shader& s, const std::string& at,
@@ -446,6 +250,36 @@ Texture GltfReader::imageTexture(const Info& info, const std::string& where,
                     picture);
     }
     return picture;
+}
+
+int GltfReader::extensionTexture(const tinygltf::Value& ext, const char* key, int channel,
+                                 bool colour, const std::string& where, const std::string& what) {
+    if (!ext.Has(key)) return -1;
+    const std::string at = where + "/" + key;
+    const tinygltf::Value& v = ext.Get(key);
+    if (!v.IsObject()) fail(at, "must be a textureInfo object");
+    auto integer = [&](const char* field) {
+        const tinygltf::Value& x = v.Get(field);
+        const double d = x.IsNumber() ? x.GetNumberAsDouble() : NAN;
+        if (!(d >= 0.0 && d <= double(std::numeric_limits<int>::max())) || d != std::floor(d))
+            fail(at + "/" + field, "must be an integer of at least 0");
+        return int(d);
+    };
+    if (!v.Has("index")) fail(at, "a textureInfo needs an index");
+    tinygltf::TextureInfo info;
+    info.index = integer("index");
+    if (v.Has("texCoord")) info.texCoord = integer("texCoord");
+    if (v.Has("extensions")) {
+        const tinygltf::Value& e = v.Get("extensions");
+        if (!e.IsObject()) fail(at + "/extensions", "must be an object");
+        for (const std::string& name : e.Keys())
+            info.extensions[name] = e.Get(name);
+    }
+    Texture picture = imageTexture(info, at, what);
+    picture.channel = channel;
+    picture.linear = !colour;
+    scene_.textures.push_back(picture);
+    return int(scene_.textures.size()) - 1;
 }
 
 std::string GltfReader::imageError() {

@@ -131,9 +131,9 @@ class GltfReader {
     // (transmissionFactor 1) and is no metal is glass, a Dielectric of that ior (1.5) and GGX
     // alpha roughness^2 (smooth below kGgxSmoothAlpha), as Blender's importer and Cycles render
     // it: a refracting solid, not the specification's thin wall, its base colour tinting what it
-    // refracts. Transmitting part of it (0 < transmissionFactor < 1), a
-    // TransmissiveMetallicRoughness: that glass mixed with the opaque material by the factor
-    // (shared/transmission.h). On a metal it is warned about and drawn opaque.
+    // refracts. Transmitting part of it (0 < transmissionFactor < 1, a transmissionTexture, or a
+    // metallic above 0), a TransmissiveMetallicRoughness: that glass mixed with the opaque
+    // material by the factor times 1 - metallic (shared/transmission.h).
     void readTransmission(const tinygltf::Material& mat, Shader& s, const std::string& at,
                           const std::string& name);
     // KHR_materials_volume on glass, whole or partial: attenuationColor left after
@@ -143,12 +143,15 @@ class GltfReader {
                     const std::string& name);
     // KHR_materials_clearcoat: a material with a coat of weight clearcoatFactor > 0 is a
     // CoatedMetallicRoughness shader (shared/clearcoat.h), its coat's GGX alpha
-    // clearcoatRoughnessFactor^2; the coat's images are warned about and not rendered.
+    // clearcoatRoughnessFactor^2, each factor times its image where it has one; the coat's normal
+    // map is warned about and not rendered.
     // KHR_materials_sheen: a material with a sheen of colour above 0 is a SheenMetallicRoughness
-    // shader (shared/sheen.h); the sheen's images are warned about and not rendered.
+    // shader (shared/sheen.h), colour and roughness each times its image where it has one.
     void readSheen(const tinygltf::Material& mat, Shader& s, const std::string& at,
                    const std::string& name);
-    // KHR_materials_specular: the dielectric reflection's weight and F0 colour (factors only).
+    // KHR_materials_specular: the dielectric reflection's weight and F0 colour, each times its
+    // image where the material is no clear coat or sheen (those take the hit's extension values;
+    // there the images are warned about and the factors alone rendered).
     void readSpecular(const tinygltf::Material& mat, Shader& s, const std::string& at,
                       const std::string& name);
     void readClearcoat(const tinygltf::Material& mat, Shader& s, const std::string& at,
@@ -190,6 +193,11 @@ class GltfReader {
     // The coordinate set it names (texCoord, or the transform's override) joins uvSetsRead_.
     template <class Info> // tinygltf::TextureInfo, NormalTextureInfo
     Texture imageTexture(const Info& info, const std::string& where, const std::string& what);
+    // A material extension's texture `key` of object `ext` (at JSON pointer `where`): its image
+    // as a Standard texture of the scene read from `channel` on (3: alpha alone), as colour (sRGB)
+    // or as data; its index, or -1 where `ext` has none.
+    int extensionTexture(const tinygltf::Value& ext, const char* key, int channel, bool colour,
+                         const std::string& where, const std::string& what);
 
     // OpenImageIO's error after a failed open, as ": why" (or nothing). Asking also clears it:
     // OpenImageIO keeps it per thread until asked, and reports it at exit otherwise.

@@ -140,8 +140,10 @@ class TextureReader {
 // The metallic-roughness models' keys (shared/gltf.h, shared/clearcoat.h), and the Dielectric's
 // absorption.
 void readGltfParams(const Reader& rd, const YAML::Node& n, uint takes, ShaderParams& p) {
-    if (takes & kTakesMetallic)
-        p.metallic = n["metallic"] ? float(rd.number(n["metallic"], "metallic", 0.0, 1.0)) : 1.0f;
+    if (takes & kTakesMetallic) // glass that transmits part of the light is no metal unless told
+        p.metallic = n["metallic"] ? float(rd.number(n["metallic"], "metallic", 0.0, 1.0))
+                     : takes & kTakesTransmission ? 0.0f
+                                                  : 1.0f;
     if (takes & kTakesRoughness) {
         const float r =
             n["roughness"] ? float(rd.number(n["roughness"], "roughness", 0.0, 1.0)) : 1.0f;

@@ -8,6 +8,7 @@
 
 #include <glm/vec3.hpp>
 
+#include <array>
 #include <memory>
 #include <optional>
 #include <stdexcept>
@@ -186,8 +187,22 @@ struct Shader {
     // from the light data (shared/emission_map.h), not hit setup: light sampling needs it too.
     int emissionTexture = -1;
 
+    // The model's extension parameters, with kShaderHitExtension (shared/bsdf.h's shaderAtHit
+    // says what each of the four slots is to each model): slot k at a hit is its factor times
+    // component `component` of texture `texture`'s texel there, or the factor alone at -1; carried
+    // as halves in SurfaceHit::extension.
+    struct ExtensionMap {
+        int texture = -1;
+        int component = 0;
+        float factor = 0.0f;
+    };
+    std::array<ExtensionMap, 4> extension{};
+
     // Maps beyond the colour, looked up in hit setup after it (HitSetup::applyMaps).
-    bool hasMaps() const { return normalTexture >= 0 || metallicRoughnessTexture >= 0; }
+    bool hasMaps() const {
+        return normalTexture >= 0 || metallicRoughnessTexture >= 0 ||
+               (params.flags & kShaderHitExtension) != 0u;
+    }
     // Whether hit setup looks anything up at a hit's texture coordinates.
     bool looksUpTextures() const { return texture >= 0 || hasMaps(); }
     std::string typeName;

@@ -22,7 +22,8 @@ enum SurfaceParam : uint {
     kTakesTexture = 1u << 2,       // texture: a texture tree for the colour, instead of colour
     kTakesAlpha = 1u << 3,         // alpha: GGX width in [0, 1] (default 0: smooth)
     kTakesIor = 1u << 4,           // ior: index of refraction behind the surface, [1.01, 10] (1.5)
-    kTakesMetallic = 1u << 5,      // metallic: glTF's metallic factor in [0, 1] (default 1)
+    kTakesMetallic = 1u << 5,      // metallic: glTF's metallic factor in [0, 1] (default 1; 0 on
+                                   // TransmissiveMetallicRoughness)
     kTakesRoughness = 1u << 6,     // roughness: glTF's perceptual roughness in [0, 1] (default 1),
                                    // GGX alpha = roughness^2 (shared/gltf.h)
     kTakesAbsorption = 1u << 7,    // absorption: [r, g, b], each >= 0, per unit length (default 0)

@@ -42,6 +42,7 @@ void HitSetup::surfaceHit(uint meshIndex, uint prim, float u, float v, float t,
     hit.albedo = vec3(0.0f);
     hit.offset = surfaceOffset(hit.p, p0, p1, p2, hit.ng);
     hit.material = 0u;
+    hit.extension = uvec2(0u);
     hit.lift = smoothLift(mesh, tri, u, v, hit.p, hit.ng);
 }
 
@@ -101,6 +102,31 @@ void HitSetup::applyMaps(const Shader& shader, const TextureResolver& textures, 
             hit[k]->material = unorm16(shader.params.metallic * texels[k].z) |
                                unorm16(shader.roughness * texels[k].y) << 16u;
     }
+    if ((shader.params.flags & kShaderHitExtension) != 0u)
+        applyExtensionMaps(shader, textures, n, uv, footprint, hit);
+}
+
+void HitSetup::applyExtensionMaps(const Shader& shader, const TextureResolver& textures, size_t n,
+                                  const vec2* uv, const float* footprint, SurfaceHit* const* hit) {
+    thread_local std::vector<vec4> slots;
+    thread_local std::vector<vec3> texels;
+    slots.resize(n);
+    texels.resize(n);
+    for (size_t k = 0; k < n; ++k)
+        for (int s = 0; s < 4; ++s)
+            slots[k][s] = shader.extension[size_t(s)].factor;
+    int looked = -1; // the texture `texels` holds
+    for (int s = 0; s < 4; ++s) {
+        const Shader::ExtensionMap& m = shader.extension[size_t(s)];
+        if (m.texture < 0) continue;
+        if (m.texture != looked) textures.values(m.texture, n, uv, footprint, texels.data());
+        looked = m.texture;
+        for (size_t k = 0; k < n; ++k)
+            slots[k][s] *= texels[k][m.component];
+    }
+    for (size_t k = 0; k < n; ++k)
+        hit[k]->extension = uvec2(packHalf2x16(vec2(slots[k].x, slots[k].y)),
+                                  packHalf2x16(vec2(slots[k].z, slots[k].w)));
 }
 
 void HitSetup::tiltNormal(const HitRecord& h, vec3 texel, float scale, SurfaceHit& hit) const {
@@ -213,6 +239,7 @@ void HitSetup::setUpHits(size_t n, const HitRecord* const* hits, const vec3* dir
         hit.albedo = vec3(0.0f);
         hit.offset = l.offset.v[j];
         hit.material = 0u;
+        hit.extension = uvec2(0u);
         hit.lift = smoothLift(mesh, mesh.triangles[h.prim], h.u, h.v, hit.p, hit.ng);
         uv[j] = vec2(l.uv.x.v[j], l.uv.y.v[j]);
         footprint[j] = l.footprint.v[j];

@@ -52,11 +52,15 @@ class HitSetup {
     // texture frame or the tilted normal is degenerate.
     void tiltNormal(const HitRecord& h, vec3 texel, float scale, SurfaceHit& hit) const;
     // What a shader's maps beyond its colour give n hits of it at uv[k] (footprints as
-    // albedos()): its normal map's tilt and its metallic-roughness image's SurfaceHit::material.
-    // hits[k] is the closest hit hit[k] was set up from.
+    // albedos()): its normal map's tilt, its metallic-roughness image's SurfaceHit::material and
+    // its extension maps' SurfaceHit::extension. hits[k] is the closest hit hit[k] was set up
+    // from.
     void applyMaps(const Shader& shader, const TextureResolver& textures, size_t n, const vec2* uv,
                    const float* footprint, const HitRecord* const* hits,
                    SurfaceHit* const* hit) const;
+    // Shader::extension's four values at n hits into their SurfaceHit::extension.
+    static void applyExtensionMaps(const Shader& shader, const TextureResolver& textures, size_t n,
+                                   const vec2* uv, const float* footprint, SurfaceHit* const* hit);
     // The albedo times the hit's interpolated vertex colour, where its mesh has them
     // (Mesh::colours). After the albedo is set.
     void applyVertexColour(const HitRecord& h, SurfaceHit& hit) const {

@@ -174,6 +174,8 @@ TextureResolver::TextureResolver(const Scene& scene, double cacheMiB, bool filte
         compile(sh.texture);
         compile(sh.normalTexture);
         compile(sh.metallicRoughnessTexture);
+        for (const Shader::ExtensionMap& m : sh.extension)
+            compile(m.texture);
         if (sh.cutout.enabled) compile(sh.cutout.texture);
     }
     int standard = 0;

@@ -21,13 +21,13 @@ static_assert(sizeof(Emitter) == 80, "Emitter layout changed");
 static_assert(offsetof(Emitter, normal) == 48 && offsetof(Emitter, type) == 60 &&
                   offsetof(Emitter, radiance) == 64,
               "Emitter layout");
-static_assert(sizeof(SurfaceHit) == 72, "SurfaceHit layout changed");
+static_assert(sizeof(SurfaceHit) == 80, "SurfaceHit layout changed");
 static_assert(sizeof(PathState) == 32, "PathState layout changed");
 static_assert(sizeof(RenderParams) == 52, "RenderParams layout changed");
 // What the shading kernels read and write (shaders/shared/shade_io.h, shaders/shade_kernel.glsl).
 static_assert(offsetof(SurfaceHit, shader) == 28 && offsetof(SurfaceHit, emitter) == 44 &&
                   offsetof(SurfaceHit, albedo) == 48 && offsetof(SurfaceHit, material) == 64 &&
-                  offsetof(SurfaceHit, lift) == 68,
+                  offsetof(SurfaceHit, lift) == 68 && offsetof(SurfaceHit, extension) == 72,
               "SurfaceHit layout");
 static_assert(offsetof(PathState, pathId) == 16 && offsetof(PathState, flags) == 24,
               "PathState layout");
@@ -37,7 +37,7 @@ static_assert(offsetof(ShadeResult, emitted) == 4 && offsetof(ShadeResult, shado
                   offsetof(ShadeResult, nextDir) == 68 && offsetof(ShadeResult, next) == 80,
               "ShadeResult layout");
 static_assert(sizeof(ShadeInput) == 128, "ShadeInput layout changed");
-static_assert(offsetof(ShadeInput, path) == 72 && offsetof(ShadeInput, rayDir) == 104,
+static_assert(offsetof(ShadeInput, path) == 80 && offsetof(ShadeInput, rayDir) == 112,
               "ShadeInput layout");
 static_assert(sizeof(ShadePush) == 64 && offsetof(ShadePush, offset) == 52 &&
                   offsetof(ShadePush, count) == 56,

@@ -23,11 +23,31 @@
 SHARED_BEGIN
 
 // The shader's parameters at a hit: with kShaderHitParams (a MetallicRoughness shader with a
-// metallic-roughness image), the metallic and the GGX alpha of the roughness the hit carries.
+// metallic-roughness image), the metallic and the GGX alpha of the roughness the hit carries;
+// with kShaderHitExtension (a glTF material extension's images), the four values the hit carries
+// (e0 .. e3) as the model's extension: the clear coat's weight e0 and roughness e1, the sheen's
+// colour (e0, e1, e2) and roughness e3, the transmission e0, or, on the plain model, the specular
+// colour (e0, e1, e2) and specular e3.
 SHARED_FN ShaderParams shaderAtHit(ShaderParams sh, SurfaceHit hit) {
     if ((sh.flags & kShaderHitParams) != 0u) {
         sh.metallic = float(hit.material & 0xFFFFu) * (1.0f / 65535.0f);
         sh.alpha = gltfAlpha(float(hit.material >> 16u) * (1.0f / 65535.0f));
+    }
+    if ((sh.flags & kShaderHitExtension) != 0u) {
+        vec2 e01 = unpackHalf2x16(hit.extension.x);
+        vec2 e23 = unpackHalf2x16(hit.extension.y);
+        if (sh.model == kModelCoatedMetallicRoughness) {
+            sh.coat = e01.x;
+            sh.coatAlpha = gltfAlpha(e01.y);
+        } else if (sh.model == kModelSheenMetallicRoughness) {
+            sh.sheenColour = vec3(e01.x, e01.y, e23.x);
+            sh.sheenRoughness = e23.y;
+        } else if (sh.model == kModelTransmissiveMetallicRoughness) {
+            sh.transmission = e01.x;
+        } else {
+            sh.specularColour = vec3(e01.x, e01.y, e23.x);
+            sh.specular = e23.y;
+        }
     }
     return sh;
 }

@@ -61,8 +61,10 @@ using glm::max;
 using glm::min;
 using glm::mix;
 using glm::normalize;
+using glm::packHalf2x16;
 using glm::sign;
 using glm::uintBitsToFloat;
+using glm::unpackHalf2x16;
 using std::acos;
 using std::atan;
 // GLSL's two-argument atan.

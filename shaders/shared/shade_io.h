@@ -17,8 +17,6 @@ struct ShadeInput {
     PathState path;
     vec3 rayDir;
     uint pad0; // to 128 bytes, the 8 texels a kernel fetches it in
-    uint pad1;
-    uint pad2;
 };
 
 // Threads per workgroup of every shading kernel.

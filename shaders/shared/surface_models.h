@@ -30,8 +30,8 @@
       kTakesColour | kTakesTexture | kTakesMetallic | kTakesRoughness | kTakesCoat |               \
           kTakesSpecular)                                                                          \
     X(TransmissiveMetallicRoughness, 6u, transmission,                                             \
-      kTakesColour | kTakesTexture | kTakesRoughness | kTakesIor | kTakesAbsorption |              \
-          kTakesTransmission)                                                                      \
+      kTakesColour | kTakesTexture | kTakesMetallic | kTakesRoughness | kTakesIor |                \
+          kTakesAbsorption | kTakesTransmission)                                                   \
     X(SheenMetallicRoughness, 7u, sheen,                                                           \
       kTakesColour | kTakesTexture | kTakesMetallic | kTakesRoughness | kTakesSpecular |           \
           kTakesSheen)

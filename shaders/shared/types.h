@@ -23,6 +23,8 @@ const uint kShaderTextured = 2u;  // albedo comes from a texture tree, resolved 
 const uint kShaderHitParams = 4u; // metallic and roughness come from the hit (SurfaceHit.material)
 const uint kShaderSpecular = 8u;  // MetallicRoughness models: the dielectric reflection takes
                                   // specular and specularColour (KHR_materials_specular)
+const uint kShaderHitExtension = 16u; // the model's extension parameters come from the hit
+                                      // (SurfaceHit.extension; bsdf.h's shaderAtHit says which)
 
 struct ShaderParams {
     vec3 emission;     // radiance leaving the front face (both with kShaderTwoSided)
@@ -86,20 +88,24 @@ const uint kNoEmissionMap = 0u;
 
 // What the shading step needs to know about a hit, already in world space.
 struct SurfaceHit {
-    vec3 p;        // position, interpolated from the triangle's vertices (not o + t d)
-    float t;       // distance along the unit ray direction
-    vec3 ng;       // unit geometric normal, cross(v1 - v0, v2 - v0)
-    uint shader;   // index into the scene's shaders
-    vec3 ns;       // unit shading normal (interpolated vertex normals, or ng)
-    uint emitter;  // index of the emitting triangle hit, or kNoEmitter
-    vec3 albedo;   // reflectance x texture, resolved on the host in hit-sorted order
-    float offset;  // how far rays leaving p start off the surface (shared/offset.h), set with p
-    uint material; // with kShaderHitParams: the metallic (low 16 bits) and perceptual roughness
-                   // (high) that the host's texture lookup gave the hit, as unorm16 (bsdf.h's
-                   // shaderAtHit); 0 otherwise
-    float lift;    // how far above its flat triangle the smooth surface its vertex normals
-                   // describe lies at p, along ng (negative: below), for shadow rays leaving on
-                   // that side (shared/offset.h's shadowLift); 0 without vertex normals
+    vec3 p;          // position, interpolated from the triangle's vertices (not o + t d)
+    float t;         // distance along the unit ray direction
+    vec3 ng;         // unit geometric normal, cross(v1 - v0, v2 - v0)
+    uint shader;     // index into the scene's shaders
+    vec3 ns;         // unit shading normal (interpolated vertex normals, or ng)
+    uint emitter;    // index of the emitting triangle hit, or kNoEmitter
+    vec3 albedo;     // reflectance x texture, resolved on the host in hit-sorted order
+    float offset;    // how far rays leaving p start off the surface (shared/offset.h), set with p
+    uint material;   // with kShaderHitParams: the metallic (low 16 bits) and perceptual roughness
+                     // (high) that the host's texture lookup gave the hit, as unorm16 (bsdf.h's
+                     // shaderAtHit); 0 otherwise
+    float lift;      // how far above its flat triangle the smooth surface its vertex normals
+                     // describe lies at p, along ng (negative: below), for shadow rays leaving on
+                     // that side (shared/offset.h's shadowLift); 0 without vertex normals
+    uvec2 extension; // with kShaderHitExtension: four values as halves (packHalf2x16: x holds the
+                     // first two, y the last two) that the host's extension maps gave the hit
+                     // (KHR_materials_clearcoat's, sheen's, specular's and transmission's
+                     // textures times their factors); 0 otherwise
 };
 const uint kNoEmitter = 0xFFFFFFFFu;
 

@@ -108,7 +108,7 @@ TEST(SurfaceModels, MetallicRoughnessTakesGltfFactorsAndDefaults) {
 }
 
 // The transmissive model's roughness is its glass's: alpha = roughness^2 unfloored (smooth glass
-// at 0; the opaque part floors it itself); transmission defaults to 1.
+// at 0; the opaque part floors it itself); transmission defaults to 1, metallic to 0.
 TEST(SurfaceModels, TransmissiveMetallicRoughnessTakesItsGlassAlphaAndTransmission) {
     TempDir dir;
     const auto load = [&](const std::string& keys) {
@@ -124,7 +124,8 @@ TEST(SurfaceModels, TransmissiveMetallicRoughnessTakesItsGlassAlphaAndTransmissi
     EXPECT_EQ(set.transmission, 0.25f);
     EXPECT_EQ(set.ior, 1.33f);
     EXPECT_THROW(load(", transmission: 1.5"), SceneError);
-    EXPECT_THROW(load(", metallic: 0.5"), SceneError);
+    EXPECT_EQ(load("").metallic, 0.0f); // glass, not a metal, unless told
+    EXPECT_EQ(load(", metallic: 0.5").metallic, 0.5f);
 }
 
 } // namespace

@@ -2,7 +2,8 @@
 // the light: rough glass mixed with the opaque material sampled against the pdf (chi-square),
 // from outside and inside; transmission 0 and 1 are MetallicRoughness and the Dielectric bit for
 // bit; over smooth glass, the delta lobes are sampled with probability transmission and keep the
-// glass's weights; energy at the narrow-lobe limit.
+// glass's weights; energy at the narrow-lobe limit; on a metal, the glass's weight is
+// transmission (1 - metallic), and metallic 1 is the opaque metal.
 #include "bsdf_test_util.h"
 
 #include "shared/gltf.h"
@@ -58,6 +59,43 @@ TEST(TransmissiveMetallicRoughness, SampledDirectionsFollowThePdf) {
                                      4000 + uint(theta + 10 * t + 100 * alpha) + inside),
                         tests, name);
                 }
+}
+
+// On a metal the glass's weight is transmission (1 - metallic): at metallic 0.5, sampled against
+// the pdf (chi-square) as above.
+TEST(TransmissiveMetallicRoughness, OnAMetalSampledDirectionsFollowThePdf) {
+    const double thetas[] = {0.0, 60.0};
+    for (bool inside : {false, true})
+        for (double theta : thetas) {
+            BsdfUnderTest m = transmissive(0.8f, 0.09f, theta, inside);
+            m.sh.metallic = 0.5f;
+            char name[80];
+            std::snprintf(name, sizeof name, "metallic 0.5, theta %g, %s", theta,
+                          inside ? "inside" : "outside");
+            expectSamplingMatchesPdf(testSampling(m, lobes(m), 200000, 4500 + uint(theta) + inside),
+                                     4, name);
+        }
+}
+
+// Metallic 1 leaves no glass whatever the transmission: MetallicRoughness's metal, bit for bit
+// in eval, and never a delta BSDF.
+TEST(TransmissiveMetallicRoughness, AWholeMetalIsTheOpaqueMetal) {
+    Uniform u(43);
+    for (float t : {0.5f, 1.0f})
+        for (double theta : {0.0, 50.0}) {
+            BsdfUnderTest m = transmissive(t, 0.0f, theta, false);
+            m.sh.metallic = 1.0f;
+            ShaderParams metal = shaderParams(kModelMetallicRoughness, kGltfMinAlpha, kIor);
+            metal.metallic = 1.0f;
+            EXPECT_FALSE(bsdfIsDelta(m.sh));
+            for (int k = 0; k < 300; ++k) {
+                const vec3 wi = glm::normalize(u.next3() - vec3(0.5f));
+                float pdfA, pdfB;
+                const vec3 a = bsdfEval(m.sh, m.albedo, m.ng, m.ns, m.wo, wi, pdfA);
+                ASSERT_EQ(a, bsdfEval(metal, m.albedo, m.ng, m.ns, m.wo, wi, pdfB));
+                ASSERT_EQ(pdfA, pdfB);
+            }
+        }
 }
 
 // transmission 0: MetallicRoughness at metallic 0 (its alpha floored as glTF's loader floors

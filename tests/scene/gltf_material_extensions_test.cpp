@@ -15,7 +15,7 @@
 //     lobe's albedo;
 // and what is not rendered is warned about, and malformed values are refused naming where.
 #include "host/loaders/scene_loader.h"
-#include "scene/gltf_builder.h"
+#include "scene/gltf_spheres.h"
 #include "test_util.h"
 
 #include "shared/gltf.h"
@@ -28,82 +28,6 @@
 
 namespace spw::test {
 namespace {
-
-// A UV sphere of radius 1 (48 around, 24 rings) with its normals, material 0.
-json sphere(GltfBuilder& b) {
-    std::vector<float> pos;
-    std::vector<uint32_t> idx;
-    const int rings = 24, segments = 48;
-    for (int r = 0; r <= rings; ++r)
-        for (int s = 0; s <= segments; ++s) {
-            const double t = M_PI * r / rings, p = 2.0 * M_PI * s / segments;
-            pos.insert(pos.end(), {float(std::sin(t) * std::cos(p)), float(std::cos(t)),
-                                   float(-std::sin(t) * std::sin(p))});
-        }
-    for (int r = 0; r < rings; ++r)
-        for (int s = 0; s < segments; ++s) {
-            const uint32_t a = uint32_t(r * (segments + 1) + s), c = a + uint32_t(segments) + 1;
-            idx.insert(idx.end(), {a, c, a + 1, a + 1, c, c + 1});
-        }
-    return {{"attributes",
-             {{"POSITION", b.accessor<float>(pos, 5126, "VEC3")},
-              {"NORMAL", b.accessor<float>(pos, 5126, "VEC3")}}},
-            {"indices", b.accessor<uint32_t>(idx, 5125, "SCALAR")},
-            {"material", 0}};
-}
-
-// The sphere of material `mat`, filling most of the view, no light: glTF's uniform environment.
-std::string sphereFile(const TempDir& dir, const json& mat) {
-    GltfBuilder b;
-    b.doc["materials"] = json::array({mat});
-    b.doc["extensionsUsed"] = {"KHR_materials_transmission", "KHR_materials_ior",
-                               "KHR_materials_volume",       "KHR_materials_clearcoat",
-                               "KHR_materials_specular",     "KHR_materials_sheen"};
-    b.doc["cameras"] =
-        json::array({{{"type", "perspective"},
-                      {"perspective", {{"yfov", 0.6}, {"aspectRatio", 1.0}, {"znear", 0.1}}}}});
-    b.scene({b.node({{"mesh", b.mesh(sphere(b))}}),
-             b.node({{"camera", 0}, {"translation", {0, 0, 3.5}}})});
-    return b.embedded(dir, "glass.gltf");
-}
-
-json glass(double transmission, double ior, double roughness = 0.0) {
-    json m = material(vec3(1.0f), 0.0f, float(roughness));
-    m["extensions"]["KHR_materials_transmission"]["transmissionFactor"] = transmission;
-    m["extensions"]["KHR_materials_ior"]["ior"] = ior;
-    return m;
-}
-
-// glass with KHR_materials_volume's attenuation: `colour` left after `distance`, thickness 1.
-json volume(json m, std::vector<double> colour, double distance) {
-    m["extensions"]["KHR_materials_volume"] = {
-        {"thicknessFactor", 1.0}, {"attenuationColor", colour}, {"attenuationDistance", distance}};
-    return m;
-}
-
-// A black smooth dielectric under a smooth clear coat of weight `coat` and roughness `roughness`.
-json coated(double coat, double roughness) {
-    json m = material(vec3(0.0f), 0.0f, 0.0f);
-    m["extensions"]["KHR_materials_clearcoat"] = {{"clearcoatFactor", coat},
-                                                  {"clearcoatRoughnessFactor", roughness}};
-    return m;
-}
-
-// A black smooth dielectric with KHR_materials_specular's weight and F0 colour.
-json specular(double weight, std::vector<double> colour) {
-    json m = material(vec3(0.0f), 0.0f, 0.0f);
-    m["extensions"]["KHR_materials_specular"] = {{"specularFactor", weight},
-                                                 {"specularColorFactor", colour}};
-    return m;
-}
-
-// A black dielectric whose reflection is off (KHR_materials_specular's weight 0) under a sheen.
-json sheen(std::vector<double> colour, double roughness) {
-    json m = specular(0.0, {1.0, 1.0, 1.0});
-    m["extensions"]["KHR_materials_sheen"] = {{"sheenColorFactor", colour},
-                                              {"sheenRoughnessFactor", roughness}};
-    return m;
-}
 
 // The channels' mean over the 8 x 8 pixels at the centre of a 24 x 24 image (a view within 16
 // degrees of the sphere's normal), and its standard error from the pixels' spread.
@@ -198,8 +122,8 @@ TEST(GltfGlass, WhatIsNotRenderedIsWarnedAndBadValuesRefused) {
     EXPECT_EQ(partial.second, "");
     json metal = glass(1.0, 1.5);
     metal["pbrMetallicRoughness"]["metallicFactor"] = 0.5;
-    EXPECT_EQ(warnings(metal).first, kModelMetallicRoughness);
-    EXPECT_NE(warnings(metal).second.find("drawn opaque"), std::string::npos);
+    EXPECT_EQ(warnings(metal).first, kModelTransmissiveMetallicRoughness); // GltfTransmission.*
+    EXPECT_EQ(warnings(metal).second, "");
     json tinted = glass(1.0, 1.5);
     tinted["pbrMetallicRoughness"]["baseColorFactor"] = {0.2, 0.8, 0.3, 1.0};
     const auto tint = warnings(tinted);
@@ -222,19 +146,9 @@ TEST(GltfGlass, WhatIsNotRenderedIsWarnedAndBadValuesRefused) {
     json iorOnly = material(vec3(1.0f), 0.0f, 0.5f);
     iorOnly["extensions"]["KHR_materials_ior"]["ior"] = 1.7;
     EXPECT_EQ(warnings(iorOnly).second, ""); // an opaque material's F0 (GltfIor.*)
-    json specularImages = specular(0.5, {1.0, 1.0, 1.0});
-    specularImages["extensions"]["KHR_materials_specular"]["specularColorTexture"] = {{"index", 0}};
-    EXPECT_NE(warnings(specularImages).second.find("specularColorTexture is not rendered"),
-              std::string::npos);
     json sheenGlass = glass(1.0, 1.5);
     sheenGlass["extensions"]["KHR_materials_sheen"]["sheenColorFactor"] = {1.0, 1.0, 1.0};
     EXPECT_NE(warnings(sheenGlass).second.find("a sheen on glass"), std::string::npos);
-    json sheenImages = material(vec3(0.5f), 0.0f, 0.5f);
-    sheenImages["extensions"]["KHR_materials_sheen"] = {{"sheenColorFactor", {1.0, 1.0, 1.0}},
-                                                        {"sheenRoughnessTexture", {{"index", 0}}}};
-    const auto sheenImage = warnings(sheenImages);
-    EXPECT_EQ(sheenImage.first, kModelSheenMetallicRoughness);
-    EXPECT_NE(sheenImage.second.find("sheenRoughnessTexture is not rendered"), std::string::npos);
     json specularGlass = glass(1.0, 1.5);
     specularGlass["extensions"]["KHR_materials_specular"]["specularFactor"] = 0.5;
     EXPECT_NE(warnings(specularGlass).second.find("KHR_materials_specular on glass"),
@@ -392,31 +306,44 @@ TEST(GltfSpecular, TheWeightAndColourSetTheReflectionAtNormalIncidence) {
 }
 
 // Glass transmitting a share t of the light (ior 1.01: about no Fresnel reflection, 2.5e-5) over
-// an opaque base of colour c, a sphere in a white furnace, seen within 16 degrees of its normal:
+// an opaque base of colour c and metallic m (the glass's weight w = t (1 - m), the
+// specification's transmission of the dielectric part alone), a sphere in a white furnace, seen
+// within 16 degrees of its normal:
 //   * at max depth 1, a path sees the environment only through the opaque part's reflection
-//     (what the glass refracts reaches the sphere's far side and ends there): (1 - t) c;
+//     (what the glass refracts reaches the sphere's far side and ends there): (1 - w) c at
+//     metallic 0, and the MetallicRoughness model's reflectance at m / (1 - w) otherwise;
 //   * at full depth, with a white base, nothing is absorbed anywhere: 1.
 // Each within 4 standard errors (from the pixels' spread; a sample picks a lobe with probability
 // t, so 16 spp leave several per cent of noise) and 0.5 % (the Fresnel terms). On every backend.
 TEST(GltfTransmission, PartialTransmissionMixesTheGlassWithTheOpaqueMaterial) {
     TempDir dir;
-    for (double t : {0.25, 0.75}) {
+    for (auto [t, metallic] :
+         {std::pair(0.25, 0.0), std::pair(0.75, 0.0), std::pair(1.0, 0.5), std::pair(0.5, 0.5)}) {
         for (float c : {0.5f, 1.0f}) {
             json m = glass(t, 1.01);
             m["pbrMetallicRoughness"]["baseColorFactor"] = {c, c, c, 1.0};
+            m["pbrMetallicRoughness"]["metallicFactor"] = metallic;
             Scene scene = loadScene(sphereFile(dir, m));
             ASSERT_EQ(scene.shaders.at(0).params.model, kModelTransmissiveMetallicRoughness);
             EXPECT_EQ(scene.shaders[0].params.transmission, float(t));
             EXPECT_TRUE(scene.warnings.empty()) << scene.warnings.at(0);
-            const bool direct = c < 1.0f;
+            // The glass's weight is the dielectric part's transmission, t (1 - metallic); the
+            // rest is MetallicRoughness at metallic m' = m / (1 - w), which reflects
+            // F0 + (1 - F0) (1 - m') c near the centre, F0 = m' c (glTF's appendix B: short of c
+            // where 0 < m' < 1, so the furnace's 1 holds only at m' = 0 or 1).
+            const double w = t * (1.0 - metallic), mPrime = metallic / (1.0 - w);
+            const bool direct = c < 1.0f || (mPrime > 0.0 && mPrime < 1.0);
             if (direct) scene.settings.maxDepth = 1;
-            const double expected = direct ? (1.0 - t) * c : 1.0;
+            const double f0 = mPrime * c;
+            const double expected =
+                direct ? (1.0 - w) * (f0 + (1.0 - f0) * (1.0 - mPrime) * c) : 1.0;
             onEveryBackend(
                 scene,
                 [&](const std::vector<float>& img) {
                     const auto [mean, se] = centreMean(img);
                     EXPECT_NEAR(mean, expected, 4.0 * se + 0.005 * expected)
-                        << "transmission " << t << ", colour " << c << ", standard error " << se;
+                        << "transmission " << t << ", metallic " << metallic << ", colour " << c
+                        << ", standard error " << se;
                 },
                 256);
         }

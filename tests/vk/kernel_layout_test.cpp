@@ -55,11 +55,11 @@ Fields nested(const std::string& prefix, size_t base, const Fields& inner) {
         out[prefix + "." + name] = {base + f.offset, f.size};
     return out;
 }
-const Fields kSurfaceHit = {SPW_FIELD(SurfaceHit, p),        SPW_FIELD(SurfaceHit, t),
-                            SPW_FIELD(SurfaceHit, ng),       SPW_FIELD(SurfaceHit, shader),
-                            SPW_FIELD(SurfaceHit, ns),       SPW_FIELD(SurfaceHit, emitter),
-                            SPW_FIELD(SurfaceHit, albedo),   SPW_FIELD(SurfaceHit, offset),
-                            SPW_FIELD(SurfaceHit, material), SPW_FIELD(SurfaceHit, lift)};
+const Fields kSurfaceHit = {
+    SPW_FIELD(SurfaceHit, p),      SPW_FIELD(SurfaceHit, t),        SPW_FIELD(SurfaceHit, ng),
+    SPW_FIELD(SurfaceHit, shader), SPW_FIELD(SurfaceHit, ns),       SPW_FIELD(SurfaceHit, emitter),
+    SPW_FIELD(SurfaceHit, albedo), SPW_FIELD(SurfaceHit, offset),   SPW_FIELD(SurfaceHit, material),
+    SPW_FIELD(SurfaceHit, lift),   SPW_FIELD(SurfaceHit, extension)};
 const Fields kPathState = {SPW_FIELD(PathState, beta),   SPW_FIELD(PathState, prevPdf),
                            SPW_FIELD(PathState, pathId), SPW_FIELD(PathState, bounce),
                            SPW_FIELD(PathState, flags),  SPW_FIELD(PathState, cone)};
@@ -69,8 +69,6 @@ Fields shadeInputFields() {
         out.insert(f);
     out.insert(SPW_FIELD(ShadeInput, rayDir));
     out.insert(SPW_FIELD(ShadeInput, pad0));
-    out.insert(SPW_FIELD(ShadeInput, pad1));
-    out.insert(SPW_FIELD(ShadeInput, pad2));
     return out;
 }
 Fields shadeResultFields() {

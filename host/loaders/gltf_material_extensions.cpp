@@ -1,0 +1,242 @@
+// GltfReader's material extensions (gltf_reader.h): KHR_materials_transmission with _ior and
+// _volume, _clearcoat, _specular and _sheen, each a part of the metallic-roughness model or a
+// surface model of its own, their factors and images (the images as Shader::extension's maps).
+#include "host/loaders/gltf_reader.h"
+
+#include "shared/gltf.h"
+
+#include <cmath>
+#include <sstream>
+
+namespace spw {
+
+namespace {
+// x as the shortest decimal that reads back as it (1.01, not 1.010000).
+std::string number(double x) {
+    std::ostringstream out;
+    out << x;
+    return out.str();
+}
+} // namespace
+
+double GltfReader::extensionNumber(const tinygltf::Value& ext, const char* key, double fallback,
+                                   double lo, double hi, const std::string& at) const {
+    if (!ext.Has(key)) return fallback;
+    const tinygltf::Value& v = ext.Get(key);
+    const double x = v.IsNumber() ? v.GetNumberAsDouble() : NAN;
+    if (!(x >= lo && x <= hi) || !std::isfinite(x))
+        fail(at + "/" + key, std::isfinite(hi)
+                                 ? "must be a number in [" + number(lo) + ", " + number(hi) + "]"
+                                 : "must be a finite number of at least " + number(lo));
+    return x;
+}
+
+double GltfReader::extensionNumber(const tinygltf::Value& values, int k, double lo, double hi,
+                                   const std::string& at) const {
+    const tinygltf::Value& v = values.Get(k);
+    const double x = v.IsNumber() ? v.GetNumberAsDouble() : NAN;
+    if (!(x >= lo && x <= hi) || !std::isfinite(x))
+        fail(at + "/" + std::to_string(k),
+             std::isfinite(hi) ? "must be a number in [" + number(lo) + ", " + number(hi) + "]"
+                               : "must be a finite number of at least " + number(lo));
+    return x;
+}
+
+void GltfReader::readTransmission(const tinygltf::Material& mat, Shader& s, const std::string& at,
+                                  const std::string& name) {
+    const auto iorExt = mat.extensions.find("KHR_materials_ior");
+    double ior = 1.5;
+    if (iorExt != mat.extensions.end()) {
+        ior = extensionNumber(iorExt->second, "ior", 1.5, 0.0, 10.0,
+                              at + "/extensions/KHR_materials_ior");
+        if (ior > 0.0 && ior < 1.0)
+            fail(at + "/extensions/KHR_materials_ior/ior", "must be 0 or at least 1");
+    }
+    const auto t = mat.extensions.find("KHR_materials_transmission");
+    const double factor = t == mat.extensions.end()
+                              ? 0.0
+                              : extensionNumber(t->second, "transmissionFactor", 0.0, 0.0, 1.0,
+                                                at + "/extensions/KHR_materials_transmission");
+    const bool textured = t != mat.extensions.end() && t->second.Has("transmissionTexture");
+    // Opaque, the ior sets the dielectric reflection's F0 ((ior - 1) / (ior + 1))^2
+    // (shared/gltf.h's gltfDielectricF0); 0 keeps glTF's 0.04.
+    if (ior == 0.0 && iorExt != mat.extensions.end())
+        warn(name + ": KHR_materials_ior's ior 0 is rendered as 1.5");
+    s.params.ior = float(ior == 0.0 ? 1.5 : ior);
+    if (factor == 0.0) return;
+    if (ior > 0.0 && ior < kMinGlassIor)
+        warn(name + ": an ior below " + number(kMinGlassIor) + " is rendered as " +
+             number(kMinGlassIor));
+    // Below 1, where an image may make it so, or on a metal, glass mixed with the opaque material
+    // (shared/transmission.h); the image's red channel times the factor at each hit.
+    const bool metal = s.params.metallic > 0.0f || s.metallicRoughnessTexture >= 0;
+    const bool partial = factor < 1.0 || textured || metal;
+    s.typeName = partial ? "TransmissiveMetallicRoughness" : "Dielectric";
+    s.params.model = partial ? kModelTransmissiveMetallicRoughness : kModelDielectric;
+    s.params.transmission = float(factor);
+    if (textured) {
+        s.extension[0] = {extensionTexture(t->second, "transmissionTexture", 0, false,
+                                           at + "/extensions/KHR_materials_transmission",
+                                           name + ": its transmissionTexture"),
+                          0, float(factor)};
+        s.params.flags |= kShaderHitExtension;
+    }
+    s.params.ior = float(ior == 0.0 ? 1.5 : std::max(ior, kMinGlassIor));
+    s.params.alpha = s.roughness * s.roughness; // below kGgxSmoothAlpha: smooth glass
+    // The base colour (its factor, image and vertex colours) tints what the glass refracts. A
+    // metallic-roughness image gives each hit its metallic and (floored as MetallicRoughness
+    // floors it) roughness, for the glass too.
+}
+
+void GltfReader::readVolume(const tinygltf::Material& mat, Shader& s, const std::string& at,
+                            const std::string& name) {
+    const auto v = mat.extensions.find("KHR_materials_volume");
+    if (v == mat.extensions.end()) return;
+    const std::string where = at + "/extensions/KHR_materials_volume";
+    const double thickness =
+        extensionNumber(v->second, "thicknessFactor", 0.0, 0.0, HUGE_VAL, where);
+    const double distance =
+        extensionNumber(v->second, "attenuationDistance", HUGE_VAL, 0.0, HUGE_VAL, where);
+    if (v->second.Has("attenuationDistance") && !(distance > 0.0))
+        fail(where + "/attenuationDistance", "must be a positive number");
+    vec3 colour(1.0f);
+    if (v->second.Has("attenuationColor")) {
+        const tinygltf::Value& c = v->second.Get("attenuationColor");
+        if (!c.IsArray() || c.ArrayLen() != 3)
+            fail(where + "/attenuationColor", "needs 3 numbers in [0, 1]");
+        for (int k = 0; k < 3; ++k)
+            colour[k] = float(extensionNumber(c, k, 0.0, 1.0, where + "/attenuationColor"));
+    }
+    if (v->second.Has("thicknessTexture"))
+        warn(name + ": its thicknessTexture is not read (the mesh's own thickness is rendered)");
+    const bool transmits =
+        s.params.model == kModelDielectric || s.params.model == kModelTransmissiveMetallicRoughness;
+    if (!transmits || !std::isfinite(distance) || colour == vec3(1.0f))
+        return; // nothing absorbs: the volume of an opaque material is never entered
+    if (thickness == 0.0) {
+        warn(name + ": KHR_materials_volume's thicknessFactor 0 makes it thin-walled: its "
+                    "attenuation is not rendered");
+        return;
+    }
+    // Beer-Lambert: attenuationColor is what is left after attenuationDistance.
+    for (int k = 0; k < 3; ++k)
+        s.params.absorption[k] = float(-std::log(std::max(double(colour[k]), 1e-30)) / distance);
+    if (!std::isfinite(maxComponent(s.params.absorption)))
+        fail(where + "/attenuationDistance", "gives an absorption beyond the float range");
+}
+
+void GltfReader::readClearcoat(const tinygltf::Material& mat, Shader& s, const std::string& at,
+                               const std::string& name) {
+    const auto c = mat.extensions.find("KHR_materials_clearcoat");
+    if (c == mat.extensions.end()) return;
+    const std::string where = at + "/extensions/KHR_materials_clearcoat";
+    const double factor = extensionNumber(c->second, "clearcoatFactor", 0.0, 0.0, 1.0, where);
+    const double roughness =
+        extensionNumber(c->second, "clearcoatRoughnessFactor", 0.0, 0.0, 1.0, where);
+    if (factor == 0.0) return;
+    if (s.params.model != kModelMetallicRoughness) {
+        warn(name + ": a clear coat on glass is not rendered");
+        return;
+    }
+    if (c->second.Has("clearcoatNormalTexture"))
+        warn(name + ": its clearcoatNormalTexture is not rendered (the coat takes the base's "
+                    "shading normal)");
+    s.typeName = "CoatedMetallicRoughness";
+    s.params.model = kModelCoatedMetallicRoughness;
+    s.params.coat = float(factor);
+    s.params.coatAlpha = gltfAlpha(float(roughness));
+    // The weight times the red channel of clearcoatTexture, the roughness times the green of
+    // clearcoatRoughnessTexture.
+    const int weight = extensionTexture(c->second, "clearcoatTexture", 0, false, where,
+                                        name + ": its clearcoatTexture");
+    const int rough = extensionTexture(c->second, "clearcoatRoughnessTexture", 0, false, where,
+                                       name + ": its clearcoatRoughnessTexture");
+    s.extension[0] = {weight, 0, float(factor)};
+    s.extension[1] = {rough, 1, float(roughness)};
+    if (weight >= 0 || rough >= 0) s.params.flags |= kShaderHitExtension;
+}
+
+void GltfReader::readSpecular(const tinygltf::Material& mat, Shader& s, const std::string& at,
+                              const std::string& name) {
+    const auto e = mat.extensions.find("KHR_materials_specular");
+    if (e == mat.extensions.end()) return;
+    const std::string where = at + "/extensions/KHR_materials_specular";
+    const double factor = extensionNumber(e->second, "specularFactor", 1.0, 0.0, 1.0, where);
+    vec3 colour(1.0f);
+    if (e->second.Has("specularColorFactor")) {
+        const tinygltf::Value& c = e->second.Get("specularColorFactor");
+        if (!c.IsArray() || c.ArrayLen() != 3)
+            fail(where + "/specularColorFactor", "needs 3 numbers of at least 0");
+        for (int k = 0; k < 3; ++k)
+            colour[k] = float(std::min(
+                extensionNumber(c, k, 0.0, HUGE_VAL, where + "/specularColorFactor"), 1e3));
+    }
+    const bool textured = e->second.Has("specularTexture") || e->second.Has("specularColorTexture");
+    if (factor == 1.0 && colour == vec3(1.0f) && !textured)
+        return; // the defaults: glTF's own reflection
+    if (s.params.model == kModelDielectric ||
+        s.params.model == kModelTransmissiveMetallicRoughness) {
+        warn(name + ": KHR_materials_specular on glass is not rendered (its reflection follows "
+                    "the ior alone)");
+        return;
+    }
+    s.params.flags |= kShaderSpecular;
+    s.params.specular = float(factor);
+    s.params.specularColour = colour;
+    if (!textured) return;
+    if (s.params.model != kModelMetallicRoughness) {
+        warn(name + ": KHR_materials_specular's images are not rendered on a clear coat or a "
+                    "sheen (its factors are)");
+        return;
+    }
+    // The colour times specularColorTexture's RGB (sRGB), the weight times specularTexture's
+    // alpha.
+    const int tint = extensionTexture(e->second, "specularColorTexture", 0, true, where,
+                                      name + ": its specularColorTexture");
+    const int weight = extensionTexture(e->second, "specularTexture", 3, false, where,
+                                        name + ": its specularTexture");
+    for (int k = 0; k < 3; ++k)
+        s.extension[size_t(k)] = {tint, k, colour[k]};
+    s.extension[3] = {weight, 0, float(factor)};
+    s.params.flags |= kShaderHitExtension;
+}
+
+void GltfReader::readSheen(const tinygltf::Material& mat, Shader& s, const std::string& at,
+                           const std::string& name) {
+    const auto e = mat.extensions.find("KHR_materials_sheen");
+    if (e == mat.extensions.end()) return;
+    const std::string where = at + "/extensions/KHR_materials_sheen";
+    vec3 colour(0.0f);
+    if (e->second.Has("sheenColorFactor")) {
+        const tinygltf::Value& c = e->second.Get("sheenColorFactor");
+        if (!c.IsArray() || c.ArrayLen() != 3)
+            fail(where + "/sheenColorFactor", "needs 3 numbers in [0, 1]");
+        for (int k = 0; k < 3; ++k)
+            colour[k] = float(extensionNumber(c, k, 0.0, 1.0, where + "/sheenColorFactor"));
+    }
+    const double roughness =
+        extensionNumber(e->second, "sheenRoughnessFactor", 0.0, 0.0, 1.0, where);
+    if (colour == vec3(0.0f)) return;
+    if (s.params.model != kModelMetallicRoughness) {
+        warn(name + ": a sheen on " +
+             (s.params.model == kModelCoatedMetallicRoughness ? "a clear coat" : "glass") +
+             " is not rendered");
+        return;
+    }
+    s.typeName = "SheenMetallicRoughness";
+    s.params.model = kModelSheenMetallicRoughness;
+    s.params.sheenColour = colour;
+    s.params.sheenRoughness = float(roughness);
+    // The colour times sheenColorTexture's RGB (sRGB), the roughness times
+    // sheenRoughnessTexture's alpha.
+    const int tint = extensionTexture(e->second, "sheenColorTexture", 0, true, where,
+                                      name + ": its sheenColorTexture");
+    const int rough = extensionTexture(e->second, "sheenRoughnessTexture", 3, false, where,
+                                       name + ": its sheenRoughnessTexture");
+    for (int k = 0; k < 3; ++k)
+        s.extension[size_t(k)] = {tint, k, colour[k]};
+    s.extension[3] = {rough, 0, float(roughness)};
+    if (tint >= 0 || rough >= 0) s.params.flags |= kShaderHitExtension;
+}
+
+} // namespace spw
