@@ -237,10 +237,11 @@ def relmse(spillway, image, reference):
     return json.loads(r.stdout)["relmse"]
 
 
-def spillway_render(spillway, backend, file, width, spp, seed, out):
+def spillway_render(spillway, backend, file, width, spp, seed, out, extra=()):
     """Seconds of the whole process (best of the repeats), and the image written."""
     cmd = [spillway, "render", file, "--backend", backend, "--width", str(width), "--spp",
            str(spp), "--seed", str(seed), "--threads", str(THREADS), "--quiet", "-o", out]
+    cmd += list(extra)
     start = time.perf_counter()
     r = subprocess.run(cmd, capture_output=True, text=True)
     seconds = time.perf_counter() - start
@@ -319,6 +320,20 @@ def bench_scene(spillway, backends, scene, width, cycles_spp, ref_spp, repeat, m
              "ratio": seconds / row["cycles_seconds"] if seconds else None,
              "ratio_without_start": (seconds - start) / row["cycles_seconds"] if seconds else None,
              "against_cycles_reference": relmse(spillway, ref, cycles_ref)}
+        # As a user asks for an error: --target-error at twice, once and half Cycles' error
+        # (adaptive sampling toward it, the default), timed to the true error by interpolation.
+        asked = []
+        for k, factor in enumerate((2.0, 1.0, 0.5)):
+            out = os.path.join(work, "%s-target-%d.exr" % (backend, k))
+            t = min(spillway_render(spillway, backend, ours, width, max_spp, 0, out,
+                                    ["--target-error", "%g" % (factor * target)])
+                    for _ in range(repeat))
+            asked.append((factor, t, relmse(spillway, out, ref)))
+        asked.sort(key=lambda p: -p[2])
+        b["target_curve"] = asked
+        b["target_seconds"], _ = interpolate_time(asked, target)
+        b["target_ratio"] = b["target_seconds"] / row["cycles_seconds"] \
+            if b["target_seconds"] else None
         if name == "cornell":
             # The same error against Cycles' reference (the BRDFs nearly agree here).
             b["curve_against_cycles"] = [(n, t, relmse(spillway, os.path.join(
@@ -339,6 +354,11 @@ def print_row(row):
               "start   (its reference vs Cycles': relMSE %.3g)" % (
                   backend, b["spp"], b["seconds"], b["ratio"], b["ratio_without_start"],
                   b["start_seconds"], b["against_cycles_reference"]))
+        if b.get("target_seconds"):
+            print("  %-10s --target-error: %7.2f s  %.2fx Cycles' time" % (
+                "", b["target_seconds"], b["target_ratio"]))
+        else:
+            print("  %-10s --target-error: did not reach it (%s)" % ("", b.get("target_curve")))
     sys.stdout.flush()
 
 
@@ -362,7 +382,7 @@ def main(spillway, backends, quick, repeat, scenes=None):
     def measured(points):
         return all(0 < t < math.inf and 0 < e < math.inf for _, t, e in points)
     bad = [r["scene"] for r in rows if not (measured(r["cycles_curve"]) and all(
-        measured(b["curve"]) for b in r["backends"].values()))]
+        measured(b["curve"]) and measured(b["target_curve"]) for b in r["backends"].values()))]
     if bad:
         print("FAIL: no usable measurement on %s" % ", ".join(bad))
     return 1 if bad else 0

@@ -169,6 +169,10 @@ const std::vector<CliOption> kOwnOptions = {
      "stop after the first iteration whose relMSE, estimated from two half buffers (the "
      "--error-csv estimate), is at or below E",
      0, 1e9, [](O& r, const C& o, const S& v) { r.config.targetError = numberValue(o, v); }},
+    {"--uniform", nullptr, nullptr, Section::Render,
+     "with --target-error, every pixel takes every sample (by default the image's 8 x 8 tiles "
+     "share them by their noise, which reaches the target sooner)",
+     0, 0, [](O& r, const C&, const S&) { r.config.adaptiveToTarget = false; }},
     {"--checkpoint", nullptr, "FILE.exr", Section::Render,
      "write the render's exact state (an EXR of the image so far, with the film's sums bit "
      "for bit in extra channels) at the end, however the render stops, and every "

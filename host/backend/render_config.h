@@ -112,6 +112,9 @@ struct RenderConfig {
     // Stop after the first iteration whose half-buffer relMSE estimate (Film::halfBufferRelMse)
     // is at or below this.
     std::optional<double> targetError;
+    // With targetError and no adaptive threshold: the tiles share the samples by their noise
+    // toward it (Film::setAdaptiveTarget); false: every pixel samples alike.
+    bool adaptiveToTarget = true;
     // Nonzero: stop at the next batch (or tile) boundary and discard the iteration in progress;
     // the render keeps every completed iteration. Set from a signal handler (the CLI's).
     // kStopByWindow when the preview window was closed, kStopByLostDisplay when its display went

@@ -142,6 +142,11 @@ void Film::setAdaptive(double threshold, int minSamples) {
     decideTiles();
 }
 
+void Film::setAdaptiveTarget(double relMse) {
+    adaptiveTarget_ = relMse;
+    decideTiles();
+}
+
 void Film::decideTiles() {
     decideAdaptiveTiles();
     // This process's share: every shares_-th of the tiles still sampling.

@@ -150,6 +150,10 @@ class Film {
     // their pixels hold `minSamples` samples. Takes effect from the next iteration.
     static constexpr int kAdaptiveTile = 8;
     void setAdaptive(double threshold, int minSamples);
+    // Adaptive sampling toward a target relMSE (with threshold 0): the tiles share the samples in
+    // proportion to their noise, which reaches the target soonest (decideTargetTiles); 0 turns
+    // it off. Takes effect from the next iteration.
+    void setAdaptiveTarget(double relMse);
     // Whether this process takes pixel (x, y)'s samples in the coming iteration: the pixel's tile
     // is still sampling, and is in this process's share.
     bool sampling(int x, int y) const {
@@ -203,6 +207,8 @@ class Film {
     int halfOf(uint sampleIndex) const; // by stratum or by stream (halves_)
     void decideTiles();                 // the tiles this process samples: adaptive mask and share
     void decideAdaptiveTiles();         // the adaptive mask, from the sums and counts
+    // The mask toward adaptiveTarget_, from each tile's mean term (-1: not ready) and values.
+    void decideTargetTiles(const std::vector<double>& mean, const std::vector<size_t>& count);
     // Pixel `pixel`'s eight sums in radiance and weight units.
     void pixelSums(size_t pixel, double* s) const;
     // The half-buffer relMSE's terms of rows y0 .. y1 - 1, three a pixel, into terms: per
@@ -259,6 +265,7 @@ class Film {
     const PixelSums* lastIteration_ = nullptr;
     std::atomic<std::uint64_t> nonFinite_{0}, saturated_{0};
     double adaptiveThreshold_ = 0.0;
+    double adaptiveTarget_ = 0.0;
     int adaptiveMinSamples_ = 0;
     int tilesX_ = 0, tilesY_ = 0;
     // Camera samples each pixel of a tile took in whole iterations: all of a tile's pixels

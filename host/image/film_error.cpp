@@ -123,21 +123,25 @@ void Film::errorRows(int y0, int y1, float* rgb) const {
 }
 
 void Film::decideAdaptiveTiles() {
-    if (!(adaptiveThreshold_ > 0.0)) {
+    if (!(adaptiveThreshold_ > 0.0) && !(adaptiveTarget_ > 0.0)) {
         active_.clear();
         activeTiles_ = 1;
         return;
     }
-    active_.assign(size_t(tilesX_) * size_t(tilesY_), 1);
-    activeTiles_ = active_.size();
-    const double limit = adaptiveThreshold_ * adaptiveThreshold_; // on the mean square
+    const size_t tiles = size_t(tilesX_) * size_t(tilesY_);
+    active_.assign(tiles, 1);
+    activeTiles_ = tiles;
+    // Each tile's mean half-buffer term over its values, and how many; not ready (-1) before its
+    // minimum samples or while a pixel has no estimate.
+    std::vector<double> mean(tiles, -1.0);
+    std::vector<size_t> count(tiles, 0);
     forHalfBufferTerms(0, height_, [&](int y0, int y1, const double* terms) {
         for (int ty = y0 / kAdaptiveTile; ty * kAdaptiveTile < y1; ++ty)
             for (int tx = 0; tx < tilesX_; ++tx) {
+                const size_t tile = size_t(ty) * size_t(tilesX_) + size_t(tx);
                 double total = 0.0;
                 size_t values = 0;
-                bool ready = tileSamples_[size_t(ty) * size_t(tilesX_) + size_t(tx)] >=
-                             std::uint32_t(adaptiveMinSamples_);
+                bool ready = tileSamples_[tile] >= std::uint32_t(adaptiveMinSamples_);
                 for (int y = ty * kAdaptiveTile; y < std::min(y1, (ty + 1) * kAdaptiveTile); ++y)
                     for (int x = tx * kAdaptiveTile; x < std::min(width_, (tx + 1) * kAdaptiveTile);
                          ++x) {
@@ -150,12 +154,45 @@ void Film::decideAdaptiveTiles() {
                             total += t[c];
                         values += 3;
                     }
-                if (ready && values > 0 && total / double(values) < limit) {
-                    active_[size_t(ty) * size_t(tilesX_) + size_t(tx)] = 0;
-                    --activeTiles_;
-                }
+                if (ready && values > 0) mean[tile] = total / double(values);
+                count[tile] = values;
             }
     });
+    if (adaptiveThreshold_ > 0.0) {
+        const double limit = adaptiveThreshold_ * adaptiveThreshold_; // on the mean square
+        for (size_t t = 0; t < tiles; ++t)
+            if (mean[t] >= 0.0 && mean[t] < limit) active_[t] = 0, --activeTiles_;
+        return;
+    }
+    decideTargetTiles(mean, count);
+}
+
+void Film::decideTargetTiles(const std::vector<double>& mean, const std::vector<size_t>& count) {
+    // A tile's noise sigma = sqrt(relMSE x samples) (its relMSE falls as sigma^2 / n). For a
+    // given sample budget the image's relMSE (the mean over its values) is least with n_i
+    // proportional to sigma_i; reaching the target E then takes n_i = k sigma_i with
+    // k = sum(p_i sigma_i) / (P E), p_i a tile's values and P all of them. A tile that has its
+    // n_i rests; the others sample. Tiles not ready sample, and count at the mean sigma.
+    const size_t tiles = mean.size();
+    std::vector<double> sigma(tiles, -1.0);
+    double weighted = 0.0, weight = 0.0;
+    for (size_t t = 0; t < tiles; ++t)
+        if (mean[t] >= 0.0) {
+            sigma[t] = std::sqrt(mean[t] * double(tileSamples_[t]));
+            weighted += double(count[t]) * sigma[t];
+            weight += double(count[t]);
+        }
+    if (!(weight > 0.0)) return;
+    const double k = weighted / (weight * adaptiveTarget_);
+    for (size_t t = 0; t < tiles; ++t)
+        if (sigma[t] >= 0.0 && double(tileSamples_[t]) >= k * sigma[t])
+            active_[t] = 0, --activeTiles_;
+    // Every tile at its share while the estimate is still above the target (the estimates are
+    // noisy): all sample on, as uniform sampling would. The stop is the target's.
+    if (activeTiles_ == 0) {
+        std::fill(active_.begin(), active_.end(), std::uint8_t(1));
+        activeTiles_ = tiles;
+    }
 }
 
 std::vector<float> Film::halfImage(int half) const {

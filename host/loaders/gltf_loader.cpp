@@ -350,6 +350,10 @@ Scene loadGltfScene(const std::string& path) {
     scene.file = path;
     GltfReader(path, scene).readScene();
     scene.image.samplingStated = false; // glTF has no sampling settings
+    // 16 samples a pixel an iteration, where the samples asked for allow it (planSampling): an
+    // iteration's work per pixel (the film's sums, the error estimate, adaptive sampling's
+    // decision) is then a few per cent of its samples' (docs/performance.md).
+    scene.image.sampleBase = kGltfSampleBase;
     return scene;
 }
 

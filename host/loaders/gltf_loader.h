@@ -19,6 +19,10 @@ namespace spw {
 // Whether `path` names a glTF file (by its extension: .gltf or .glb, any case).
 bool isGltfPath(const std::string& path);
 
+// A glTF scene's sample base (ImageSettings::sampleBase): 4 x 4 = 16 samples a pixel an
+// iteration.
+constexpr int kGltfSampleBase = 4;
+
 // Loads a glTF file as a whole scene. Throws SceneError naming the file, and where in it (a JSON
 // pointer such as /meshes/0/primitives/1) the problem is.
 Scene loadGltfScene(const std::string& path);

@@ -285,6 +285,11 @@ void RenderSession::startAt() {
     done_ = first_;
     result_->film->setAdaptive(scene_.settings.adaptiveThreshold,
                                scene_.settings.adaptiveMinSamples);
+    // Toward a target the tiles share the samples by their noise; not in a partial render,
+    // whose samples are the whole render's range and not its own to share.
+    if (config_.targetError && config_.adaptiveToTarget && !config_.sampleRange &&
+        !(scene_.settings.adaptiveThreshold > 0.0))
+        result_->film->setAdaptiveTarget(*config_.targetError);
     sync_.share(*result_->film);
     key_ = checkpoints_.key;
     if (!key_ && (!checkpoints_.path.empty() || checkpoints_.resume))
