@@ -317,8 +317,9 @@ TEST(GltfSpecular, TheWeightAndColourSetTheReflectionAtNormalIncidence) {
 // t, so 16 spp leave several per cent of noise) and 0.5 % (the Fresnel terms). On every backend.
 TEST(GltfTransmission, PartialTransmissionMixesTheGlassWithTheOpaqueMaterial) {
     TempDir dir;
-    for (auto [t, metallic] :
+    for (const std::pair<double, double>& tm :
          {std::pair(0.25, 0.0), std::pair(0.75, 0.0), std::pair(1.0, 0.5), std::pair(0.5, 0.5)}) {
+        const double t = tm.first, metallic = tm.second; // named, for the lambda to capture
         for (float c : {0.5f, 1.0f}) {
             json m = glass(t, 1.01);
             m["pbrMetallicRoughness"]["baseColorFactor"] = {c, c, c, 1.0};
