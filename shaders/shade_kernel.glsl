@@ -92,7 +92,7 @@ ShaderParams kernelShader(uint i) {
     s.specular = uintBitsToFloat(w5.x);
     s.transmission = uintBitsToFloat(w5.y);
     s.sheenRoughness = uintBitsToFloat(w5.z);
-    s.pad0 = w5.w;
+    s.coatNormal = w5.w;
     s.sheenColour = uintBitsToFloat(w6.xyz);
     s.pad1 = w6.w;
 #ifdef SPW_KERNEL_MODEL

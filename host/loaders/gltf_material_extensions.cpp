@@ -31,15 +31,24 @@ double GltfReader::extensionNumber(const tinygltf::Value& ext, const char* key, 
     return x;
 }
 
-double GltfReader::extensionNumber(const tinygltf::Value& values, int k, double lo, double hi,
-                                   const std::string& at) const {
-    const tinygltf::Value& v = values.Get(k);
-    const double x = v.IsNumber() ? v.GetNumberAsDouble() : NAN;
-    if (!(x >= lo && x <= hi) || !std::isfinite(x))
-        fail(at + "/" + std::to_string(k),
-             std::isfinite(hi) ? "must be a number in [" + number(lo) + ", " + number(hi) + "]"
-                               : "must be a finite number of at least " + number(lo));
-    return x;
+vec3 GltfReader::extensionColour(const tinygltf::Value& ext, const char* key, vec3 fallback,
+                                 double hi, const std::string& at) const {
+    if (!ext.Has(key)) return fallback;
+    const tinygltf::Value& values = ext.Get(key);
+    const std::string where = at + "/" + key;
+    const std::string range = std::isfinite(hi) ? "in [0, " + number(hi) + "]" : "of at least 0";
+    if (!values.IsArray() || values.ArrayLen() != 3) fail(where, "needs 3 numbers " + range);
+    vec3 colour;
+    for (int k = 0; k < 3; ++k) {
+        const tinygltf::Value& v = values.Get(k);
+        const double x = v.IsNumber() ? v.GetNumberAsDouble() : NAN;
+        if (!(x >= 0.0 && x <= hi) || !std::isfinite(x))
+            fail(where + "/" + std::to_string(k),
+                 std::isfinite(hi) ? "must be a number in [0, " + number(hi) + "]"
+                                   : "must be a finite number of at least 0");
+        colour[k] = float(std::min(x, 1e3));
+    }
+    return colour;
 }
 
 void GltfReader::readTransmission(const tinygltf::Material& mat, Shader& s, const std::string& at,
@@ -99,14 +108,7 @@ void GltfReader::readVolume(const tinygltf::Material& mat, Shader& s, const std:
         extensionNumber(v->second, "attenuationDistance", HUGE_VAL, 0.0, HUGE_VAL, where);
     if (v->second.Has("attenuationDistance") && !(distance > 0.0))
         fail(where + "/attenuationDistance", "must be a positive number");
-    vec3 colour(1.0f);
-    if (v->second.Has("attenuationColor")) {
-        const tinygltf::Value& c = v->second.Get("attenuationColor");
-        if (!c.IsArray() || c.ArrayLen() != 3)
-            fail(where + "/attenuationColor", "needs 3 numbers in [0, 1]");
-        for (int k = 0; k < 3; ++k)
-            colour[k] = float(extensionNumber(c, k, 0.0, 1.0, where + "/attenuationColor"));
-    }
+    const vec3 colour = extensionColour(v->second, "attenuationColor", vec3(1.0f), 1.0, where);
     if (v->second.Has("thicknessTexture"))
         warn(name + ": its thicknessTexture is not read (the mesh's own thickness is rendered)");
     const bool transmits =
@@ -138,9 +140,6 @@ void GltfReader::readClearcoat(const tinygltf::Material& mat, Shader& s, const s
         warn(name + ": a clear coat on glass is not rendered");
         return;
     }
-    if (c->second.Has("clearcoatNormalTexture"))
-        warn(name + ": its clearcoatNormalTexture is not rendered (the coat takes the base's "
-                    "shading normal)");
     s.typeName = "CoatedMetallicRoughness";
     s.params.model = kModelCoatedMetallicRoughness;
     s.params.coat = float(factor);
@@ -154,6 +153,16 @@ void GltfReader::readClearcoat(const tinygltf::Material& mat, Shader& s, const s
     s.extension[0] = {weight, 0, float(factor)};
     s.extension[1] = {rough, 1, float(roughness)};
     if (weight >= 0 || rough >= 0) s.params.flags |= kShaderHitExtension;
+    // The coat's own normal map; without one the coat is not normal-mapped, even where the base
+    // is: it takes the interpolated normal.
+    s.coatNormalTexture = extensionTexture(c->second, "clearcoatNormalTexture", 0, false, where,
+                                           name + ": its clearcoatNormalTexture");
+    if (s.coatNormalTexture >= 0)
+        s.coatNormalScale =
+            float(extensionNumber(c->second.Get("clearcoatNormalTexture"), "scale", 1.0, -1e3, 1e3,
+                                  where + "/clearcoatNormalTexture"));
+    if (s.coatNormalTexture >= 0 || s.normalTexture >= 0)
+        s.params.flags |= kShaderHitExtension | kShaderCoatNormal;
 }
 
 void GltfReader::readSpecular(const tinygltf::Material& mat, Shader& s, const std::string& at,
@@ -162,15 +171,9 @@ void GltfReader::readSpecular(const tinygltf::Material& mat, Shader& s, const st
     if (e == mat.extensions.end()) return;
     const std::string where = at + "/extensions/KHR_materials_specular";
     const double factor = extensionNumber(e->second, "specularFactor", 1.0, 0.0, 1.0, where);
-    vec3 colour(1.0f);
-    if (e->second.Has("specularColorFactor")) {
-        const tinygltf::Value& c = e->second.Get("specularColorFactor");
-        if (!c.IsArray() || c.ArrayLen() != 3)
-            fail(where + "/specularColorFactor", "needs 3 numbers of at least 0");
-        for (int k = 0; k < 3; ++k)
-            colour[k] = float(std::min(
-                extensionNumber(c, k, 0.0, HUGE_VAL, where + "/specularColorFactor"), 1e3));
-    }
+    // Unbounded above by the specification; taken up to 1000.
+    const vec3 colour =
+        extensionColour(e->second, "specularColorFactor", vec3(1.0f), HUGE_VAL, where);
     const bool textured = e->second.Has("specularTexture") || e->second.Has("specularColorTexture");
     if (factor == 1.0 && colour == vec3(1.0f) && !textured)
         return; // the defaults: glTF's own reflection
@@ -206,14 +209,7 @@ void GltfReader::readSheen(const tinygltf::Material& mat, Shader& s, const std::
     const auto e = mat.extensions.find("KHR_materials_sheen");
     if (e == mat.extensions.end()) return;
     const std::string where = at + "/extensions/KHR_materials_sheen";
-    vec3 colour(0.0f);
-    if (e->second.Has("sheenColorFactor")) {
-        const tinygltf::Value& c = e->second.Get("sheenColorFactor");
-        if (!c.IsArray() || c.ArrayLen() != 3)
-            fail(where + "/sheenColorFactor", "needs 3 numbers in [0, 1]");
-        for (int k = 0; k < 3; ++k)
-            colour[k] = float(extensionNumber(c, k, 0.0, 1.0, where + "/sheenColorFactor"));
-    }
+    const vec3 colour = extensionColour(e->second, "sheenColorFactor", vec3(0.0f), 1.0, where);
     const double roughness =
         extensionNumber(e->second, "sheenRoughnessFactor", 0.0, 0.0, 1.0, where);
     if (colour == vec3(0.0f)) return;

@@ -160,10 +160,11 @@ class GltfReader {
     // it is absent; refused unless it is a finite number in [lo, hi] (hi may be HUGE_VAL).
     double extensionNumber(const tinygltf::Value& ext, const char* key, double fallback, double lo,
                            double hi, const std::string& at) const;
-    // Element k of the array `values` (at JSON pointer `at`), refused unless a finite number in
-    // [lo, hi].
-    double extensionNumber(const tinygltf::Value& values, int k, double lo, double hi,
-                           const std::string& at) const;
+    // The three numbers at `key` of extension object `ext` (a colour factor), or `fallback`
+    // where it is absent; refused unless an array of three finite numbers in [0, hi] (hi may be
+    // HUGE_VAL; values above 1000 are taken as 1000).
+    vec3 extensionColour(const tinygltf::Value& ext, const char* key, vec3 fallback, double hi,
+                         const std::string& at) const;
     // The Dielectric model's least index of refraction.
     static constexpr double kMinGlassIor = 1.01;
 

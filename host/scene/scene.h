@@ -174,9 +174,15 @@ struct Shader {
     Cutout cutout;
     // A tangent-space normal map (glTF's normalTexture), or -1: its texel t tilts the shading
     // normal to (2 t - 1) (x and y times normalScale) in the frame of the triangle's texture
-    // coordinates (HitSetup::tiltNormal).
+    // coordinates (HitSetup::tiltedNormal).
     int normalTexture = -1;
     float normalScale = 1.0f;
+    // CoatedMetallicRoughness with kShaderCoatNormal: the coat's own normal map
+    // (KHR_materials_clearcoat's clearcoatNormalTexture), tilting the interpolated normal as
+    // normalTexture does, or -1: the coat takes the interpolated normal (the base's normal map
+    // is the base's alone). Carried in SurfaceHit::extension (HitSetup::applyMaps).
+    int coatNormalTexture = -1;
+    float coatNormalScale = 1.0f;
     // MetallicRoughness: glTF's metallicRoughnessTexture, or -1: its texel's blue channel times
     // params.metallic is the hit's metallic, its green times `roughness` (the factor alpha was
     // made from) the hit's roughness, carried in SurfaceHit::material (kShaderHitParams).

@@ -4,6 +4,7 @@
 
 #include "shared/cone.h"
 #include "shared/offset.h"
+#include "shared/sampling.h"
 
 #include <algorithm>
 #include <cmath>
@@ -89,12 +90,18 @@ void HitSetup::applyMaps(const Shader& shader, const TextureResolver& textures, 
                          const vec2* uv, const float* footprint, const HitRecord* const* hits,
                          SurfaceHit* const* hit) const {
     if (!shader.hasMaps()) return;
-    thread_local std::vector<vec3> texels;
+    thread_local std::vector<vec3> texels, interpolated;
     texels.resize(n);
+    const bool coatNormal = (shader.params.flags & kShaderCoatNormal) != 0u;
+    if (coatNormal) { // the coat's normal map tilts the interpolated normal, not the base's map
+        interpolated.resize(n);
+        for (size_t k = 0; k < n; ++k)
+            interpolated[k] = hit[k]->ns;
+    }
     if (shader.normalTexture >= 0) {
         textures.values(shader.normalTexture, n, uv, footprint, texels.data());
         for (size_t k = 0; k < n; ++k)
-            tiltNormal(*hits[k], texels[k], shader.normalScale, *hit[k]);
+            hit[k]->ns = tiltedNormal(*hits[k], hit[k]->ns, texels[k], shader.normalScale);
     }
     if (shader.metallicRoughnessTexture >= 0) {
         textures.values(shader.metallicRoughnessTexture, n, uv, footprint, texels.data());
@@ -104,6 +111,15 @@ void HitSetup::applyMaps(const Shader& shader, const TextureResolver& textures, 
     }
     if ((shader.params.flags & kShaderHitExtension) != 0u)
         applyExtensionMaps(shader, textures, n, uv, footprint, hit);
+    if (!coatNormal) return;
+    if (shader.coatNormalTexture >= 0) {
+        textures.values(shader.coatNormalTexture, n, uv, footprint, texels.data());
+        for (size_t k = 0; k < n; ++k)
+            interpolated[k] =
+                tiltedNormal(*hits[k], interpolated[k], texels[k], shader.coatNormalScale);
+    }
+    for (size_t k = 0; k < n; ++k)
+        hit[k]->extension.y = packHalf2x16(octahedralEncode(interpolated[k]));
 }
 
 void HitSetup::applyExtensionMaps(const Shader& shader, const TextureResolver& textures, size_t n,
@@ -129,28 +145,27 @@ void HitSetup::applyExtensionMaps(const Shader& shader, const TextureResolver& t
                                   packHalf2x16(vec2(slots[k].z, slots[k].w)));
 }
 
-void HitSetup::tiltNormal(const HitRecord& h, vec3 texel, float scale, SurfaceHit& hit) const {
+vec3 HitSetup::tiltedNormal(const HitRecord& h, vec3 n, vec3 texel, float scale) const {
     const Mesh& mesh = src_.meshes[h.mesh];
-    if (mesh.uvs.empty()) return;
+    if (mesh.uvs.empty()) return n;
     const uvec3 tri = mesh.triangles[h.prim];
     const vec3 e1 = mesh.positions[tri.y] - mesh.positions[tri.x],
                e2 = mesh.positions[tri.z] - mesh.positions[tri.x];
     const vec2 d1 = mesh.uvs[tri.y] - mesh.uvs[tri.x], d2 = mesh.uvs[tri.z] - mesh.uvs[tri.x];
     const float det = d1.x * d2.y - d2.x * d1.y;
-    if (!(std::fabs(det) > 0.0f)) return;
+    if (!(std::fabs(det) > 0.0f)) return n;
     // dp/du and dp/dv of the triangle's texture mapping.
     const vec3 dpdu = (e1 * d2.y - e2 * d1.y) / det, dpdv = (e2 * d1.x - e1 * d2.x) / det;
-    const vec3 n = hit.ns;
     const vec3 t = dpdu - n * glm::dot(n, dpdu);
     const float tLength = glm::length(t);
-    if (!(tLength > 0.0f) || !std::isfinite(tLength)) return;
+    if (!(tLength > 0.0f) || !std::isfinite(tLength)) return n;
     const vec3 tangent = t / tLength;
     vec3 bitangent = glm::cross(n, tangent);
     if (glm::dot(bitangent, dpdv) < 0.0f) bitangent = -bitangent; // a mirrored mapping
     const vec3 local = (2.0f * texel - 1.0f) * vec3(scale, scale, 1.0f);
     const vec3 tilted = tangent * local.x + bitangent * local.y + n * local.z;
     const float length = glm::length(tilted);
-    if (length > 0.0f && std::isfinite(length)) hit.ns = tilted / length;
+    return length > 0.0f && std::isfinite(length) ? tilted / length : n;
 }
 
 // Wide twin: setUpHitLanes (host/scene_view/wide_hits.cpp), with surfaceHit.

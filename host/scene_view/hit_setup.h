@@ -45,16 +45,16 @@ class HitSetup {
     // uv[j] and footprint[j].
     void setUpHits(size_t n, const HitRecord* const* hits, const vec3* dir, const uint* cone,
                    SurfaceHit* const* out, vec2* uv, float* footprint) const;
-    // The shading normal tilted by a tangent-space normal map's value `texel` (linear, [0, 1]
-    // per channel): to (2 texel - 1), its x and y times `scale`, in the frame the triangle's
-    // texture coordinates make (x: growing u, y: growing v), made orthonormal about the
-    // interpolated normal (Gram-Schmidt), z along it. Left as it was where the triangle has no
-    // texture frame or the tilted normal is degenerate.
-    void tiltNormal(const HitRecord& h, vec3 texel, float scale, SurfaceHit& hit) const;
+    // Unit normal n at hit h tilted by a tangent-space normal map's value `texel` (linear,
+    // [0, 1] per channel): to (2 texel - 1), its x and y times `scale`, in the frame the
+    // triangle's texture coordinates make (x: growing u, y: growing v), made orthonormal about n
+    // (Gram-Schmidt), z along it. n itself where the triangle has no texture frame or the tilted
+    // normal is degenerate.
+    vec3 tiltedNormal(const HitRecord& h, vec3 n, vec3 texel, float scale) const;
     // What a shader's maps beyond its colour give n hits of it at uv[k] (footprints as
-    // albedos()): its normal map's tilt, its metallic-roughness image's SurfaceHit::material and
-    // its extension maps' SurfaceHit::extension. hits[k] is the closest hit hit[k] was set up
-    // from.
+    // albedos()): its normal map's tilt, its metallic-roughness image's SurfaceHit::material,
+    // its extension maps' SurfaceHit::extension, and the coat's own normal (kShaderCoatNormal).
+    // hits[k] is the closest hit hit[k] was set up from.
     void applyMaps(const Shader& shader, const TextureResolver& textures, size_t n, const vec2* uv,
                    const float* footprint, const HitRecord* const* hits,
                    SurfaceHit* const* hit) const;

@@ -173,6 +173,7 @@ TextureResolver::TextureResolver(const Scene& scene, double cacheMiB, bool filte
     for (const Shader& sh : scene.shaders) {
         compile(sh.texture);
         compile(sh.normalTexture);
+        compile(sh.coatNormalTexture);
         compile(sh.metallicRoughnessTexture);
         for (const Shader::ExtensionMap& m : sh.extension)
             compile(m.texture);

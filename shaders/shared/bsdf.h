@@ -25,7 +25,8 @@ SHARED_BEGIN
 // The shader's parameters at a hit: with kShaderHitParams (a MetallicRoughness shader with a
 // metallic-roughness image), the metallic and the GGX alpha of the roughness the hit carries;
 // with kShaderHitExtension (a glTF material extension's images), the four values the hit carries
-// (e0 .. e3) as the model's extension: the clear coat's weight e0 and roughness e1, the sheen's
+// (e0 .. e3) as the model's extension: the clear coat's weight e0 and roughness e1 (and, with
+// kShaderCoatNormal, its shading normal in e2 and e3's place), the sheen's
 // colour (e0, e1, e2) and roughness e3, the transmission e0, or, on the plain model, the specular
 // colour (e0, e1, e2) and specular e3.
 SHARED_FN ShaderParams shaderAtHit(ShaderParams sh, SurfaceHit hit) {
@@ -39,6 +40,7 @@ SHARED_FN ShaderParams shaderAtHit(ShaderParams sh, SurfaceHit hit) {
         if (sh.model == kModelCoatedMetallicRoughness) {
             sh.coat = e01.x;
             sh.coatAlpha = gltfAlpha(e01.y);
+            sh.coatNormal = hit.extension.y;
         } else if (sh.model == kModelSheenMetallicRoughness) {
             sh.sheenColour = vec3(e01.x, e01.y, e23.x);
             sh.sheenRoughness = e23.y;

@@ -5,7 +5,9 @@
 //   specular, specular colour), and
 //   coat (1) in [0, 1], the coat's weight; coat roughness (0) in [0, 1], its perceptual
 //   roughness (GGX alpha = coat roughness^2, at least kGltfMinAlpha).
-//   The coat is a dielectric of ior 1.5 (F0 = 0.04) over the base, sharing its shading normal:
+//   The coat is a dielectric of ior 1.5 (F0 = 0.04) over the base, about its own shading normal
+//   nc (clearcoatNormalTexture's; without it the interpolated normal, not the base's normal map,
+//   as the specification says; with neither, the base's ns):
 //     Fc = coat (0.04 + 0.96 (1 - |n.wo|)^5)
 //     f = (1 - Fc) f_base + Fc D_c G2_c / (4 |co| |ci|)
 //   the specification's fresnel_coat: the coat's Fresnel term is taken once, from the view
@@ -15,8 +17,9 @@
 //   own sampling (gltfSample) otherwise; pdf = the mixture's, weight = fcos / pdf. pCoat = Fc /
 //   (Fc + (1 - Fc) a), a the base's lobes' weights seen from wo (as gltfSpecularProbability
 //   reckons them), within [0.1, 0.9] while the coat has weight.
-//   Not rendered: the coat's own normal map (clearcoatNormalTexture), which the glTF loader
-//   warns about; the coat dims nothing the surface emits.
+//   Each lobe's cosine is to its own normal; the coat's Fresnel and lobe are taken in the frame
+//   of nc (made valid for wo as ns is: sampling.h's facingShadingNormal), the base's in ns's.
+//   Not rendered: the coat dims nothing the surface emits.
 #ifndef SPILLWAY_SHARED_CLEARCOAT_H
 #define SPILLWAY_SHARED_CLEARCOAT_H
 #include "gltf.h"
@@ -36,42 +39,61 @@ SHARED_FN float gltfCoatProbability(vec3 colour, float metallic, vec3 f0d, float
     return clamp(fc / (fc + (1.0f - fc) * base), 0.1f, 0.9f);
 }
 
+// The coat's shading normal: its own with kShaderCoatNormal (KHR_materials_clearcoat's
+// clearcoatNormalTexture, or the interpolated normal where only the base is normal-mapped),
+// the base's `ns` otherwise.
+SHARED_FN vec3 gltfCoatNormal(ShaderParams sh, vec3 ns) {
+    if ((sh.flags & kShaderCoatNormal) == 0u) return ns;
+    return octahedralDecode(unpackHalf2x16(sh.coatNormal));
+}
+
+// f * cos and the pdf, the base about its shading normal ns, the coat about its own, nc (the
+// two the same: one frame, as the specification draws it).
 SHARED_FN vec3 gltfCoatEval(vec3 colour, float metallic, float alpha, vec3 f0d, float f90d,
-                            float coat, float coatAlpha, vec3 ng, vec3 ns, vec3 wo, vec3 wi,
-                            OUT(float) pdf) {
+                            float coat, float coatAlpha, vec3 ng, vec3 ns, vec3 nc, vec3 wo,
+                            vec3 wi, OUT(float) pdf) {
     float basePdf;
     vec3 base = gltfEval(colour, metallic, alpha, f0d, f90d, ng, ns, wo, wi, basePdf);
     pdf = 0.0f;
     if (dot(ng, wo) * dot(ng, wi) <= 0.0f) return vec3(0.0f);
-    Frame f = shadingFrame(ns, ng, wo);
+    Frame f = shadingFrame(nc, ng, wo);
     vec3 lo = frameToLocal(f, wo);
     vec3 li = frameToLocal(f, wi);
-    if (lo.z <= 0.0f || li.z <= 0.0f) return vec3(0.0f);
-    vec3 h = lo + li;
-    float len2 = dot(h, h);
-    if (!(len2 > 0.0f)) return vec3(0.0f);
-    h = h * inversesqrt(len2);
+    if (lo.z <= 0.0f) return vec3(0.0f);
     float fc = gltfCoatFresnel(coat, lo.z);
-    float d = ggxD(h, coatAlpha);
-    float denom = ggxG2Denominator(lo, li, coatAlpha);
-    float layer = denom > 0.0f ? fc * d * li.z / (2.0f * denom) : 0.0f;
-    float pCoat = gltfCoatProbability(colour, metallic, f0d, f90d, fc, lo.z);
-    pdf = pCoat * (d / (2.0f * (lo.z + ggxA(lo, coatAlpha)))) + (1.0f - pCoat) * basePdf;
+    // The base's lobes' weight is reckoned from wo's cosine to the base's own normal.
+    float cosBase = lo.z;
+    if (nc != ns) cosBase = dot(facingShadingNormal(ns, ng, wo), wo);
+    float pCoat = gltfCoatProbability(colour, metallic, f0d, f90d, fc, cosBase);
+    float layer = 0.0f;
+    float coatPdf = 0.0f;
+    if (li.z > 0.0f) {
+        vec3 h = lo + li; // li.z > 0 and lo.z > 0: never 0
+        h = h * inversesqrt(dot(h, h));
+        float d = ggxD(h, coatAlpha);
+        float denom = ggxG2Denominator(lo, li, coatAlpha);
+        layer = denom > 0.0f ? fc * d * li.z / (2.0f * denom) : 0.0f;
+        coatPdf = d / (2.0f * (lo.z + ggxA(lo, coatAlpha)));
+    }
+    pdf = pCoat * coatPdf + (1.0f - pCoat) * basePdf;
     return base * (1.0f - fc) + vec3(layer);
 }
 
 SHARED_FN bool gltfCoatSample(vec3 colour, float metallic, float alpha, vec3 f0d, float f90d,
-                              float coat, float coatAlpha, vec3 ng, vec3 ns, vec3 wo, vec3 u,
-                              OUT(vec3) wi, OUT(vec3) weight, OUT(float) pdf, OUT(bool) specular) {
+                              float coat, float coatAlpha, vec3 ng, vec3 ns, vec3 nc, vec3 wo,
+                              vec3 u, OUT(vec3) wi, OUT(vec3) weight, OUT(float) pdf,
+                              OUT(bool) specular) {
     wi = vec3(0.0f);
     weight = vec3(0.0f);
     pdf = 0.0f;
     specular = false;
-    Frame f = shadingFrame(ns, ng, wo);
+    Frame f = shadingFrame(nc, ng, wo);
     vec3 lo = frameToLocal(f, wo);
     if (lo.z <= 0.0f) return false;
     float fc = gltfCoatFresnel(coat, lo.z);
-    float pCoat = gltfCoatProbability(colour, metallic, f0d, f90d, fc, lo.z);
+    float cosBase = lo.z;
+    if (nc != ns) cosBase = dot(facingShadingNormal(ns, ng, wo), wo);
+    float pCoat = gltfCoatProbability(colour, metallic, f0d, f90d, fc, cosBase);
     if (u.z < pCoat) {
         vec3 h = ggxSampleVisibleNormal(lo, coatAlpha, vec2(u.x, u.y));
         float oh = dot(lo, h);
@@ -88,7 +110,7 @@ SHARED_FN bool gltfCoatSample(vec3 colour, float metallic, float alpha, vec3 f0d
             return false;
     }
     vec3 fcos =
-        gltfCoatEval(colour, metallic, alpha, f0d, f90d, coat, coatAlpha, ng, ns, wo, wi, pdf);
+        gltfCoatEval(colour, metallic, alpha, f0d, f90d, coat, coatAlpha, ng, ns, nc, wo, wi, pdf);
     if (!(pdf > 0.0f)) return false;
     weight = fcos / pdf;
     return true;
@@ -106,15 +128,16 @@ SHARED_FN vec3 clearcoatBsdfEval(ShaderParams sh, vec3 albedo, vec3 ng, vec3 ns,
                                  OUT(float) pdf) {
     return gltfCoatEval(albedo, sh.metallic, max(sh.alpha, kGltfMinAlpha),
                         gltfDielectricF0Colour(sh), gltfDielectricF90(sh), sh.coat,
-                        max(sh.coatAlpha, kGltfMinAlpha), ng, ns, wo, wi, pdf);
+                        max(sh.coatAlpha, kGltfMinAlpha), ng, ns, gltfCoatNormal(sh, ns), wo, wi,
+                        pdf);
 }
 SHARED_FN bool clearcoatBsdfSample(ShaderParams sh, vec3 albedo, vec3 ng, vec3 ns, vec3 wo, vec3 u,
                                    OUT(vec3) wi, OUT(vec3) weight, OUT(float) pdf,
                                    OUT(bool) specular) {
     return gltfCoatSample(albedo, sh.metallic, max(sh.alpha, kGltfMinAlpha),
                           gltfDielectricF0Colour(sh), gltfDielectricF90(sh), sh.coat,
-                          max(sh.coatAlpha, kGltfMinAlpha), ng, ns, wo, u, wi, weight, pdf,
-                          specular);
+                          max(sh.coatAlpha, kGltfMinAlpha), ng, ns, gltfCoatNormal(sh, ns), wo, u,
+                          wi, weight, pdf, specular);
 }
 
 SHARED_END

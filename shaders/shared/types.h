@@ -25,6 +25,8 @@ const uint kShaderSpecular = 8u;  // MetallicRoughness models: the dielectric re
                                   // specular and specularColour (KHR_materials_specular)
 const uint kShaderHitExtension = 16u; // the model's extension parameters come from the hit
                                       // (SurfaceHit.extension; bsdf.h's shaderAtHit says which)
+const uint kShaderCoatNormal = 32u;   // CoatedMetallicRoughness: the coat has a shading normal of
+                                      // its own (ShaderParams.coatNormal, from the hit)
 
 struct ShaderParams {
     vec3 emission;     // radiance leaving the front face (both with kShaderTwoSided)
@@ -47,7 +49,10 @@ struct ShaderParams {
     float specular;
     float transmission;   // TransmissiveMetallicRoughness: the glass lobe's weight in [0, 1]
     float sheenRoughness; // SheenMetallicRoughness: the sheen's perceptual roughness
-    uint pad0;
+    // CoatedMetallicRoughness with kShaderCoatNormal: the coat's shading normal at the hit, which
+    // shaderAtHit takes from SurfaceHit::extension's last two halves (octahedralEncode's point,
+    // packHalf2x16); without the flag the coat shares the base's.
+    uint coatNormal;
     vec3 sheenColour; // SheenMetallicRoughness: the sheen's colour (KHR_materials_sheen)
     uint pad1;
 };
@@ -105,7 +110,8 @@ struct SurfaceHit {
     uvec2 extension; // with kShaderHitExtension: four values as halves (packHalf2x16: x holds the
                      // first two, y the last two) that the host's extension maps gave the hit
                      // (KHR_materials_clearcoat's, sheen's, specular's and transmission's
-                     // textures times their factors); 0 otherwise
+                     // textures times their factors); with kShaderCoatNormal, y is the coat's
+                     // shading normal instead (octahedralEncode's point); 0 otherwise
 };
 const uint kNoEmitter = 0xFFFFFFFFu;
 

@@ -2,7 +2,8 @@
 // coat (KHR_materials_clearcoat): its sampling against its pdf (chi-square) over coat weights and
 // roughnesses on dielectric and metal bases, at normal, oblique and grazing incidence; without
 // weight it is MetallicRoughness bit for bit; the coat's reflectance at normal incidence in
-// closed form; energy in a white furnace.
+// closed form; energy in a white furnace; a coat normal of its own (kShaderCoatNormal) moves the
+// coat's lobe and not the base's.
 #include "bsdf_test_util.h"
 
 #include "shared/clearcoat.h"
@@ -106,6 +107,73 @@ TEST(CoatedMetallicRoughness, NarrowLobesReflectTheClosedFormAndAFurnaceGainsNot
             EXPECT_GT(r.fcosIntegral, 0.3)
                 << "metallic " << metallic << ", roughness " << roughness;
         }
+}
+
+// `m` with the coat about normal nc of its own (as a hit carries it: octahedral, in halves); the
+// unit vector the model decodes.
+vec3 withCoatNormal(BsdfUnderTest& m, vec3 nc) {
+    m.sh.flags |= kShaderCoatNormal;
+    m.sh.coatNormal = packHalf2x16(octahedralEncode(glm::normalize(nc)));
+    return gltfCoatNormal(m.sh, m.ns);
+}
+
+TEST(CoatedMetallicRoughness, WithItsOwnNormalSampledDirectionsFollowThePdf) {
+    const double thetas[] = {0.0, 40.0, 80.0};
+    const vec3 tilts[] = {vec3(0.3f, 0.1f, 1.0f), vec3(-0.6f, 0.4f, 0.7f)};
+    const int tests = int(std::size(thetas) * std::size(tilts)) * 2;
+    for (float metallic : {0.0f, 1.0f})
+        for (vec3 tilt : tilts)
+            for (double theta : thetas) {
+                BsdfUnderTest m = coated(metallic, 0.6f, 1.0f, 0.2f, theta);
+                m.ns = glm::normalize(vec3(-0.2f, 0.0f, 1.0f)); // the base's normal map
+                withCoatNormal(m, tilt);
+                char name[128];
+                std::snprintf(name, sizeof name, "metallic %g, coat normal (%g %g %g), theta %g",
+                              metallic, tilt.x, tilt.y, tilt.z, theta);
+                ExpectedLobes l = lobes(m);
+                l.width = 1.0; // two lobes about two normals
+                expectSamplingMatchesPdf(
+                    testSampling(m, l, 200000, 900 + uint(theta) + uint(10 * tilt.y)), tests, name);
+            }
+}
+
+// Over a base that reflects nothing (black, its specular weight 0) only the coat reflects: its
+// f cos follows the coat's normal bit for bit, whatever the base's; with the coat's normal equal
+// to the base's, the flag changes nothing.
+TEST(CoatedMetallicRoughness, TheCoatsOwnNormalTurnsTheCoatAlone) {
+    Uniform u(11);
+    size_t differ = 0, lit = 0;
+    for (double theta : {0.0, 35.0, 70.0}) {
+        BsdfUnderTest m = coated(0.0f, 0.5f, 1.0f, 0.3f, theta);
+        m.albedo = vec3(0.0f);
+        m.sh.flags |= kShaderSpecular;
+        m.sh.specular = 0.0f;
+        m.sh.specularColour = vec3(1.0f);
+        m.ns = glm::normalize(vec3(0.3f, -0.2f, 1.0f));
+        const vec3 nc = withCoatNormal(m, vec3(-0.25f, 0.15f, 1.0f));
+        BsdfUnderTest same = m; // the base about the coat's normal too
+        same.ns = nc;
+        BsdfUnderTest unflagged = same;
+        unflagged.sh.flags &= ~kShaderCoatNormal;
+        BsdfUnderTest shared = m; // the coat about the base's normal
+        shared.sh.flags &= ~kShaderCoatNormal;
+        for (int k = 0; k < 500; ++k) {
+            const vec3 wi = glm::normalize(u.next3() - vec3(0.5f));
+            float pdf, pdfSame, pdfUnflagged, pdfShared;
+            const vec3 f = bsdfEval(m.sh, m.albedo, m.ng, m.ns, m.wo, wi, pdf);
+            const vec3 fSame = bsdfEval(same.sh, m.albedo, m.ng, same.ns, m.wo, wi, pdfSame);
+            const vec3 fUnflagged =
+                bsdfEval(unflagged.sh, m.albedo, m.ng, same.ns, m.wo, wi, pdfUnflagged);
+            const vec3 fShared = bsdfEval(shared.sh, m.albedo, m.ng, m.ns, m.wo, wi, pdfShared);
+            ASSERT_EQ(f, fSame) << theta;
+            ASSERT_EQ(fSame, fUnflagged) << theta;
+            ASSERT_EQ(pdfSame, pdfUnflagged) << theta;
+            lit += f.x > 0.0f;
+            differ += f != fShared;
+        }
+    }
+    EXPECT_GT(lit, 600u);
+    EXPECT_GT(differ, 600u);
 }
 
 } // namespace
