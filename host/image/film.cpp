@@ -492,6 +492,7 @@ void Film::addIterationToSums() {
 
 void Film::endIteration() {
     if (!open_) throw std::logic_error("Film::endIteration without beginIteration");
+    errorOfDecision_.reset(); // the sums change; decideTiles() below may make it again
     finishSamples();
     if (!sumLo_) {
         // The first iteration is the whole render so far: its sums become the render's, and

@@ -220,6 +220,13 @@ class Film {
     // fn(b0, b1, terms) for bands of rows b0 .. b1 - 1 of y0 .. y1 - 1, top to bottom, 64 rows
     // at most (from y0 = 0, whole tiles): the terms of every pixel, a band's at a time.
     template <typename Fn> void forHalfBufferTerms(int y0, int y1, const Fn& fn) const;
+    // The estimate's running sums over a band's terms (n pixels), in pixel order.
+    struct ErrorSums {
+        double total = 0.0, squares = 0.0;
+        size_t count = 0;
+        void add(const double* terms, size_t n);
+        ErrorEstimate estimate() const;
+    };
     float weight1D(float d) const;
     // fn(x, y, w) for each pixel of the filter's footprint around filmPos, w > 0 its weight.
     template <typename Fn> void forFootprint(vec2 filmPos, const Fn& fn) const;
@@ -271,6 +278,9 @@ class Film {
     // Camera samples each pixel of a tile took in whole iterations: all of a tile's pixels
     // sample together (adaptive sampling and the shares decide by tile), so one count a tile.
     std::vector<std::uint32_t> tileSamples_;
+    // halfBufferError() of the sums as they are, where the adaptive decision that followed their
+    // last change computed it in its own pass over the terms; empty otherwise.
+    std::optional<ErrorEstimate> errorOfDecision_;
     std::vector<std::uint8_t> active_; // per tile; empty: adaptive sampling off
     size_t activeTiles_ = 1;
     int share_ = 0, shares_ = 1;

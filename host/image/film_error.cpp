@@ -123,6 +123,7 @@ void Film::errorRows(int y0, int y1, float* rgb) const {
 }
 
 void Film::decideAdaptiveTiles() {
+    errorOfDecision_.reset();
     if (!(adaptiveThreshold_ > 0.0) && !(adaptiveTarget_ > 0.0)) {
         active_.clear();
         activeTiles_ = 1;
@@ -132,10 +133,13 @@ void Film::decideAdaptiveTiles() {
     active_.assign(tiles, 1);
     activeTiles_ = tiles;
     // Each tile's mean half-buffer term over its values, and how many; not ready (-1) before its
-    // minimum samples or while a pixel has no estimate.
+    // minimum samples or while a pixel has no estimate. The same terms give the image's
+    // estimate, which the stop asks for next: one pass over them, not two.
     std::vector<double> mean(tiles, -1.0);
     std::vector<size_t> count(tiles, 0);
+    ErrorSums error;
     forHalfBufferTerms(0, height_, [&](int y0, int y1, const double* terms) {
+        error.add(terms, size_t(y1 - y0) * size_t(width_));
         for (int ty = y0 / kAdaptiveTile; ty * kAdaptiveTile < y1; ++ty)
             for (int tx = 0; tx < tilesX_; ++tx) {
                 const size_t tile = size_t(ty) * size_t(tilesX_) + size_t(tx);
@@ -158,6 +162,7 @@ void Film::decideAdaptiveTiles() {
                 count[tile] = values;
             }
     });
+    errorOfDecision_ = error.estimate();
     if (adaptiveThreshold_ > 0.0) {
         const double limit = adaptiveThreshold_ * adaptiveThreshold_; // on the mean square
         for (size_t t = 0; t < tiles; ++t)
@@ -221,26 +226,34 @@ std::optional<double> Film::halfBufferRelMseEstimate() const {
     return halfBufferError().relMse;
 }
 
-Film::ErrorEstimate Film::halfBufferError() const {
+void Film::ErrorSums::add(const double* terms, size_t n) {
+    for (size_t i = 0; i < n; ++i) {
+        const double* t = terms + i * 3;
+        if (t[0] == kNoTerm) continue;
+        for (int c = 0; c < 3; ++c) // one at a time, in pixel order, as the sum always was
+            total += t[c];
+        const double p = t[0] + t[1] + t[2];
+        squares += p * p;
+        count += 3;
+    }
+}
+
+Film::ErrorEstimate Film::ErrorSums::estimate() const {
     // The standard error: a pixel's term sum P (its three channels, whose noise is mostly
     // shared) is a scaled chi-square of one degree of freedom where the halves' difference is
     // Gaussian: its variance is 2/3 of E[P^2], and P^2 estimates E[P^2] from the pixel alone.
     // Pixels are independent (up to the filter's reach), so the variances add.
-    double total = 0.0, squares = 0.0;
-    size_t count = 0;
-    forHalfBufferTerms(0, height_, [&](int y0, int y1, const double* terms) {
-        for (size_t i = 0; i < size_t(y1 - y0) * size_t(width_); ++i) {
-            const double* t = terms + i * 3;
-            if (t[0] == kNoTerm) continue;
-            for (int c = 0; c < 3; ++c) // one at a time, in pixel order, as the sum always was
-                total += t[c];
-            const double p = t[0] + t[1] + t[2];
-            squares += p * p;
-            count += 3;
-        }
-    });
     if (count == 0) return {std::nullopt, 0.0};
     return {total / double(count), std::sqrt(2.0 / 3.0 * squares) / double(count)};
+}
+
+Film::ErrorEstimate Film::halfBufferError() const {
+    if (errorOfDecision_) return *errorOfDecision_;
+    ErrorSums error;
+    forHalfBufferTerms(0, height_, [&](int y0, int y1, const double* terms) {
+        error.add(terms, size_t(y1 - y0) * size_t(width_));
+    });
+    return error.estimate();
 }
 
 } // namespace spw

@@ -98,6 +98,7 @@ void Film::restore(const State& state) {
         state.weightExponent != std::ilogb(weightScale_))
         throw std::invalid_argument("a film state of another fixed-point scale");
     const auto fits = [](Fixed v) { return v == Fixed(std::int64_t(v)); };
+    errorOfDecision_.reset(); // decideTiles() below may make it again
     sumLo_ = zeroedSums(pixels());
     sumHi_.reset();
     if (!std::all_of(state.sums.begin(), state.sums.end(), fits)) widenSums();

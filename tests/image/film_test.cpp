@@ -7,6 +7,7 @@
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <random>
 
 namespace spw {
 namespace {
@@ -276,6 +277,38 @@ TEST(Film, SharesCoverEveryTileOnceAndAddUpToOneFilm) {
     EXPECT_EQ(parts[0]->image(), whole.image());
     EXPECT_EQ(parts[0]->sampleCounts(), whole.sampleCounts());
     EXPECT_EQ(parts[0]->nonFiniteSamples(), 1u);
+}
+
+// Adaptive sampling toward a target computes the error estimate in the pass its decision makes
+// over the terms, and the stop reads that: after every iteration it is what the film's state
+// gives computed afresh, bit for bit (a film without adaptive sampling, restored to the state).
+TEST(Film, TheAdaptiveDecisionsEstimateIsTheEstimateAfresh) {
+    const int w = 24, h = 20; // 3 x 3 tiles, the last row and column partial
+    Film film(w, h, Filter{}, 1e3f, 4);
+    film.setAdaptiveTarget(1e-3);
+    std::mt19937 rng(5);
+    std::exponential_distribution<float> radiance(2.0f);
+    uint key = 1;
+    for (int it = 0; it < 6; ++it) {
+        if (it > 0) film.beginIteration();
+        for (int y = 0; y < h; ++y)
+            for (int x = 0; x < w; ++x)
+                for (uint s = 0; s < 4; ++s) {
+                    const uint path = uint(y * w + x) * 4 + s, index = uint(it) * 4 + s;
+                    const vec2 at(float(x) + 0.5f, float(y) + 0.5f);
+                    film.addSample(path, at, index);
+                    // Brighter and noisier to the right: tiles that rest and tiles that sample.
+                    film.splat(path, at, index, vec3(radiance(rng) * float(1 + x)), key++);
+                }
+        film.endIteration();
+        Film fresh(w, h, Filter{}, 1e3f, 4);
+        fresh.restore(film.state());
+        const Film::ErrorEstimate a = film.halfBufferError(), b = fresh.halfBufferError();
+        SCOPED_TRACE(it);
+        ASSERT_TRUE(a.relMse.has_value());
+        EXPECT_EQ(a.relMse, b.relMse);
+        EXPECT_EQ(a.standardError, b.standardError);
+    }
 }
 
 } // namespace
