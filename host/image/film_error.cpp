@@ -15,88 +15,108 @@
 namespace spw {
 
 namespace {
-// The value d in one channel's term (A - B)^2 / 4 / (d^2 + 0.01) of a pixel whose halves read a
-// and b, m the two together, from `samples` samples, among neighbours (the 3 x 3 window, the
-// pixel included, `count` values) whose brightest, the pixel left out, reads `brightest`.
+// A pixel's values from its sums: m (the two halves together) and the halves' own, a and b, per
+// channel, and whether both halves hold samples.
+struct PixelValues {
+    double m[3], a[3], b[3];
+    bool both;
+};
+
+// The image's values, a pixel's, from row r0 on: pixels' neighbourhoods.
+struct ValueRows {
+    const PixelValues* values;
+    int width, height, r0;
+    const PixelValues& at(int x, int y) const {
+        return values[size_t(y - r0) * size_t(width) + size_t(x)];
+    }
+    // The brightest value of each channel around (x, y) inside the image, the pixel left out.
+    void brightest(int x, int y, double* out) const {
+        out[0] = out[1] = out[2] = 0.0;
+        for (int ny = std::max(0, y - 1); ny <= std::min(height - 1, y + 1); ++ny)
+            for (int nx = std::max(0, x - 1); nx <= std::min(width - 1, x + 1); ++nx) {
+                if (nx == x && ny == y) continue;
+                const double* m = at(nx, ny).m;
+                for (int c = 0; c < 3; ++c)
+                    out[c] = std::max(out[c], m[c]);
+            }
+    }
+    // The median of channel c over the 3 x 3 window around (x, y) inside the image, the pixel
+    // included (the upper one of an even count).
+    double median(int x, int y, int c) const {
+        double window[9];
+        int count = 0;
+        for (int ny = std::max(0, y - 1); ny <= std::min(height - 1, y + 1); ++ny)
+            for (int nx = std::max(0, x - 1); nx <= std::min(width - 1, x + 1); ++nx)
+                window[count++] = at(nx, ny).m[c];
+        std::nth_element(window, window + count / 2, window + count);
+        return window[count / 2];
+    }
+};
+
+// The value d in one channel's term (A - B)^2 / 4 / (d^2 + 0.01) of pixel (x, y), whose halves
+// read a and b, m the two together, from `samples` samples.
 //
 // d is m, the pixel's own value, unless its samples spread more than anything around it shows:
 // the per-sample standard deviation that the halves' difference gives, |a - b| sqrt(n / 4), and
-// its brighter half both above the brightest neighbour's value. That is a spike no surface in
-// view explains, a glint: a rare path of large value (a glossy bounce into a small light), whose
-// one sample inflates m as much as the difference, so that with m as d the term reads at most
-// about 1 where the pixel's true relative error is tens. Such a pixel takes d = min(m,
-// max(min(a, b), median of the window)): its spike-free half, or its neighbourhood's level if
-// that is higher. A pixel at an edge (a sliver of the light, a bright wall behind a dark one) has
-// spikes that a neighbour shows as its steady value, and keeps m: its rare samples are a large
-// part of its true value. What the rule cannot tell apart: a light smaller than a pixel or two,
-// seen directly, that one half has hit and the other not yet, reads as a glint, and its term is
-// far too high until both halves have hit it.
+// its brighter half both above the brightest value of its 3 x 3 neighbourhood. That is a spike
+// no surface in view explains, a glint: a rare path of large value (a glossy bounce into a small
+// light), whose one sample inflates m as much as the difference, so that with m as d the term
+// reads at most about 1 where the pixel's true relative error is tens. Such a pixel takes d =
+// min(m, max(min(a, b), the window's median)): its spike-free half, or its neighbourhood's level
+// if that is higher. A pixel at an edge (a sliver of the light, a bright wall behind a dark one)
+// has spikes that a neighbour shows as its steady value, and keeps m: its rare samples are a
+// large part of its true value. What the rule cannot tell apart: a light smaller than a pixel or
+// two, seen directly, that one half has hit and the other not yet, reads as a glint, and its
+// term is far too high until both halves have hit it.
 // docs/performance.md ("The denominator: glints") has the measurements behind the rule.
-double termValue(double a, double b, double m, double samples, double* window, int count,
-                 double brightest) {
+// `brightest`: the brightest value of the channel around the pixel, the pixel left out.
+double termValue(const ValueRows& rows, int x, int y, int c, double samples, double brightest) {
+    const PixelValues& v = rows.at(x, y);
+    const double a = v.a[c], b = v.b[c];
     const double spread = std::fabs(a - b) * std::sqrt(samples / 4.0);
-    if (!(spread > brightest && std::max(a, b) > brightest)) return m;
-    std::nth_element(window, window + count / 2, window + count);
-    return std::min(m, std::max(std::min(a, b), window[count / 2]));
+    if (!(spread > brightest && std::max(a, b) > brightest)) return v.m[c];
+    return std::min(v.m[c], std::max(std::min(a, b), rows.median(x, y, c)));
 }
-
-// The image's values m, three a pixel, from row r0 on: pixels' neighbourhoods.
-struct ValueRows {
-    const double* values;
-    int width, height, r0;
-    double at(int x, int y, int c) const {
-        return values[(size_t(y - r0) * size_t(width) + size_t(x)) * 3 + size_t(c)];
-    }
-    // Channel c of the 3 x 3 window around (x, y) inside the image, into window (the pixel
-    // included); returns the count, and the brightest value but the pixel's in brightest.
-    int window(int x, int y, int c, double* window, double& brightest) const {
-        int count = 0;
-        brightest = 0.0;
-        for (int ny = std::max(0, y - 1); ny <= std::min(height - 1, y + 1); ++ny)
-            for (int nx = std::max(0, x - 1); nx <= std::min(width - 1, x + 1); ++nx) {
-                window[count++] = at(nx, ny, c);
-                if (nx != x || ny != y) brightest = std::max(brightest, at(nx, ny, c));
-            }
-        return count;
-    }
-};
 } // namespace
 
 void Film::halfBufferTermRows(int y0, int y1, double* terms) const {
     // The image's rows y0 - 1 .. y1 (those inside it): every pixel's neighbours.
     const int r0 = std::max(0, y0 - 1), r1 = std::min(height_, y1 + 1);
     const size_t w = size_t(width_);
-    std::vector<double> value(size_t(r1 - r0) * w * 3);
+    std::vector<PixelValues> values(size_t(r1 - r0) * w);
     forPixels(size_t(r1 - r0) * w, [&](size_t begin, size_t end) {
         for (size_t j = begin; j < end; ++j) {
             double s[8];
             pixelSums(size_t(r0) * w + j, s);
+            PixelValues& v = values[j];
             const double weight = s[3] + s[7];
-            for (int c = 0; c < 3; ++c)
-                value[j * 3 + size_t(c)] = weight > 0 ? (s[c] + s[4 + c]) / weight : 0.0;
+            v.both = s[3] > 0 && s[7] > 0;
+            for (int c = 0; c < 3; ++c) {
+                v.m[c] = weight > 0 ? (s[c] + s[4 + c]) / weight : 0.0;
+                v.a[c] = v.both ? s[c] / s[3] : 0.0;
+                v.b[c] = v.both ? s[4 + c] / s[7] : 0.0;
+            }
         }
     });
-    const ValueRows rows{value.data(), width_, height_, r0};
+    const ValueRows rows{values.data(), width_, height_, r0};
     forPixels(size_t(y1 - y0) * w, [&](size_t begin, size_t end) {
         for (size_t j = begin; j < end; ++j) {
             const size_t pixel = size_t(y0) * w + j;
             const int x = int(pixel % w), y = int(pixel / w);
-            double s[8];
-            pixelSums(pixel, s);
             double* out = terms + j * 3;
-            if (!(s[3] > 0 && s[7] > 0)) {
+            const PixelValues& v = rows.at(x, y);
+            if (!v.both) {
                 out[0] = out[1] = out[2] = kNoTerm;
                 continue;
             }
             // The camera samples centred in the pixel. A wide filter's value averages more of
             // them, so the spread reads low there and the rule errs towards m.
             const double samples = double(tileSamples_[tileOf(pixel)]);
+            double brightest[3];
+            rows.brightest(x, y, brightest);
             for (int c = 0; c < 3; ++c) {
-                double window[9], brightest;
-                const int count = rows.window(x, y, c, window, brightest);
-                const double a = s[c] / s[3], b = s[4 + c] / s[7];
-                const double d =
-                    termValue(a, b, rows.at(x, y, c), samples, window, count, brightest);
+                const double a = v.a[c], b = v.b[c];
+                const double d = termValue(rows, x, y, c, samples, brightest[c]);
                 out[c] = (a - b) * (a - b) / 4.0 / (d * d + kRelMseEpsilon);
             }
         }
