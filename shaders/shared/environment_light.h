@@ -67,12 +67,35 @@ SHARED_FN float environmentCdfInterval(SCENE_PARAM uint base, uint i) {
     return LIGHT_DATA(base + i) - (i > 0u ? LIGHT_DATA(base + i - 1u) : 0.0f);
 }
 
-// Radiance arriving from direction d (unit) out of environment e.
-SHARED_FN vec3 environmentRadiance(SCENE_PARAM RenderParams rp, Emitter e, vec3 d) {
-    if (rp.envWidth == 0u) return e.radiance;
-    uvec2 t = environmentTexel(SCENE_ARG rp, d);
+// The radiance of map texel t.
+SHARED_FN vec3 environmentTexelRadiance(SCENE_PARAM RenderParams rp, uvec2 t) {
     uint i = 3u * (t.y * rp.envWidth + t.x);
     return vec3(LIGHT_DATA(i), LIGHT_DATA(i + 1u), LIGHT_DATA(i + 2u));
+}
+
+// Solid-angle density of environmentSample() choosing direction d in map texel t, d's
+// sin(theta) sinTheta > 0.
+SHARED_FN float environmentTexelPdf(SCENE_PARAM RenderParams rp, uvec2 t, float sinTheta) {
+    uint marginal = 3u * rp.envWidth * rp.envHeight;
+    uint conditional = marginal + rp.envHeight + t.y * rp.envWidth;
+    float p = environmentCdfInterval(SCENE_ARG marginal, t.y) *
+              environmentCdfInterval(SCENE_ARG conditional, t.x);
+    return p * float(rp.envWidth) * float(rp.envHeight) / (2.0f * kPi * kPi * sinTheta);
+}
+
+// Radiance arriving from direction d (unit) out of environment e, and with `withPdf` the
+// solid-angle density of environmentSample() choosing d (before the pick probability) in pdf:
+// the texel found once for both.
+SHARED_FN vec3 environmentLookUp(SCENE_PARAM RenderParams rp, Emitter e, vec3 d, bool withPdf,
+                                 OUT(float) pdf) {
+    pdf = 0.25f * kInvPi;
+    if (rp.envWidth == 0u) return e.radiance;
+    uvec2 t = environmentTexel(SCENE_ARG rp, d);
+    if (withPdf) {
+        float sinTheta = sqrt(max(0.0f, 1.0f - d.y * d.y));
+        pdf = sinTheta > 0.0f ? environmentTexelPdf(SCENE_ARG rp, t, sinTheta) : 0.0f;
+    }
+    return environmentTexelRadiance(SCENE_ARG rp, t);
 }
 
 // Solid-angle density of environmentSample() choosing d, before the pick probability.
@@ -80,12 +103,7 @@ SHARED_FN float environmentPdf(SCENE_PARAM RenderParams rp, vec3 d) {
     if (rp.envWidth == 0u) return 0.25f * kInvPi;
     float sinTheta = sqrt(max(0.0f, 1.0f - d.y * d.y));
     if (!(sinTheta > 0.0f)) return 0.0f;
-    uvec2 t = environmentTexel(SCENE_ARG rp, d);
-    uint marginal = 3u * rp.envWidth * rp.envHeight;
-    uint conditional = marginal + rp.envHeight + t.y * rp.envWidth;
-    float p = environmentCdfInterval(SCENE_ARG marginal, t.y) *
-              environmentCdfInterval(SCENE_ARG conditional, t.x);
-    return p * float(rp.envWidth) * float(rp.envHeight) / (2.0f * kPi * kPi * sinTheta);
+    return environmentTexelPdf(SCENE_ARG rp, environmentTexel(SCENE_ARG rp, d), sinTheta);
 }
 
 // Index of the first entry of cdf[base .. base + n) above u (binary search), and u rescaled to
@@ -106,8 +124,10 @@ SHARED_FN uint environmentSearch(SCENE_PARAM uint base, uint n, INOUT(float) u) 
     return lo;
 }
 
-// A direction toward the environment, with importance over its map (or uniform without one).
-SHARED_FN vec3 environmentSample(SCENE_PARAM RenderParams rp, vec2 u) {
+// A direction toward the environment, with importance over its map (or uniform without one),
+// and the map texel it was drawn in (0 without a map).
+SHARED_FN vec3 environmentSample(SCENE_PARAM RenderParams rp, vec2 u, OUT(uvec2) texel) {
+    texel = uvec2(0u);
     if (rp.envWidth == 0u) {
         float z = 1.0f - 2.0f * u.x;
         float r = sqrt(max(0.0f, 1.0f - z * z));
@@ -118,17 +138,28 @@ SHARED_FN vec3 environmentSample(SCENE_PARAM RenderParams rp, vec2 u) {
     uint row = environmentSearch(SCENE_ARG marginal, rp.envHeight, u.y);
     uint column =
         environmentSearch(SCENE_ARG marginal + rp.envHeight + row * rp.envWidth, rp.envWidth, u.x);
+    texel = uvec2(column, row);
     return environmentDirection(
         vec2((float(column) + u.x) / float(rp.envWidth), (float(row) + u.y) / float(rp.envHeight)));
 }
 
-// A direction toward the environment, by its map; radiance is what arrives along it.
+// A direction toward the environment, by its map; radiance is what arrives along it. The
+// radiance and density are the texel's the direction was drawn in, not searched for again: the
+// same texel but for a direction that rounding put a hair across its edge, where it is the
+// texel whose density drew it.
 SHARED_FN LightSample environment_lightSample(SCENE_PARAM RenderParams rp, Emitter e,
                                               SurfaceHit hit, vec2 u) {
     LightSample ls;
-    ls.wi = environmentSample(SCENE_ARG rp, u);
-    ls.pdf = e.pickPdf * environmentPdf(SCENE_ARG rp, ls.wi);
-    ls.radiance = environmentRadiance(SCENE_ARG rp, e, ls.wi);
+    uvec2 texel;
+    ls.wi = environmentSample(SCENE_ARG rp, u, texel);
+    ls.radiance = e.radiance;
+    float pdf = 0.25f * kInvPi;
+    if (rp.envWidth != 0u) {
+        float sinTheta = sqrt(max(0.0f, 1.0f - ls.wi.y * ls.wi.y));
+        pdf = sinTheta > 0.0f ? environmentTexelPdf(SCENE_ARG rp, texel, sinTheta) : 0.0f;
+        ls.radiance = environmentTexelRadiance(SCENE_ARG rp, texel);
+    }
+    ls.pdf = e.pickPdf * pdf;
     ls.tmax = kInfiniteDistance;
     return ls;
 }

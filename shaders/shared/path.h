@@ -43,9 +43,11 @@ SHARED_FN vec3 escapedRadiance(SCENE_PARAM RenderParams rp, vec3 rayDir, PathSta
     float w = 1.0f;
     bool sampledByBsdf = st.bounce > 0u && (st.flags & kPathSpecular) == 0u;
     if (sampledByBsdf && rp.strategy == kStrategyLight) w = 0.0f;
-    if (sampledByBsdf && rp.strategy == kStrategyMis)
-        w = powerHeuristic(st.prevPdf, e.pickPdf * environmentPdf(SCENE_ARG rp, rayDir));
-    return st.beta * environmentRadiance(SCENE_ARG rp, e, rayDir) * w;
+    bool weighed = sampledByBsdf && rp.strategy == kStrategyMis;
+    float pdf;
+    vec3 radiance = environmentLookUp(SCENE_ARG rp, e, rayDir, weighed, pdf);
+    if (weighed) w = powerHeuristic(st.prevPdf, e.pickPdf * pdf);
+    return st.beta * radiance * w;
 }
 
 // Step 1 of shadeSurface: what the hit's emitter sends back along the ray (r.emitted, with

@@ -260,7 +260,10 @@ Scene mapScene(int w, int h) {
 
 // Directions drawn by environmentSample() land in texels as often as their share of
 // luminance x sin(theta) says (chi-square over the texels; none in black ones), and
-// environmentPdf() is that density in solid angle: it integrates to 1 over the sphere.
+// environmentPdf() is that density in solid angle: it integrates to 1 over the sphere. A light
+// sample's radiance and density, taken from the texel it was drawn in, are the lookup's at its
+// direction bit for bit wherever the direction lies in that texel, which is all but a few in a
+// hundred thousand.
 TEST(EnvironmentLight, MapSamplingPassesChiSquareAgainstItsPdf) {
     const int w = 16, h = 8;
     const Scene scene = mapScene(w, h);
@@ -295,11 +298,25 @@ TEST(EnvironmentLight, MapSamplingPassesChiSquareAgainstItsPdf) {
     std::mt19937 rng(7);
     std::uniform_real_distribution<float> unit(0.0f, 1.0f);
     double worstPdf = 0;
+    int across = 0; // directions rounded across their texel's edge
+    Emitter e{};
+    e.pickPdf = 0.5f;
     for (int i = 0; i < n; ++i) {
-        const vec3 d = environmentSample(view, rp, vec2(unit(rng), unit(rng)));
+        const vec2 u(unit(rng), unit(rng));
+        uvec2 drawn;
+        const vec3 d = environmentSample(view, rp, u, drawn);
         ASSERT_NEAR(glm::length(d), 1.0f, 1e-5f);
         const uvec2 t = environmentTexel(view, rp, d);
         ++counts[t.y * uint(w) + t.x];
+        const LightSample ls = environment_lightSample(view, rp, e, SurfaceHit{}, u);
+        ASSERT_EQ(ls.wi, d);
+        across += drawn != t;
+        if (drawn == t) {
+            float pdf;
+            ASSERT_EQ(ls.radiance, environmentLookUp(view, rp, e, d, true, pdf));
+            ASSERT_EQ(ls.pdf, e.pickPdf * pdf);
+            ASSERT_EQ(pdf, environmentPdf(view, rp, d));
+        }
         // The density at d: the texel's probability over its solid angle at d's sin(theta)
         // (none at a pole, where float rounds the direction to straight up or down).
         const double sinTheta = std::sqrt(std::max(0.0, 1.0 - double(d.y) * d.y));
@@ -309,6 +326,7 @@ TEST(EnvironmentLight, MapSamplingPassesChiSquareAgainstItsPdf) {
         worstPdf = std::max(worstPdf, std::fabs(environmentPdf(view, rp, d) / expected - 1.0));
     }
     EXPECT_LT(worstPdf, 1e-4);
+    EXPECT_LE(across, n / 20000);
     double chi2 = 0;
     int bins = 0;
     for (size_t t = 0; t < counts.size(); ++t) {
