@@ -9,6 +9,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
 #include <set>
 
 namespace spw {
@@ -20,16 +21,31 @@ namespace {
 class CpuShading : public SlottedEngine {
   public:
     CpuShading(const RenderContext& ctx, bool simd)
-        : SlottedEngine(ctx, sortRule(ctx.config.pipeline, ctx.textures.active())),
+        : SlottedEngine(ctx, sortRule(ctx.config.pipeline, ctx.scene, ctx.textures)),
           view_(ctx.lights.view()), params_(ctx.params),
           chunk_(size_t(ctx.scene.settings.shadingSize)), simd_(simd),
           fused_(ctx.config.pipeline.fuseStages) {}
 
-    // Sorted hits pay on the cpu only where textures are read (coherent tile reads); elsewhere it
-    // shades the same function whatever the order, and the sort measured a pure cost (0.25 s of
-    // a 4 s render on the Cornell box).
-    static bool sortRule(const PipelineConfig& p, bool textured) {
-        return p.sortsHits() && (p.hitSort == HitSortMode::On || textured);
+    // Sorted hits pay on the cpu only where they make image reads coherent: where many shaders
+    // read image textures (a shader's hits together read its images together, texture by
+    // texture), or where the images outgrow the tile cache (sorted by object and primitive,
+    // neighbouring lookups share tiles before they are evicted: ProductionScene.* reads a third
+    // of the tiles). Elsewhere the C++ engine shades the same function whatever the order, and
+    // the sort is a pure cost (0.25 s of a 4 s render on the Cornell box); with a few textured
+    // shaders whose images the cache holds, the reads it makes coherent gain less than it costs.
+    // Measured (docs/performance.md, "Time to Cycles' error"): 2 textured shaders, 64^2 or
+    // 1024^2 images, 3-6 % slower sorted; 4 and 16 shaders of 7 images each, the same within the
+    // noise; 64, 6 % faster.
+    static constexpr size_t kSortedTexturedShaders = 16;
+    static bool sortRule(const PipelineConfig& p, const Scene& scene,
+                         const TextureResolver& textures) {
+        if (!p.sortsHits()) return false;
+        if (p.hitSort == HitSortMode::On) return true;
+        if (!textures.active()) return false;
+        const size_t readers =
+            size_t(std::count_if(scene.shaders.begin(), scene.shaders.end(),
+                                 [](const Shader& s) { return s.looksUpTextures(); }));
+        return readers >= kSortedTexturedShaders || textures.outgrowsCache();
     }
     bool takesTraversalOrder() const override {
         return fused_ && !sortsHits() && ctx_.params.environment == kNoEmitter;

@@ -205,6 +205,7 @@ TextureResolver::TextureResolver(const Scene& scene, double cacheMiB, bool filte
     std::vector<bool> readWhole(scene.textures.size(), false);
     for (const Shader& sh : scene.shaders)
         if (sh.emissionTexture >= 0) readWhole[size_t(sh.emissionTexture)] = true;
+    double heldBytes = 0.0; // what the cache would hold of the images hit setup reads
     for (size_t i = 0; i < scene.textures.size(); ++i) {
         const Texture& t = scene.textures[i];
         if (t.type != TextureType::Standard) continue;
@@ -212,7 +213,12 @@ TextureResolver::TextureResolver(const Scene& scene, double cacheMiB, bool filte
         openImage(scene, *impl_, t, img, readWhole[i]);
         img.firstHeld = impl_->heldSlots;
         impl_->heldSlots += img.levels.size();
+        if (readWhole[i]) continue;
+        for (const Impl::Level& level : img.levels)
+            heldBytes += double(level.width) * double(level.height) * double(img.channels) *
+                         (img.eightBit ? 1.0 : 4.0);
     }
+    outgrowsCache_ = heldBytes > cacheMiB * 1048576.0;
     // The tiles the threads hold together stay within a quarter of the cache.
     const int workers = std::max(1, tbb::this_task_arena::max_concurrency());
     impl_->heldLimit = size_t(cacheMiB * 1048576.0 / 4.0) / size_t(workers);

@@ -71,6 +71,10 @@ class TextureResolver {
     std::vector<vec3> finestLevel(int texture, int& width, int& height) const;
     // True when the scene has image textures (OpenImageIO is in use).
     bool active() const { return impl_ != nullptr; }
+    // True when the images hit setup reads (every MIP level, as the tile cache holds them) total
+    // more than the cache's budget: tiles are then evicted and read again, as often as the order
+    // of the lookups makes them.
+    bool outgrowsCache() const { return outgrowsCache_; }
     // Throws SceneError (the texture's file and scene line) if an image lookup failed since the
     // scene loaded: a file that was readable when loaded but whose pixels are not.
     void checkErrors() const;
@@ -95,6 +99,7 @@ class TextureResolver {
     std::vector<std::vector<Op>> programs_; // per Scene::textures root used by a shader
     std::unique_ptr<Impl> impl_;
     bool wide_ = true;
+    bool outgrowsCache_ = false;
 };
 
 } // namespace spw
