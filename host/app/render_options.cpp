@@ -216,8 +216,8 @@ const std::vector<CliOption> kOwnOptions = {
      }},
     {"--hit-sort", nullptr, "MODE", Section::Pipeline,
      "sort hits by (shader, object, texture order) before shading: auto (default: for vulkan "
-     "always, for cpu where 16 or more shaders read image textures or the images outgrow the "
-     "texture cache), on or off",
+     "always, for cpu where the scene has image textures, by shader alone unless the images "
+     "outgrow the texture cache), on or off",
      0, 0,
      [](O& r, const C& o, const S& v) {
          r.config.pipeline.hitSort = choice(o, v, parseHitSortMode);

@@ -9,7 +9,6 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
-#include <algorithm>
 #include <set>
 
 namespace spw {
@@ -21,31 +20,26 @@ namespace {
 class CpuShading : public SlottedEngine {
   public:
     CpuShading(const RenderContext& ctx, bool simd)
-        : SlottedEngine(ctx, sortRule(ctx.config.pipeline, ctx.scene, ctx.textures)),
+        : SlottedEngine(ctx, sortRule(ctx.config.pipeline, ctx.textures.active())),
           view_(ctx.lights.view()), params_(ctx.params),
           chunk_(size_t(ctx.scene.settings.shadingSize)), simd_(simd),
           fused_(ctx.config.pipeline.fuseStages) {}
 
-    // Sorted hits pay on the cpu only where they make image reads coherent: where many shaders
-    // read image textures (a shader's hits together read its images together, texture by
-    // texture), or where the images outgrow the tile cache (sorted by object and primitive,
-    // neighbouring lookups share tiles before they are evicted: ProductionScene.* reads a third
-    // of the tiles). Elsewhere the C++ engine shades the same function whatever the order, and
-    // the sort is a pure cost (0.25 s of a 4 s render on the Cornell box); with a few textured
-    // shaders whose images the cache holds, the reads it makes coherent gain less than it costs.
-    // Measured (docs/performance.md, "Time to Cycles' error"): 2 textured shaders, 64^2 or
-    // 1024^2 images, 3-6 % slower sorted; 4 and 16 shaders of 7 images each, the same within the
-    // noise; 64, 6 % faster.
-    static constexpr size_t kSortedTexturedShaders = 16;
-    static bool sortRule(const PipelineConfig& p, const Scene& scene,
-                         const TextureResolver& textures) {
-        if (!p.sortsHits()) return false;
-        if (p.hitSort == HitSortMode::On) return true;
-        if (!textures.active()) return false;
-        const size_t readers =
-            size_t(std::count_if(scene.shaders.begin(), scene.shaders.end(),
-                                 [](const Shader& s) { return s.looksUpTextures(); }));
-        return readers >= kSortedTexturedShaders || textures.outgrowsCache();
+    // Sorted hits pay on the cpu only where textures are read (coherent tile reads); elsewhere it
+    // shades the same function whatever the order, and the sort measured a pure cost (0.25 s of
+    // a 4 s render on the Cornell box).
+    static bool sortRule(const PipelineConfig& p, bool textured) {
+        return p.sortsHits() && (p.hitSort == HitSortMode::On || textured);
+    }
+    // Sorted by shader alone, a shader's hits read its images together (texture by texture, the
+    // 8-bit lookups SIMD-wide); object and texture order within it pay only where the images
+    // outgrow the tile cache (neighbouring lookups then share tiles before they are evicted:
+    // ProductionScene.* reads a third of the tiles), or where --hit-sort on asks for them. Where
+    // the cache holds the images they cost more than they gain. Measured (docs/performance.md,
+    // "Time to Cycles' error"): the shader alone 4-12 % faster than the whole key on 2 textured
+    // shaders (64^2 and 1024^2 images) and on 4, 16 and 64 shaders of 7 images each.
+    bool ordersByTexture() const override {
+        return ctx_.config.pipeline.hitSort == HitSortMode::On || ctx_.textures.outgrowsCache();
     }
     bool takesTraversalOrder() const override {
         return fused_ && !sortsHits() && ctx_.params.environment == kNoEmitter;

@@ -45,6 +45,10 @@ class ShadingEngine {
     // Whether the hits are sorted by (shader, object, texture order) before shading: the
     // engine's rule for --hit-sort auto (render_config.h: HitSortMode).
     virtual bool sortsHits() const = 0;
+    // Whether, within a shader, sorted hits follow object and texture order where the scene reads
+    // image textures (neighbouring lookups share tiles); otherwise they keep traversal order, and
+    // the radix sort takes one pass instead of three or four.
+    virtual bool ordersByTexture() const { return true; }
     // Whether, where the scene has no environment for the misses to see, the engine takes the
     // hits unsorted, in traversal order, misses in place (no hit sort at all).
     virtual bool takesTraversalOrder() const { return false; }

@@ -129,9 +129,10 @@ size_t SortedRenderer::traceBatch(bool camera) {
         return n;
     }
     StageTimer t(times, "sort hits");
-    // Within a shader, texture order only where textures are read: otherwise the traversal
-    // order stays, and the radix sort needs one pass instead of three or four.
-    return sortHits(ctx_.scene, shaderOrder_, s.hits, shading_->sortsHits(), ctx_.textures.active(),
+    // Within a shader, texture order only where textures are read and the engine takes it:
+    // otherwise the traversal order stays, and the radix sort needs one pass instead of three or
+    // four.
+    return sortHits(ctx_.scene, shaderOrder_, s.hits, shading_->sortsHits(), textureOrder(),
                     s.order, s.keyTmp);
 }
 
@@ -156,6 +157,8 @@ void SortedRenderer::publishStats() {
     x["ray_record_bytes"] = rayRecordBytes(config_.rayFormat);
     x["ray_sort"] = raySortName(config_.raySort);
     x["hit_sort"] = shading_->sortsHits();
+    if (shading_->sortsHits())
+        x["hit_sort_key"] = textureOrder() ? "shader, object, texture order" : "shader";
     x["shading"] =
         shadingModeName(shading_->sortsHits() ? ShadingMode::Sorted : ShadingMode::Megakernel);
     x["batches_ray_sorted"] = policy_.sortedBatches();

@@ -151,18 +151,16 @@ OIIO::ImageCache::ImageHandle* TextureResolver::Impl::tiledCopy(const Texture& t
     return cache->get_image_handle(OIIO::ustring(found->second->path()));
 }
 
-TextureResolver::TextureResolver(const Scene& scene, double cacheMiB, bool filtered, bool wide,
-                                 const std::string& scratch)
-    : scene_(scene), wide_(wide) {
-    programs_.resize(scene.textures.size());
+void TextureResolver::compilePrograms() {
+    programs_.resize(scene_.textures.size());
     auto compile = [&](int root) {
         if (root < 0 || !programs_[size_t(root)].empty()) return;
         // The loader bounds the depth (kMaxTextureDepth), so this recursion is bounded too.
-        std::vector<int> slotOf(scene.textures.size(), -1), order;
-        visit(scene, root, slotOf, order);
+        std::vector<int> slotOf(scene_.textures.size(), -1), order;
+        visit(scene_, root, slotOf, order);
         std::vector<Op>& program = programs_[size_t(root)];
         for (int t : order) {
-            const Texture& tex = scene.textures[size_t(t)];
+            const Texture& tex = scene_.textures[size_t(t)];
             Op op{tex.type, t, -1, -1, -1};
             if (tex.type == TextureType::Layered)
                 op.upper = slotOf[size_t(tex.upper)], op.lower = slotOf[size_t(tex.lower)],
@@ -170,7 +168,7 @@ TextureResolver::TextureResolver(const Scene& scene, double cacheMiB, bool filte
             program.push_back(op);
         }
     };
-    for (const Shader& sh : scene.shaders) {
+    for (const Shader& sh : scene_.shaders) {
         compile(sh.texture);
         compile(sh.normalTexture);
         compile(sh.coatNormalTexture);
@@ -179,6 +177,12 @@ TextureResolver::TextureResolver(const Scene& scene, double cacheMiB, bool filte
             compile(m.texture);
         if (sh.cutout.enabled) compile(sh.cutout.texture);
     }
+}
+
+TextureResolver::TextureResolver(const Scene& scene, double cacheMiB, bool filtered, bool wide,
+                                 const std::string& scratch)
+    : scene_(scene), wide_(wide) {
+    compilePrograms();
     int standard = 0;
     for (const Texture& t : scene.textures)
         standard += t.type == TextureType::Standard;

@@ -92,6 +92,8 @@ class TextureResolver {
         int texture;            // index into Scene::textures
         int upper, lower, mask; // Layered: operand slots
     };
+    // The trees of Scene::textures that shaders read, flattened into programs_.
+    void compilePrograms();
     // The tree's values for n lookups, in a per-thread buffer that the next call reuses.
     const vec3* evaluate(int tree, size_t n, const vec2* uv, const float* footprint) const;
 
