@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Builds OpenImageIO lean, for the release bundle: from Debian's source package, with the image
+# Builds OpenImageIO lean, for every build (oiio-choice.sh) and the release bundle: from Debian's source package, with the image
 # formats Spillway reads and writes and nothing else (formats=, below: OpenEXR, TIFF, PNG, JPEG,
 # Radiance HDR, and the uncompressed PNM, Targa and BMP that sample scenes and asset libraries'
 # textures come in; none of them needs a library of its own beyond zlib, libpng, libjpeg, libtiff
@@ -19,7 +19,11 @@ prefix="$(realpath -m "${1:?usage: build-lean-oiio.sh PREFIX}")"
 work="$prefix.build"
 stamp="$prefix/.spillway-lean-oiio"
 formats="openexr tiff png jpeg hdr pnm targa bmp"
-if [ -f "$stamp" ] && [ "$(tail -1 "$stamp")" = "$formats" ]; then
+# Built as Debian builds it (CMAKE_BUILD_TYPE=None, -O2, NDEBUG not defined), so it behaves as
+# Debian's library does: a Release build (NDEBUG) raises any ImageCache bound under 10 MB to 10 MB,
+# and --texture-cache 1 would hold 10 MiB.
+flags="-O2"
+if [ -f "$stamp" ] && [ "$(tail -1 "$stamp")" = "$formats | $flags" ]; then
   echo "build-lean-oiio: $prefix is built ($(head -1 "$stamp"))"
   exit 0
 fi
@@ -67,7 +71,7 @@ for pkg in OpenColorIO OpenCV TBB DCMTK FFmpeg GIF Libheif LibRaw OpenJPEG OpenV
 done
 
 cmake -S "$src" -B "$work/build" -G Ninja \
-  -DCMAKE_BUILD_TYPE=Release -DCMAKE_INSTALL_PREFIX="$prefix" -DCMAKE_INSTALL_LIBDIR=lib \
+  -DCMAKE_BUILD_TYPE=None -DCMAKE_C_FLAGS="$flags" -DCMAKE_CXX_FLAGS="$flags" -DCMAKE_INSTALL_PREFIX="$prefix" -DCMAKE_INSTALL_LIBDIR=lib \
   -DOIIO_BUILD_TOOLS=OFF -DOIIO_BUILD_TESTS=OFF -DBUILD_DOCS=OFF -DINSTALL_DOCS=OFF \
   -DINSTALL_FONTS=OFF -DUSE_PYTHON=OFF -DUSE_QT=OFF -DEMBEDPLUGINS=ON -DUSE_CCACHE=OFF \
   -DSTOP_ON_WARNING=OFF -DBUILD_MISSING_FMT=OFF -DBUILD_MISSING_ROBINMAP=OFF \
@@ -75,5 +79,6 @@ cmake -S "$src" -B "$work/build" -G Ninja \
   "${deps_off[@]}" "${off[@]}" >"$work/configure.log"
 cmake --build "$work/build" --parallel "$(nproc)"
 cmake --install "$work/build" >/dev/null
-printf '%s\n%s\n' "$(basename "$tarball")" "$formats" >"$stamp"
+rm -rf "$src" "$work/build"   # 170 MB; the source tarball stays, for a rebuild without the network
+printf '%s\n%s\n' "$(basename "$tarball")" "$formats | $flags" >"$stamp"
 echo "build-lean-oiio: installed $(basename "$tarball") into $prefix"

@@ -19,9 +19,9 @@ work="$root/build-bundle"
 limit_mib=48
 
 "$root/scripts/install-deps.sh" --bundle
-"$root/scripts/build-lean-oiio.sh" "$work/oiio"
+"$root/scripts/build-lean-oiio.sh" "$root/build-oiio"
 cmake -S "$root" -B "$work/spillway" -G Ninja -DCMAKE_BUILD_TYPE=Release -DBUILD_TESTING=OFF \
-  -DOpenImageIO_DIR="$work/oiio/lib/cmake/OpenImageIO" >/dev/null
+  -DOpenImageIO_DIR="$root/build-oiio/lib/cmake/OpenImageIO" >/dev/null
 cmake --build "$work/spillway" --target spillway --parallel "$(nproc)"
 
 version="$("$work/spillway/spillway" --version | awk '{print $2}')"

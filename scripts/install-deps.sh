@@ -6,7 +6,11 @@ set -euo pipefail
 packages=(
   build-essential cmake pkg-config ninja-build
   libembree-dev libtbb-dev                 # ray traversal (Embree 3) and its task scheduler
-  libopenimageio-dev openimageio-tools     # textures (lazy, mipmapped) and image output
+  libopenimageio-dev openimageio-tools     # textures (lazy, mipmapped) and image output;
+                                           # maketx for the production scene generator
+  # What OpenImageIO is built lean with (build-lean-oiio.sh, oiio-choice.sh).
+  libboost-thread-dev libboost-filesystem-dev robin-map-dev libfmt-dev libtiff-dev libjpeg-dev
+  libpng-dev zlib1g-dev curl xz-utils
   libopenexr-dev                           # float EXR through OpenImageIO
   libyaml-cpp-dev                          # the scene format
   libglm-dev                               # vector math shared by C++ and GLSL
@@ -24,12 +28,9 @@ packages=(
   blender                                  # scripts/cycles_compare.py: glTF files in Cycles
 )
 
-# scripts/bundle.sh: what the lean OpenImageIO builds with (scripts/build-lean-oiio.sh), and the
-# tools that make the release (patchelf, zstd) and test it in a bare root (debootstrap).
-if [ "${1:-}" = "--bundle" ]; then
-  packages+=(libboost-thread-dev libboost-filesystem-dev robin-map-dev libfmt-dev libtiff-dev
-             libjpeg-dev libpng-dev zlib1g-dev patchelf zstd debootstrap)
-fi
+# scripts/bundle.sh: the tools that make the release (patchelf, zstd) and test it in a bare root
+# (debootstrap).
+if [ "${1:-}" = "--bundle" ]; then packages+=(patchelf zstd debootstrap); fi
 # scripts/fuzz.sh: clang with libFuzzer and the sanitizer runtimes.
 if [ "${1:-}" = "--fuzz" ]; then packages+=(clang libclang-rt-dev); fi
 

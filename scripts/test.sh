@@ -18,8 +18,10 @@ fi
 
 if [ "$mode" = all ] || [ "$mode" = --asan ]; then
   "$root/scripts/install-deps.sh" --fuzz
+  . "$root/scripts/oiio-choice.sh"
+  oiio_choose "$root"
   CC=clang CXX=clang++ cmake -S "$root" -B "$root/build-asan" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
-    -DSPILLWAY_SANITIZE=ON >/dev/null
+    -DSPILLWAY_SANITIZE=ON "${oiio_cmake_args[@]}" >/dev/null
   cmake --build "$root/build-asan" --parallel "$(nproc)"
   # Any sanitizer report fails the test it happens in (the process aborts). Two exceptions, both
   # in libraries: OpenImageIO's TextureSystem::destroy frees with another size than it allocated
