@@ -354,6 +354,8 @@ Scene loadGltfScene(const std::string& path) {
     // iteration's work per pixel (the film's sums, the error estimate, adaptive sampling's
     // decision) is then a few per cent of its samples' (docs/performance.md).
     scene.image.sampleBase = kGltfSampleBase;
+    scene.settings.minDepth = kGltfMinDepth;
+    scene.settings.threshold = kGltfRouletteThreshold;
     return scene;
 }
 

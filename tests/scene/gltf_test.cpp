@@ -284,6 +284,17 @@ TEST(Gltf, AFileWithoutSamplingRendersToADefaultErrorAndSaysSo) {
     }
 }
 
+// A glTF file rendered as the scene takes glTF's Russian roulette (from the second bounce, at
+// throughput 0.3), where the YAML format's defaults are the third bounce and 0.1.
+TEST(Gltf, AFileRenderedAsTheSceneEndsItsPathsByGltfsRoulette) {
+    TempDir dir;
+    const Scene scene = loadGltfScene(cameraAndQuads().binary(dir, "model.glb"));
+    EXPECT_EQ(scene.settings.minDepth, kGltfMinDepth);
+    EXPECT_EQ(scene.settings.threshold, kGltfRouletteThreshold);
+    EXPECT_LT(kGltfMinDepth, Settings{}.minDepth);
+    EXPECT_GT(kGltfRouletteThreshold, Settings{}.threshold);
+}
+
 // `type: Gltf` places a file in a YAML scene: moved by the object's transform, relative to the
 // scene's camera; its materials follow the scene's shaders, or `shader:` replaces them all.
 TEST(Gltf, AYamlSceneObjectPlacesAFileWithItsMaterialsOrAShader) {
@@ -306,7 +317,10 @@ TEST(Gltf, AYamlSceneObjectPlacesAFileWithItsMaterialsOrAShader) {
     EXPECT_EQ(own.shaders[0].params.model, kModelLambert);
     EXPECT_EQ(own.shaders[size_t(own.meshes[0].shader)].params.colour, vec3(0.8f, 0.5f, 0.25f));
     EXPECT_GE(own.meshes[1].shader, 1);
-    EXPECT_FALSE(own.environment);      // a YAML scene lights itself
+    EXPECT_FALSE(own.environment); // a YAML scene lights itself
+    // ... and keeps its own settings: the format's Russian roulette, not a glTF file's.
+    EXPECT_EQ(own.settings.minDepth, Settings{}.minDepth);
+    EXPECT_EQ(own.settings.threshold, Settings{}.threshold);
     ASSERT_EQ(own.warnings.size(), 1u); // the file's camera, not used
     EXPECT_NE(own.warnings[0].find("cameras are not used"), std::string::npos);
 
