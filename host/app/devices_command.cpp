@@ -27,8 +27,10 @@ int devicesCommand(const std::vector<std::string>& args) {
         std::printf("%u: %s\n   type: %s, Vulkan %s, driver: %s\n   %s\n", d.index, d.name.c_str(),
                     d.type.c_str(), d.api.c_str(), d.driver.c_str(),
                     d.usable ? "usable" : ("unusable: " + d.whyNot).c_str());
-    std::printf("--backend auto takes %s\n",
-                vk::chooseAutoDevice(devices, vk::driverVariablesSet()).why.c_str());
+    const std::optional<vk::AutoChoice> known = vk::autoChoiceWithoutLoader();
+    std::printf(
+        "--backend auto takes %s\n",
+        (known ? *known : vk::chooseAutoDevice(devices, vk::driverVariablesSet())).why.c_str());
     return 0;
 }
 

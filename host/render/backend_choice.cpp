@@ -33,8 +33,9 @@ BackendChoice resolveBackend(const RenderConfig& config) {
     bool wanted = config.backend == BackendKind::Vulkan || !vkConfig.device.empty();
     try {
         if (!wanted) {
+            const std::optional<vk::AutoChoice> known = vk::autoChoiceWithoutLoader();
             const vk::AutoChoice automatic =
-                vk::chooseAutoDevice(vk::listDevices(), vk::driverVariablesSet());
+                known ? *known : vk::chooseAutoDevice(vk::listDevices(), vk::driverVariablesSet());
             choice.autoWhy = automatic.why;
             choice.kind = BackendKind::Cpu;
             if (automatic.device >= 0) {

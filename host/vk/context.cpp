@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
 #include <memory>
 
 namespace spw::vk {
@@ -268,6 +269,37 @@ bool driverVariablesSet() {
     for (const char* v : {"VK_DRIVER_FILES", "VK_ICD_FILENAMES", "VK_ADD_DRIVER_FILES"})
         if (const char* value = std::getenv(v); value && *value) return true;
     return false;
+}
+
+std::vector<std::string> gpuDeviceFiles(const std::string& root) {
+    const auto starts = [](const std::string& name, const char* prefix) {
+        return name.rfind(prefix, 0) == 0;
+    };
+    std::vector<std::string> found;
+    std::error_code ec;
+    for (const auto& entry : std::filesystem::directory_iterator(root + "/dri", ec)) {
+        const std::string name = entry.path().filename().string();
+        if (starts(name, "renderD") || starts(name, "card")) found.push_back(entry.path().string());
+    }
+    for (const auto& entry : std::filesystem::directory_iterator(root, ec)) {
+        const std::string name = entry.path().filename().string();
+        const bool nvidia =
+            starts(name, "nvidia") && name.size() > 6 &&
+            (std::isdigit(static_cast<unsigned char>(name[6])) || name == "nvidiactl");
+        if (nvidia || name == "dxg" || name == "kgsl-3d0" || starts(name, "mali"))
+            found.push_back(entry.path().string());
+    }
+    std::sort(found.begin(), found.end());
+    return found;
+}
+
+std::optional<AutoChoice> autoChoiceWithoutLoader() {
+    if (driverVariablesSet() || !gpuDeviceFiles().empty()) return std::nullopt;
+    return AutoChoice{-1,
+                      "cpu: no GPU on this machine (no device file in /dev/dri, no /dev/nvidia*, "
+                      "/dev/dxg or another GPU's), so no Vulkan driver can reach one; a "
+                      "software device such as lavapipe shades more slowly than the cpu "
+                      "backend on the same cores; --backend vulkan takes it"};
 }
 
 Context::Context(const VulkanConfig& config) {

@@ -10,6 +10,7 @@
 
 #include <atomic>
 #include <cstdint>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -49,6 +50,17 @@ struct AutoChoice {
 AutoChoice chooseAutoDevice(const std::vector<DeviceInfo>& devices, bool softwareAllowed);
 // Whether the environment names Vulkan drivers (the variables above).
 bool driverVariablesSet();
+
+// The device files through which a GPU driver reaches a GPU under `root` (/dev): DRM's render
+// and card nodes (dri/renderD*, dri/card*: Mesa's, AMD's, Intel's, virtio's drivers), NVIDIA's
+// (nvidia0..., nvidiactl), WSL's dxg, Qualcomm's kgsl-3d0 and Arm's mali*. None: no Vulkan
+// driver on this machine can reach a GPU, whatever drivers are installed (Mesa installs Intel's
+// and AMD's beside lavapipe).
+std::vector<std::string> gpuDeviceFiles(const std::string& root = "/dev");
+// --backend auto's choice where it can be made without starting the loader, which loads every
+// installed driver (30-130 ms of a render's start with Mesa's): no driver variable set and no GPU
+// device file, so the cpu backend. Empty where the devices must be listed to choose.
+std::optional<AutoChoice> autoChoiceWithoutLoader();
 
 // Total warnings and errors the validation messengers of this process have reported (tests
 // read it after a render, when the instance and its messenger are gone).
