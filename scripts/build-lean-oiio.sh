@@ -1,11 +1,10 @@
 #!/usr/bin/env bash
-# Builds OpenImageIO lean, for every build (oiio-choice.sh) and the release bundle: from Debian's source package, with the image
-# formats Spillway reads and writes and nothing else (formats=, below: OpenEXR, TIFF, PNG, JPEG,
-# Radiance HDR, and the uncompressed PNM, Targa and BMP that sample scenes and asset libraries'
-# textures come in; none of them needs a library of its own beyond zlib, libpng, libjpeg, libtiff
-# and OpenEXR), so
-# the bundle carries none of the OpenCV, FFmpeg, GDAL, OpenVDB and codec closure that Debian's
-# binary package links.
+# Builds OpenImageIO lean, for every build (oiio-choice.sh) and the release bundle: from Debian's
+# source package, with the image formats Spillway reads and writes and nothing else (formats=,
+# below: OpenEXR, TIFF, PNG, JPEG, Radiance HDR, and the uncompressed PNM, Targa and BMP that
+# sample scenes and asset libraries' textures come in; none of them needs a library of its own
+# beyond zlib, libpng, libjpeg, libtiff and OpenEXR), so nothing loads the OpenCV, FFmpeg, GDAL,
+# OpenVDB and codec closure that Debian's binary package links.
 #
 #   scripts/build-lean-oiio.sh PREFIX      # installs into PREFIX (lib/, include/, lib/cmake/)
 #
@@ -71,7 +70,8 @@ for pkg in OpenColorIO OpenCV TBB DCMTK FFmpeg GIF Libheif LibRaw OpenJPEG OpenV
 done
 
 cmake -S "$src" -B "$work/build" -G Ninja \
-  -DCMAKE_BUILD_TYPE=None -DCMAKE_C_FLAGS="$flags" -DCMAKE_CXX_FLAGS="$flags" -DCMAKE_INSTALL_PREFIX="$prefix" -DCMAKE_INSTALL_LIBDIR=lib \
+  -DCMAKE_BUILD_TYPE=None -DCMAKE_C_FLAGS="$flags" -DCMAKE_CXX_FLAGS="$flags" \
+  -DCMAKE_INSTALL_PREFIX="$prefix" -DCMAKE_INSTALL_LIBDIR=lib \
   -DOIIO_BUILD_TOOLS=OFF -DOIIO_BUILD_TESTS=OFF -DBUILD_DOCS=OFF -DINSTALL_DOCS=OFF \
   -DINSTALL_FONTS=OFF -DUSE_PYTHON=OFF -DUSE_QT=OFF -DEMBEDPLUGINS=ON -DUSE_CCACHE=OFF \
   -DSTOP_ON_WARNING=OFF -DBUILD_MISSING_FMT=OFF -DBUILD_MISSING_ROBINMAP=OFF \
