@@ -289,13 +289,15 @@ HWY_INLINE V mean(V3 v) {
     return hn::Div(hn::Add(hn::Add(v.x, v.y), v.z), hn::Set(D(), 3.0f));
 }
 // Twin of gltfSpecularProbability (shared/gltf.h).
-HWY_INLINE V gltfSpecularProbability(V3 f0, V f90, V3 cDiff, V cosO) {
+HWY_INLINE V gltfSpecularProbability(V3 f0, V f90, V3 cDiff, V cosO, V alpha) {
     const D d;
     const V one = hn::Set(d, 1.0f);
     const V3 F = gltfFresnel(f0, f90, cosO);
     const V fs = mean(F);
     const V fd = mean(mul(cDiff, sub(V3{one, one, one}, F)));
-    const V p = gmin(gmax(hn::Div(fs, hn::Add(fs, fd)), hn::Set(d, 0.25f)), hn::Set(d, 0.9f));
+    const V open = hn::Sub(one, gmin(alpha, one));
+    const V floor = hn::Mul(hn::Mul(hn::Set(d, 0.25f), open), open);
+    const V p = gmin(gmax(hn::Div(fs, hn::Add(fs, fd)), floor), hn::Set(d, 0.9f));
     return hn::IfThenElse(hn::Gt(fd, hn::Zero(d)), p, one);
 }
 // Twin of gltfEval (shared/gltf.h), given dot(ng, wo) and shadingFrame's frame.
@@ -321,7 +323,7 @@ HWY_INLINE V3 gltfEval(V3 colour, V metallic, V alpha, V3 f0d, V f90d, V3 ng, V 
         select(hn::Gt(denom, zero), mul(F, hn::Div(hn::Mul(ndf, li.z), hn::Mul(two, denom))),
                V3{zero, zero, zero});
     const V3 diffuse = mul(mul(sub(V3{one, one, one}, F), cDiff), hn::Mul(li.z, invPi));
-    const V pSpecular = gltfSpecularProbability(f0, f90, cDiff, lo.z);
+    const V pSpecular = gltfSpecularProbability(f0, f90, cDiff, lo.z, alpha);
     const V specularPdf = hn::Div(ndf, hn::Mul(two, hn::Add(lo.z, ggxA(lo, alpha))));
     pdf = hn::IfThenElseZero(evaluated,
                              hn::Add(hn::Mul(pSpecular, specularPdf),
@@ -337,7 +339,7 @@ HWY_INLINE BsdfSample gltfSample(V3 colour, V metallic, V alpha, V3 f0d, V f90d,
     const V3 f0 = mix(f0d, colour, metallic);
     const V3 cDiff = mul(colour, hn::Sub(one, metallic));
     const M specularLobe =
-        hn::Lt(uz, gltfSpecularProbability(f0, gltfF90(f90d, metallic), cDiff, lo.z));
+        hn::Lt(uz, gltfSpecularProbability(f0, gltfF90(f90d, metallic), cDiff, lo.z, alpha));
     BsdfSample s;
     s.ok = hn::Gt(lo.z, zero);
     V3 li = sampleCosineHemisphere(ux, uy);

@@ -138,8 +138,8 @@ void runBsdfTwin(Twin twin, const TwinLanes& in, size_t i, TwinResults& out) {
     }
     case Twin::gltfFresnel: // f0 f0-2, f90 f3, cosTheta f4 -> f0-2
         return store3(gltfFresnel(load3(in, 0, i), f(3), f(4)), out, 0, i);
-    case Twin::gltfSpecularProbability: // f0 f0-2, cDiff f3-5, cosO f6, f90 f7 -> f0
-        return store(gltfSpecularProbability(load3(in, 0, i), f(7), load3(in, 3, i), f(6)),
+    case Twin::gltfSpecularProbability: // f0 f0-2, cDiff f3-5, cosO f6, f90 f7, alpha f8 -> f0
+        return store(gltfSpecularProbability(load3(in, 0, i), f(7), load3(in, 3, i), f(6), f(8)),
                      out.f[0], i);
     case Twin::gltfEval: { // colour f0-2, metallic f3, alpha f4, ng f5-7, ns f8-10, wo f11-13,
                            // wi f14-16, f0d f17-19, f90d f20 -> f0-2, pdf f3

@@ -54,6 +54,22 @@ TEST(MetallicRoughness, SampledDirectionsFollowThePdf) {
                              "metallic 0.3, roughness 0.5, back side, tilted");
 }
 
+// The lobe is picked by the lobes' weights seen from wo, Fs / (Fs + Fd), at normal incidence
+// F = f0: floored at 0.25 (1 - alpha)^2 while the specular lobe is narrow, not at all at alpha 1,
+// where it is as wide as the diffuse one; at most 0.9; 1 for a pure metal.
+TEST(MetallicRoughness, TheSpecularLobeIsPickedByItsWeightFlooredWhileItIsNarrow) {
+    const vec3 f0(kGltfDielectricF0), white(0.9f);
+    const float ratio = 0.04f / (0.04f + 0.9f * 0.96f); // about 0.044
+    EXPECT_NEAR(gltfSpecularProbability(f0, 1.0f, white, 1.0f, 1.0f), ratio, 1e-6f);
+    EXPECT_NEAR(gltfSpecularProbability(f0, 1.0f, white, 1.0f, 0.5f), 0.0625f, 1e-6f);
+    EXPECT_NEAR(gltfSpecularProbability(f0, 1.0f, white, 1.0f, kGltfMinAlpha),
+                0.25f * (1.0f - kGltfMinAlpha) * (1.0f - kGltfMinAlpha), 1e-6f);
+    EXPECT_NEAR(gltfSpecularProbability(f0, 1.0f, vec3(0.01f), 1.0f, 1.0f),
+                0.04f / (0.04f + 0.01f * 0.96f), 1e-6f); // a dark base: the weights alone
+    EXPECT_EQ(gltfSpecularProbability(vec3(0.9f), 1.0f, vec3(1e-3f), 1.0f, 1.0f), 0.9f);
+    EXPECT_EQ(gltfSpecularProbability(vec3(0.9f), 1.0f, vec3(0.0f), 1.0f, 0.01f), 1.0f);
+}
+
 // metallic 1: c_diff = 0 and f0 = the base colour, which is the Conductor's model exactly.
 TEST(MetallicRoughness, APureMetalIsTheConductorBitForBit) {
     Uniform u(8);

@@ -364,11 +364,12 @@ const std::map<Twin, ScalarSide>& scalarSides() {
          {[](Inputs& in) {
               for (int row = 0; row < 6; ++row)
                   in.setUnit(row);
-              in.setRange(6, 0.0f, 1.0f), in.setF90(7);
+              in.setRange(6, 0.0f, 1.0f), in.setF90(7), in.setAlpha(8);
               in.lanes.f[3].v[0] = in.lanes.f[4].v[0] = in.lanes.f[5].v[0] = 0.0f; // no diffuse
           },
           [](const Inputs& in, size_t k, Expected& e) {
-              e.put(gltfSpecularProbability(in.get3(0, k), in.f(7, k), in.get3(3, k), in.f(6, k)));
+              e.put(gltfSpecularProbability(in.get3(0, k), in.f(7, k), in.get3(3, k), in.f(6, k),
+                                            in.f(8, k)));
           }}},
         {Twin::gltfEval,
          {[](Inputs& in) {
