@@ -47,6 +47,7 @@ void HitSetup::surfaceHit(uint meshIndex, uint prim, float u, float v, float t,
     hit.lift = smoothLift(mesh, tri, u, v, hit.p, hit.ng);
 }
 
+// Wide twin: smoothLift in host/scene_view/wide_hits.cpp.
 float HitSetup::smoothLift(const Mesh& mesh, uvec3 tri, float u, float v, vec3 p, vec3 ng) {
     if (mesh.normals.empty()) return 0.0f;
     // Each vertex's tangent plane lifts p onto it where p lies below it.
@@ -255,7 +256,7 @@ void HitSetup::setUpHits(size_t n, const HitRecord* const* hits, const vec3* dir
         hit.offset = l.offset.v[j];
         hit.material = 0u;
         hit.extension = uvec2(0u);
-        hit.lift = smoothLift(mesh, mesh.triangles[h.prim], h.u, h.v, hit.p, hit.ng);
+        hit.lift = l.lift.v[j];
         uv[j] = vec2(l.uv.x.v[j], l.uv.y.v[j]);
         footprint[j] = l.footprint.v[j];
     }

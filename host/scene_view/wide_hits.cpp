@@ -1,6 +1,6 @@
 // setUpHitLanes (wide_hits.h), compiled once per instruction set through foreach_target.h. It is
-// HitSetup::surfaceHit's arithmetic and HitSetup::textureQuery (hit_setup.cpp), lane by lane, in
-// the same operations.
+// HitSetup::surfaceHit's arithmetic, HitSetup::smoothLift and HitSetup::textureQuery
+// (hit_setup.cpp), lane by lane, in the same operations.
 #include "host/scene_view/wide_hits.h"
 
 #undef HWY_TARGET_INCLUDE
@@ -51,6 +51,15 @@ HWY_INLINE void textureQuery(spw::HitLanes& l, size_t i, V w, V u, V v, V3 norma
     store(hn::IfThenElseZero(uvs, uv.y), l.uv.y, i);
 }
 
+// HitSetup::smoothLift: each vertex's tangent plane lifts p onto it where p lies below it; the
+// lift along ng, 0 where it is not finite.
+HWY_INLINE V smoothLift(V w, V u, V v, V3 p, V3 p0, V3 p1, V3 p2, V3 n0, V3 n1, V3 n2, V3 ng) {
+    const V zero = hn::Zero(D());
+    auto toPlane = [&](V3 corner, V3 n) { return mul(n, gmax(zero, dot(sub(corner, p), n))); };
+    const V lift = dot(interpolate(w, u, v, toPlane(p0, n0), toPlane(p1, n1), toPlane(p2, n2)), ng);
+    return hn::IfThenElseZero(hn::IsFinite(lift), lift);
+}
+
 void SetUpHitLanes(size_t count, spw::HitLanes& l) {
     const D d;
     const V zero = hn::Zero(d);
@@ -63,16 +72,20 @@ void SetUpHitLanes(size_t count, spw::HitLanes& l) {
         const V3 ng = normalize(normal);
         // The shading normal: the interpolated vertex normals, where they have a length.
         V3 ns = ng;
+        V lift = zero;
         if (l.anyNormals) {
-            const V3 n = interpolate(w, u, v, load(l.n0, i), load(l.n1, i), load(l.n2, i));
+            const V3 n0 = load(l.n0, i), n1 = load(l.n1, i), n2 = load(l.n2, i);
+            const V3 n = interpolate(w, u, v, n0, n1, n2);
             const V length = hn::Sqrt(dot(n, n));
-            const M normals = hn::And(loadMask(l.hasNormals, i), hn::Gt(length, zero));
-            ns = select(normals, div(n, length), ng);
+            const M has = loadMask(l.hasNormals, i);
+            ns = select(hn::And(has, hn::Gt(length, zero)), div(n, length), ng);
+            lift = hn::IfThenElseZero(has, smoothLift(w, u, v, p, p0, p1, p2, n0, n1, n2, ng));
         }
         store(p.x, l.p.x, i), store(p.y, l.p.y, i), store(p.z, l.p.z, i);
         store(ng.x, l.ng.x, i), store(ng.y, l.ng.y, i), store(ng.z, l.ng.z, i);
         store(ns.x, l.ns.x, i), store(ns.y, l.ns.y, i), store(ns.z, l.ns.z, i);
         store(surfaceOffset(p, p0, p1, p2, ng), l.offset, i);
+        store(lift, l.lift, i);
         if (l.anyUvs) {
             textureQuery(l, i, w, u, v, normal, ng);
         } else {

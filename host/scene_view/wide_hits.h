@@ -26,10 +26,10 @@ struct HitLanes {
     // false: those rows and masks are not read (with anyUvs, nor dir and the cone's)
     bool anyNormals = false, anyUvs = false;
     simd::Floats coneWidth, coneSpread;
-    // Out: what SurfaceHit takes (p, ng, ns, offset), and the texture lookup's coordinates and
-    // filter footprint (HitSetup::textureQuery).
+    // Out: what SurfaceHit takes (p, ng, ns, offset, lift: 0 without vertex normals), and the
+    // texture lookup's coordinates and filter footprint (HitSetup::textureQuery).
     simd::Vec3s p, ng, ns;
-    simd::Floats offset, footprint;
+    simd::Floats offset, lift, footprint;
     simd::Vec2s uv;
 };
 
