@@ -251,6 +251,53 @@ void Film::splat(uint path, vec2 filmPos, uint sampleIndex, vec3 radiance, uint 
         filtered(filmPos, halfOf(sampleIndex), radiance, 0.0f, roundingKey(key, sampleIndex));
 }
 
+void Film::splat(const Splat* splats, size_t n) {
+    if (sumsSamples()) {
+        for (size_t k = 0; k < n; ++k)
+            splat(splats[k].path, splats[k].pos, splats[k].sample, splats[k].value, splats[k].key);
+        return;
+    }
+    // The Box filter: filtered()'s pixel and add()'s rounding, each lane as add() rounds (the
+    // radiance at weight 1, whose double product is the value itself; the weight's add unused).
+    static_assert(kSplatBatch <= simd::kBlock, "a batch is one block of lanes");
+    FootprintLanes lanes;
+    std::atomic<std::int64_t>* target[simd::kBlock];
+    size_t count = 0;
+    for (size_t k = 0; k < n; ++k) {
+        const Splat& s = splats[k];
+        const vec3 v = s.value;
+        if (!std::isfinite(v.x) || !std::isfinite(v.y) || !std::isfinite(v.z)) {
+            nonFinite_.fetch_add(1, std::memory_order_relaxed);
+            continue;
+        }
+        if (v.x == 0.0f && v.y == 0.0f && v.z == 0.0f) continue;
+        const int px = std::min(int(s.pos.x), width_ - 1), py = std::min(int(s.pos.y), height_ - 1);
+        const uint pixel = uint(py * width_ + px);
+        target[count] = &acc_[size_t(py) * width_ + size_t(px)].v[halfOf(s.sample) * 4];
+        lanes.pixel.v[count] = pixel;
+        lanes.rgbKey.v[count] = roundingKey(s.key, s.sample);
+        lanes.weightKey.v[count] = 0u;
+        lanes.weight.v[count] = 1.0f;
+        lanes.r[count] = v.x * scale_, lanes.g[count] = v.y * scale_, lanes.b[count] = v.z * scale_;
+        ++count;
+    }
+    const size_t end = simd::wholeVectors(count);
+    for (size_t k = count; k < end; ++k) { // padding: nothing added
+        lanes.pixel.v[k] = lanes.weightKey.v[k] = lanes.rgbKey.v[k] = 0u;
+        lanes.weight.v[k] = 0.0f;
+        lanes.r[k] = lanes.g[k] = lanes.b[k] = 0.0;
+    }
+    FootprintAdds adds;
+    const size_t saturated = roundFootprint(lanes, end, weightScale_, maxAdd_, adds);
+    if (saturated) saturated_.fetch_add(saturated, std::memory_order_relaxed);
+    for (size_t k = 0; k < count; ++k) {
+        std::atomic<std::int64_t>* a = target[k];
+        if (adds.r[k] != 0) a[0].fetch_add(adds.r[k], std::memory_order_relaxed);
+        if (adds.g[k] != 0) a[1].fetch_add(adds.g[k], std::memory_order_relaxed);
+        if (adds.b[k] != 0) a[2].fetch_add(adds.b[k], std::memory_order_relaxed);
+    }
+}
+
 void Film::addSample(uint path, vec2 filmPos, uint sampleIndex) {
     if (!sumsSamples()) {
         filtered(filmPos, halfOf(sampleIndex), vec3(0.0f), 1.0f, roundingKey(0u, sampleIndex));

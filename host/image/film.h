@@ -99,6 +99,17 @@ class Film {
     // a path's contributions must arrive in path order (as every backend makes them: by bounce,
     // the emission before the shadow ray), and filmPos is not read.
     void splat(uint path, vec2 filmPos, uint sampleIndex, vec3 radiance, uint key);
+    // Thread-safe. splat() of each of splats[0, n), n <= kSplatBatch, in order, with the same
+    // sums bit for bit: with the Box filter the batch is rounded SIMD-wide (roundFootprint).
+    struct Splat {
+        vec2 pos;
+        uint path;
+        uint sample;
+        uint key;
+        vec3 value;
+    };
+    static constexpr size_t kSplatBatch = 64;
+    void splat(const Splat* splats, size_t n);
     // A hint, thread-safe: starts bringing the accumulators that a splat of `path` at `filmPos`
     // adds to into this core's cache. The sorted pipeline's splats land in no pixel order, and
     // an atomic add to a line not in cache stalls the core until it arrives; prefetching a

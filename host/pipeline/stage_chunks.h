@@ -47,14 +47,6 @@ void setUpChunk(const RenderContext& ctx, const std::vector<RayState>& rays,
                 const std::vector<HitRecord>& hits, const SortedHit* order, size_t n,
                 ShadeInput* in);
 
-// One contribution for the film: which path, where, which sample, what, and its rounding key.
-struct Splat {
-    vec2 pos;
-    uint path;
-    uint sample;
-    uint key;
-    vec3 value;
-};
 // Splats gathered a few dozen at a time: each one's film line is prefetched when it joins, and
 // the adds wait until the batch is full, so that the lines' cache misses overlap instead of
 // stalling one atomic add after another (the sorted order has no pixel locality).
@@ -70,7 +62,7 @@ class SplatBatch {
         // A film that sums samples does not need where the sample lies.
         const vec2 pos = sums_ ? vec2(0.0f) : filmPosition(ctx, rp, path);
         film_.prefetch(path, pos);
-        Splat& s = splats_[count_++];
+        Film::Splat& s = splats_[count_++];
         s.pos = pos;
         s.path = path;
         s.sample = pathSample(rp, path);
@@ -89,18 +81,15 @@ class SplatBatch {
     }
     // In the order pushed: a path's contributions stay in order (Film::splat).
     void flush() {
-        for (size_t k = 0; k < count_; ++k) {
-            const Splat& s = splats_[k];
-            film_.splat(s.path, s.pos, s.sample, s.value, s.key);
-        }
+        film_.splat(splats_, count_);
         count_ = 0;
     }
 
   private:
-    static constexpr size_t kSize = 64;
+    static constexpr size_t kSize = Film::kSplatBatch;
     Film& film_;
     const bool sums_;
-    Splat splats_[kSize];
+    Film::Splat splats_[kSize];
     size_t count_ = 0;
 };
 inline void binOne(const RenderParams& rp, RayFormat format, const ShadeResult& res,
