@@ -252,16 +252,13 @@ void Film::splat(uint path, vec2 filmPos, uint sampleIndex, vec3 radiance, uint 
 }
 
 void Film::splat(const Splat* splats, size_t n) {
-    if (sumsSamples()) {
-        for (size_t k = 0; k < n; ++k)
-            splat(splats[k].path, splats[k].pos, splats[k].sample, splats[k].value, splats[k].key);
-        return;
-    }
-    // The Box filter: filtered()'s pixel and add()'s rounding, each lane as add() rounds (the
-    // radiance at weight 1, whose double product is the value itself; the weight's add unused).
+    // Each lane is rounded as add() (the Box filter: hashed with the pixel) or addToSample() (a
+    // sample sum: hashed with the path) rounds: the radiance at weight 1, whose double product
+    // is the value itself; the weight's add is not used.
     static_assert(kSplatBatch <= simd::kBlock, "a batch is one block of lanes");
+    const bool sums = sumsSamples();
     FootprintLanes lanes;
-    std::atomic<std::int64_t>* target[simd::kBlock];
+    std::atomic<std::int64_t>* target[simd::kBlock]; // the three sums the splat adds to
     size_t count = 0;
     for (size_t k = 0; k < n; ++k) {
         const Splat& s = splats[k];
@@ -271,10 +268,15 @@ void Film::splat(const Splat* splats, size_t n) {
             continue;
         }
         if (v.x == 0.0f && v.y == 0.0f && v.z == 0.0f) continue;
-        const int px = std::min(int(s.pos.x), width_ - 1), py = std::min(int(s.pos.y), height_ - 1);
-        const uint pixel = uint(py * width_ + px);
-        target[count] = &acc_[size_t(py) * width_ + size_t(px)].v[halfOf(s.sample) * 4];
-        lanes.pixel.v[count] = pixel;
+        if (sums) {
+            target[count] = samples_[s.path].rgb;
+            lanes.pixel.v[count] = s.path;
+        } else { // filtered()'s pixel
+            const int px = std::min(int(s.pos.x), width_ - 1);
+            const int py = std::min(int(s.pos.y), height_ - 1);
+            target[count] = &acc_[size_t(py) * width_ + size_t(px)].v[halfOf(s.sample) * 4];
+            lanes.pixel.v[count] = uint(py * width_ + px);
+        }
         lanes.rgbKey.v[count] = roundingKey(s.key, s.sample);
         lanes.weightKey.v[count] = 0u;
         lanes.weight.v[count] = 1.0f;
@@ -291,10 +293,14 @@ void Film::splat(const Splat* splats, size_t n) {
     const size_t saturated = roundFootprint(lanes, end, weightScale_, maxAdd_, adds);
     if (saturated) saturated_.fetch_add(saturated, std::memory_order_relaxed);
     for (size_t k = 0; k < count; ++k) {
-        std::atomic<std::int64_t>* a = target[k];
-        if (adds.r[k] != 0) a[0].fetch_add(adds.r[k], std::memory_order_relaxed);
-        if (adds.g[k] != 0) a[1].fetch_add(adds.g[k], std::memory_order_relaxed);
-        if (adds.b[k] != 0) a[2].fetch_add(adds.b[k], std::memory_order_relaxed);
+        const std::int64_t q[3] = {adds.r[k], adds.g[k], adds.b[k]};
+        for (int c = 0; c < 3; ++c)
+            if (q[c] != 0) {
+                if (sums)
+                    addToSum(target[k][c], q[c]);
+                else
+                    target[k][c].fetch_add(q[c], std::memory_order_relaxed);
+            }
     }
 }
 
@@ -316,16 +322,19 @@ void Film::addToSample(uint path, vec3 radiance, uint key) {
     const uint rnd[3] = {h.x, h.y, h.z};
     for (int c = 0; c < 3; ++c) {
         const std::int64_t q = quantize(double(in[c]) * scale_, rnd[c]);
-        if (q == 0) continue;
-        // Saturating: the sum stays within the clamp of one film add (both terms are within
-        // it, so their sum fits 64 bits).
-        std::int64_t v = sum[c].load(std::memory_order_relaxed) + q;
-        if (v > sampleCap_ || v < -sampleCap_) {
-            saturated_.fetch_add(1, std::memory_order_relaxed);
-            v = v > 0 ? sampleCap_ : -sampleCap_;
-        }
-        sum[c].store(v, std::memory_order_relaxed);
+        if (q != 0) addToSum(sum[c], q);
     }
+}
+
+void Film::addToSum(std::atomic<std::int64_t>& sum, std::int64_t q) {
+    // Saturating: the sum stays within the clamp of one film add (both terms are within it, so
+    // their sum fits 64 bits).
+    std::int64_t v = sum.load(std::memory_order_relaxed) + q;
+    if (v > sampleCap_ || v < -sampleCap_) {
+        saturated_.fetch_add(1, std::memory_order_relaxed);
+        v = v > 0 ? sampleCap_ : -sampleCap_;
+    }
+    sum.store(v, std::memory_order_relaxed);
 }
 
 void Film::finishSamples() {

@@ -100,7 +100,7 @@ class Film {
     // the emission before the shadow ray), and filmPos is not read.
     void splat(uint path, vec2 filmPos, uint sampleIndex, vec3 radiance, uint key);
     // Thread-safe. splat() of each of splats[0, n), n <= kSplatBatch, in order, with the same
-    // sums bit for bit: with the Box filter the batch is rounded SIMD-wide (roundFootprint).
+    // sums bit for bit: the batch is rounded SIMD-wide (roundFootprint), then added in order.
     struct Splat {
         vec2 pos;
         uint path;
@@ -248,6 +248,7 @@ class Film {
     // Sample sums (wide filters): the contribution into path's sum; the sums of rows [y0, y1)
     // filtered (not thread-safe: finishSamples() keeps the threads' footprints apart).
     void addToSample(uint path, vec3 radiance, uint key);
+    void addToSum(std::atomic<std::int64_t>& sum, std::int64_t q); // one rounded add, saturating
     void filterSamples(int y0, int y1);
 
     int width_, height_;
