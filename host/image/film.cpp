@@ -251,6 +251,17 @@ void Film::splat(uint path, vec2 filmPos, uint sampleIndex, vec3 radiance, uint 
         filtered(filmPos, halfOf(sampleIndex), radiance, 0.0f, roundingKey(key, sampleIndex));
 }
 
+void Film::roundLanes(FootprintLanes& lanes, size_t count, FootprintAdds& adds) {
+    const size_t end = simd::wholeVectors(count);
+    for (size_t k = count; k < end; ++k) { // padding: no weight, nothing added
+        lanes.pixel.v[k] = lanes.weightKey.v[k] = lanes.rgbKey.v[k] = 0u;
+        lanes.weight.v[k] = 0.0f;
+        lanes.r[k] = lanes.g[k] = lanes.b[k] = 0.0;
+    }
+    const size_t saturated = roundFootprint(lanes, end, weightScale_, maxAdd_, adds);
+    if (saturated) saturated_.fetch_add(saturated, std::memory_order_relaxed);
+}
+
 void Film::splat(const Splat* splats, size_t n) {
     // Each lane is rounded as add() (the Box filter: hashed with the pixel) or addToSample() (a
     // sample sum: hashed with the path) rounds: the radiance at weight 1, whose double product
@@ -283,15 +294,8 @@ void Film::splat(const Splat* splats, size_t n) {
         lanes.r[count] = v.x * scale_, lanes.g[count] = v.y * scale_, lanes.b[count] = v.z * scale_;
         ++count;
     }
-    const size_t end = simd::wholeVectors(count);
-    for (size_t k = count; k < end; ++k) { // padding: nothing added
-        lanes.pixel.v[k] = lanes.weightKey.v[k] = lanes.rgbKey.v[k] = 0u;
-        lanes.weight.v[k] = 0.0f;
-        lanes.r[k] = lanes.g[k] = lanes.b[k] = 0.0;
-    }
     FootprintAdds adds;
-    const size_t saturated = roundFootprint(lanes, end, weightScale_, maxAdd_, adds);
-    if (saturated) saturated_.fetch_add(saturated, std::memory_order_relaxed);
+    roundLanes(lanes, count, adds);
     for (size_t k = 0; k < count; ++k) {
         const std::int64_t q[3] = {adds.r[k], adds.g[k], adds.b[k]};
         for (int c = 0; c < 3; ++c)
@@ -378,15 +382,7 @@ void Film::filterSamples(int y0, int y1) {
         halves[s] = halfOf(base + s), weightKeys[s] = roundingKey(0u, base + s);
     FootprintBatch batch;
     auto flush = [&] {
-        const size_t end = simd::wholeVectors(batch.count);
-        for (size_t k = batch.count; k < end; ++k) { // padding: no weight, nothing added
-            batch.lanes.pixel.v[k] = batch.lanes.weightKey.v[k] = batch.lanes.rgbKey.v[k] = 0;
-            batch.lanes.weight.v[k] = 0.0f;
-            batch.lanes.r[k] = batch.lanes.g[k] = batch.lanes.b[k] = 0.0;
-        }
-        const size_t saturated =
-            roundFootprint(batch.lanes, end, weightScale_, maxAdd_, batch.adds);
-        if (saturated) saturated_.fetch_add(saturated, std::memory_order_relaxed);
+        roundLanes(batch.lanes, batch.count, batch.adds);
         // No other thread adds to these pixels now (finishSamples).
         auto addTo = [](std::atomic<std::int64_t>& v, std::int64_t q) {
             if (q != 0) v.store(v.load(std::memory_order_relaxed) + q, std::memory_order_relaxed);

@@ -59,6 +59,9 @@
 
 namespace spw {
 
+struct FootprintLanes;
+struct FootprintAdds;
+
 // The stochastic-rounding key of a contribution: every backend uses the same one, so that
 // backends tracing the same paths produce the same film bit for bit.
 inline uint filmKey(uint pathId, uint bounce, bool shadow) {
@@ -249,6 +252,9 @@ class Film {
     // filtered (not thread-safe: finishSamples() keeps the threads' footprints apart).
     void addToSample(uint path, vec3 radiance, uint key);
     void addToSum(std::atomic<std::int64_t>& sum, std::int64_t q); // one rounded add, saturating
+    // lanes[0, count) rounded (roundFootprint, host/simd/film_rounding.h) into adds, the
+    // padding to whole vectors adding nothing; the clamped values counted as saturated.
+    void roundLanes(FootprintLanes& lanes, size_t count, FootprintAdds& adds);
     void filterSamples(int y0, int y1);
 
     int width_, height_;
