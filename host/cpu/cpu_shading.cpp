@@ -4,7 +4,7 @@
 #include "host/pipeline/slotted_engine.h"
 #include "host/pipeline/stages.h"
 #include "host/scene/surface_models.h"
-#include "host/simd/simd_random.h"
+#include "host/simd/simd_target.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>

@@ -4,7 +4,6 @@
 #include "host/pipeline/radix_sort.h"
 #include "host/pipeline/stage_chunks.h"
 #include "host/simd/lanes.h"
-#include "host/simd/simd_random.h"
 #include "shared/path.h"
 
 #include <tbb/blocked_range.h>
@@ -60,22 +59,18 @@ void CameraRays::generate(const RenderContext& ctx, size_t count, Film& film,
     const size_t last =
         size_t(std::lower_bound(tileStart_.begin(), tileStart_.end(), end) - tileStart_.begin());
     const CameraModel& camera = ctx.camera;
-    const bool random = camera.usesRandomNumbers();
     tbb::parallel_for(first, last, [&](size_t t) {
-        // The tile's rays a block at a time: their random numbers made SIMD-wide (rand4Many),
-        // then the rays.
+        // The tile's rays a block at a time, made SIMD-wide with their random numbers
+        // (CameraModel::generateMany).
         constexpr size_t kBlock = 64;
         uint x[kBlock], y[kBlock], pixel[kBlock], sampleIndex[kBlock], sample[kBlock];
         std::uint64_t ray[kBlock];
-        vec4 u[kBlock];
+        CameraRay made[kBlock];
         size_t pending = 0;
         auto flush = [&] {
-            if (random)
-                rand4Many(camera.sampling(), rp_.seed, kBounceCamera, kDimCamera, pixel,
-                          sampleIndex, pending, u);
+            camera.generateMany(x, y, sample, sampleIndex, rp_.seed, pending, made);
             for (size_t j = 0; j < pending; ++j) {
-                const CameraRay cr =
-                    camera.generate(x[j], y[j], sample[j], random ? u[j] : vec4(0.0f));
+                const CameraRay& cr = made[j];
                 RayState& r = rays[size_t(ray[j] - begin)];
                 r.origin = cr.origin;
                 r.dir = cr.dir;

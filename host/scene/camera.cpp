@@ -7,34 +7,41 @@
 
 namespace spw {
 
-CameraModel::CameraModel(const Scene& scene, int sampleBase)
-    : cam_(scene.camera), sampler_(scene.sampler), width_(scene.image.width),
-      height_(scene.image.height), base_(sampleBase) {
-    tanX_ = cam_.tanHalfFovX();
-    tanY_ = tanX_ * float(height_) / float(width_);
-    rot_ = mat3(cam_.cameraToWorld);
-    eye_ = vec3(cam_.cameraToWorld[3]);
+CameraModel::CameraModel(const Scene& scene, int sampleBase) {
+    const Camera& cam = scene.camera;
+    n_.sampler = scene.sampler;
+    n_.lens = cam.type == CameraType::ThinLens && cam.apertureRadius > 0.0f;
+    n_.apertureRadius = cam.apertureRadius;
+    n_.focalDistance = cam.focalDistance;
+    n_.width = scene.image.width;
+    n_.height = scene.image.height;
+    n_.base = sampleBase;
+    n_.tanX = cam.tanHalfFovX();
+    n_.tanY = n_.tanX * float(n_.height) / float(n_.width);
+    n_.rot = mat3(cam.cameraToWorld);
+    n_.eye = vec3(cam.cameraToWorld[3]);
 }
 
 vec4 CameraModel::randomNumbers(uint x, uint y, uint sampleIndex, uint seed) const {
-    return rand4(sampling(), seed, y * uint(width_) + x, sampleIndex, kBounceCamera, kDimCamera);
+    return rand4(sampling(), seed, y * uint(n_.width) + x, sampleIndex, kBounceCamera, kDimCamera);
 }
 
 vec2 CameraModel::filmPosition(uint x, uint y, uint sample, uint sampleIndex, uint seed) const {
     // The Grid sampler's place in the pixel needs no random number.
     return filmPosition(x, y, sample,
-                        sampler_ == SamplerType::Grid ? vec4(0.0f)
-                                                      : randomNumbers(x, y, sampleIndex, seed));
+                        n_.sampler == SamplerType::Grid ? vec4(0.0f)
+                                                        : randomNumbers(x, y, sampleIndex, seed));
 }
 
+// SIMD twin: host/scene/camera_wide.cpp
 vec2 CameraModel::filmPosition(uint x, uint y, uint sample, vec4 u) const {
     vec2 offset;
-    uint cx = sample % uint(base_), cy = sample / uint(base_);
-    if (sampler_ == SamplerType::Grid) {
-        offset = (vec2(float(cx), float(cy)) + 0.5f) / float(base_);
+    uint cx = sample % uint(n_.base), cy = sample / uint(n_.base);
+    if (n_.sampler == SamplerType::Grid) {
+        offset = (vec2(float(cx), float(cy)) + 0.5f) / float(n_.base);
     } else {
-        if (sampler_ == SamplerType::Stratified)
-            offset = (vec2(float(cx), float(cy)) + vec2(u.x, u.y)) / float(base_);
+        if (n_.sampler == SamplerType::Stratified)
+            offset = (vec2(float(cx), float(cy)) + vec2(u.x, u.y)) / float(n_.base);
         else
             offset = vec2(u.x, u.y);
     }
@@ -49,8 +56,7 @@ vec2 CameraModel::filmPosition(uint x, uint y, uint sample, vec4 u) const {
 }
 
 bool CameraModel::usesRandomNumbers() const {
-    return sampler_ != SamplerType::Grid ||
-           (cam_.type == CameraType::ThinLens && cam_.apertureRadius > 0.0f);
+    return n_.sampler != SamplerType::Grid || n_.lens;
 }
 
 CameraRay CameraModel::generate(uint x, uint y, uint sample, uint sampleIndex, uint seed) const {
@@ -58,22 +64,23 @@ CameraRay CameraModel::generate(uint x, uint y, uint sample, uint sampleIndex, u
                     usesRandomNumbers() ? randomNumbers(x, y, sampleIndex, seed) : vec4(0.0f));
 }
 
+// SIMD twin: host/scene/camera_wide.cpp
 CameraRay CameraModel::generate(uint x, uint y, uint sample, vec4 u) const {
     CameraRay r;
     r.filmPos = filmPosition(x, y, sample, u);
     // Film plane at z = -1 in camera space, +Y up, pixel rows going down.
-    float sx = (2.0f * r.filmPos.x / float(width_) - 1.0f) * tanX_;
-    float sy = (1.0f - 2.0f * r.filmPos.y / float(height_)) * tanY_;
+    float sx = (2.0f * r.filmPos.x / float(n_.width) - 1.0f) * n_.tanX;
+    float sy = (1.0f - 2.0f * r.filmPos.y / float(n_.height)) * n_.tanY;
     vec3 d(sx, sy, -1.0f);
     vec3 o(0.0f);
-    if (cam_.type == CameraType::ThinLens && cam_.apertureRadius > 0.0f) {
-        vec2 lens = sampleConcentricDisk(vec2(u.z, u.w)) * cam_.apertureRadius;
-        vec3 focus = d * cam_.focalDistance;
+    if (n_.lens) {
+        vec2 lens = sampleConcentricDisk(vec2(u.z, u.w)) * n_.apertureRadius;
+        vec3 focus = d * n_.focalDistance;
         o = vec3(lens, 0.0f);
         d = focus - o;
     }
-    r.origin = eye_ + rot_ * o;
-    r.dir = glm::normalize(rot_ * d);
+    r.origin = n_.eye + n_.rot * o;
+    r.dir = glm::normalize(n_.rot * d);
     return r;
 }
 

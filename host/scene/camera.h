@@ -20,6 +20,18 @@ inline uint dimensionSampler(SamplerType s) {
     return s == SamplerType::Sobol ? kSamplerSobol : kSamplerIndependent;
 }
 
+// What a camera ray is made of besides its sample: CameraModel's numbers, read by generate() and
+// by its SIMD twin (camera_wide.cpp) alike.
+struct CameraNumbers {
+    SamplerType sampler;
+    bool lens; // a ThinLens with an aperture
+    float apertureRadius, focalDistance;
+    int width, height, base;
+    float tanX, tanY;
+    mat3 rot;
+    vec3 eye;
+};
+
 class CameraModel {
   public:
     // `sampleBase`: n of the n x n samples per pixel and iteration (after --spp).
@@ -33,22 +45,21 @@ class CameraModel {
     // (for a caller that makes many at once).
     CameraRay generate(uint x, uint y, uint sample, vec4 u) const;
     vec2 filmPosition(uint x, uint y, uint sample, vec4 u) const;
+    // n rays at once, random numbers included, SIMD-wide (camera_wide.cpp): out[i] is
+    // generate(x[i], y[i], sample[i], sampleIndex[i], seed) to the bit.
+    void generateMany(const uint* x, const uint* y, const uint* sample, const uint* sampleIndex,
+                      uint seed, size_t n, CameraRay* out) const;
     // The camera's random numbers: whether it reads any (not a Grid pinhole), and what they are,
     // rand4(sampling(), seed, pixel, sampleIndex, kBounceCamera, kDimCamera).
     bool usesRandomNumbers() const;
-    uint sampling() const { return dimensionSampler(sampler_); }
+    uint sampling() const { return dimensionSampler(n_.sampler); }
     vec4 randomNumbers(uint x, uint y, uint sampleIndex, uint seed) const;
     // The angle (radians) one pixel subtends at the image centre: camera rays' cone spread
     // (shared/cone.h).
-    float pixelSpread() const { return 2.0f * tanX_ / float(width_); }
+    float pixelSpread() const { return 2.0f * n_.tanX / float(n_.width); }
 
   private:
-    Camera cam_;
-    SamplerType sampler_;
-    int width_, height_, base_;
-    float tanX_, tanY_;
-    mat3 rot_;
-    vec3 eye_;
+    CameraNumbers n_;
 };
 
 } // namespace spw

@@ -1,10 +1,10 @@
 // The SIMD twins of the shared scalar functions (shaders/shared/), one Highway helper each, for
-// the kernels that include this file (host/cpu/simd_shading.cpp, host/simd/simd_random.cpp) and
-// for the test that compares each twin with its scalar function lane by lane
-// (host/simd/twins.h, tests/simd/twins_test.cpp). Each helper is its scalar function to the bit:
-// the same operations in the same order, each rounded once (no fused multiply-add). glm's
-// operations are written out in glm's order: dot is (x x' + y y') + z z', max(a, b) is
-// (a < b) ? b : a and min(a, b) is (b < a) ? b : a. The scalar side carries the tag
+// the kernels that include this file (the shading kernels, the camera rays, the hit setup, the
+// texel filtering, the film's rounding) and for the test that compares each twin with its scalar
+// function lane by lane (host/simd/twins.h, tests/simd/twins_test.cpp). Each helper is its scalar
+// function to the bit: the same operations in the same order, each rounded once (no fused
+// multiply-add). glm's operations are written out in glm's order: dot is (x x' + y y') + z z',
+// max(a, b) is (a < b) ? b : a and min(a, b) is (b < a) ? b : a. The scalar side carries the tag
 // "// SIMD twin: host/simd/simd_math-inl.h" on the line above its definition. This file holds the
 // vector arithmetic, sampling, triangle emitters, Lambert and the random numbers; the surface
 // models built on GGX are simd_bsdf-inl.h's.

@@ -11,7 +11,7 @@
 #include "host/render/render.h"
 #include "host/scene/scene.h"
 #include "host/scene/surface_models.h"
-#include "host/simd/simd_random.h"
+#include "host/simd/simd_target.h"
 #include "test_util.h"
 
 #include "shared/path.h"
@@ -279,34 +279,6 @@ void expectEveryModelsHitsAreShadeSurface() {
                 }
             }
     }
-}
-
-// The camera's random numbers made many at a time are rand4's, bit for bit, in every
-// instruction set, for both samplers and any count (blocks of 64 and a ragged last one).
-TEST(SimdShading, Rand4ManyIsRand4ToTheBit) {
-    std::mt19937 rng(9);
-    std::vector<uint> pixel(203), sampleIndex(203);
-    for (size_t i = 0; i < pixel.size(); ++i) {
-        pixel[i] = rng();
-        sampleIndex[i] = i % 3 == 0 ? uint(i) : rng();
-    }
-    for (int64_t target : hwy::SupportedAndGeneratedTargets()) {
-        hwy::SetSupportedTargetsForTest(target);
-        SCOPED_TRACE(simdTarget());
-        for (uint sampling : {kSamplerIndependent, kSamplerSobol})
-            for (size_t n : {size_t(1), size_t(64), size_t(203)}) {
-                std::vector<vec4> many(n);
-                rand4Many(sampling, 42u, kBounceCamera, kDimCamera, pixel.data(),
-                          sampleIndex.data(), n, many.data());
-                for (size_t i = 0; i < n; ++i) {
-                    const vec4 one =
-                        rand4(sampling, 42u, pixel[i], sampleIndex[i], kBounceCamera, kDimCamera);
-                    ASSERT_EQ(std::memcmp(&one, &many[i], sizeof(vec4)), 0)
-                        << "sampler " << sampling << ", " << n << " numbers, #" << i;
-                }
-            }
-    }
-    hwy::SetSupportedTargetsForTest(0);
 }
 
 TEST(SimdShading, RunsInTheWidestInstructionSet) {

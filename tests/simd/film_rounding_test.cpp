@@ -3,7 +3,7 @@
 // bit, in every instruction set this machine has: ordinary, negative, zero, tiny and clamped
 // values, and the count of clamped ones.
 #include "host/simd/film_rounding.h"
-#include "host/simd/simd_random.h"
+#include "host/simd/simd_target.h"
 
 #include "shared/rng.h"
 

@@ -3,7 +3,7 @@
 // angles, every sampler), in every instruction set this machine has: a change to either side of
 // a twin fails here, at the function that drifted. And the tags: the scalar functions marked
 // "SIMD twin" in shaders/shared/ are exactly the registry's.
-#include "host/simd/simd_random.h"
+#include "host/simd/simd_target.h"
 #include "host/simd/twins.h"
 #include "test_util.h"
 
