@@ -1,5 +1,7 @@
 #include "host/pipeline/directional_bins.h"
 
+#include "host/simd/lanes.h"
+
 #include <algorithm>
 #include <cerrno>
 #include <cstdlib>
@@ -103,16 +105,47 @@ size_t DirectionalBins::raysWaiting() {
     return n / recordBytes_;
 }
 
-void RayBuffer::push(vec3 origin, vec3 dir, const PathState& path, RayFormat format,
-                     uvec4 rounding) {
-    const uint b = cardinalBin(dir);
-    const size_t bytes = rayRecordBytes(format);
+// Room for a record at the end of bin b's bytes: the vector only grows (zero-filled once, by
+// doubling); `used` says how much holds rays.
+std::uint8_t* RayBuffer::reserve(uint b, size_t bytes) {
     std::vector<std::uint8_t>& dst = perBin[b];
-    // The vector only grows (zero-filled once, by doubling); `used` says how much holds rays.
     if (dst.size() < used[b] + bytes) dst.resize(std::max(dst.size() * 2, 256 * kFullRayBytes));
-    encodeRay(origin, dir, path, format, rounding, dst.data() + used[b]);
+    std::uint8_t* at = dst.data() + used[b];
     used[b] += bytes;
     ++count;
+    return at;
+}
+
+void RayBuffer::push(vec3 origin, vec3 dir, const PathState& path, RayFormat format,
+                     uvec4 rounding) {
+    encodeRay(origin, dir, path, format, rounding,
+              reserve(cardinalBin(dir), rayRecordBytes(format)));
+}
+
+void RayBuffer::pushContinuations(const RenderParams& rp, RayFormat format, const ShadeResult* res,
+                                  size_t n) {
+    if (format == RayFormat::Full) { // every bit kept: nothing to round, nothing SIMD-wide
+        for (size_t i = 0; i < n; ++i)
+            if (res[i].flags & kShadeContinue)
+                push(res[i].nextOrigin, res[i].nextDir, res[i].next, format, uvec4(0u));
+        return;
+    }
+    const ShadeResult* block[simd::kBlock];
+    std::uint8_t records[simd::kBlock * kCompactRayBytes], bins[simd::kBlock];
+    size_t count = 0;
+    auto flush = [&] {
+        encodeCompactBlock(rp, block, count, records, bins);
+        for (size_t k = 0; k < count; ++k)
+            std::memcpy(reserve(bins[k], kCompactRayBytes), records + k * kCompactRayBytes,
+                        kCompactRayBytes);
+        count = 0;
+    };
+    for (size_t i = 0; i < n; ++i) {
+        if (!(res[i].flags & kShadeContinue)) continue;
+        block[count++] = &res[i];
+        if (count == simd::kBlock) flush();
+    }
+    if (count > 0) flush();
 }
 
 } // namespace spw

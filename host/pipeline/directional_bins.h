@@ -17,6 +17,14 @@ struct RayBuffer {
     size_t used[6] = {};
     size_t count = 0;
     void push(vec3 origin, vec3 dir, const PathState& path, RayFormat format, uvec4 rounding);
+    // The continuation rays of n shading results (those with kShadeContinue), each rounded with
+    // its path's compactRounding; compact records are made a block at a time, SIMD-wide
+    // (encodeCompactBlock).
+    void pushContinuations(const RenderParams& rp, RayFormat format, const ShadeResult* res,
+                           size_t n);
+
+  private:
+    std::uint8_t* reserve(uint bin, size_t bytes);
 };
 
 // Six cardinal-direction bins. Rays arrive in thread-local buffers; a bin holding 2^e rays

@@ -72,8 +72,7 @@ class FusedTask {
             }
         splats.flush();
         lap(kAccumulate);
-        for (size_t i = 0; i < n; ++i)
-            binOne(rp, format, out[i], buffer);
+        buffer.pushContinuations(rp, format, out, n);
         lap(kBin);
     }
 

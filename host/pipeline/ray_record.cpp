@@ -131,8 +131,7 @@ void encodeRay(vec3 origin, vec3 dir, const PathState& path, RayFormat format, u
     put<std::uint16_t>(p, toBfloat16(path.beta.y, rounding.x));
     put<std::uint16_t>(p, toBfloat16(path.beta.z, rounding.x));
     put<std::uint16_t>(p, std::uint16_t(floatBitsToUint(path.prevPdf) >> 16));
-    put<std::uint16_t>(p, std::uint16_t(std::min(path.bounce, kMaxCompactBounce) |
-                                        ((path.flags & kPathSpecular) ? 0x8000u : 0u)));
+    put<std::uint16_t>(p, compactBounce(path));
     put<std::uint16_t>(p, std::uint16_t(path.cone));
 }
 

@@ -34,8 +34,10 @@
 #pragma once
 
 #include "host/backend/render_config.h"
+#include "shared/path.h"
 #include "shared/types.h"
 
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <string>
@@ -63,6 +65,25 @@ inline void encodeRay(const RayState& ray, RayFormat format, uvec4 rounding, std
     encodeRay(ray.origin, ray.dir, ray.path, format, rounding, out);
 }
 void decodeRay(const std::uint8_t* in, RayFormat format, RayState& ray);
+
+// The random numbers that round a ray's compact record: the path's own (dimension kDimRounding).
+inline uvec4 compactRounding(const RenderParams& rp, const PathState& path) {
+    return pcg4d(uvec4(pathPixel(rp, path.pathId), pathSample(rp, path.pathId),
+                       (path.bounce << 8u) | kDimRounding, rp.seed));
+}
+// The compact record's bounce field: the bounce (at most kMaxCompactBounce), the specular flag
+// in the top bit.
+inline std::uint16_t compactBounce(const PathState& path) {
+    return std::uint16_t(std::min(path.bounce, kMaxCompactBounce) |
+                         ((path.flags & kPathSpecular) ? 0x8000u : 0u));
+}
+
+// The compact records of the continuation rays of n <= simd::kBlock shading results, their
+// arithmetic SIMD-wide (ray_record_wide.cpp): record i, at out + i * kCompactRayBytes, is the
+// bytes encodeRay(res[i]->nextOrigin, res[i]->nextDir, res[i]->next, RayFormat::Compact,
+// compactRounding(rp, res[i]->next), ...) writes, and bin[i] is cardinalBin(res[i]->nextDir).
+void encodeCompactBlock(const RenderParams& rp, const ShadeResult* const* res, size_t n,
+                        std::uint8_t* out, std::uint8_t* bin);
 
 // The octahedral map (Cigolle et al. 2014) of a direction to [-1, 1]^2, in double so that the
 // compact record's 2^24 grid is its only rounding; the Morton key (ray_sort.cpp) quantises the

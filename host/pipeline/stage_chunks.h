@@ -1,6 +1,6 @@
 // What the pipeline's per-hit stages share (stages.cpp, fused_stages.cpp): the chunk of hits that
-// hit setup works on, the film splats gathered a few dozen at a time, and the encoding of
-// continuation rays. Internal to host/pipeline/.
+// hit setup works on and the film splats gathered a few dozen at a time. Internal to
+// host/pipeline/.
 #pragma once
 
 #include "host/pipeline/stages.h"
@@ -15,12 +15,6 @@ inline RenderParams paramsAt(const RenderContext& ctx, uint iteration) {
     RenderParams rp = ctx.params;
     rp.iteration = iteration;
     return rp;
-}
-
-// The random numbers that round a ray's compact record: the path's own (dimension kDimRounding).
-inline uvec4 roundingBits(const RenderParams& rp, const PathState& path) {
-    return pcg4d(uvec4(pathPixel(rp, path.pathId), pathSample(rp, path.pathId),
-                       (path.bounce << 8u) | kDimRounding, rp.seed));
 }
 
 // Where a path's contributions land on the film.
@@ -92,9 +86,4 @@ class SplatBatch {
     Film::Splat splats_[kSize];
     size_t count_ = 0;
 };
-inline void binOne(const RenderParams& rp, RayFormat format, const ShadeResult& res,
-                   RayBuffer& buffer) {
-    if (!(res.flags & kShadeContinue)) return;
-    buffer.push(res.nextOrigin, res.nextDir, res.next, format, roundingBits(rp, res.next));
-}
 } // namespace spw

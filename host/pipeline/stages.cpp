@@ -350,8 +350,7 @@ void binContinuations(const RenderContext& ctx, uint iteration, RayFormat format
     tbb::parallel_for(tbb::blocked_range<size_t>(0, hitCount, chunk),
                       [&](const tbb::blocked_range<size_t>& r) {
                           RayBuffer buffer;
-                          for (size_t i = r.begin(); i < r.end(); ++i)
-                              binOne(rp, format, results[i], buffer);
+                          buffer.pushContinuations(rp, format, results + r.begin(), r.size());
                           bins.add(buffer);
                       });
 }

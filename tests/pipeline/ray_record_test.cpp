@@ -1,11 +1,14 @@
 // The compact ray record's claims (host/pipeline/ray_record.h): the direction within the octahedral
 // grid's error bound, the throughput's stochastic rounding unbiased and order-keeping, the MIS
 // pdf stored exactly once quantised (so the two MIS weights still sum to one), and the exact
-// fields exact. The full record round-trips every bit.
+// fields exact. The full record round-trips every bit. The block encoder makes the same bytes.
 #include "host/pipeline/ray_record.h"
+#include "host/simd/lanes.h"
+#include "host/simd/simd_target.h"
 #include "shared/sampling.h"
 
 #include <gtest/gtest.h>
+#include <hwy/targets.h>
 
 #include <cmath>
 #include <cstring>
@@ -162,4 +165,70 @@ TEST(CompactRay, ExactFieldsAreExactAndFullRecordsKeepEveryBit) {
 }
 
 } // namespace
+} // namespace spw
+
+namespace spw {
+
+// The sorted pipeline encodes its continuation rays a block at a time, SIMD-wide
+// (encodeCompactBlock): in every instruction set, for ragged block sizes, each record is the bytes
+// encodeRay writes with the path's compactRounding, and each bin the direction's cardinalBin.
+// The rays include ties, signed zeros, the fold lines, throughputs at the bfloat16 edges
+// (the largest finite, denormals, zero, a NaN) and bounces past the field's width.
+TEST(CompactRay, BlockEncodingIsEncodeRayByteForByte) {
+    std::mt19937 rng(11);
+    std::normal_distribution<float> g;
+    std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+    // The axes, signed zeros, ties between the largest components (the bin's >=), fold lines.
+    const vec3 special[] = {
+        {1, 0, 0}, {-1, 0, 0},   {0, 1, 0},       {0, -0.0f, -1}, {-0.0f, 0, 1},
+        {1, 1, 0}, {0, 1, 1},    {0.2f, -1, -1},  {-1, 1, 0.5f},  {1, -1, -0.0f},
+        {1, 1, 1}, {-1, -1, -1}, {0.6f, 0.8f, 0}, {1e-7f, 0, -1}, {0.5f, -0.5f, -1e-7f}};
+    const std::uint32_t nanBits = 0x7FC0FFFFu; // a NaN whose dropped bits would round it
+    float nan;
+    std::memcpy(&nan, &nanBits, 4);
+    const float betas[] = {3.4028235e38f, 1e-40f, 0.0f, 0.999999f, 1.0f, 65504.0f, nan, -2.5f};
+    RenderParams rp{};
+    rp.samplesPerIteration = 7;
+    rp.iteration = 3;
+    rp.seed = 99;
+    std::vector<ShadeResult> results(203);
+    for (size_t i = 0; i < results.size(); ++i) {
+        ShadeResult& r = results[i];
+        r = ShadeResult{};
+        r.flags = kShadeContinue;
+        r.nextOrigin = vec3(g(rng) * 1e3f, -g(rng), g(rng) * 1e-20f);
+        r.nextDir =
+            glm::normalize(i < std::size(special) ? special[i] : vec3(g(rng), g(rng), g(rng)));
+        r.next.beta = i < std::size(betas) ? vec3(betas[i], 0.5f, betas[i])
+                                           : vec3(unit(rng), unit(rng) * 3.0f, unit(rng));
+        r.next.prevPdf = quantizePdf(unit(rng) * 10.0f);
+        r.next.pathId = std::uint32_t(rng());
+        r.next.bounce = i % 9 == 0 ? kMaxCompactBounce + uint(i) : uint(rng() % 64);
+        r.next.flags = i % 3 == 0 ? kPathSpecular : 0u;
+        r.next.cone = std::uint32_t(rng() & 0xFFFFu);
+    }
+    for (int64_t target : hwy::SupportedAndGeneratedTargets()) {
+        hwy::SetSupportedTargetsForTest(target);
+        SCOPED_TRACE(simdTarget());
+        for (size_t n : {size_t(1), size_t(17), size_t(64)})
+            for (size_t begin = 0; begin + n <= results.size(); begin += n) {
+                const ShadeResult* block[simd::kBlock];
+                for (size_t k = 0; k < n; ++k)
+                    block[k] = &results[begin + k];
+                std::uint8_t records[simd::kBlock * kCompactRayBytes], bins[simd::kBlock];
+                encodeCompactBlock(rp, block, n, records, bins);
+                for (size_t k = 0; k < n; ++k) {
+                    const ShadeResult& r = *block[k];
+                    std::uint8_t one[kCompactRayBytes];
+                    encodeRay(r.nextOrigin, r.nextDir, r.next, RayFormat::Compact,
+                              compactRounding(rp, r.next), one);
+                    ASSERT_EQ(std::memcmp(one, records + k * kCompactRayBytes, kCompactRayBytes), 0)
+                        << "ray " << begin + k << " of a block of " << n;
+                    ASSERT_EQ(bins[k], cardinalBin(r.nextDir)) << "ray " << begin + k;
+                }
+            }
+    }
+    hwy::SetSupportedTargetsForTest(0);
+}
+
 } // namespace spw
