@@ -84,6 +84,9 @@ inline std::uint16_t compactBounce(const PathState& path) {
 // compactRounding(rp, res[i]->next), ...) writes, and bin[i] is cardinalBin(res[i]->nextDir).
 void encodeCompactBlock(const RenderParams& rp, const ShadeResult* const* res, size_t n,
                         std::uint8_t* out, std::uint8_t* bin);
+// n compact records at `in` decoded, their directions SIMD-wide (ray_record_wide.cpp): out[i] is
+// what decodeRay makes of record i.
+void decodeCompactBlock(const std::uint8_t* in, size_t n, RayState* out);
 
 // The octahedral map (Cigolle et al. 2014) of a direction to [-1, 1]^2, in double so that the
 // compact record's 2^24 grid is its only rounding; the Morton key (ray_sort.cpp) quantises the

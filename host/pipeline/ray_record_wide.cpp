@@ -1,8 +1,9 @@
-// encodeCompactBlock (ray_record.h): a block of continuation rays' compact records, their
-// arithmetic SIMD-wide, compiled once per instruction set through foreach_target.h. Each step is
-// the scalar encoder's (ray_record.cpp: octEncode in double, toBfloat16, cardinalBin) and
-// compactRounding's, in the same order and rounding, so the bytes are the same
-// (CompactRay.BlockEncodingIsEncodeRayByteForByte).
+// encodeCompactBlock and decodeCompactBlock (ray_record.h): a block of compact records made and
+// read with their arithmetic SIMD-wide, compiled once per instruction set through
+// foreach_target.h. Each step is the scalar code's (ray_record.cpp: octEncode and octDecode in
+// double, toBfloat16, cardinalBin; compactRounding), in the same order and rounding, so the
+// bytes and rays are the same (CompactRay.BlockEncodingIsEncodeRayByteForByte,
+// CompactRay.BlockDecodingIsDecodeRayBitForBit).
 #include "host/pipeline/ray_record.h"
 
 #include "host/simd/lanes.h"
@@ -26,6 +27,11 @@ struct CompactLanes {
     Uints betaX, betaY, betaZ, pdf;   // bfloat16 bits
     Uints bin;                        // cardinalBin
 };
+// A block of records' octahedral cells, and the directions decoded from them.
+struct DirectionLanes {
+    Uints u, v;
+    Vec3s dir;
+};
 } // namespace spw::compact_lanes
 #endif
 
@@ -39,6 +45,7 @@ struct CompactLanes {
 HWY_BEFORE_NAMESPACE();
 namespace spw::HWY_NAMESPACE {
 using compact_lanes::CompactLanes;
+using compact_lanes::DirectionLanes;
 
 // Twin of toBfloat16: the top half of f's bits, rounded up with probability (dropped bits /
 // 2^16) by `random`, never into Inf/NaN.
@@ -117,12 +124,44 @@ void EncodeCompactLanes(CompactLanes& l, size_t count, uint seed) {
         octEncodeLanes(l, i);
 }
 
+// Twin of octDecode (ray_record.cpp), in double.
+void DecodeDirectionLanes(DirectionLanes& l, size_t count) {
+    const hn::ScalableTag<double> dd;
+    const hn::Rebind<float, decltype(dd)> df;
+    const hn::Rebind<std::int32_t, decltype(dd)> di;
+    using VD = hn::Vec<decltype(dd)>;
+    const VD zero = hn::Zero(dd), one = hn::Set(dd, 1.0);
+    const VD toUnit = hn::Set(dd, 2.0 / double((1u << 24) - 1));
+    for (size_t i = 0; i < count; i += hn::Lanes(dd)) {
+        auto coordinate = [&](const Uints& cell) { // double(cell) * kToUnit - 1.0
+            const VD c = hn::PromoteTo(
+                dd,
+                hn::BitCast(di, hn::Load(hn::Rebind<std::uint32_t, decltype(dd)>(), cell.v + i)));
+            return hn::Sub(hn::Mul(c, toUnit), one);
+        };
+        VD px = coordinate(l.u), py = coordinate(l.v);
+        const VD z = hn::Sub(hn::Sub(one, hn::Abs(px)), hn::Abs(py));
+        const VD fx = hn::Sub(one, hn::Abs(py)), fy = hn::Sub(one, hn::Abs(px));
+        const VD foldX = hn::IfThenElse(hn::Not(hn::Ge(px, zero)), hn::Neg(fx), fx);
+        const VD foldY = hn::IfThenElse(hn::Not(hn::Ge(py, zero)), hn::Neg(fy), fy);
+        const auto lower = hn::Lt(z, zero);
+        px = hn::IfThenElse(lower, foldX, px);
+        py = hn::IfThenElse(lower, foldY, py);
+        const VD inv = hn::Div(
+            one, hn::Sqrt(hn::Add(hn::Add(hn::Mul(px, px), hn::Mul(py, py)), hn::Mul(z, z))));
+        hn::Store(hn::DemoteTo(df, hn::Mul(px, inv)), df, l.dir.x.v + i);
+        hn::Store(hn::DemoteTo(df, hn::Mul(py, inv)), df, l.dir.y.v + i);
+        hn::Store(hn::DemoteTo(df, hn::Mul(z, inv)), df, l.dir.z.v + i);
+    }
+}
+
 } // namespace spw::HWY_NAMESPACE
 HWY_AFTER_NAMESPACE();
 
 #if HWY_ONCE
 namespace spw {
 HWY_EXPORT(EncodeCompactLanes);
+HWY_EXPORT(DecodeDirectionLanes);
 
 namespace {
 template <class T> void put(std::uint8_t*& p, T v) {
@@ -134,6 +173,21 @@ void put24(std::uint8_t*& p, uint v) {
     p[1] = std::uint8_t(v >> 8);
     p[2] = std::uint8_t(v >> 16);
     p += 3;
+}
+template <class T> T get(const std::uint8_t*& p) {
+    T v;
+    std::memcpy(&v, p, sizeof(T));
+    p += sizeof(T);
+    return v;
+}
+uint get24(const std::uint8_t* p) {
+    return uint(p[0]) | uint(p[1]) << 8 | uint(p[2]) << 16;
+}
+float fromBits16(std::uint16_t h) { // fromBfloat16
+    const std::uint32_t bits = std::uint32_t(h) << 16;
+    float f;
+    std::memcpy(&f, &bits, 4);
+    return f;
 }
 } // namespace
 
@@ -164,6 +218,34 @@ void encodeCompactBlock(const RenderParams& rp, const ShadeResult* const* res, s
         put(p, compactBounce(r.next));
         put(p, std::uint16_t(r.next.cone));
         bin[k] = std::uint8_t(l.bin.v[k]);
+    }
+}
+
+void decodeCompactBlock(const std::uint8_t* in, size_t n, RayState* out) {
+    compact_lanes::DirectionLanes l;
+    constexpr size_t kCellAt = 16; // origin, pathId, then the two 24-bit cells
+    const size_t end = simd::wholeVectors(n);
+    for (size_t k = 0; k < end; ++k) { // the padding repeats the last ray
+        const std::uint8_t* p = in + std::min(k, n - 1) * kCompactRayBytes + kCellAt;
+        l.u.v[k] = get24(p);
+        l.v.v[k] = get24(p + 3);
+    }
+    HWY_DYNAMIC_DISPATCH(DecodeDirectionLanes)(l, end);
+    for (size_t k = 0; k < n; ++k) { // the record's layout: ray_record.h, decodeRay
+        const std::uint8_t* p = in + k * kCompactRayBytes;
+        RayState& r = out[k];
+        r.origin.x = get<float>(p), r.origin.y = get<float>(p), r.origin.z = get<float>(p);
+        r.path.pathId = get<std::uint32_t>(p);
+        p += 6;
+        r.dir = vec3(l.dir.x.v[k], l.dir.y.v[k], l.dir.z.v[k]);
+        r.path.beta.x = fromBits16(get<std::uint16_t>(p));
+        r.path.beta.y = fromBits16(get<std::uint16_t>(p));
+        r.path.beta.z = fromBits16(get<std::uint16_t>(p));
+        r.path.prevPdf = fromBits16(get<std::uint16_t>(p));
+        const std::uint16_t bf = get<std::uint16_t>(p);
+        r.path.bounce = bf & 0x7FFFu;
+        r.path.flags = (bf & 0x8000u) ? kPathSpecular : 0u;
+        r.path.cone = get<std::uint16_t>(p);
     }
 }
 

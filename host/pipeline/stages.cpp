@@ -108,10 +108,17 @@ void decompressRays(const RayBatch& batch, std::vector<RayState>& rays) {
     const size_t n = batch.count;
     const size_t recordBytes = rayRecordBytes(batch.format);
     rays.resize(n);
+    const bool compact = batch.format == RayFormat::Compact;
     tbb::parallel_for(tbb::blocked_range<size_t>(0, n, batchGrain(n, 256, 4096)),
                       [&](const tbb::blocked_range<size_t>& r) {
-                          for (size_t i = r.begin(); i < r.end(); ++i)
-                              decodeRay(&batch.bytes[i * recordBytes], batch.format, rays[i]);
+                          if (!compact) {
+                              for (size_t i = r.begin(); i < r.end(); ++i)
+                                  decodeRay(&batch.bytes[i * recordBytes], batch.format, rays[i]);
+                              return;
+                          }
+                          for (size_t i = r.begin(); i < r.end(); i += simd::kBlock)
+                              decodeCompactBlock(&batch.bytes[i * recordBytes],
+                                                 std::min(simd::kBlock, r.end() - i), &rays[i]);
                       });
 }
 

@@ -231,4 +231,55 @@ TEST(CompactRay, BlockEncodingIsEncodeRayByteForByte) {
     hwy::SetSupportedTargetsForTest(0);
 }
 
+// And decoded a block at a time (decodeCompactBlock), the same rays as decodeRay makes, to the
+// bit: over every cell of the octahedral grid's edges and folds, and random cells.
+TEST(CompactRay, BlockDecodingIsDecodeRayBitForBit) {
+    std::mt19937 rng(13);
+    const uint last = (1u << 24) - 1, mid = last / 2;
+    std::vector<uvec2> cells = {{0, 0},      {last, last},       {0, last},
+                                {last, 0},   {mid, mid},         {mid + 1, mid},
+                                {mid, 0},    {0, mid + 1},       {last, mid},
+                                {mid, last}, {mid / 2, mid / 2}, {mid + mid / 2, mid / 2 + 1}};
+    while (cells.size() < 20000)
+        cells.push_back(uvec2(rng() & last, rng() & last));
+    std::vector<std::uint8_t> records(cells.size() * kCompactRayBytes);
+    for (size_t i = 0; i < cells.size(); ++i) {
+        RayState r = someRay(vec3(0, 0, 1), vec3(0.25f * float(i % 7), 1.0f, 3.0f));
+        r.path.pathId = std::uint32_t(rng());
+        r.path.bounce = uint(i % 40);
+        r.path.flags = i % 2 ? kPathSpecular : 0u;
+        r.path.cone = std::uint32_t(i * 257u & 0xFFFFu);
+        std::uint8_t* p = &records[i * kCompactRayBytes];
+        encodeRay(r, RayFormat::Compact, uvec4(uint(rng())), p);
+        for (int b = 0; b < 3; ++b) { // the cell itself, over the encoded direction
+            p[16 + b] = std::uint8_t(cells[i].x >> (8 * b));
+            p[19 + b] = std::uint8_t(cells[i].y >> (8 * b));
+        }
+    }
+    for (int64_t target : hwy::SupportedAndGeneratedTargets()) {
+        hwy::SetSupportedTargetsForTest(target);
+        SCOPED_TRACE(simdTarget());
+        for (size_t n : {size_t(1), size_t(23), size_t(64)})
+            for (size_t begin = 0; begin + n <= cells.size(); begin += n) {
+                std::vector<RayState> block(n);
+                decodeCompactBlock(&records[begin * kCompactRayBytes], n, block.data());
+                for (size_t k = 0; k < n; ++k) {
+                    RayState one;
+                    decodeRay(&records[(begin + k) * kCompactRayBytes], RayFormat::Compact, one);
+                    const RayState& many = block[k];
+                    ASSERT_EQ(std::memcmp(&one.origin, &many.origin, sizeof(vec3)), 0);
+                    ASSERT_EQ(std::memcmp(&one.dir, &many.dir, sizeof(vec3)), 0)
+                        << "cell " << cells[begin + k].x << ", " << cells[begin + k].y;
+                    ASSERT_EQ(std::memcmp(&one.path.beta, &many.path.beta, sizeof(vec3)), 0);
+                    ASSERT_EQ(std::memcmp(&one.path.prevPdf, &many.path.prevPdf, 4), 0);
+                    ASSERT_EQ(one.path.pathId, many.path.pathId);
+                    ASSERT_EQ(one.path.bounce, many.path.bounce);
+                    ASSERT_EQ(one.path.flags, many.path.flags);
+                    ASSERT_EQ(one.path.cone, many.path.cone);
+                }
+            }
+    }
+    hwy::SetSupportedTargetsForTest(0);
+}
+
 } // namespace spw
