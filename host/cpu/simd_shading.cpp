@@ -9,6 +9,8 @@
 // scalar function lane by lane).
 #include "host/cpu/simd_shading.h"
 
+#include "host/cpu/simd_light_pick.h"
+
 #include "host/simd/lanes.h"
 #include "shared/path.h"
 
@@ -388,16 +390,12 @@ void fillLane(const SceneView& scene, const RenderParams& rp, const ShadeInput& 
     setRandomLane(rp, st, lanes.random, k);
 }
 
-// Lane k's emitter, picked with the random number MakeRandomNumbers made (zeros where the path ends
-// here or nothing is sampled, so that the kernel reads defined values); where it is not a
-// triangle without an emission map, its light sample from `hit`, made here.
-void pickLaneEmitter(const SceneView& scene, const RenderParams& rp, bool nee,
+// Lane k's emitter, `picked` with probability pickPdf (zeros where the path ends here or nothing
+// is sampled, so that the kernel reads defined values); where it is not a triangle without an
+// emission map, its light sample from `hit`, made here.
+void pickLaneEmitter(const SceneView& scene, const RenderParams& rp, uint picked, float pickPdf,
                      const SurfaceHit& hit, SurfaceLanes& lanes, size_t k) {
     static const Emitter kNone{};
-    float pickPdf = 0.0f;
-    const uint picked = nee && lanes.live.v[k] != 0u ? pickLight(scene, rp, get(lanes.p, k),
-                                                                 lanes.random.uLightX.v[k], pickPdf)
-                                                     : kNoEmitter;
     const Emitter& e = picked != kNoEmitter ? scene.emitters[picked] : kNone;
     const bool sampled =
         picked != kNoEmitter && (e.type != kEmitterTriangle || e.map != kNoEmissionMap);
@@ -496,8 +494,13 @@ void shadeBlock(const SceneView& view, const RenderParams& rp, bool nee, bool mi
     const size_t end = wholeVectors(b.count);
     padLanes(b.lanes, b.count, end);
     HWY_DYNAMIC_DISPATCH(MakeRandomNumbers)(b.lanes.random, end, rp.sampling, rp.seed);
+    uint picked[kBlock];
+    float pickPdf[kBlock];
+    pickLights(view, rp, b.lanes.p, b.lanes.random.uLightX, nee ? b.lanes.live : simd::Uints{}, end,
+               picked, pickPdf);
     for (size_t k = 0; k < end; ++k) // padding lanes are lane 0's copies
-        pickLaneEmitter(view, rp, nee, in[b.hitOf[k < b.count ? k : 0]].hit, b.lanes, k);
+        pickLaneEmitter(view, rp, picked[k], pickPdf[k], in[b.hitOf[k < b.count ? k : 0]].hit,
+                        b.lanes, k);
     switch (model) {
     case kModelLambert:
         HWY_DYNAMIC_DISPATCH(ShadeLambertLanes)(b.lanes, end, nee, mis, rp.threshold, results);

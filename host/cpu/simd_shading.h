@@ -10,9 +10,12 @@
 // The kernel is shadeSurface() to the bit: the same operations in the same order, each rounded
 // once (no fused multiply-add), so an image does not depend on which hits were shaded
 // together, on the instruction set, or on whether the kernel ran at all
-// (SimdShading.EveryModelsHitsAreShadeSurfaceToTheBit). What stays scalar, per hit: the emitter
-// pick (a binary search), gathering the emitter and the hit into rows, and the emission of an
-// emitter that was hit.
+// (SimdShading.EveryModelsHitsAreShadeSurfaceToTheBit). The emitter pick's walk down the light
+// tree runs SIMD-wide too, each lane on its own path through the tree
+// (SimdShading.HitsUnderALightTreeAreShadeSurfaceToTheBit). What stays scalar, per hit: the
+// pick's last step (among a leaf's members, or the binary search of the lights outside the
+// tree), gathering the emitter and the hit into rows, and the emission of an emitter that was
+// hit.
 #pragma once
 
 #include "shared/scene_access.h"

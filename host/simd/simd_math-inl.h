@@ -6,8 +6,9 @@
 // multiply-add). glm's operations are written out in glm's order: dot is (x x' + y y') + z z',
 // max(a, b) is (a < b) ? b : a and min(a, b) is (b < a) ? b : a. The scalar side carries the tag
 // "// SIMD twin: host/simd/simd_math-inl.h" on the line above its definition. This file holds the
-// vector arithmetic, sampling, triangle emitters, Lambert and the random numbers; the surface
-// models built on GGX are simd_bsdf-inl.h's.
+// vector arithmetic, sampling, triangle emitters, Lambert, the random numbers and the light
+// tree's descent (checked through the shading kernels, whose light pick is its only caller); the
+// surface models built on GGX are simd_bsdf-inl.h's.
 //
 // Highway's per-target header convention: the includer defines HWY_TARGET_INCLUDE, includes
 // <hwy/foreach_target.h>, and this file is compiled once per instruction set.
@@ -19,6 +20,7 @@
 #endif
 
 #include "host/simd/lanes.h"
+#include "shared/light_tree.h"
 #include "shared/path.h"
 
 #include <hwy/highway.h>
@@ -382,6 +384,94 @@ HWY_INLINE U4 rand4(uint sampling, uint seed, VU pixel, VU sampleIndex, VU bounc
             {pixel, dimension, hn::Set(du, seed),
              hn::Add(hn::Set(du, 0x50B01u), hn::And(sampleIndex, hn::Set(du, 1u)))});
     return pcg4d({pixel, sampleIndex, dimension, hn::Set(du, seed)});
+}
+
+// --- the light tree (shared/light_tree.h) --------------------------------------------------------
+
+// Twin of treeImportance (shared/light_tree.h), for node words gathered from `cdf` at `base`
+// (each lane's treeNodeBase): every branch computed, the scalar's choices as masks.
+HWY_INLINE V treeImportance(const float* cdf, hn::Vec<hn::RebindToSigned<D>> base, V3 p) {
+    const D d;
+    const hn::RebindToSigned<D> di;
+    auto word = [&](int k) { return hn::GatherIndex(d, cdf, hn::Add(base, hn::Set(di, k))); };
+    const V zero = hn::Zero(d), one = hn::Set(d, 1.0f);
+    const V power = word(10);
+    const V3 dv = sub(p, V3{word(0), word(1), word(2)});
+    const V radius = word(3);
+    const V r2 = hn::Mul(radius, radius);
+    const V d2 = dot(dv, dv);
+    const M outside = hn::Gt(d2, r2);
+    const V3 axis{word(4), word(5), word(6)};
+    const V cosO = word(7);
+    const V invD = hn::Div(one, hn::Sqrt(d2)); // glm::inversesqrt
+    V cosW = hn::Mul(dot(axis, dv), invD);
+    const VU links = hn::BitCast(DU(), word(11));
+    const M twoSided =
+        hn::RebindMask(d, hn::Ne(hn::And(links, hn::Set(DU(), kTreeTwoSided)), hn::Zero(DU())));
+    cosW = hn::IfThenElse(twoSided, hn::Abs(cosW), cosW);
+    const M beyondCone = hn::Lt(cosW, cosO);
+    const V sinO = word(8);
+    const V sinW = hn::Sqrt(gmax(zero, hn::Sub(one, hn::Mul(cosW, cosW))));
+    const V cosX = hn::Add(hn::Mul(cosW, cosO), hn::Mul(sinW, sinO));
+    const V sinX = gmax(hn::Sub(hn::Mul(sinW, cosO), hn::Mul(cosW, sinO)), zero);
+    const V sinB = gmin(hn::Mul(radius, invD), one);
+    const V cosB = hn::Sqrt(gmax(zero, hn::Sub(one, hn::Mul(sinB, sinB))));
+    const V cosCone =
+        hn::IfThenElse(hn::Gt(cosX, cosB), one, hn::Add(hn::Mul(cosX, cosB), hn::Mul(sinX, sinB)));
+    const V cosP = hn::IfThenElse(hn::And(outside, beyondCone), cosCone, one);
+    const M none =
+        hn::Or(hn::Not(hn::Gt(power, zero)), hn::And(outside, hn::Not(hn::Gt(cosP, word(9)))));
+    const V importance = hn::Div(hn::Mul(power, cosP), gmax(gmax(d2, r2), hn::Set(d, 1e-30f)));
+    return hn::IfThenZeroElse(none, importance);
+}
+
+// Twin of treePick's descent (shared/light_tree.h) for the lanes in `active`: from the root to a
+// leaf, each lane with its own point p and number u. Out: the leaf reached (node; treeLeafPick
+// takes it from there with the u and pmf left), or kTreeRoot where the scalar walk gives up
+// (kNoEmitter: no child can reach p, or 64 levels).
+HWY_INLINE void treeDescent(const float* cdf, uint nodesAt, V3 p, M active, VU& node, V& u,
+                            V& pmf) {
+    const D d;
+    const DU du;
+    const hn::RebindToSigned<D> di;
+    const V one = hn::Set(d, 1.0f), last = hn::Set(d, kOneMinusEpsilon);
+    auto base = [&](VU n) { // treeNodeBase
+        return hn::BitCast(di,
+                           hn::Add(hn::Set(du, nodesAt), hn::Mul(n, hn::Set(du, kTreeNodeWords))));
+    };
+    node = hn::Zero(du);
+    pmf = one;
+    M running = active;
+    M failed = hn::Not(active);
+    for (uint depth = 0u; depth < 64u && !hn::AllFalse(d, running); ++depth) {
+        const VU links =
+            hn::BitCast(du, hn::GatherIndex(d, cdf, hn::Add(base(node), hn::Set(di, 11))));
+        const M leaf =
+            hn::RebindMask(d, hn::Ne(hn::And(links, hn::Set(du, kTreeLeaf)), hn::Zero(du)));
+        running = hn::AndNot(leaf, running);
+        if (hn::AllFalse(d, running)) break;
+        const VU runningBits = hn::BitCast(du, hn::VecFromMask(d, running));
+        // Lanes that have stopped read the root's words: in range, their results unused.
+        const VU first = hn::And(hn::Add(node, hn::Set(du, 1u)), runningBits);
+        const VU second = hn::And(hn::And(links, hn::Set(du, kTreeIndex)), runningBits);
+        const V i0 = treeImportance(cdf, base(first), p);
+        const V i1 = treeImportance(cdf, base(second), p);
+        const V sum = hn::Add(i0, i1);
+        const M stuck = hn::AndNot(hn::Gt(sum, hn::Zero(d)), running);
+        failed = hn::Or(failed, stuck);
+        running = hn::AndNot(stuck, running);
+        const V p0 = hn::Div(i0, sum);
+        const M left = hn::Lt(u, p0);
+        const V uLeft = gmin(hn::Div(u, p0), last);
+        const V uRight = gmin(hn::Div(hn::Sub(u, p0), hn::Sub(one, p0)), last);
+        const V pmfLeft = hn::Mul(pmf, p0), pmfRight = hn::Mul(pmf, hn::Div(i1, sum));
+        u = hn::IfThenElse(running, hn::IfThenElse(left, uLeft, uRight), u);
+        pmf = hn::IfThenElse(running, hn::IfThenElse(left, pmfLeft, pmfRight), pmf);
+        const VU next = hn::IfThenElse(hn::RebindMask(du, left), first, second);
+        node = hn::IfThenElse(hn::RebindMask(du, running), next, node);
+    }
+    failed = hn::Or(failed, running); // 64 levels without a leaf
+    node = hn::IfThenElse(hn::RebindMask(du, failed), hn::Set(du, kTreeRoot), node);
 }
 
 } // namespace spw::HWY_NAMESPACE

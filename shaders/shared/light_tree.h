@@ -50,7 +50,7 @@ SHARED_FN uint treeLinks(SCENE_PARAM RenderParams rp, uint node) {
 // Conty Estevez and Kulla 2018, eq. 3, without the receiver's cosine: power x cos(theta') /
 // d^2, theta' = max(0, theta_w - theta_o - theta_b) the least angle between the direction from
 // the node toward p and any emitter's axis, theta_b the angle the node's sphere subtends at p;
-// 0 where theta' is beyond theta_e.
+// 0 where theta' is beyond theta_e. Its SIMD form: host/simd/simd_math-inl.h's treeImportance.
 SHARED_FN float treeImportance(SCENE_PARAM RenderParams rp, uint node, vec3 p) {
     uint b = treeNodeBase(rp, node);
     float power = EMITTER_CDF(b + 10u);
@@ -120,7 +120,9 @@ SHARED_FN float treeLeafPmf(SCENE_PARAM RenderParams rp, uint node, uint emitter
 }
 
 // The tree emitter picked for shading point p with u uniform in [0, 1), and its probability
-// (pmf; 0 and kNoEmitter when no emitter can reach p).
+// (pmf; 0 and kNoEmitter when no emitter can reach p). Its SIMD form, up to the leaf, is
+// host/simd/simd_math-inl.h's treeDescent (checked through the cpu engine's shading,
+// SimdShading.HitsUnderALightTreeAreShadeSurfaceToTheBit).
 SHARED_FN uint treePick(SCENE_PARAM RenderParams rp, vec3 p, float u, OUT(float) pmf) {
     uint node = 0u;
     pmf = 1.0f;

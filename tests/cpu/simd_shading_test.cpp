@@ -11,6 +11,7 @@
 #include "host/render/render.h"
 #include "host/scene/scene.h"
 #include "host/scene/surface_models.h"
+#include "host/scene_view/lights.h"
 #include "host/simd/simd_target.h"
 #include "test_util.h"
 
@@ -20,6 +21,8 @@
 #include <hwy/targets.h>
 #include <nlohmann/json.hpp>
 
+#include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <map>
@@ -278,6 +281,97 @@ void expectEveryModelsHitsAreShadeSurface() {
                     EXPECT_GT(c.emitted, 5u) << what;
                 }
             }
+    }
+}
+
+// A scene of many lights over [-1, 3]^2, from 0.1 to 2.6 above y = 0: emissive triangles
+// (half of them two-sided), quads and spots facing down, and with `points`, point lights too
+// (without them, picks above the lights find none).
+Scene manyLightsScene(test::TempDir& dir, std::mt19937& rng, bool points) {
+    std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+    std::string obj[2], lights = "[";
+    int vertices[2] = {0, 0};
+    char buf[256];
+    for (int i = 0; i < 80; ++i) {
+        const float x = -1.0f + 4.0f * unit(rng), z = -1.0f + 4.0f * unit(rng);
+        const float y = 0.1f + 2.5f * unit(rng), power = std::pow(10.0f, 2.0f * unit(rng));
+        if (i % 4 < 2) { // an emissive triangle, tilted at random
+            std::string& o = obj[i % 2];
+            for (int k = 0; k < 3; ++k) {
+                std::snprintf(buf, sizeof buf, "v %g %g %g\n", x + 0.3f * unit(rng),
+                              y + 0.2f * (unit(rng) - 0.5f), z + 0.3f * unit(rng));
+                o += buf;
+            }
+            const int v = vertices[i % 2] += 3;
+            o += "f " + std::to_string(v - 2) + " " + std::to_string(v - 1) + " " +
+                 std::to_string(v) + "\n";
+            continue;
+        }
+        if (i % 4 == 2 || !points)
+            std::snprintf(buf, sizeof buf,
+                          i % 8 == 3 ? "{type: Quad, translation: [%g, %g, %g], rotation: [90, 0, "
+                                       "0], scale: [0.3, 0.2], intensity: %g}"
+                                     : "{type: Spot, position: [%g, %g, %g], direction: [0.3, -1, "
+                                       "0.1], intensity: %g, inner angle: 20, outer angle: 50}",
+                          x, y, z, power);
+        else
+            std::snprintf(buf, sizeof buf, "{type: Point, position: [%g, %g, %g], intensity: %g}",
+                          x, y, z, power);
+        lights += std::string(lights.size() > 1 ? ", " : "") + buf;
+    }
+    dir.write("floor.obj", test::floorObj(4.0f));
+    dir.write("one-sided.obj", obj[0]);
+    dir.write("two-sided.obj", obj[1]);
+    return loadScene(dir.write(
+        "lights.yaml",
+        "image: {width: 16, height: 16}\n"
+        "camera: {look at: {eye: [0.2, 0.6, 0.1], target: [0.2, 0, 0.1], up: [0, 0, -1]}}\n"
+        "shaders:\n  - {type: Lambert}\n  - {type: Null, emission: [3, 2, 1]}\n"
+        "  - {type: Null, emission: [1, 2, 3], two sided: true}\n"
+        "objects:\n  - {filename: floor.obj, shader: 0}\n"
+        "  - {filename: one-sided.obj, shader: 1}\n  - {filename: two-sided.obj, shader: 2}\n"
+        "lights: " +
+            lights + "]\n"));
+}
+
+// Under a light tree, whose descent the kernel's light pick runs SIMD-wide: every hit shaded as
+// shadeSurface shades it, in every instruction set, with two-sided and one-sided emitters, where
+// point lights reach every hit and where, without them, picks above the lights find none.
+TEST(SimdShading, HitsUnderALightTreeAreShadeSurfaceToTheBit) {
+    std::mt19937 rng(77);
+    for (bool points : {true, false}) {
+        test::TempDir dir;
+        const Scene scene = manyLightsScene(dir, rng, points);
+        const SceneLights sceneLights(scene);
+        ASSERT_GT(sceneLights.treeEmitters(), 60u);
+        const Fixture f = makeFixture(rng, 0);
+        SceneView view = sceneLights.view();
+        view.shaders = f.shaders.data();
+        std::vector<ShadeInput> hits = randomHits(rng, f, 2003);
+        for (ShadeInput& h : hits) // in the scene's camera-relative frame, hitting no emitter
+            h.hit.p -= vec3(scene.origin), h.hit.emitter = kNoEmitter;
+        RenderParams rp = params(kStrategyMis, kSamplerSobol, sceneLights.sampledEmitters());
+        rp.treeEmitters = sceneLights.treeEmitters();
+        // The comparison reached picks that find a light and picks that find none.
+        size_t found = 0, none = 0;
+        for (const ShadeInput& h : hits) {
+            float pdf;
+            const uint e = pickLight(view, rp, h.hit.p, 0.37f, pdf);
+            (e == kNoEmitter ? none : found)++;
+        }
+        EXPECT_GT(found, 1000u);
+        if (!points) EXPECT_GT(none, 20u);
+        for (int64_t target : hwy::SupportedAndGeneratedTargets()) {
+            hwy::SetSupportedTargetsForTest(target);
+            SCOPED_TRACE(simdTarget());
+            for (uint sampling : {kSamplerIndependent, kSamplerSobol}) {
+                rp.sampling = sampling;
+                const FlagCounts c = compareWithShadeSurface(
+                    view, rp, hits, points ? "light tree, points" : "light tree");
+                EXPECT_GT(c.shadow, 200u);
+            }
+        }
+        hwy::SetSupportedTargetsForTest(0);
     }
 }
 
