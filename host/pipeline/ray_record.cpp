@@ -1,5 +1,7 @@
 #include "host/pipeline/ray_record.h"
 
+#include "host/pipeline/record_bytes.h"
+
 #include "host/scene/scene.h"
 
 #include <cmath>
@@ -12,6 +14,7 @@ static_assert(kMaxCompactBounce >= uint(kMaxDepth),
               "the loader accepts depths the compact ray cannot hold");
 
 namespace {
+using namespace record_bytes;
 
 constexpr double kOctScale = double((1u << 24) - 1);
 
@@ -34,15 +37,6 @@ double signOf(double s, double a) {
     double out;
     std::memcpy(&out, &x, 8);
     return out;
-}
-
-void put24(std::uint8_t* p, uint v) {
-    p[0] = std::uint8_t(v);
-    p[1] = std::uint8_t(v >> 8);
-    p[2] = std::uint8_t(v >> 16);
-}
-uint get24(const std::uint8_t* p) {
-    return uint(p[0]) | uint(p[1]) << 8 | uint(p[2]) << 16;
 }
 
 void octEncode(vec3 d, uint& u, uint& v) {
@@ -71,23 +65,6 @@ std::uint16_t toBfloat16(float f, uint random) {
     // Without a branch (the comparison is a coin flip); never rounds into Inf/NaN.
     hi += std::uint32_t((random & 0xFFFFu) < lo) & std::uint32_t((hi & 0x7F80u) != 0x7F80u);
     return std::uint16_t(hi);
-}
-float fromBfloat16(std::uint16_t h) {
-    std::uint32_t bits = std::uint32_t(h) << 16;
-    float f;
-    std::memcpy(&f, &bits, 4);
-    return f;
-}
-
-template <class T> void put(std::uint8_t*& p, T v) {
-    std::memcpy(p, &v, sizeof(T));
-    p += sizeof(T);
-}
-template <class T> T get(const std::uint8_t*& p) {
-    T v;
-    std::memcpy(&v, p, sizeof(T));
-    p += sizeof(T);
-    return v;
 }
 
 } // namespace

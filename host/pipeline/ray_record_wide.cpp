@@ -6,6 +6,8 @@
 // CompactRay.BlockDecodingIsDecodeRayBitForBit).
 #include "host/pipeline/ray_record.h"
 
+#include "host/pipeline/record_bytes.h"
+
 #include "host/simd/lanes.h"
 
 #include <algorithm>
@@ -163,33 +165,7 @@ namespace spw {
 HWY_EXPORT(EncodeCompactLanes);
 HWY_EXPORT(DecodeDirectionLanes);
 
-namespace {
-template <class T> void put(std::uint8_t*& p, T v) {
-    std::memcpy(p, &v, sizeof(T));
-    p += sizeof(T);
-}
-void put24(std::uint8_t*& p, uint v) {
-    p[0] = std::uint8_t(v);
-    p[1] = std::uint8_t(v >> 8);
-    p[2] = std::uint8_t(v >> 16);
-    p += 3;
-}
-template <class T> T get(const std::uint8_t*& p) {
-    T v;
-    std::memcpy(&v, p, sizeof(T));
-    p += sizeof(T);
-    return v;
-}
-uint get24(const std::uint8_t* p) {
-    return uint(p[0]) | uint(p[1]) << 8 | uint(p[2]) << 16;
-}
-float fromBits16(std::uint16_t h) { // fromBfloat16
-    const std::uint32_t bits = std::uint32_t(h) << 16;
-    float f;
-    std::memcpy(&f, &bits, 4);
-    return f;
-}
-} // namespace
+using namespace record_bytes;
 
 void encodeCompactBlock(const RenderParams& rp, const ShadeResult* const* res, size_t n,
                         std::uint8_t* out, std::uint8_t* bin) {
@@ -212,7 +188,8 @@ void encodeCompactBlock(const RenderParams& rp, const ShadeResult* const* res, s
         put(p, r.nextOrigin.x), put(p, r.nextOrigin.y), put(p, r.nextOrigin.z);
         put(p, r.next.pathId);
         put24(p, l.u.v[k]);
-        put24(p, l.v.v[k]);
+        put24(p + 3, l.v.v[k]);
+        p += 6;
         put(p, std::uint16_t(l.betaX.v[k])), put(p, std::uint16_t(l.betaY.v[k]));
         put(p, std::uint16_t(l.betaZ.v[k])), put(p, std::uint16_t(l.pdf.v[k]));
         put(p, compactBounce(r.next));
@@ -238,10 +215,10 @@ void decodeCompactBlock(const std::uint8_t* in, size_t n, RayState* out) {
         r.path.pathId = get<std::uint32_t>(p);
         p += 6;
         r.dir = vec3(l.dir.x.v[k], l.dir.y.v[k], l.dir.z.v[k]);
-        r.path.beta.x = fromBits16(get<std::uint16_t>(p));
-        r.path.beta.y = fromBits16(get<std::uint16_t>(p));
-        r.path.beta.z = fromBits16(get<std::uint16_t>(p));
-        r.path.prevPdf = fromBits16(get<std::uint16_t>(p));
+        r.path.beta.x = fromBfloat16(get<std::uint16_t>(p));
+        r.path.beta.y = fromBfloat16(get<std::uint16_t>(p));
+        r.path.beta.z = fromBfloat16(get<std::uint16_t>(p));
+        r.path.prevPdf = fromBfloat16(get<std::uint16_t>(p));
         const std::uint16_t bf = get<std::uint16_t>(p);
         r.path.bounce = bf & 0x7FFFu;
         r.path.flags = (bf & 0x8000u) ? kPathSpecular : 0u;
