@@ -35,9 +35,11 @@ void fillRayHit(RTCRayHit& rh, vec3 o, vec3 d) {
     rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
 }
 
-HitRecord toHitRecord(const RTCRayHit& rh) {
+HitRecord toHitRecord(const RTCRayHit& rh, uint instanceBase) {
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return HitRecord{kNoHit, 0, 0.0f, 0.0f, 0.0f};
-    return HitRecord{rh.hit.geomID, rh.hit.primID, rh.hit.u, rh.hit.v, rh.ray.tfar};
+    const uint instance =
+        rh.hit.instID[0] == RTC_INVALID_GEOMETRY_ID ? kNoInstance : rh.hit.instID[0] - instanceBase;
+    return HitRecord{rh.hit.geomID, rh.hit.primID, rh.hit.u, rh.hit.v, rh.ray.tfar, instance};
 }
 
 RTCIntersectContext context(bool coherent) {
@@ -61,7 +63,7 @@ void intersectBatch(const EmbreeScene& scene, const RayStream& rays, bool cohere
         RTCIntersectContext ctx = context(coherent);
         rtcIntersect1M(scene.handle(), &ctx, buf, unsigned(end - begin), sizeof(RTCRayHit));
         for (size_t i = begin; i < end; ++i)
-            hits[i] = toHitRecord(buf[i - begin]);
+            hits[i] = toHitRecord(buf[i - begin], scene.instanceBase());
     });
 }
 
@@ -94,7 +96,7 @@ HitRecord intersectOne(const EmbreeScene& scene, vec3 origin, vec3 dir) {
     fillRayHit(rh, origin, dir);
     RTCIntersectContext ctx = context(false);
     rtcIntersect1(scene.handle(), &ctx, &rh);
-    return toHitRecord(rh);
+    return toHitRecord(rh, scene.instanceBase());
 }
 
 bool occludedOne(const EmbreeScene& scene, const ShadowRay& ray) {

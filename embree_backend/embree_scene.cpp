@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <vector>
 
 namespace spw {
 namespace {
@@ -31,42 +32,75 @@ void filterHits(const RTCFilterFunctionNArguments* args) {
 }
 } // namespace
 
+namespace {
+// Mesh `m` as a triangle geometry of `target`, attached under its own index (so that a hit's
+// geometry id names the mesh in the scene's list, whichever Embree scene holds it).
+void attachMesh(RTCDevice device, RTCScene target, const Scene& scene, size_t m,
+                const HitFilter* filter) {
+    const Mesh& mesh = scene.meshes[m];
+    RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
+    auto* vb = static_cast<float*>(rtcSetNewGeometryBuffer(
+        g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), mesh.positions.size()));
+    for (size_t i = 0; i < mesh.positions.size(); ++i)
+        for (int k = 0; k < 3; ++k)
+            vb[3 * i + k] = mesh.positions[i][k];
+    auto* ib = static_cast<unsigned*>(
+        rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned),
+                                mesh.triangles.size()));
+    for (size_t i = 0; i < mesh.triangles.size(); ++i)
+        for (int k = 0; k < 3; ++k)
+            ib[3 * i + k] = mesh.triangles[i][k];
+    if (filter && filter->filters(uint(m))) {
+        rtcSetGeometryUserData(g, const_cast<HitFilter*>(filter));
+        rtcSetGeometryIntersectFilterFunction(g, filterHits);
+        rtcSetGeometryOccludedFilterFunction(g, filterHits);
+    }
+    rtcCommitGeometry(g);
+    rtcAttachGeometryByID(target, g, unsigned(m));
+    rtcReleaseGeometry(g);
+}
+
+RTCScene newScene(RTCDevice device) {
+    RTCScene s = rtcNewScene(device);
+    rtcSetSceneFlags(s, RTC_SCENE_FLAG_ROBUST);
+    rtcSetSceneBuildQuality(s, RTC_BUILD_QUALITY_HIGH);
+    return s;
+}
+} // namespace
+
 EmbreeScene::EmbreeScene(const Scene& scene, const HitFilter* filter) {
     device_ = rtcNewDevice(nullptr);
     if (!device_)
         throw std::runtime_error("cannot create the Embree device (error " +
                                  std::to_string(int(rtcGetDeviceError(nullptr))) + ")");
     rtcSetDeviceErrorFunction(device_, onEmbreeError, &error_);
-    scene_ = rtcNewScene(device_);
-    rtcSetSceneFlags(scene_, RTC_SCENE_FLAG_ROBUST);
-    rtcSetSceneBuildQuality(scene_, RTC_BUILD_QUALITY_HIGH);
+    scene_ = newScene(device_);
 
+    // Each prototype a scene of its own, built once; the world's meshes in the top scene.
+    std::vector<RTCScene> prototypes;
+    for (size_t p = 0; p < scene.prototypes.size(); ++p)
+        prototypes.push_back(newScene(device_));
     for (size_t m = 0; m < scene.meshes.size(); ++m) {
-        const Mesh& mesh = scene.meshes[m];
-        RTCGeometry g = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
-        auto* vb = static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0,
-                                                               RTC_FORMAT_FLOAT3, 3 * sizeof(float),
-                                                               mesh.positions.size()));
-        for (size_t i = 0; i < mesh.positions.size(); ++i)
-            for (int k = 0; k < 3; ++k)
-                vb[3 * i + k] = mesh.positions[i][k];
-        auto* ib = static_cast<unsigned*>(
-            rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
-                                    3 * sizeof(unsigned), mesh.triangles.size()));
-        for (size_t i = 0; i < mesh.triangles.size(); ++i)
-            for (int k = 0; k < 3; ++k)
-                ib[3 * i + k] = mesh.triangles[i][k];
-        if (filter && filter->filters(uint(m))) {
-            rtcSetGeometryUserData(g, const_cast<HitFilter*>(filter));
-            rtcSetGeometryIntersectFilterFunction(g, filterHits);
-            rtcSetGeometryOccludedFilterFunction(g, filterHits);
-        }
+        const int proto = scene.meshes[m].prototype;
+        attachMesh(device_, proto >= 0 ? prototypes[size_t(proto)] : scene_, scene, m, filter);
+    }
+    for (RTCScene p : prototypes)
+        rtcCommitScene(p);
+    // The instances, after the meshes' ids: instance i is geometry meshes.size() + i.
+    for (size_t i = 0; i < scene.instances.size(); ++i) {
+        const Instance& inst = scene.instances[i];
+        RTCGeometry g = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_INSTANCE);
+        rtcSetGeometryInstancedScene(g, prototypes[inst.prototype]);
+        rtcSetGeometryTransform(g, 0, RTC_FORMAT_FLOAT4X4_COLUMN_MAJOR, &inst.toWorld[0][0]);
         rtcCommitGeometry(g);
-        rtcAttachGeometryByID(scene_, g, unsigned(m));
+        rtcAttachGeometryByID(scene_, g, unsigned(scene.meshes.size() + i));
         rtcReleaseGeometry(g);
     }
+    for (RTCScene p : prototypes) // the instances hold them
+        rtcReleaseScene(p);
     rtcCommitScene(scene_);
     checkError("building the scene");
+    instanceBase_ = uint(scene.meshes.size());
 }
 
 EmbreeScene::~EmbreeScene() {

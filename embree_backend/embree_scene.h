@@ -1,7 +1,9 @@
-// The scene as Embree sees it: one triangle geometry per mesh (geometry id = mesh index), built
-// with the robust flag. Only acceleration lives in embree_backend/: what a hit means (hit setup) is
-// the scene's (host/scene_view/hit_setup.h), and so are the shaders and emitters
-// (host/scene_view/lights.h).
+// The scene as Embree sees it, in two levels: one triangle geometry per mesh (geometry id = mesh
+// index, whichever scene holds it), the world's meshes in the top scene, each prototype's in a
+// scene of its own that instances place (instance i: geometry id instanceBase() + i of the top
+// scene), every scene built with the robust flag. Only acceleration lives in embree_backend/: what
+// a hit means (hit setup) is the scene's (host/scene_view/hit_setup.h), and so are the shaders and
+// emitters (host/scene_view/lights.h).
 #pragma once
 
 #include "host/scene/scene.h"
@@ -39,6 +41,8 @@ class EmbreeScene {
     EmbreeScene& operator=(const EmbreeScene&) = delete;
 
     RTCSceneTy* handle() const { return scene_; }
+    // The top scene's geometry id of instance 0 (Scene::instances).
+    uint instanceBase() const { return instanceBase_; }
 
     // Throws if Embree reported an error since the last check.
     void checkError(const char* what) const;
@@ -47,6 +51,7 @@ class EmbreeScene {
     RTCDeviceTy* device_ = nullptr;
     RTCSceneTy* scene_ = nullptr;
     mutable std::string error_;
+    uint instanceBase_ = 0;
 };
 
 } // namespace spw

@@ -51,6 +51,12 @@ are noisy; ratios travel, absolute seconds do not).
                                own 4096-spp reference: scripts/cycles_bench.py says how.
                                --backends cpu,reference (default), --scenes NAME,... (default
                                all), --quick (tiny, for the suite). Writes out/bench/cycles.json.
+  scripts/bench.py scale       production-shaped glTF scenes at increasing sizes (an instanced
+                               forest, unique geometry, many embedded images), Spillway beside
+                               Cycles on each file: load, BVH, render and wall seconds, peak RSS,
+                               bytes per instance and per triangle (scripts/scale_bench.py says
+                               how). --quick (small, no Cycles, for the suite), --scenes NAME,...
+                               Writes out/bench/scale.json.
   scripts/bench.py all         reference and pipeline (default)
 
 Options: --repeat N (best of N, default 3; production: 1), --spillway PATH (default
@@ -411,7 +417,7 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("what", nargs="?", default="all",
                     choices=["reference", "pipeline", "production", "incore", "mpi", "large", "cycles",
-                             "all"])
+                             "scale", "all"])
     ap.add_argument("--repeat", type=int)
     ap.add_argument("--depths", default="1,2,3")
     ap.add_argument("--exponents", default="8,11,14,17")
@@ -423,9 +429,12 @@ def main():
                     help="mpi: threads of each rank (default: --threads / ranks)")
     ap.add_argument("--threads", type=int, default=2, help="mpi: threads of the single process")
     ap.add_argument("--backends", default="cpu,reference", help="cycles: Spillway's backends")
-    ap.add_argument("--scenes", default="", help="cycles: the scenes to run (default all)")
-    ap.add_argument("--quick", action="store_true", help="cycles: tiny images, to check it runs")
+    ap.add_argument("--scenes", default="", help="cycles, scale: the scenes to run (default all)")
+    ap.add_argument("--quick", action="store_true", help="cycles, scale: small, to check it runs")
     a = ap.parse_args()
+    if a.what == "scale":
+        import scale_bench
+        sys.exit(scale_bench.main(a.spillway, a.quick, [s for s in a.scenes.split(",") if s]))
     if a.what == "cycles":
         import cycles_bench
         sys.exit(cycles_bench.main(a.spillway, a.backends.split(","), a.quick, a.repeat or 1,

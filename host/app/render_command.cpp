@@ -16,6 +16,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <csignal>
 #include <cstdio>
 #include <exception>
@@ -272,7 +273,11 @@ int renderCommand(const std::vector<std::string>& args, Ranks* ranks) {
         if (!path->empty() && writes) checkWritable(*path);
     fitToRank(o, ranks, writes);
     const std::optional<Checkpoint> resume = readResume(o);
+    const auto loadStart = std::chrono::steady_clock::now();
     const Scene scene = loadForRender(o, writes);
+    const double loadSeconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - loadStart).count();
+    const double loadPeakMiB = peakResidentMiB();
     applyDefaultSampling(o, scene, writes);
     const std::unique_ptr<ErrorCsv> errorCsv = openErrorCsv(o, scene, resume);
     // Under mpirun at most four updates a second (progress.h says why).
@@ -323,6 +328,8 @@ int renderCommand(const std::vector<std::string>& args, Ranks* ranks) {
         std::fprintf(stderr, "spillway: stopped by signal %d after %d spp; writing them\n", signal,
                      result->stats.spp);
     if (errorCsv) explainMissingEstimate(*result);
+    result->stats.stages.add("load scene", loadSeconds);
+    result->stats.extra["peak_rss_mib_after_load"] = loadPeakMiB;
     writeOutputs(o, scene, *result, errorCsv.get());
     return status;
 }

@@ -1,8 +1,16 @@
 #include "host/backend/stats.h"
 
+#include <sys/resource.h>
+
 #include <algorithm>
 
 namespace spw {
+
+double peakResidentMiB() {
+    rusage usage{};
+    if (getrusage(RUSAGE_SELF, &usage) != 0) return 0.0;
+    return double(usage.ru_maxrss) / 1024.0; // Linux: KiB
+}
 
 void StageTimes::add(const std::string& stage, double seconds) {
     std::lock_guard<std::mutex> lock(mutex_);

@@ -14,6 +14,9 @@
 
 namespace spw {
 
+// The process's peak resident memory so far, in MiB (getrusage's ru_maxrss).
+double peakResidentMiB();
+
 // Seconds per pipeline stage, in the order stages first report. Thread-safe.
 class StageTimes {
   public:

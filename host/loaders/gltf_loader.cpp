@@ -75,7 +75,7 @@ std::string lower(std::string s) {
 } // namespace
 
 void GltfReader::readScene() {
-    read(glm::dmat4(1.0), true);
+    read({glm::dmat4(1.0)}, true);
     if (!cameraFound_) frameBounds();
     scene_.objectCount = int(scene_.meshes.size());
     bool emissive = !scene_.punctualLights.empty();
@@ -85,13 +85,13 @@ void GltfReader::readScene() {
     if (scene_.shaders.empty()) scene_.shaders.push_back(defaultShader());
 }
 
-void GltfReader::readObject(const glm::dmat4& transform, int shader) {
+void GltfReader::readObject(const std::vector<glm::dmat4>& transforms, int shader) {
     shaderOverride_ = shader;
-    read(transform, false);
+    read(transforms, false);
     if (cameraSeen_) warn("its cameras are not used: the scene has its own");
 }
 
-void GltfReader::read(const glm::dmat4& transform, bool takesCamera) {
+void GltfReader::read(const std::vector<glm::dmat4>& transforms, bool takesCamera) {
     parse();
     checkExtensions();
     const int sceneIndex = model_.defaultScene >= 0 ? model_.defaultScene : 0;
@@ -104,10 +104,13 @@ void GltfReader::read(const glm::dmat4& transform, bool takesCamera) {
     // the meshes and lights, placed relative to it.
     for (Pass pass : {Pass::Camera, Pass::Geometry}) {
         if (pass == Pass::Camera && !takesCamera) continue;
-        for (size_t i = 0; i < s.nodes.size(); ++i)
-            visit(s.nodes[i], transform,
-                  "/scenes/" + std::to_string(sceneIndex) + "/nodes/" + std::to_string(i), pass, 0);
+        for (const glm::dmat4& transform : transforms)
+            for (size_t i = 0; i < s.nodes.size(); ++i)
+                visit(s.nodes[i], transform,
+                      "/scenes/" + std::to_string(sceneIndex) + "/nodes/" + std::to_string(i), pass,
+                      0);
     }
+    placeMeshes();
     warnUnrendered();
 }
 
@@ -205,7 +208,7 @@ void GltfReader::visit(int index, const glm::dmat4& parent, const std::string& a
         if (n.camera >= 0 && !cameraFound_) readCamera(n.camera, world, self + "/camera");
     } else {
         cameraSeen_ = cameraSeen_ || n.camera >= 0;
-        if (n.mesh >= 0) readMesh(n.mesh, world, self + "/mesh");
+        if (n.mesh >= 0) placements_.push_back({n.mesh, world, self + "/mesh"});
         readLight(n, world, self);
         if (n.skin >= 0) warn("has skins: rendered in their bind pose");
     }
@@ -269,8 +272,11 @@ void GltfReader::frameBounds() {
     const glm::dvec3 shift = glm::dvec3(world[3]); // the origin moves: shift what was read
     placeCamera(world, yfov, kDefaultAspect);
     for (Mesh& m : scene_.meshes)
-        for (vec3& p : m.positions)
-            p = vec3(glm::dvec3(p) - shift);
+        if (m.prototype < 0)
+            for (vec3& p : m.positions)
+                p = vec3(glm::dvec3(p) - shift);
+    for (Instance& inst : scene_.instances)
+        inst.toWorld[3] = vec4(vec3(glm::dvec3(vec3(inst.toWorld[3])) - shift), 1.0f);
     for (PunctualLight& l : scene_.punctualLights)
         l.position = vec3(glm::dvec3(l.position) - shift);
     if (const std::string far = beyondReach(hi - glm::dvec3(world[3]), "the scene's bounds");
@@ -359,9 +365,9 @@ Scene loadGltfScene(const std::string& path) {
     return scene;
 }
 
-void appendGltfObject(const std::string& path, const glm::dmat4& transform, int shader,
-                      Scene& scene) {
-    GltfReader(path, scene).readObject(transform, shader);
+void appendGltfObject(const std::string& path, const std::vector<glm::dmat4>& transforms,
+                      int shader, Scene& scene) {
+    GltfReader(path, scene).readObject(transforms, shader);
 }
 
 } // namespace spw

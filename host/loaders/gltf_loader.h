@@ -13,6 +13,7 @@
 #include <glm/mat4x4.hpp>
 
 #include <string>
+#include <vector>
 
 namespace spw {
 
@@ -36,10 +37,11 @@ constexpr float kGltfRouletteThreshold = 0.3f;
 Scene loadGltfScene(const std::string& path);
 
 // A glTF file as an object of a YAML scene (`type: Gltf`): its default scene's meshes and lights
-// placed by `transform` relative to `scene.origin` (the scene's camera), appended to
-// `scene.meshes` and `scene.punctualLights`; every mesh takes shader `shader` where it is >= 0,
-// else the file's materials, appended to `scene.shaders`. The file's cameras are not used.
-void appendGltfObject(const std::string& path, const glm::dmat4& transform, int shader,
-                      Scene& scene);
+// placed by each of `transforms` relative to `scene.origin` (the scene's camera), appended to
+// `scene.meshes` (a mesh placed more than once as a prototype, with its instances) and
+// `scene.punctualLights`; every mesh takes shader `shader` where it is >= 0, else the file's
+// materials, appended to `scene.shaders`. The file's cameras are not used.
+void appendGltfObject(const std::string& path, const std::vector<glm::dmat4>& transforms,
+                      int shader, Scene& scene);
 
 } // namespace spw

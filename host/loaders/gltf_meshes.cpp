@@ -175,8 +175,9 @@ void GltfReader::readPrimitive(const tinygltf::Primitive& prim, const glm::dmat4
         if (!std::isfinite(w.x) || !std::isfinite(w.y) || !std::isfinite(w.z))
             fail("/accessors/" + std::to_string(position->second),
                  "position " + std::to_string(i) + " is not finite");
-        include(w);
-        const glm::dvec3 rel = w - scene_.origin;
+        // A prototype's vertices stay in its frame; its instances are placed (and bounded) later.
+        if (prototype_ < 0) include(w);
+        const glm::dvec3 rel = prototype_ < 0 ? w - scene_.origin : w;
         if (const std::string far = beyondReach(rel, "position " + std::to_string(i)); !far.empty())
             fail("/accessors/" + std::to_string(position->second), far);
         m.positions[i] = vec3(rel);
@@ -191,7 +192,80 @@ void GltfReader::readPrimitive(const tinygltf::Primitive& prim, const glm::dmat4
     if (m.triangles.empty()) return;
     if (scene_.meshes.size() >= size_t(kMaxObjects))
         fail(at, "more than " + std::to_string(kMaxObjects) + " primitives");
+    m.prototype = prototype_;
     scene_.meshes.push_back(std::move(m));
+}
+
+bool GltfReader::emissive(int index, const std::string& at) {
+    if (index < 0 || index >= int(model_.meshes.size())) return false; // readMesh names it
+    for (size_t p = 0; p < model_.meshes[size_t(index)].primitives.size(); ++p) {
+        const tinygltf::Primitive& prim = model_.meshes[size_t(index)].primitives[p];
+        const int shader = shaderFor(prim.material, at + "/primitives/" + std::to_string(p));
+        if (scene_.shaders[size_t(shader)].params.emission != vec3(0.0f)) return true;
+    }
+    return false;
+}
+
+int GltfReader::readPrototype(int index, const std::string& at) {
+    Prototype proto;
+    const size_t first = scene_.meshes.size();
+    prototype_ = int(scene_.prototypes.size());
+    readMesh(index, glm::dmat4(1.0), at);
+    prototype_ = -1;
+    if (scene_.meshes.size() == first) return -1; // no triangles: nothing to place
+    const tinygltf::Mesh& mesh = model_.meshes[size_t(index)];
+    proto.name = path_ + ": " + (mesh.name.empty() ? "mesh " + std::to_string(index) : mesh.name);
+    proto.lo = vec3(std::numeric_limits<float>::max());
+    proto.hi = vec3(-std::numeric_limits<float>::max());
+    for (size_t m = first; m < scene_.meshes.size(); ++m) {
+        proto.meshes.push_back(uint(m));
+        for (const vec3& p : scene_.meshes[m].positions) {
+            proto.lo = glm::min(proto.lo, p);
+            proto.hi = glm::max(proto.hi, p);
+        }
+    }
+    scene_.prototypes.push_back(std::move(proto));
+    return int(scene_.prototypes.size()) - 1;
+}
+
+void GltfReader::placeMeshes() {
+    std::map<int, size_t> uses;
+    for (const Placement& p : placements_)
+        ++uses[p.mesh];
+    std::map<int, int> prototypeOf; // glTF mesh -> prototype, or -1 for none (no triangles)
+    for (const Placement& p : placements_) {
+        if (uses[p.mesh] < 2 || emissive(p.mesh, p.at)) {
+            readMesh(p.mesh, p.world, p.at);
+            continue;
+        }
+        const auto known = prototypeOf.find(p.mesh);
+        const int proto = known != prototypeOf.end()
+                              ? known->second
+                              : prototypeOf[p.mesh] = readPrototype(p.mesh, p.at);
+        if (proto < 0) continue;
+        glm::dmat4 world = p.world;
+        world[3] -= glm::dvec4(scene_.origin, 0.0);
+        std::string error;
+        const Prototype& prototype = scene_.prototypes[size_t(proto)];
+        if (world[0][3] != 0.0 || world[1][3] != 0.0 || world[2][3] != 0.0 || world[3][3] != 1.0)
+            fail(p.at, "the node's transform is not affine (its last row is not 0 0 0 1)");
+        Instance inst = makeInstance(prototype, uint(proto), world, error);
+        if (!error.empty()) {
+            if (error.find("singular") == std::string::npos) fail(p.at, error);
+            warn("places a mesh with a singular transform (a zero scale): not rendered there");
+            continue;
+        }
+        if (scene_.instances.size() >= size_t(kMaxInstances))
+            fail(p.at, "more than " + std::to_string(kMaxInstances) + " instances");
+        for (int k = 0; k < 8; ++k) { // the bounds a camera framing the scene sees
+            const glm::dvec3 corner(k & 1 ? prototype.hi.x : prototype.lo.x,
+                                    k & 2 ? prototype.hi.y : prototype.lo.y,
+                                    k & 4 ? prototype.hi.z : prototype.lo.z);
+            include(glm::dvec3(p.world * glm::dvec4(corner, 1.0)));
+        }
+        scene_.instances.push_back(inst);
+    }
+    placements_.clear();
 }
 
 void GltfReader::readNormals(const tinygltf::Primitive& prim, const glm::dmat4& world,

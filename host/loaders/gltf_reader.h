@@ -31,12 +31,12 @@ class GltfReader {
     // environment).
     void readScene();
 
-    // The file's meshes and lights placed by `transform` into a scene whose camera is set;
-    // every mesh takes `shader` where it is >= 0, else the file's materials, appended.
-    void readObject(const glm::dmat4& transform, int shader);
+    // The file's meshes and lights placed by each of `transforms` into a scene whose camera is
+    // set; every mesh takes `shader` where it is >= 0, else the file's materials, appended.
+    void readObject(const std::vector<glm::dmat4>& transforms, int shader);
 
   private:
-    void read(const glm::dmat4& transform, bool takesCamera);
+    void read(const std::vector<glm::dmat4>& transforms, bool takesCamera);
 
     enum class Pass { Camera, Geometry };
 
@@ -89,6 +89,17 @@ class GltfReader {
     // --- meshes ----------------------------------------------------------------------------
 
     void readMesh(int index, const glm::dmat4& world, const std::string& at);
+
+    // Every mesh the node graph placed (placements_), once it is all walked: a mesh placed once,
+    // or emissive (the light table holds world-space triangles), is read into world space at
+    // each placement; one placed more often is read once, in its own frame, as a prototype, and
+    // each placement is an instance of it.
+    void placeMeshes();
+    // Mesh `index` read in its own frame as a new prototype: its index, or -1 when it has no
+    // triangles.
+    int readPrototype(int index, const std::string& at);
+    // Whether any primitive of mesh `index` takes an emissive shader.
+    bool emissive(int index, const std::string& at);
 
     void readPrimitive(const tinygltf::Primitive& prim, const glm::dmat4& world,
                        const std::string& at, const std::string& name);
@@ -249,6 +260,15 @@ class GltfReader {
     bool bounded_ = false;
     bool cameraFound_ = false, cameraSeen_ = false;
     int shaderOverride_ = -1;
+    // The meshes the node graph places, in the order it names them (visit), read by placeMeshes.
+    struct Placement {
+        int mesh;
+        glm::dmat4 world;
+        std::string at; // the node's mesh, as a JSON pointer
+    };
+    std::vector<Placement> placements_;
+    // While a prototype's meshes are read: its index (their positions stay in the mesh's frame).
+    int prototype_ = -1;
 };
 
 } // namespace spw

@@ -251,14 +251,41 @@ struct PendingObject {
 // A glTF file placed as an object: read once every YAML shader is (its materials follow them).
 struct PendingGltf {
     std::string path;
-    glm::dmat4 transform;
-    int shader; // -1: the file's own materials
+    std::vector<glm::dmat4> transforms; // one per placement (an object's `instances:`)
+    int shader;                         // -1: the file's own materials
 };
 
+// An OBJ placed by `instances:`: read once, in its own frame (Scene::meshes[mesh]), and made a
+// prototype once the shaders are known (an emissive one is copied at each placement instead).
+struct PendingInstances {
+    size_t mesh;
+    std::string path;
+    std::vector<glm::dmat4> transforms;
+    int line; // the `instances:` key's
+};
+
+// The object's transform, or with `instances:` that transform after each instance's own.
+std::vector<glm::dmat4> placements(const Reader& rd, const YAML::Node& n) {
+    const glm::dmat4 xf = readTransform(rd, n, "object", true);
+    if (!n["instances"]) return {xf};
+    const YAML::Node& list = n["instances"];
+    if (!list.IsSequence() || list.size() == 0)
+        rd.fail(list, "instances must be a list of transforms ({translation, rotation, scale})");
+    std::vector<glm::dmat4> out;
+    for (const YAML::Node& e : list) {
+        if (!e.IsMap()) rd.fail(e, "an instance is a map of translation, rotation and scale");
+        rd.checkKeys(e, "instance", {"translation", "rotation", "scale"});
+        out.push_back(xf * readTransform(rd, e, "instance", true));
+    }
+    return out;
+}
+
 void readObject(const Reader& rd, const YAML::Node& n, const fs::path& dir, Scene& scene,
-                std::vector<PendingObject>& pending, std::vector<PendingGltf>& gltf) {
+                std::vector<PendingObject>& pending, std::vector<PendingGltf>& gltf,
+                std::vector<PendingInstances>& instanced) {
     if (!n.IsMap()) rd.fail(n, "object must be a map of keys to values");
-    rd.checkKeys(n, "object", {"type", "filename", "translation", "rotation", "scale", "shader"});
+    rd.checkKeys(n, "object",
+                 {"type", "filename", "translation", "rotation", "scale", "shader", "instances"});
     std::string t = n["type"] ? rd.string(n["type"], "object type") : "Polygon";
     if (t != "Polygon" && t != "Gltf")
         rd.fail(n["type"], "unknown object type '" + t + "' (Polygon, Gltf)");
@@ -272,13 +299,18 @@ void readObject(const Reader& rd, const YAML::Node& n, const fs::path& dir, Scen
     if (isGltf && !isGltfPath(p.string()))
         rd.fail(n["filename"], "a Gltf object's file ends in .gltf or .glb");
     int shader = n["shader"] ? int(rd.integer(n["shader"], "object shader", 0, 1 << 30)) : 0;
-    const glm::dmat4 xf = readTransform(rd, n, "object", true);
+    const std::vector<glm::dmat4> xf = placements(rd, n);
     if (isGltf) {
         gltf.push_back({p.string(), xf, n["shader"] ? shader : -1});
         if (n["shader"]) pending.push_back({n, shader, n["shader"].Mark().line + 1});
         return;
     }
-    Mesh mesh = loadObjMesh(p.string(), xf, scene.origin, rd.file(), n["filename"].Mark().line + 1);
+    const bool instances = bool(n["instances"]);
+    Mesh mesh = loadObjMesh(p.string(), instances ? glm::dmat4(1.0) : xf[0],
+                            instances ? glm::dvec3(0.0) : scene.origin, rd.file(),
+                            n["filename"].Mark().line + 1);
+    if (instances)
+        instanced.push_back({scene.meshes.size(), p.string(), xf, n["instances"].Mark().line + 1});
     scene.inputs.push_back(p.string());
     mesh.shader = shader;
     scene.meshes.push_back(std::move(mesh));
@@ -345,6 +377,11 @@ class SceneReader {
     void finish(const YAML::Node& root);
 
   private:
+    // The OBJ objects placed by `instances:`, once their shaders are known (PendingInstances).
+    void placeInstances();
+    // The glTF objects, a file placed by several objects of one shader read once, as instances.
+    void appendGltfObjects();
+
     void readEntry(const YAML::Node& keyNode, const YAML::Node& v) {
         const std::string key = keyNode.as<std::string>();
         const bool single = key == "image" || key == "settings" || key == "camera" ||
@@ -374,7 +411,7 @@ class SceneReader {
         else if (key == "object" || key == "objects")
             each("objects", [&](const YAML::Node& e) {
                 roomFor(e, 0, 1);
-                readObject(rd_, e, dir_, scene_, pending_, gltf_);
+                readObject(rd_, e, dir_, scene_, pending_, gltf_, instanced_);
             });
         else if (key == "shader" || key == "shaders")
             each("shaders", [&](const YAML::Node& e) {
@@ -424,10 +461,66 @@ class SceneReader {
     TextureReader textures_;
     std::vector<PendingObject> pending_;
     std::vector<PendingGltf> gltf_;
+    std::vector<PendingInstances> instanced_;
     std::vector<Mesh> lightMeshes_;
     std::vector<Shader> lightShaders_;
     std::set<std::string> seenOnce_;
 };
+
+void SceneReader::placeInstances() {
+    for (const PendingInstances& o : instanced_) {
+        Mesh& mesh = scene_.meshes[o.mesh];
+        if (scene_.shaders[size_t(mesh.shader)].params.emission != vec3(0.0f)) {
+            // An emitter: a copy at each placement (the light table holds world triangles).
+            const int shader = mesh.shader;
+            for (size_t i = 0; i < o.transforms.size(); ++i) {
+                Mesh copy = loadObjMesh(o.path, o.transforms[i], scene_.origin, rd_.file(), o.line);
+                copy.shader = shader;
+                if (i == 0)
+                    scene_.meshes[o.mesh] = std::move(copy);
+                else
+                    scene_.meshes.push_back(std::move(copy));
+            }
+            continue;
+        }
+        Prototype proto;
+        proto.name = mesh.name;
+        proto.meshes = {uint(o.mesh)};
+        proto.lo = vec3(std::numeric_limits<float>::max());
+        proto.hi = vec3(-std::numeric_limits<float>::max());
+        for (const vec3& p : mesh.positions) {
+            proto.lo = glm::min(proto.lo, p);
+            proto.hi = glm::max(proto.hi, p);
+        }
+        mesh.prototype = int(scene_.prototypes.size());
+        scene_.prototypes.push_back(std::move(proto));
+        if (scene_.instances.size() + o.transforms.size() > size_t(kMaxInstances))
+            rd_.fail(o.line, "more than " + std::to_string(kMaxInstances) + " instances");
+        for (const glm::dmat4& t : o.transforms) {
+            glm::dmat4 world = t;
+            world[3] -= glm::dvec4(scene_.origin, 0.0);
+            std::string error;
+            scene_.instances.push_back(
+                makeInstance(scene_.prototypes.back(), uint(mesh.prototype), world, error));
+            if (!error.empty()) rd_.fail(o.line, error);
+        }
+    }
+}
+
+void SceneReader::appendGltfObjects() {
+    std::vector<bool> done(gltf_.size(), false);
+    for (size_t i = 0; i < gltf_.size(); ++i) {
+        if (done[i]) continue;
+        std::vector<glm::dmat4> transforms;
+        for (size_t j = i; j < gltf_.size(); ++j)
+            if (gltf_[j].path == gltf_[i].path && gltf_[j].shader == gltf_[i].shader) {
+                transforms.insert(transforms.end(), gltf_[j].transforms.begin(),
+                                  gltf_[j].transforms.end());
+                done[j] = true;
+            }
+        appendGltfObject(gltf_[i].path, transforms, gltf_[i].shader, scene_);
+    }
+}
 
 // What can be checked only once everything is read: the objects' shaders exist, the quad
 // lights' meshes follow the objects', and the camera and sample counts stay in range.
@@ -438,8 +531,8 @@ void SceneReader::finish(const YAML::Node& root) {
             rd_.fail(o.line, "object uses shader " + std::to_string(o.shader) +
                                  " but the scene has " + std::to_string(sceneShaders) + " shader" +
                                  (sceneShaders == 1 ? "" : "s"));
-    for (const PendingGltf& g : gltf_)
-        appendGltfObject(g.path, g.transform, g.shader, scene_);
+    placeInstances();
+    appendGltfObjects();
     if (scene_.shaders.size() + lightShaders_.size() > size_t(kMaxShaders) ||
         scene_.meshes.size() + lightMeshes_.size() > size_t(kMaxObjects))
         rd_.fail(1, "more than " + std::to_string(kMaxShaders) + " shaders or " +

@@ -133,6 +133,8 @@ std::uint64_t sceneHash(const Scene& scene) {
         if (!m.colours.empty()) f.array(m.colours);
         f.array(m.triangles);
     }
+    for (const Instance& inst : scene.instances) // none: the hash as before instances were
+        f.value(inst.prototype).value(inst.toWorld);
     for (const Texture& t : scene.textures) {
         if (t.type != TextureType::Standard) continue;
         if (t.bytes) // embedded in the scene file

@@ -104,6 +104,8 @@ class RenderSession {
     RenderIdentity identity() const;
     void chooseBackend();
     void build();
+    // --stats' "geometry": meshes, prototypes, instances, triangles, and the peak memory so far.
+    void recordGeometry();
     void startAt();
     void writeCheckpoint();
     const char* iterate(const ProgressCallback& onIteration);
@@ -223,6 +225,20 @@ void RenderSession::chooseBackend() {
 
 // What the scene needs (BVH, textures, camera), the render-wide parameters, the film and the
 // backend.
+void RenderSession::recordGeometry() {
+    double stored = 0.0;
+    for (const Mesh& m : scene_.meshes)
+        stored += double(m.triangles.size());
+    stats_.extra["geometry"] = {
+        {"meshes", scene_.meshes.size()},
+        {"prototypes", scene_.prototypes.size()},
+        {"instances", scene_.instances.size()},
+        {"triangles_stored", stored},
+        {"triangles_rendered", scene_.renderedTriangles()},
+        {"peak_rss_mib_after_bvh", peakResidentMiB()},
+    };
+}
+
 void RenderSession::build() {
     textures_.emplace(scene_, scene_.settings.textureCacheMiB,
                       config_.textureFilter == TextureFilter::Cone, config_.pipeline.simdShading,
@@ -238,6 +254,7 @@ void RenderSession::build() {
         embree_ =
             std::make_unique<EmbreeScene>(scene_, cutouts_->meshes() > 0 ? &*cutouts_ : nullptr);
     }
+    recordGeometry();
     hitSetup_.emplace(scene_, *lights_);
     camera_.emplace(scene_, plan_.sampleBase);
 
@@ -384,6 +401,7 @@ void RenderSession::report(const char* stopReason) {
     stats_.spp = (done_ - first_) * spi_;
     if (config_.sampleRange) stats_.extra["samples_range"] = {first_ * spi_, done_ * spi_};
     stats_.extra["render_seconds"] = renderSeconds_;
+    stats_.extra["peak_rss_mib"] = peakResidentMiB();
     stats_.extra["samples_taken"] = film.samplesTaken();
     if (scene_.settings.adaptiveThreshold > 0.0)
         stats_.extra["adaptive"] = {

@@ -6,6 +6,7 @@
 #include "shared/texture_wrap.h"
 #include "shared/types.h"
 
+#include <glm/mat4x4.hpp>
 #include <glm/vec3.hpp>
 
 #include <array>
@@ -54,6 +55,9 @@ constexpr int kMaxTextures = 1 << 16;
 // (one per light included).
 constexpr int kMaxShaders = (1 << 12) - 1;
 constexpr int kMaxObjects = 1 << 20;
+// Instances (Scene::instances): Embree's geometry ids are 32 bits; 2^26 instances of one mesh
+// are about 16 GB of Embree's and Spillway's own records, past any machine this renders on.
+constexpr int kMaxInstances = 1 << 26;
 // A glTF accessor holds at most this many values (elements x components): 2 GiB as the doubles
 // the loader reads them into, and 2^28 / 3 vertices a primitive, far past what one mesh needs.
 constexpr size_t kMaxGltfAccessorValues = size_t(1) << 28;
@@ -228,6 +232,9 @@ struct Mesh {
     int shader = 0;
     std::string name;         // the file, or "quad light N"
     int droppedTriangles = 0; // zero-area triangles left out when loading
+    // The prototype (Scene::prototypes) this mesh belongs to, its vertices then in the
+    // prototype's own frame, placed only by instances; -1: in world space, placed once.
+    int prototype = -1;
 
     // Texture coordinates interpolated at Embree's barycentrics (u, v) of triangle `prim`;
     // (0, 0) where the mesh has none.
@@ -237,6 +244,32 @@ struct Mesh {
         return (1.0f - u - v) * uvs[tri.x] + u * uvs[tri.y] + v * uvs[tri.z];
     }
 };
+
+// Meshes placed many times without copies (glTF's nodes naming one mesh, a YAML object's
+// `instances:`): one Embree scene of their own, placed in the world by instances. A prototype
+// is never emissive (emitters are copied where they are placed: the light table holds world-space
+// triangles).
+struct Prototype {
+    std::vector<uint> meshes; // indices into Scene::meshes, each with Mesh::prototype this one
+    vec3 lo{0.0f}, hi{0.0f};  // the meshes' bounds, in the prototype's frame
+    std::string name;         // the file and mesh, for messages and --stats
+};
+
+// One placement of a prototype: its frame to the camera-relative world (an affine map, made in
+// double and rounded once) and what hit setup needs of it: the inverse transpose that takes
+// normals, and whether the map mirrors (turning its triangles' winding, as a copy's would be).
+struct Instance {
+    uint prototype = 0;
+    mat4 toWorld{1.0f};
+    mat3 normalToWorld{1.0f};
+    bool mirrors = false;
+};
+
+// The instance placing prototype `prototype` by `toWorld` (a finite affine map in double,
+// camera-relative); empty `error` unless it cannot be one: singular, or reaching beyond
+// kMaxDistance with the prototype's bounds.
+Instance makeInstance(const Prototype& proto, uint prototype, const glm::dmat4& toWorld,
+                      std::string& error);
 
 // A punctual light of an emitter kind that takes a position or a direction
 // (host/scene/emitter_kinds.h): a point light's `intensity` W/sr in every direction at
@@ -279,6 +312,8 @@ struct Scene {
     std::vector<Mesh> meshes; // objects first, then the quad lights' geometry
     int objectCount = 0;
     int quadLightCount = 0;
+    std::vector<Prototype> prototypes;
+    std::vector<Instance> instances;
     std::vector<PunctualLight> punctualLights;
     std::optional<Environment> environment;
     // What the file holds that is not rendered ("file: what"), once each: the CLI prints them.
@@ -290,7 +325,13 @@ struct Scene {
     std::vector<std::string> inputs;
 
     bool usesTextures() const;
+    // The triangles the scene renders, every instance's counted.
+    double renderedTriangles() const;
 };
+
+// The bounds of every vertex the scene renders, in double: world-space meshes' vertices, and
+// each instance's prototype bounds moved to world space; lo > hi where the scene has none.
+void sceneBounds(const Scene& scene, glm::dvec3& lo, glm::dvec3& hi);
 
 // Empty when `p` (relative to the camera) lies within kMaxDistance of it; else the message that
 // says so, naming `what` (the loader and the OBJ reader report it at their own file and line).

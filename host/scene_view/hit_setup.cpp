@@ -1,5 +1,6 @@
 #include "host/scene_view/hit_setup.h"
 
+#include "host/scene_view/hit_triangle.h"
 #include "host/scene_view/wide_hits.h"
 
 #include "shared/cone.h"
@@ -19,50 +20,68 @@ HitSetup::HitSetup(const Scene& scene, const SceneLights& lights) : src_(scene),
     }
 }
 
-// Wide twin: setUpHitLanes (host/scene_view/wide_hits.cpp), with textureQuery.
-void HitSetup::surfaceHit(uint meshIndex, uint prim, float u, float v, float t,
-                          SurfaceHit& hit) const {
-    const Mesh& mesh = src_.meshes[meshIndex];
-    const uvec3 tri = mesh.triangles[prim];
-    // References, not copies: GCC copies a 12-byte vec3 through the stack in two stores that one
-    // 8-byte load then straddles, a store-forwarding stall that was a quarter of this function.
-    const vec3 &p0 = mesh.positions[tri.x], &p1 = mesh.positions[tri.y],
-               &p2 = mesh.positions[tri.z];
-    const float w = 1.0f - u - v;
-    hit.p = w * p0 + u * p1 + v * p2;
-    hit.t = t;
-    hit.ng = glm::normalize(glm::cross(p1 - p0, p2 - p0));
-    hit.ns = hit.ng;
-    if (!mesh.normals.empty()) {
-        vec3 n = w * mesh.normals[tri.x] + u * mesh.normals[tri.y] + v * mesh.normals[tri.z];
-        float len = glm::length(n);
-        if (len > 0.0f) hit.ns = n / len;
-    }
-    hit.shader = uint(mesh.shader);
-    hit.emitter = lights_.emitterOf(meshIndex, prim);
-    hit.albedo = vec3(0.0f);
-    hit.offset = surfaceOffset(hit.p, p0, p1, p2, hit.ng);
-    hit.material = 0u;
-    hit.extension = uvec2(0u);
-    hit.lift = smoothLift(mesh, tri, u, v, hit.p, hit.ng);
-}
-
+namespace {
+// Each vertex's tangent plane lifts p onto it where p lies below it: the smooth surface's height
+// over triangle c (unit geometric normal ng) at p; 0 without vertex normals.
 // Wide twin: smoothLift in host/scene_view/wide_hits.cpp.
-float HitSetup::smoothLift(const Mesh& mesh, uvec3 tri, float u, float v, vec3 p, vec3 ng) {
-    if (mesh.normals.empty()) return 0.0f;
-    // Each vertex's tangent plane lifts p onto it where p lies below it.
-    auto toPlane = [&](uint i) {
-        const vec3 n = mesh.normals[i];
-        return n * std::max(0.0f, glm::dot(mesh.positions[i] - p, n));
+template <class Triangle> float liftOver(const Triangle& c, vec3 p, vec3 ng) {
+    if (!c.hasNormals()) return 0.0f;
+    auto toPlane = [&](int i) {
+        const vec3 n = c.n(i);
+        return n * std::max(0.0f, glm::dot(c.p(i) - p, n));
     };
-    const vec3 up = (1.0f - u - v) * toPlane(tri.x) + u * toPlane(tri.y) + v * toPlane(tri.z);
+    const vec3 up = (1.0f - c.u - c.v) * toPlane(0) + c.u * toPlane(1) + c.v * toPlane(2);
     const float lift = glm::dot(up, ng);
     return std::isfinite(lift) ? lift : 0.0f;
 }
 
+// The geometry of a hit on triangle c at distance t: position, normals, offset, lift.
+// Wide twin: setUpHitLanes (host/scene_view/wide_hits.cpp).
+template <class Triangle> void placeHit(const Triangle& c, float t, SurfaceHit& hit) {
+    // References, not copies: GCC copies a 12-byte vec3 through the stack in two stores that one
+    // 8-byte load then straddles, a store-forwarding stall that was a quarter of this function.
+    const vec3 &p0 = c.p(0), &p1 = c.p(1), &p2 = c.p(2);
+    const float u = c.u, v = c.v, w = 1.0f - u - v;
+    hit.p = w * p0 + u * p1 + v * p2;
+    hit.t = t;
+    hit.ng = glm::normalize(glm::cross(p1 - p0, p2 - p0));
+    hit.ns = hit.ng;
+    if (c.hasNormals()) {
+        vec3 n = w * c.n(0) + u * c.n(1) + v * c.n(2);
+        float len = glm::length(n);
+        if (len > 0.0f) hit.ns = n / len;
+    }
+    hit.offset = surfaceOffset(hit.p, p0, p1, p2, hit.ng);
+    hit.lift = liftOver(c, hit.p, hit.ng);
+}
+} // namespace
+
+void HitSetup::surfaceHit(const HitRecord& h, SurfaceHit& hit) const {
+    onHitTriangle(src_, h.mesh, h.prim, h.u, h.v, h.instance,
+                  [&](const auto& c) { placeHit(c, h.t, hit); });
+    hit.shader = uint(src_.meshes[h.mesh].shader);
+    hit.emitter = lights_.emitterOf(h.mesh, h.prim);
+    hit.albedo = vec3(0.0f);
+    hit.material = 0u;
+    hit.extension = uvec2(0u);
+}
+
+float HitSetup::smoothLift(const Mesh& mesh, uvec3 tri, float u, float v, vec3 p, vec3 ng) {
+    MeshTriangle c(mesh, 0, u, v);
+    c.tri = tri;
+    return liftOver(c, p, ng);
+}
+
+void HitSetup::applyVertexColour(const HitRecord& h, SurfaceHit& hit) const {
+    if (src_.meshes[h.mesh].colours.empty()) return;
+    onHitTriangle(src_, h.mesh, h.prim, h.u, h.v, h.instance, [&](const auto& c) {
+        hit.albedo *= (1.0f - c.u - c.v) * c.colour(0) + c.u * c.colour(1) + c.v * c.colour(2);
+    });
+}
+
 void HitSetup::setUpHit(const HitRecord& h, vec3 dir, uint cone, const TextureResolver& textures,
                         bool albedo, SurfaceHit& hit) const {
-    surfaceHit(h.mesh, h.prim, h.u, h.v, h.t, hit);
+    surfaceHit(h, hit);
     if (!albedo) return;
     const Shader& shader = src_.shaders[hit.shader];
     if (!shader.looksUpTextures()) {
@@ -146,13 +165,11 @@ void HitSetup::applyExtensionMaps(const Shader& shader, const TextureResolver& t
                                   packHalf2x16(vec2(slots[k].z, slots[k].w)));
 }
 
-vec3 HitSetup::tiltedNormal(const HitRecord& h, vec3 n, vec3 texel, float scale) const {
-    const Mesh& mesh = src_.meshes[h.mesh];
-    if (mesh.uvs.empty()) return n;
-    const uvec3 tri = mesh.triangles[h.prim];
-    const vec3 e1 = mesh.positions[tri.y] - mesh.positions[tri.x],
-               e2 = mesh.positions[tri.z] - mesh.positions[tri.x];
-    const vec2 d1 = mesh.uvs[tri.y] - mesh.uvs[tri.x], d2 = mesh.uvs[tri.z] - mesh.uvs[tri.x];
+namespace {
+template <class Triangle> vec3 tiltOn(const Triangle& c, vec3 n, vec3 texel, float scale) {
+    if (!c.hasUvs()) return n;
+    const vec3 e1 = c.p(1) - c.p(0), e2 = c.p(2) - c.p(0);
+    const vec2 d1 = c.uv(1) - c.uv(0), d2 = c.uv(2) - c.uv(0);
     const float det = d1.x * d2.y - d2.x * d1.y;
     if (!(std::fabs(det) > 0.0f)) return n;
     // dp/du and dp/dv of the triangle's texture mapping.
@@ -169,27 +186,38 @@ vec3 HitSetup::tiltedNormal(const HitRecord& h, vec3 n, vec3 texel, float scale)
     return length > 0.0f && std::isfinite(length) ? tilted / length : n;
 }
 
-// Wide twin: setUpHitLanes (host/scene_view/wide_hits.cpp), with surfaceHit.
+// The texture lookup's coordinates on triangle c and its filter width in texture space: the
+// cone's width at the hit, stretched by the incidence (1/|cos|, at most 1000x at grazing angles)
+// and scaled by the triangle's texture area over its world area (the Delta_0 term of
+// Akenine-Moller et al. 2019's ray-cone LOD).
+// Wide twin: setUpHitLanes (host/scene_view/wide_hits.cpp), with placeHit.
+template <class Triangle>
+void queryOn(const Triangle& c, vec3 dir, uint cone, float t, vec3 ng, vec2& uv, float& footprint) {
+    footprint = 0.0f;
+    if (!c.hasUvs()) {
+        uv = vec2(0.0f);
+        return;
+    }
+    const vec3 p0 = c.p(0);
+    const vec2 t0 = c.uv(0);
+    const float worldArea = glm::length(glm::cross(c.p(1) - p0, c.p(2) - p0));
+    const vec2 a = c.uv(1) - t0, b = c.uv(2) - t0;
+    const float uvArea = std::fabs(a.x * b.y - a.y * b.x);
+    const float cosine = std::max(std::fabs(glm::dot(dir, ng)), 1e-3f);
+    if (worldArea > 0.0f) footprint = coneWidthAt(cone, t) / cosine * std::sqrt(uvArea / worldArea);
+    uv = (1.0f - c.u - c.v) * c.uv(0) + c.u * c.uv(1) + c.v * c.uv(2);
+}
+} // namespace
+
+vec3 HitSetup::tiltedNormal(const HitRecord& h, vec3 n, vec3 texel, float scale) const {
+    return onHitTriangle(src_, h.mesh, h.prim, h.u, h.v, h.instance,
+                         [&](const auto& c) { return tiltOn(c, n, texel, scale); });
+}
+
 void HitSetup::textureQuery(const HitRecord& h, vec3 dir, uint cone, const SurfaceHit& hit,
                             vec2& uv, float& footprint) const {
-    // The filter width in texture space: the cone's width at the hit, stretched by the
-    // incidence (1/|cos|, at most 1000x at grazing angles) and scaled by the triangle's texture
-    // area over its world area (the Delta_0 term of Akenine-Moller et al. 2019's ray-cone LOD).
-    const Mesh& mesh = src_.meshes[h.mesh];
-    footprint = 0.0f;
-    if (!mesh.uvs.empty()) {
-        const uvec3 tri = mesh.triangles[h.prim];
-        const vec3 p0 = mesh.positions[tri.x];
-        const vec2 t0 = mesh.uvs[tri.x];
-        const float worldArea =
-            glm::length(glm::cross(mesh.positions[tri.y] - p0, mesh.positions[tri.z] - p0));
-        const vec2 a = mesh.uvs[tri.y] - t0, b = mesh.uvs[tri.z] - t0;
-        const float uvArea = std::fabs(a.x * b.y - a.y * b.x);
-        const float cosine = std::max(std::fabs(glm::dot(dir, hit.ng)), 1e-3f);
-        if (worldArea > 0.0f)
-            footprint = coneWidthAt(cone, h.t) / cosine * std::sqrt(uvArea / worldArea);
-    }
-    uv = mesh.uvAt(h.prim, h.u, h.v);
+    onHitTriangle(src_, h.mesh, h.prim, h.u, h.v, h.instance,
+                  [&](const auto& c) { queryOn(c, dir, cone, h.t, hit.ng, uv, footprint); });
 }
 
 namespace {
@@ -203,30 +231,28 @@ vec3 lane(const simd::Vec3s& lanes, size_t j) {
     return vec3(lanes.x.v[j], lanes.y.v[j], lanes.z.v[j]);
 }
 
-// A triangle's corners' values (vertex normals, texture coordinates) into lane `to` of rows a, b
-// and c, and `has` all ones; zeros and 0 where the mesh has none.
-template <class T, class Rows>
-void setCorners(const std::vector<T>& values, uvec3 tri, Rows& a, Rows& b, Rows& c,
-                simd::Uints& has, size_t to) {
-    const bool any = !values.empty();
-    has.v[to] = any ? ~0u : 0u;
-    setLane(a, to, any ? values[tri.x] : T(0.0f));
-    setLane(b, to, any ? values[tri.y] : T(0.0f));
-    setLane(c, to, any ? values[tri.z] : T(0.0f));
-}
-
-// A hit's triangle, ray and barycentrics into lane `to` of `l`: vertex normals, and texture
+// A hit's triangle c, ray and distance t into lane `to` of `l`: vertex normals, and texture
 // coordinates with the ray's direction and cone, where the block has any (l.anyNormals,
 // l.anyUvs), zeros and a mask of 0 in the lanes of a mesh without them.
-void gatherLane(const Mesh& mesh, const HitRecord& h, vec3 dir, uint cone, HitLanes& l, size_t to) {
-    const uvec3 tri = mesh.triangles[h.prim];
-    l.u.v[to] = h.u, l.v.v[to] = h.v, l.t.v[to] = h.t;
-    setLane(l.p0, to, mesh.positions[tri.x]);
-    setLane(l.p1, to, mesh.positions[tri.y]);
-    setLane(l.p2, to, mesh.positions[tri.z]);
-    if (l.anyNormals) setCorners(mesh.normals, tri, l.n0, l.n1, l.n2, l.hasNormals, to);
+template <class Triangle>
+void gatherLane(const Triangle& c, float t, vec3 dir, uint cone, HitLanes& l, size_t to) {
+    l.u.v[to] = c.u, l.v.v[to] = c.v, l.t.v[to] = t;
+    setLane(l.p0, to, c.p(0));
+    setLane(l.p1, to, c.p(1));
+    setLane(l.p2, to, c.p(2));
+    if (l.anyNormals) {
+        const bool has = c.hasNormals();
+        l.hasNormals.v[to] = has ? ~0u : 0u;
+        setLane(l.n0, to, has ? c.n(0) : vec3(0.0f));
+        setLane(l.n1, to, has ? c.n(1) : vec3(0.0f));
+        setLane(l.n2, to, has ? c.n(2) : vec3(0.0f));
+    }
     if (!l.anyUvs) return; // the ray's direction and cone serve only the texture query
-    setCorners(mesh.uvs, tri, l.t0, l.t1, l.t2, l.hasUvs, to);
+    const bool has = c.hasUvs();
+    l.hasUvs.v[to] = has ? ~0u : 0u;
+    setLane(l.t0, to, has ? c.uv(0) : vec2(0.0f));
+    setLane(l.t1, to, has ? c.uv(1) : vec2(0.0f));
+    setLane(l.t2, to, has ? c.uv(2) : vec2(0.0f));
     setLane(l.dir, to, dir);
     l.coneWidth.v[to] = coneWidth(cone), l.coneSpread.v[to] = coneSpread(cone);
 }
@@ -239,7 +265,9 @@ void HitSetup::setUpHits(size_t n, const HitRecord* const* hits, const vec3* dir
     const size_t count = simd::wholeVectors(n);
     for (size_t j = 0; j < count; ++j) { // padding repeats the last hit
         const size_t from = std::min(j, n - 1);
-        gatherLane(src_.meshes[hits[from]->mesh], *hits[from], dir[from], cone[from], l, j);
+        const HitRecord& h = *hits[from];
+        onHitTriangle(src_, h.mesh, h.prim, h.u, h.v, h.instance,
+                      [&](const auto& c) { gatherLane(c, h.t, dir[from], cone[from], l, j); });
     }
     setUpHitLanes(count, l);
     for (size_t j = 0; j < n; ++j) {

@@ -11,12 +11,15 @@
 namespace spw {
 
 // A closest hit in Spillway's terms, what traversal hands the rest of the renderer: the mesh
-// (Embree's geometry id), the triangle, Embree's barycentric u and v, and the distance.
+// (Embree's geometry id), the triangle, Embree's barycentric u and v, the distance, and the
+// instance that placed the mesh (Scene::instances), or kNoInstance for a world-space mesh.
 constexpr uint kNoHit = 0xFFFFFFFFu;
+constexpr uint kNoInstance = 0xFFFFFFFFu;
 struct HitRecord {
     uint mesh; // kNoHit: the ray missed
     uint prim;
     float u, v, t;
+    uint instance = kNoInstance;
 };
 
 class HitSetup {
@@ -34,9 +37,7 @@ class HitSetup {
     // setUpHit in two halves, for a caller that looks textures up for many hits at once
     // (TextureResolver::albedos): the world-space hit, albedo 0; then where the hit's texture
     // is looked up, its uv and its filter footprint in texture space.
-    void setUpGeometry(const HitRecord& h, SurfaceHit& hit) const {
-        surfaceHit(h.mesh, h.prim, h.u, h.v, h.t, hit);
-    }
+    void setUpGeometry(const HitRecord& h, SurfaceHit& hit) const { surfaceHit(h, hit); }
     void textureQuery(const HitRecord& h, vec3 dir, uint cone, const SurfaceHit& hit, vec2& uv,
                       float& footprint) const;
     // setUpGeometry and textureQuery for n <= simd::kBlock hits at once, the arithmetic SIMD-wide
@@ -63,13 +64,7 @@ class HitSetup {
                                    const vec2* uv, const float* footprint, SurfaceHit* const* hit);
     // The albedo times the hit's interpolated vertex colour, where its mesh has them
     // (Mesh::colours). After the albedo is set.
-    void applyVertexColour(const HitRecord& h, SurfaceHit& hit) const {
-        const Mesh& mesh = src_.meshes[h.mesh];
-        if (mesh.colours.empty()) return;
-        const uvec3 tri = mesh.triangles[h.prim];
-        hit.albedo *= (1.0f - h.u - h.v) * mesh.colours[tri.x] + h.u * mesh.colours[tri.y] +
-                      h.v * mesh.colours[tri.z];
-    }
+    void applyVertexColour(const HitRecord& h, SurfaceHit& hit) const;
     // What setUpGeometry will read, asked for ahead by a caller that knows many hits before it
     // sets them up: first the triangle's vertex indices, then (reading those) its vertices and
     // vertex normals. On a mesh larger than the caches each is a miss that the depth-first
@@ -93,8 +88,8 @@ class HitSetup {
     static float smoothLift(const Mesh& mesh, uvec3 tri, float u, float v, vec3 p, vec3 ng);
 
   private:
-    // World-space hit for (mesh, triangle, Embree's u, v) at distance t; albedo left at 0.
-    void surfaceHit(uint meshIndex, uint prim, float u, float v, float t, SurfaceHit& hit) const;
+    // World-space hit for h (its instance's transform applied); albedo left at 0.
+    void surfaceHit(const HitRecord& h, SurfaceHit& hit) const;
 
     const Scene& src_;
     const SceneLights& lights_;

@@ -36,15 +36,12 @@ std::vector<vec3> halved(const std::vector<vec3>& in, int& w, int& h) {
     return out;
 }
 
-// The radius of a sphere around every vertex of the scene (centred on their bounding box): the
-// scale an environment's power is measured at.
+// The radius of a sphere around every vertex of the scene (centred on their bounding box; an
+// instance's vertices by its prototype's bounds): the scale an environment's power is measured
+// at.
 double sceneRadius(const Scene& scene) {
-    glm::dvec3 lo(std::numeric_limits<double>::max()), hi(-std::numeric_limits<double>::max());
-    for (const Mesh& m : scene.meshes)
-        for (const vec3& p : m.positions) {
-            lo = glm::min(lo, glm::dvec3(p));
-            hi = glm::max(hi, glm::dvec3(p));
-        }
+    glm::dvec3 lo, hi;
+    sceneBounds(scene, lo, hi);
     return lo.x <= hi.x ? 0.5 * glm::length(hi - lo) : 0.0;
 }
 
@@ -140,6 +137,8 @@ void SceneLights::addTriangles(const Scene& scene, size_t m, const TextureResolv
     const Shader& shader = scene.shaders[size_t(mesh.shader)];
     const ShaderParams& sp = shader.params;
     if (maxComponent(sp.emission) <= 0.0f) return;
+    if (mesh.prototype >= 0) // the loaders copy emitters where they are placed (Prototype)
+        throw std::logic_error(mesh.name + ": an emissive mesh placed by instances");
     const EmissionImage* image = nullptr;
     if (shader.emissionTexture >= 0) {
         if (!textures || !textures->active())

@@ -1,0 +1,289 @@
+// Instancing (Scene::prototypes, Scene::instances): a glTF mesh that several nodes name, a glTF
+// file that several YAML objects place and an OBJ placed by `instances:` are one prototype,
+// traced through a two-level BVH. Each is checked against the same scene flattened (every
+// placement a copy): the same counts, the same world-space hits up to float rounding (mirrored
+// instances included), and on every backend the same image within the standard errors of the
+// paired difference. Malformed placements are refused with the file and where in it.
+#include "embree_backend/batch_traversal.h"
+#include "embree_backend/embree_scene.h"
+#include "host/loaders/scene_loader.h"
+#include "host/scene_view/hit_setup.h"
+#include "host/scene_view/lights.h"
+#include "host/textures/textures.h"
+#include "scene/gltf_builder.h"
+#include "test_util.h"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+namespace spw::test {
+namespace {
+
+using nlohmann::json;
+
+// A box [-0.5, 0.5]^3 with smooth normals (each corner's along its diagonal) and texture
+// coordinates: 8 vertices, 12 triangles facing out.
+json boxPrimitive(GltfBuilder& b, int material) {
+    std::vector<float> pos, nor, uv;
+    for (int c = 0; c < 8; ++c) {
+        const vec3 p(c & 1 ? 0.5f : -0.5f, c & 2 ? 0.5f : -0.5f, c & 4 ? 0.5f : -0.5f);
+        const vec3 n = glm::normalize(p);
+        pos.insert(pos.end(), {p.x, p.y, p.z});
+        nor.insert(nor.end(), {n.x, n.y, n.z});
+        uv.insert(uv.end(), {p.x + 0.5f, p.y + 0.5f});
+    }
+    const std::vector<uint16_t> idx = {0, 2, 1, 1, 2, 3, 4, 5, 6, 5, 7, 6, 0, 1, 4, 1, 5, 4,
+                                       2, 6, 3, 3, 6, 7, 0, 4, 2, 2, 4, 6, 1, 3, 5, 3, 7, 5};
+    json prim = {{"attributes",
+                  {{"POSITION", b.accessor(pos, 5126, "VEC3")},
+                   {"NORMAL", b.accessor(nor, 5126, "VEC3")},
+                   {"TEXCOORD_0", b.accessor(uv, 5126, "VEC2")}}},
+                 {"indices", b.accessor(idx, 5123, "SCALAR")},
+                 {"material", material}};
+    return prim;
+}
+
+// The box placed by four nodes (turned, stretched, one mirrored) over a floor, under the file's
+// default lighting, seen by a camera: `shared` one mesh the four name, else four meshes of the
+// same accessors (the flattened scene). `emission` makes the boxes' material emissive.
+std::string boxes(const TempDir& dir, const std::string& name, bool shared,
+                  vec3 emission = vec3(0.0f)) {
+    GltfBuilder b;
+    b.doc["materials"] = json::array({material(vec3(0.8f, 0.5f, 0.25f), 0.0f, 0.5f, emission),
+                                      material(vec3(0.6f), 0.0f, 1.0f)});
+    b.doc["cameras"] =
+        json::array({{{"type", "perspective"},
+                      {"perspective", {{"yfov", 0.9}, {"aspectRatio", 1.25}, {"znear", 0.1}}}}});
+    const json box = boxPrimitive(b, 0);
+    const int floor = b.mesh(b.quad(1));
+    std::vector<int> roots = {
+        b.node({{"mesh", floor}, {"scale", {8, 8, 1}}, {"translation", {-4, -4, -0.5}}})};
+    const std::vector<json> placements = {
+        {{"translation", {-1.2, 0.0, 0.0}}},
+        {{"translation", {0.0, 0.3, 0.2}}, {"rotation", {0.0, 0.3826834, 0.0, 0.9238795}}},
+        {{"translation", {1.2, -0.2, 0.1}}, {"scale", {0.6, 1.4, 0.8}}},
+        {{"translation", {0.3, 1.3, 0.0}}, {"scale", {-1.0, 0.7, 1.0}}}, // mirrors
+    };
+    const int one = b.mesh(box);
+    for (json node : placements) {
+        node["mesh"] = shared ? one : b.mesh(box);
+        roots.push_back(b.node(node));
+    }
+    roots.push_back(b.node({{"camera", 0}, {"translation", {0.0, 0.4, 5.0}}}));
+    b.scene(roots);
+    return b.embedded(dir, name);
+}
+
+TEST(Instancing, AMeshNamedByManyNodesIsOnePrototype) {
+    TempDir dir;
+    const Scene inst = loadScene(boxes(dir, "shared.gltf", true));
+    const Scene flat = loadScene(boxes(dir, "flat.gltf", false));
+    ASSERT_EQ(inst.prototypes.size(), 1u);
+    ASSERT_EQ(inst.instances.size(), 4u);
+    EXPECT_EQ(inst.meshes.size(), 2u); // the floor and the box, once
+    EXPECT_TRUE(flat.prototypes.empty());
+    EXPECT_TRUE(flat.instances.empty());
+    EXPECT_EQ(flat.meshes.size(), 5u);
+    EXPECT_EQ(inst.renderedTriangles(), flat.renderedTriangles());
+    EXPECT_EQ(inst.renderedTriangles(), 2.0 + 4 * 12.0);
+    EXPECT_EQ(inst.instances[3].mirrors, true);
+    EXPECT_EQ(inst.instances[0].mirrors, false);
+    // The bounds every light is measured at are the flattened scene's.
+    glm::dvec3 lo, hi, flo, fhi;
+    sceneBounds(inst, lo, hi);
+    sceneBounds(flat, flo, fhi);
+    for (int k = 0; k < 3; ++k) {
+        EXPECT_NEAR(lo[k], flo[k], 1e-5);
+        EXPECT_NEAR(hi[k], fhi[k], 1e-5);
+    }
+}
+
+// Rays from the camera through a grid: each hits the same surface in both scenes, and hit setup
+// gives the same world-space point, normals, offset, lift and texture coordinates (a mirrored
+// instance's winding turned as its copy's is).
+TEST(Instancing, HitsSetUpInWorldSpaceAsTheirCopies) {
+    TempDir dir;
+    const Scene inst = loadScene(boxes(dir, "shared.gltf", true));
+    const Scene flat = loadScene(boxes(dir, "flat.gltf", false));
+    const SceneLights li(inst, nullptr), lf(flat, nullptr);
+    const EmbreeScene ei(inst), ef(flat);
+    const HitSetup si(inst, li), sf(flat, lf);
+    int instanced = 0, mirrored = 0, rays = 0, apart = 0;
+    for (int y = 0; y < 40; ++y)
+        for (int x = 0; x < 50; ++x) { // off the boxes' edges: no ray grazes one in one scene only
+            const vec3 dir = glm::normalize(
+                vec3((x - 25 + 0.3183f) / 29.7f, (y - 20 + 0.2718f) / 29.7f - 0.1f, -1.0f));
+            const HitRecord a = intersectOne(ei, vec3(0.0f), dir),
+                            b = intersectOne(ef, vec3(0.0f), dir);
+            ++rays;
+            if (a.mesh == kNoHit && b.mesh == kNoHit) continue;
+            if (a.mesh == kNoHit || b.mesh == kNoHit || a.prim != b.prim ||
+                std::fabs(a.t - b.t) > 1e-5f * b.t) {
+                ++apart; // an edge that rounding puts on the other side
+                continue;
+            }
+            SurfaceHit ha{}, hb{};
+            si.setUpGeometry(a, ha);
+            sf.setUpGeometry(b, hb);
+            vec2 uva, uvb;
+            float fa, fb;
+            si.textureQuery(a, dir, 0u, ha, uva, fa);
+            sf.textureQuery(b, dir, 0u, hb, uvb, fb);
+            if (a.instance != kNoInstance) {
+                ++instanced;
+                mirrored += inst.instances[a.instance].mirrors;
+            }
+            for (int k = 0; k < 3; ++k) {
+                EXPECT_NEAR(ha.p[k], hb.p[k], 1e-5f);
+                EXPECT_NEAR(ha.ng[k], hb.ng[k], 1e-5f);
+                EXPECT_NEAR(ha.ns[k], hb.ns[k], 1e-5f);
+            }
+            EXPECT_NEAR(ha.offset, hb.offset, 1e-6f + 1e-3f * hb.offset);
+            EXPECT_NEAR(ha.lift, hb.lift, 1e-5f);
+            EXPECT_NEAR(uva.x, uvb.x, 1e-5f);
+            EXPECT_NEAR(uva.y, uvb.y, 1e-5f);
+            EXPECT_NEAR(fa, fb, 1e-4f * fb);
+            EXPECT_EQ(ha.shader, hb.shader);
+        }
+    EXPECT_LE(apart, rays / 500) << "hits on other surfaces";
+    EXPECT_GT(instanced, 150);
+    EXPECT_GT(mirrored, 20);
+}
+
+// Every backend renders the instanced scene as the flattened one: iteration by iteration (the
+// same random numbers), their difference has mean zero within its standard errors, with a
+// per-pixel allowance for the float rounding of the two scenes' vertices.
+TEST(Instancing, EveryBackendRendersTheFlattenedImage) {
+    TempDir dir;
+    Scene inst = loadScene(boxes(dir, "shared.gltf", true));
+    Scene flat = loadScene(boxes(dir, "flat.gltf", false));
+    for (Scene* s : {&inst, &flat})
+        s->image.width = 40, s->image.height = 32;
+    for (const std::string& backend : backendsUnderTest()) {
+        RenderConfig config;
+        config.backend = backend == "reference" ? BackendKind::Reference
+                         : backend == "cpu"     ? BackendKind::Cpu
+                                                : BackendKind::Vulkan;
+        config.spp = 64;
+        const auto a = iterationImages(inst, config), b = iterationImages(flat, config);
+        ASSERT_FALSE(a.empty());
+        EXPECT_GT(mean(a.back()), 0.05) << backend;
+        expectNoPairedDifference(pairedDifference(a, b), 40, 32, backend + ": instanced - flat",
+                                 1e-4 * mean(b.back()));
+    }
+}
+
+// An emitter is copied at each placement: the light table holds world-space triangles.
+TEST(Instancing, AnEmissiveMeshIsCopiedWhereItIsPlaced) {
+    TempDir dir;
+    const Scene s = loadScene(boxes(dir, "lamps.gltf", true, vec3(1.0f)));
+    EXPECT_TRUE(s.prototypes.empty());
+    EXPECT_TRUE(s.instances.empty());
+    EXPECT_EQ(s.meshes.size(), 5u);
+}
+
+// A YAML object's `instances:` and a glTF file placed by several objects: prototypes, rendered
+// as the same placements written out as objects of their own.
+TEST(Instancing, YamlInstancesRenderAsSeparateObjects) {
+    TempDir dir;
+    dir.write("floor.obj", floorObj(4.0f));
+    dir.write("cube.obj", insideCubeObj());
+    const std::string head = "image: {width: 32, height: 24}\n"
+                             "camera: {translation: [0, 1.5, 6], rotation: [-10, 0, 0]}\n"
+                             "settings: {max depth: 4}\n"
+                             "shaders:\n  - {type: Lambert, colour: [0.7, 0.6, 0.5]}\n"
+                             "lights:\n  - {type: Point, position: [1, 4, 2], intensity: 20}\n"
+                             "  - {type: Environment, intensity: 0.3}\n"
+                             "objects:\n  - {filename: floor.obj}\n";
+    const std::vector<std::string> places = {
+        "{translation: [-1.5, 0.5, 0], scale: 0.4}",
+        "{translation: [0, 0.6, 0], rotation: [0, 30, 0], "
+        "scale: [0.5, 0.6, 0.4]}",
+        "{translation: [1.5, 0.5, 0], scale: [-0.4, 0.4, 0.4]}"};
+    std::string instanced = head + "  - filename: cube.obj\n    instances:\n";
+    std::string flattened = head;
+    for (const std::string& p : places) {
+        instanced += "      - " + p + "\n";
+        std::string object = p;
+        object.insert(1, "filename: cube.obj, ");
+        flattened += "  - " + object + "\n";
+    }
+    const Scene a = loadScene(dir.write("instanced.yaml", instanced));
+    const Scene b = loadScene(dir.write("flattened.yaml", flattened));
+    ASSERT_EQ(a.instances.size(), 3u);
+    EXPECT_TRUE(a.instances[2].mirrors);
+    EXPECT_TRUE(b.instances.empty());
+    for (BackendKind backend : {BackendKind::Reference, BackendKind::Cpu}) {
+        RenderConfig config;
+        config.backend = backend;
+        config.spp = 64;
+        const auto ia = iterationImages(a, config), ib = iterationImages(b, config);
+        EXPECT_GT(mean(ia.back()), 0.01);
+        expectNoPairedDifference(pairedDifference(ia, ib), 32, 24, "instances: - objects",
+                                 1e-4 * mean(ib.back()));
+    }
+
+    // One glTF file placed by three objects: one reader, its mesh a prototype of three.
+    boxes(dir, "box.gltf", false);
+    const Scene g = loadScene(dir.write(
+        "gltf.yaml", head + "  - {type: Gltf, filename: box.gltf, translation: [0, 0, -3]}\n"
+                            "  - {type: Gltf, filename: box.gltf, translation: [0, 0, -6]}\n"
+                            "  - type: Gltf\n    filename: box.gltf\n"
+                            "    instances: [{translation: [0, 0, -9]}]\n"));
+    // The file's five meshes (the floor and four boxes), each placed three times.
+    EXPECT_EQ(g.prototypes.size(), 5u);
+    EXPECT_EQ(g.instances.size(), 15u);
+}
+
+// The message loading `path` throws ("" where it loads).
+std::string loadError(const std::string& path) {
+    try {
+        loadScene(path);
+    } catch (const SceneError& e) {
+        return e.what();
+    }
+    return "";
+}
+
+TEST(Instancing, MalformedPlacementsAreRefusedWithWhere) {
+    TempDir dir;
+    dir.write("cube.obj", insideCubeObj());
+    const std::string head = "shaders: [{type: Lambert}]\nobjects:\n  - filename: cube.obj\n";
+    const std::string empty = dir.write("empty.yaml", head + "    instances: []\n");
+    EXPECT_EQ(loadError(empty), empty + ":4: instances must be a list of transforms "
+                                        "({translation, rotation, scale})");
+    const std::string notMap = dir.write("scalar.yaml", head + "    instances: [3]\n");
+    EXPECT_EQ(loadError(notMap),
+              notMap + ":4: an instance is a map of translation, rotation and scale");
+    const std::string key = dir.write("key.yaml", head + "    instances: [{shader: 0}]\n");
+    EXPECT_NE(loadError(key).find(key + ":4: "), std::string::npos) << loadError(key);
+    const std::string zero = dir.write("zero.yaml", head + "    instances: [{scale: 0}]\n");
+    EXPECT_NE(loadError(zero).find("scale must not be zero"), std::string::npos);
+    const std::string far =
+        dir.write("far.yaml", head + "    instances: [{translation: [1e16, 0, 0]}]\n");
+    EXPECT_NE(loadError(far).find(far + ":4: an instance of"), std::string::npos) << loadError(far);
+    EXPECT_NE(loadError(far).find("units from the camera"), std::string::npos);
+
+    // glTF: a projective matrix on a node naming a shared mesh, with its JSON pointer.
+    GltfBuilder b;
+    const int quad = b.mesh(b.quad());
+    const int a = b.node({{"mesh", quad}});
+    const int p =
+        b.node({{"mesh", quad}, {"matrix", {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0.5, 0, 0, 0, 1}}});
+    b.scene({a, p});
+    const std::string projective = b.embedded(dir, "projective.gltf");
+    EXPECT_EQ(loadError(projective),
+              projective + ": /nodes/1/mesh: the node's transform is not affine (its last row is "
+                           "not 0 0 0 1)");
+    // A zero scale hides the placement (a warning), as it drops a copy's triangles.
+    GltfBuilder h;
+    const int q = h.mesh(h.quad());
+    h.scene({h.node({{"mesh", q}}), h.node({{"mesh", q}, {"scale", {0, 1, 1}}})});
+    const Scene hidden = loadScene(h.embedded(dir, "hidden.gltf"));
+    EXPECT_EQ(hidden.instances.size(), 1u);
+    ASSERT_FALSE(hidden.warnings.empty());
+    EXPECT_NE(hidden.warnings[0].find("singular transform"), std::string::npos);
+}
+
+} // namespace
+} // namespace spw::test
