@@ -55,7 +55,8 @@ are noisy; ratios travel, absolute seconds do not).
                                forest, unique geometry, many embedded images), Spillway beside
                                Cycles on each file: load, BVH, render and wall seconds, peak RSS,
                                bytes per instance and per triangle (scripts/scale_bench.py says
-                               how). --quick (small, no Cycles, for the suite), --scenes NAME,...
+                               how). --quick (small, no Cycles, for the suite), --scenes NAME,...,
+                               --no-cycles.
                                Writes out/bench/scale.json.
   scripts/bench.py all         reference and pipeline (default)
 
@@ -431,10 +432,12 @@ def main():
     ap.add_argument("--backends", default="cpu,reference", help="cycles: Spillway's backends")
     ap.add_argument("--scenes", default="", help="cycles, scale: the scenes to run (default all)")
     ap.add_argument("--quick", action="store_true", help="cycles, scale: small, to check it runs")
+    ap.add_argument("--no-cycles", action="store_true", help="scale: Spillway alone")
     a = ap.parse_args()
     if a.what == "scale":
         import scale_bench
-        sys.exit(scale_bench.main(a.spillway, a.quick, [s for s in a.scenes.split(",") if s]))
+        sys.exit(scale_bench.main(a.spillway, a.quick, [s for s in a.scenes.split(",") if s],
+                                  cycles=not a.no_cycles))
     if a.what == "cycles":
         import cycles_bench
         sys.exit(cycles_bench.main(a.spillway, a.backends.split(","), a.quick, a.repeat or 1,

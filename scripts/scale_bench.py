@@ -224,7 +224,7 @@ def scenes(quick):
     return [("forest-100", forest, (100, 20000)), ("forest-1000", forest, (1000, 20000)),
             ("forest-10000", forest, (10000, 20000)), ("forest-100000", forest, (100000, 20000)),
             ("unique-1M", unique, (1_000_000,)), ("unique-5M", unique, (5_000_000,)),
-            ("unique-20M", unique, (20_000_000,)),
+            ("unique-20M", unique, (20_000_000,)), ("forest-1000000", forest, (1_000_000, 20000)),
             ("textures-64-2048", textures, (64, 2048)), ("textures-256-2048", textures, (256, 2048))]
 
 
@@ -302,8 +302,8 @@ def print_costs(rows):
                 r["scene"], r["bytes_per_triangle"]))
 
 
-def main(spillway, quick, only=()):
-    with_cycles = not quick and shutil.which("blender") is not None
+def main(spillway, quick, only=(), cycles=True):
+    with_cycles = cycles and not quick and shutil.which("blender") is not None
     rows = []
     with tempfile.TemporaryDirectory() as folder:
         for name, make, params in scenes(quick):
