@@ -101,6 +101,15 @@ std::string replaceAll(std::string s, const std::string& key, const std::string&
     return s;
 }
 
+std::string loadError(const std::string& path) {
+    try {
+        loadScene(path);
+    } catch (const SceneError& e) {
+        return e.what();
+    }
+    return "";
+}
+
 std::vector<std::string> backendsUnderTest() {
     return {"reference", "cpu", "vulkan"};
 }

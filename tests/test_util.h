@@ -86,6 +86,8 @@ bool waitForChildOutput(pid_t pid, const std::string& text);
 std::string smallCornellBox(const TempDir& dir, int width, int height,
                             const std::string& name = "box.yaml",
                             const std::string& light = "[17, 12, 4]");
+// The SceneError message that loading scene `path` throws ("" where it loads).
+std::string loadError(const std::string& path);
 // Whether two image files hold the same pixels, bit for bit.
 bool samePixels(const std::string& a, const std::string& b);
 

@@ -24,16 +24,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// The SceneError message that loading `path` throws ("" where it loads).
-std::string loadError(const std::string& path) {
-    try {
-        loadScene(path);
-    } catch (const SceneError& e) {
-        return e.what();
-    }
-    return "";
-}
-
 // A quad with a camera in front of it, its one material `mat`.
 GltfBuilder quadScene(const json& mat = material(vec3(0.5f), 0.0f, 0.5f)) {
     GltfBuilder b;

@@ -235,16 +235,6 @@ TEST(Instancing, YamlInstancesRenderAsSeparateObjects) {
     EXPECT_EQ(g.instances.size(), 15u);
 }
 
-// The message loading `path` throws ("" where it loads).
-std::string loadError(const std::string& path) {
-    try {
-        loadScene(path);
-    } catch (const SceneError& e) {
-        return e.what();
-    }
-    return "";
-}
-
 TEST(Instancing, MalformedPlacementsAreRefusedWithWhere) {
     TempDir dir;
     dir.write("cube.obj", insideCubeObj());
