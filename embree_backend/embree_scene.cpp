@@ -39,17 +39,19 @@ void attachMesh(RTCDevice device, RTCScene target, const Scene& scene, size_t m,
                 const HitFilter* filter) {
     const Mesh& mesh = scene.meshes[m];
     RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
-    auto* vb = static_cast<float*>(rtcSetNewGeometryBuffer(
-        g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), mesh.positions.size()));
-    for (size_t i = 0; i < mesh.positions.size(); ++i)
-        for (int k = 0; k < 3; ++k)
-            vb[3 * i + k] = mesh.positions[i][k];
-    auto* ib = static_cast<unsigned*>(
-        rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned),
-                                mesh.triangles.size()));
-    for (size_t i = 0; i < mesh.triangles.size(); ++i)
-        for (int k = 0; k < 3; ++k)
-            ib[3 * i + k] = mesh.triangles[i][k];
+    // The mesh's own arrays where the vertices have room for Embree's 16-byte load of the last
+    // one (padForSharing): the scene's geometry is held once. Else a copy.
+    static_assert(sizeof(vec3) == 3 * sizeof(float) && sizeof(uvec3) == 3 * sizeof(unsigned));
+    if (mesh.positions.capacity() > mesh.positions.size()) {
+        rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                   mesh.positions.data(), 0, sizeof(vec3), mesh.positions.size());
+    } else {
+        auto* vb = static_cast<vec3*>(rtcSetNewGeometryBuffer(
+            g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, sizeof(vec3), mesh.positions.size()));
+        std::copy(mesh.positions.begin(), mesh.positions.end(), vb);
+    }
+    rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, mesh.triangles.data(),
+                               0, sizeof(uvec3), mesh.triangles.size());
     if (filter && filter->filters(uint(m))) {
         rtcSetGeometryUserData(g, const_cast<HitFilter*>(filter));
         rtcSetGeometryIntersectFilterFunction(g, filterHits);
@@ -60,26 +62,33 @@ void attachMesh(RTCDevice device, RTCScene target, const Scene& scene, size_t m,
     rtcReleaseGeometry(g);
 }
 
-RTCScene newScene(RTCDevice device) {
+// A scene of `triangles` triangles, compact past `compactAbove` (kCompactBvhTriangles).
+RTCScene newScene(RTCDevice device, size_t triangles, size_t compactAbove) {
     RTCScene s = rtcNewScene(device);
-    rtcSetSceneFlags(s, RTC_SCENE_FLAG_ROBUST);
+    const bool compact = triangles > compactAbove;
+    rtcSetSceneFlags(s, compact ? RTCSceneFlags(RTC_SCENE_FLAG_ROBUST | RTC_SCENE_FLAG_COMPACT)
+                                : RTC_SCENE_FLAG_ROBUST);
     rtcSetSceneBuildQuality(s, RTC_BUILD_QUALITY_HIGH);
     return s;
 }
 } // namespace
 
-EmbreeScene::EmbreeScene(const Scene& scene, const HitFilter* filter) {
+EmbreeScene::EmbreeScene(const Scene& scene, const HitFilter* filter, size_t compactAbove) {
     device_ = rtcNewDevice(nullptr);
     if (!device_)
         throw std::runtime_error("cannot create the Embree device (error " +
                                  std::to_string(int(rtcGetDeviceError(nullptr))) + ")");
     rtcSetDeviceErrorFunction(device_, onEmbreeError, &error_);
-    scene_ = newScene(device_);
-
     // Each prototype a scene of its own, built once; the world's meshes in the top scene.
+    std::vector<size_t> triangles(scene.prototypes.size() + 1, 0); // the top scene's last
+    for (const Mesh& m : scene.meshes)
+        triangles[m.prototype >= 0 ? size_t(m.prototype) : scene.prototypes.size()] +=
+            m.triangles.size();
+    compact_ = triangles.back() > compactAbove;
+    scene_ = newScene(device_, triangles.back(), compactAbove);
     std::vector<RTCScene> prototypes;
     for (size_t p = 0; p < scene.prototypes.size(); ++p)
-        prototypes.push_back(newScene(device_));
+        prototypes.push_back(newScene(device_, triangles[p], compactAbove));
     for (size_t m = 0; m < scene.meshes.size(); ++m) {
         const int proto = scene.meshes[m].prototype;
         attachMesh(device_, proto >= 0 ? prototypes[size_t(proto)] : scene_, scene, m, filter);

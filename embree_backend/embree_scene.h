@@ -8,6 +8,7 @@
 
 #include "host/scene/scene.h"
 
+#include <cstddef>
 #include <string>
 
 // Embree's handles, declared as Embree declares them, so that <embree3/rtcore.h> stays inside
@@ -31,11 +32,21 @@ class HitFilter {
     virtual bool keeps(uint mesh, uint prim, float u, float v, vec3 org, vec3 dir) const = 0;
 };
 
+// The most triangles an Embree scene holds in Embree's fast layout, whose leaves carry copies of
+// their triangles' vertices. Past it the scene is built compact (RTC_SCENE_FLAG_COMPACT: leaves
+// index the mesh's own vertices): on 20M triangles the peak memory falls from 123 to 92 bytes a
+// triangle and the build from 7.0 to 4.2 s, and traversal is about 1.6x slower
+// (docs/performance.md, "Production scale"). Every scene of the benchmarks but that one is below.
+constexpr size_t kCompactBvhTriangles = size_t(1) << 23;
+
 class EmbreeScene {
   public:
     // Builds the BVH on Embree's default device. Throws std::runtime_error on a device error.
-    // `filter` (or none) must outlive the scene.
-    explicit EmbreeScene(const Scene& scene, const HitFilter* filter = nullptr);
+    // `scene` and `filter` (or none) must outlive this: the BVH reads the meshes' vertices and
+    // triangles in place where it can (padForSharing).
+    // `compactAbove`: the scenes of more triangles are built compact (kCompactBvhTriangles).
+    explicit EmbreeScene(const Scene& scene, const HitFilter* filter = nullptr,
+                         size_t compactAbove = kCompactBvhTriangles);
     ~EmbreeScene();
     EmbreeScene(const EmbreeScene&) = delete;
     EmbreeScene& operator=(const EmbreeScene&) = delete;
@@ -43,6 +54,8 @@ class EmbreeScene {
     RTCSceneTy* handle() const { return scene_; }
     // The top scene's geometry id of instance 0 (Scene::instances).
     uint instanceBase() const { return instanceBase_; }
+    // Whether the top scene is built compact (kCompactBvhTriangles).
+    bool compact() const { return compact_; }
 
     // Throws if Embree reported an error since the last check.
     void checkError(const char* what) const;
@@ -52,6 +65,7 @@ class EmbreeScene {
     RTCSceneTy* scene_ = nullptr;
     mutable std::string error_;
     uint instanceBase_ = 0;
+    bool compact_ = false;
 };
 
 } // namespace spw

@@ -22,8 +22,9 @@ namespace spw {
 
 namespace fs = std::filesystem;
 
-std::vector<double> GltfReader::readAccessor(int index, int components, const std::string& at,
-                                             bool integersOnly) const {
+template <class T>
+std::vector<T> GltfReader::readAccessor(int index, int components, const std::string& at,
+                                        bool integersOnly) const {
     if (index < 0 || index >= int(model_.accessors.size()))
         fail(at, "names accessor " + std::to_string(index) + " of " +
                      std::to_string(model_.accessors.size()));
@@ -37,6 +38,10 @@ std::vector<double> GltfReader::readAccessor(int index, int components, const st
     if (size <= 0) fail(self + "/componentType", "unknown component type");
     const bool isFloat = a.componentType == TINYGLTF_COMPONENT_TYPE_FLOAT;
     if (integersOnly && isFloat) fail(self + "/componentType", "indices must be integers");
+    if (integersOnly && (a.componentType == TINYGLTF_COMPONENT_TYPE_BYTE ||
+                         a.componentType == TINYGLTF_COMPONENT_TYPE_SHORT ||
+                         a.componentType == TINYGLTF_COMPONENT_TYPE_INT))
+        fail(self + "/componentType", "indices must be unsigned integers");
     // Normalized indices would read as fractions of the largest index, most of them 0.
     if (integersOnly && a.normalized) fail(self + "/normalized", "indices are never normalized");
     const size_t element = size_t(size) * size_t(components);
@@ -46,22 +51,27 @@ std::vector<double> GltfReader::readAccessor(int index, int components, const st
         fail(self + "/count", "is " + std::to_string(a.count) + ": an accessor holds at most " +
                                   std::to_string(kMaxGltfAccessorValues) +
                                   " values (2^28) in Spillway");
-    std::vector<double> out(a.count * size_t(components), 0.0);
+    std::vector<T> out(a.count * size_t(components), T(0));
     if (a.bufferView >= 0) { // without one, all zeros (the specification's rule)
         size_t stride = 0;
         const unsigned char* base =
             viewBytes(a.bufferView, a.byteOffset, a.count, element, self, stride);
         for (size_t i = 0; i < a.count; ++i)
             for (int k = 0; k < components; ++k)
-                out[i * size_t(components) + size_t(k)] = component(
-                    base + i * stride + size_t(k) * size_t(size), a.componentType, a.normalized);
+                out[i * size_t(components) + size_t(k)] = T(component(
+                    base + i * stride + size_t(k) * size_t(size), a.componentType, a.normalized));
     }
     if (a.sparse.isSparse) applySparse(a, components, self, out);
     return out;
 }
+template std::vector<double> GltfReader::readAccessor<double>(int, int, const std::string&,
+                                                              bool) const;
+template std::vector<uint32_t> GltfReader::readAccessor<uint32_t>(int, int, const std::string&,
+                                                                  bool) const;
 
+template <class T>
 void GltfReader::applySparse(const tinygltf::Accessor& a, int components, const std::string& self,
-                             std::vector<double>& out) const {
+                             std::vector<T>& out) const {
     const std::string at = self + "/sparse";
     const auto& s = a.sparse;
     if (s.count < 0 || size_t(s.count) > a.count)
@@ -86,8 +96,8 @@ void GltfReader::applySparse(const tinygltf::Accessor& a, int components, const 
             fail(at + "/indices", "index " + std::to_string(uint64_t(i)) +
                                       " is past the accessor's count " + std::to_string(a.count));
         for (int k = 0; k < components; ++k)
-            out[size_t(i) * size_t(components) + size_t(k)] = component(
-                values + j * valueStride + size_t(k) * size, a.componentType, a.normalized);
+            out[size_t(i) * size_t(components) + size_t(k)] = T(component(
+                values + j * valueStride + size_t(k) * size, a.componentType, a.normalized));
     }
 }
 
@@ -163,11 +173,12 @@ void GltfReader::readPrimitive(const tinygltf::Primitive& prim, const glm::dmat4
     if (!prim.targets.empty()) warn("has morph targets: rendered without them");
     const auto position = prim.attributes.find("POSITION");
     if (position == prim.attributes.end()) fail(at + "/attributes", "has no POSITION");
-    const std::vector<double> pos = readAccessor(position->second, 3, at + "/attributes/POSITION");
+    std::vector<double> pos = readAccessor(position->second, 3, at + "/attributes/POSITION");
     const size_t vertices = pos.size() / 3;
     Mesh m;
     m.name = path_ + ": " + name;
     m.shader = shaderFor(prim.material, at + "/material");
+    m.positions.reserve(vertices + 1); // padForSharing's room, without a reallocation
     m.positions.resize(vertices);
     for (size_t i = 0; i < vertices; ++i) {
         const glm::dvec3 local(pos[3 * i], pos[3 * i + 1], pos[3 * i + 2]);
@@ -182,6 +193,7 @@ void GltfReader::readPrimitive(const tinygltf::Primitive& prim, const glm::dmat4
             fail("/accessors/" + std::to_string(position->second), far);
         m.positions[i] = vec3(rel);
     }
+    std::vector<double>().swap(pos); // released before the other attributes are read
     readNormals(prim, world, vertices, at, m);
     if (prim.attributes.count("TANGENT"))
         warn("TANGENT attributes are not read: normal maps take tangents made from the "
@@ -339,18 +351,18 @@ void GltfReader::readColours(const tinygltf::Primitive& prim, size_t vertices,
 
 void GltfReader::readTriangles(const tinygltf::Primitive& prim, int mode, const glm::dmat4& world,
                                size_t vertices, const std::string& at, Mesh& m) const {
-    std::vector<uint> indices;
+    std::vector<uint32_t> indices;
     if (prim.indices >= 0) {
-        for (double x : readAccessor(prim.indices, 1, at + "/indices", true)) {
-            if (!(x >= 0.0) || x >= double(vertices))
+        indices = readAccessor<uint32_t>(prim.indices, 1, at + "/indices", true);
+        for (uint32_t x : indices)
+            if (x >= vertices)
                 fail("/accessors/" + std::to_string(prim.indices),
-                     "index " + std::to_string(uint64_t(std::max(x, 0.0))) +
-                         " is past the vertex count " + std::to_string(vertices));
-            indices.push_back(uint(x));
-        }
+                     "index " + std::to_string(x) + " is past the vertex count " +
+                         std::to_string(vertices));
     } else {
+        indices.resize(vertices);
         for (size_t i = 0; i < vertices; ++i)
-            indices.push_back(uint(i));
+            indices[i] = uint32_t(i);
     }
     // A mirroring transform turns the winding: keep the front faces the file's.
     const bool mirrored = glm::determinant(glm::dmat3(world)) < 0.0;

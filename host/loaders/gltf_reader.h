@@ -72,12 +72,16 @@ class GltfReader {
     // Accessor `index` as `count` elements of `components` doubles each (normalized integers
     // mapped to [0, 1] or [-1, 1]), its sparse substitutions applied; every byte it reads checked
     // to lie inside its buffer.
-    std::vector<double> readAccessor(int index, int components, const std::string& at,
-                                     bool integersOnly = false) const;
+    // Read as T: double for attributes; uint32_t for indices (`integersOnly`: unsigned integer
+    // components only, as the specification asks of indices; 4 bytes a value, not 8).
+    template <class T = double>
+    std::vector<T> readAccessor(int index, int components, const std::string& at,
+                                bool integersOnly = false) const;
 
     // A sparse accessor's substitutions: element indices[j] of `out` becomes values[j].
+    template <class T>
     void applySparse(const tinygltf::Accessor& a, int components, const std::string& self,
-                     std::vector<double>& out) const;
+                     std::vector<T>& out) const;
 
     // The first of `count` elements of `element` bytes at `byteOffset` in buffer view `view`,
     // and their stride; `at` (what reads them) names the error when any would lie outside.

@@ -566,8 +566,9 @@ void SceneReader::finish(const YAML::Node& root) {
 
 } // namespace
 
-Scene loadScene(const std::string& path) {
-    if (isGltfPath(path)) return loadGltfScene(path);
+namespace {
+// A YAML scene file (docs/scene-format.md).
+Scene loadYamlScene(const std::string& path) {
     Scene scene;
     scene.file = path;
     const Reader rd(path);
@@ -582,6 +583,14 @@ Scene loadScene(const std::string& path) {
         throw SceneError(path, e.mark.line + 1, e.msg);
     }
     reader.finish(root);
+    return scene;
+}
+} // namespace
+
+Scene loadScene(const std::string& path) {
+    Scene scene = isGltfPath(path) ? loadGltfScene(path) : loadYamlScene(path);
+    for (Mesh& m : scene.meshes)
+        padForSharing(m);
     return scene;
 }
 

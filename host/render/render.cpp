@@ -236,6 +236,7 @@ void RenderSession::recordGeometry() {
         {"triangles_stored", stored},
         {"triangles_rendered", scene_.renderedTriangles()},
         {"peak_rss_mib_after_bvh", peakResidentMiB()},
+        {"bvh", embree_->compact() ? "compact" : "fast"},
     };
 }
 

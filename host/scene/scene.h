@@ -271,6 +271,14 @@ struct Instance {
 Instance makeInstance(const Prototype& proto, uint prototype, const glm::dmat4& toWorld,
                       std::string& error);
 
+// Room for one more vertex behind `mesh`'s positions (a reallocation only where there is none),
+// so that Embree can read the last vertex with one 16-byte load from the mesh's own array, which
+// it then shares instead of copying (embree_backend/embree_scene.cpp).
+inline void padForSharing(Mesh& mesh) {
+    if (mesh.positions.capacity() == mesh.positions.size())
+        mesh.positions.reserve(mesh.positions.size() + 1);
+}
+
 // A punctual light of an emitter kind that takes a position or a direction
 // (host/scene/emitter_kinds.h): a point light's `intensity` W/sr in every direction at
 // `position`; a directional light's irradiance `intensity` W/m^2 arriving along the unit

@@ -90,6 +90,23 @@ TEST(GltfHostile, AccessorCountsPastTheLimitAreRefusedBeforeAllocating) {
     }
 }
 
+// Indices are unsigned integers (the specification's rule), read as 32-bit values: a signed
+// type is refused at the accessor, a float type too.
+TEST(GltfHostile, IndicesOfASignedOrFloatTypeAreRefused) {
+    TempDir dir;
+    for (const int type : {5120, 5122, 5124, 5126}) {
+        GltfBuilder b = quadScene();
+        const int accessor = b.doc["meshes"][0]["primitives"][0]["indices"];
+        b.doc["accessors"][size_t(accessor)]["componentType"] = type;
+        const std::string e = loadError(b.embedded(dir, "signed.gltf"));
+        const std::string at = "/accessors/" + std::to_string(accessor) + "/componentType: ";
+        EXPECT_NE(e.find(at + (type == 5126 ? "indices must be integers"
+                                            : "indices must be unsigned integers")),
+                  std::string::npos)
+            << e;
+    }
+}
+
 // 2. An image's buffer view must lie in its buffer before its bytes are taken (tinygltf hands
 // them over unchecked).
 TEST(GltfHostile, AnImageBufferViewPastItsBufferIsRefused) {

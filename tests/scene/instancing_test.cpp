@@ -150,6 +150,33 @@ TEST(Instancing, HitsSetUpInWorldSpaceAsTheirCopies) {
     EXPECT_GT(mirrored, 20);
 }
 
+// The compact layout (kCompactBvhTriangles) finds the same closest hits as the fast one, to the
+// bit, instances and all.
+TEST(Instancing, ACompactBvhFindsTheSameHits) {
+    TempDir dir;
+    const Scene s = loadScene(boxes(dir, "shared.gltf", true));
+    const EmbreeScene fast(s), compact(s, nullptr, 0);
+    EXPECT_FALSE(fast.compact());
+    EXPECT_TRUE(compact.compact());
+    int hits = 0;
+    for (int y = 0; y < 40; ++y)
+        for (int x = 0; x < 50; ++x) {
+            const vec3 dir = glm::normalize(
+                vec3((x - 25 + 0.3183f) / 29.7f, (y - 20 + 0.2718f) / 29.7f - 0.1f, -1.0f));
+            const HitRecord a = intersectOne(fast, vec3(0.0f), dir),
+                            b = intersectOne(compact, vec3(0.0f), dir);
+            ASSERT_EQ(a.mesh, b.mesh);
+            if (a.mesh == kNoHit) continue;
+            ++hits;
+            EXPECT_EQ(a.instance, b.instance);
+            EXPECT_EQ(a.prim, b.prim);
+            EXPECT_EQ(a.t, b.t);
+            EXPECT_EQ(a.u, b.u);
+            EXPECT_EQ(a.v, b.v);
+        }
+    EXPECT_GT(hits, 1000);
+}
+
 // Every backend renders the instanced scene as the flattened one: iteration by iteration (the
 // same random numbers), their difference has mean zero within its standard errors, with a
 // per-pixel allowance for the float rounding of the two scenes' vertices.
