@@ -302,15 +302,24 @@ def print_costs(rows):
                 r["scene"], r["bytes_per_triangle"]))
 
 
+def make_apart(name, path, quick):
+    """Scene `name` written to `path` by a Python process of its own, whose info it returns. A
+    child's peak RSS starts from its parent's at the fork (Linux keeps it through exec): made
+    here, a million nodes' Python objects would count in every render's figure."""
+    r = subprocess.run([sys.executable, os.path.abspath(__file__), name, path, str(int(quick))],
+                       capture_output=True, text=True, check=True)
+    return json.loads(r.stdout)
+
+
 def main(spillway, quick, only=(), cycles=True):
     with_cycles = cycles and not quick and shutil.which("blender") is not None
     rows = []
     with tempfile.TemporaryDirectory() as folder:
-        for name, make, params in scenes(quick):
+        for name, _, _ in scenes(quick):
             if only and name not in only:
                 continue
             glb = os.path.join(folder, name + ".glb")
-            info = make(glb, *params)
+            info = make_apart(name, glb, quick)
             info["file_mib"] = os.path.getsize(glb) / 2 ** 20
             row = {"scene": name, **info, "spillway": spillway_row(spillway, glb, folder)}
             print_row(name, "spillway", row["spillway"])
@@ -327,3 +336,12 @@ def main(spillway, quick, only=(), cycles=True):
     with open(os.path.join(ROOT, "out", "bench", "scale-quick.json" if quick else "scale.json"), "w") as f:
         json.dump(rows, f, indent=2)
     return 0
+
+
+if __name__ == "__main__":  # make_apart's child: scripts/scale_bench.py NAME PATH QUICK
+    for scene, make, params in scenes(sys.argv[3] == "1"):
+        if scene == sys.argv[1]:
+            print(json.dumps(make(sys.argv[2], *params)))
+            break
+    else:
+        sys.exit("no scene named " + sys.argv[1])
