@@ -57,8 +57,7 @@ template <class Triangle> void placeHit(const Triangle& c, float t, SurfaceHit& 
 } // namespace
 
 void HitSetup::surfaceHit(const HitRecord& h, SurfaceHit& hit) const {
-    onHitTriangle(src_, h.mesh, h.prim, h.u, h.v, h.instance,
-                  [&](const auto& c) { placeHit(c, h.t, hit); });
+    onHitTriangle(src_, h, [&](const auto& c) { placeHit(c, h.t, hit); });
     hit.shader = uint(src_.meshes[h.mesh].shader);
     hit.emitter = lights_.emitterOf(h.mesh, h.prim);
     hit.albedo = vec3(0.0f);
@@ -74,7 +73,7 @@ float HitSetup::smoothLift(const Mesh& mesh, uvec3 tri, float u, float v, vec3 p
 
 void HitSetup::applyVertexColour(const HitRecord& h, SurfaceHit& hit) const {
     if (src_.meshes[h.mesh].colours.empty()) return;
-    onHitTriangle(src_, h.mesh, h.prim, h.u, h.v, h.instance, [&](const auto& c) {
+    onHitTriangle(src_, h, [&](const auto& c) {
         hit.albedo *= (1.0f - c.u - c.v) * c.colour(0) + c.u * c.colour(1) + c.v * c.colour(2);
     });
 }
@@ -210,13 +209,12 @@ void queryOn(const Triangle& c, vec3 dir, uint cone, float t, vec3 ng, vec2& uv,
 } // namespace
 
 vec3 HitSetup::tiltedNormal(const HitRecord& h, vec3 n, vec3 texel, float scale) const {
-    return onHitTriangle(src_, h.mesh, h.prim, h.u, h.v, h.instance,
-                         [&](const auto& c) { return tiltOn(c, n, texel, scale); });
+    return onHitTriangle(src_, h, [&](const auto& c) { return tiltOn(c, n, texel, scale); });
 }
 
 void HitSetup::textureQuery(const HitRecord& h, vec3 dir, uint cone, const SurfaceHit& hit,
                             vec2& uv, float& footprint) const {
-    onHitTriangle(src_, h.mesh, h.prim, h.u, h.v, h.instance,
+    onHitTriangle(src_, h,
                   [&](const auto& c) { queryOn(c, dir, cone, h.t, hit.ng, uv, footprint); });
 }
 
@@ -266,7 +264,7 @@ void HitSetup::setUpHits(size_t n, const HitRecord* const* hits, const vec3* dir
     for (size_t j = 0; j < count; ++j) { // padding repeats the last hit
         const size_t from = std::min(j, n - 1);
         const HitRecord& h = *hits[from];
-        onHitTriangle(src_, h.mesh, h.prim, h.u, h.v, h.instance,
+        onHitTriangle(src_, h,
                       [&](const auto& c) { gatherLane(c, h.t, dir[from], cone[from], l, j); });
     }
     setUpHitLanes(count, l);

@@ -10,6 +10,7 @@
 #pragma once
 
 #include "host/scene/scene.h"
+#include "host/scene_view/hit_setup.h"
 
 #include <glm/geometric.hpp>
 
@@ -61,12 +62,10 @@ class PlacedTriangle {
 };
 
 // f(triangle) for hit h's triangle in `scene`, of the kind its placement makes.
-template <class F>
-decltype(auto) onHitTriangle(const Scene& scene, uint mesh, uint prim, float u, float v,
-                             uint instance, F&& f) {
-    const Mesh& m = scene.meshes[mesh];
-    if (instance == 0xFFFFFFFFu) return f(MeshTriangle(m, prim, u, v));
-    return f(PlacedTriangle(m, scene.instances[instance], prim, u, v));
+template <class F> decltype(auto) onHitTriangle(const Scene& scene, const HitRecord& h, F&& f) {
+    const Mesh& m = scene.meshes[h.mesh];
+    if (h.instance == kNoInstance) return f(MeshTriangle(m, h.prim, h.u, h.v));
+    return f(PlacedTriangle(m, scene.instances[h.instance], h.prim, h.u, h.v));
 }
 
 } // namespace spw
