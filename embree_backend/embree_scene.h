@@ -34,9 +34,9 @@ class HitFilter {
 
 // The most triangles an Embree scene holds in Embree's fast layout, whose leaves carry copies of
 // their triangles' vertices. Past it the scene is built compact (RTC_SCENE_FLAG_COMPACT: leaves
-// index the mesh's own vertices): on 20M triangles the peak memory falls from 123 to 92 bytes a
-// triangle and the build from 7.0 to 4.2 s, and traversal is about 1.6x slower
-// (docs/performance.md, "Production scale"). Every scene of the benchmarks but that one is below.
+// index the mesh's own vertices): less memory and a faster build for slower traversal, measured
+// on 20M triangles in docs/performance.md ("Production scale"). Every other scene of the
+// benchmarks is below it.
 constexpr size_t kCompactBvhTriangles = size_t(1) << 23;
 
 class EmbreeScene {

@@ -55,8 +55,9 @@ constexpr int kMaxTextures = 1 << 16;
 // (one per light included).
 constexpr int kMaxShaders = (1 << 12) - 1;
 constexpr int kMaxObjects = 1 << 20;
-// Instances (Scene::instances): Embree's geometry ids are 32 bits; 2^26 instances of one mesh
-// are about 16 GB of Embree's and Spillway's own records, past any machine this renders on.
+// Instances (Scene::instances): Embree's geometry ids are 32 bits, and at the 1.8 KB of peak
+// memory a glTF placement costs (docs/performance.md, "Production scale") 2^26 instances are
+// over 100 GB, past any machine this renders on.
 constexpr int kMaxInstances = 1 << 26;
 // A glTF accessor holds at most this many values (elements x components): 2 GiB as the doubles
 // the loader reads them into, and 2^28 / 3 vertices a primitive, far past what one mesh needs.
