@@ -7,6 +7,7 @@
 
 #include "host/loaders/gltf_preflight.h"
 #include "host/loaders/gltf_reader.h"
+#include "host/loaders/gltf_sources.h"
 #include "shared/gltf.h"
 
 #include <glm/gtc/matrix_inverse.hpp>
@@ -60,9 +61,13 @@ bool keepImageUndecoded(tinygltf::Image* image, const int index, std::string*, s
         cb.problem = why;
         return false;
     }
-    if (image->uri.empty() || image->uri.rfind("data:", 0) == 0)
-        (*cb.bytes)[index] = std::make_shared<const std::string>(
-            reinterpret_cast<const char*>(bytes), size_t(std::max(size, 0)));
+    if (image->uri.empty() || image->uri.rfind("data:", 0) == 0) { // in memory: the JSON held it
+        auto image = std::make_shared<EmbeddedImage>();
+        image->bytes = std::make_shared<const std::string>(reinterpret_cast<const char*>(bytes),
+                                                           size_t(std::max(size, 0)));
+        image->length = image->bytes->size();
+        (*cb.bytes)[index] = image;
+    }
     return true;
 }
 
@@ -111,6 +116,9 @@ void GltfReader::read(const std::vector<glm::dmat4>& transforms, bool takesCamer
                       0);
     }
     placeMeshes();
+    // Every accessor is read: the parser's copies of the buffers go before the BVH is built.
+    for (tinygltf::Buffer& b : model_.buffers)
+        std::vector<unsigned char>().swap(b.data);
     warnUnrendered();
 }
 
@@ -118,15 +126,30 @@ void GltfReader::parse() {
     std::error_code ec;
     if (!fs::is_regular_file(path_, ec))
         throw SceneError(path_, 0, "cannot open the glTF file: not a readable file");
-    preflightGltf(path_, kHonoured);
+    GltfDocument document = preflightGltf(path_, kHonoured);
     tinygltf::TinyGLTF loader;
     loader.SetFsCallbacks(regularFilesOnly());
+    embedded_.clear();
     ImageCallback images{&embedded_, &model_, ""};
     loader.SetImageLoader(keepImageUndecoded, &images);
     std::string err, warnings;
-    const bool binary = lower(fs::path(path_).extension().string()) == ".glb";
-    const bool ok = binary ? loader.LoadBinaryFromFile(&model_, &err, &warnings, path_)
-                           : loader.LoadASCIIFromFile(&model_, &err, &warnings, path_);
+    bool ok = false;
+    std::vector<std::string> bufferFiles;
+    if (!document.doc.is_discarded()) { // tinygltf reads the buffers through gltf_sources.h
+        GltfSources sources(path_, std::move(document));
+        loader.SetFsCallbacks(sources.callbacks());
+        ok = loader.LoadASCIIFromString(&model_, &err, &warnings, sources.text().data(),
+                                        unsigned(sources.text().size()), "");
+        for (const auto& [index, uri] : sources.imageFiles())
+            if (size_t(index) < model_.images.size()) model_.images[size_t(index)].uri = uri;
+        for (const auto& [index, image] : sources.embedded())
+            embedded_[index] = image;
+        bufferFiles = sources.bufferFiles();
+    } else { // a JSON that does not parse: tinygltf says why
+        const bool binary = lower(fs::path(path_).extension().string()) == ".glb";
+        ok = binary ? loader.LoadBinaryFromFile(&model_, &err, &warnings, path_)
+                    : loader.LoadASCIIFromFile(&model_, &err, &warnings, path_);
+    }
     if (!images.problem.empty()) throw SceneError(path_, 0, images.problem);
     // tinygltf 2.7 reports a skin without inverseBindMatrices as an error, yet parses it: the
     // specification makes them optional (identity matrices), and skins render in bind pose.
@@ -134,9 +157,7 @@ void GltfReader::parse() {
                     std::string::npos;)
         err.erase(at, std::strlen("'inverseBindMatrices' property is missing in Skin.\n"));
     scene_.inputs.push_back(path_);
-    for (const tinygltf::Buffer& b : model_.buffers)
-        if (!b.uri.empty() && b.uri.rfind("data:", 0) != 0)
-            scene_.inputs.push_back((dir_ / decodeGltfUri(b.uri)).string());
+    scene_.inputs.insert(scene_.inputs.end(), bufferFiles.begin(), bufferFiles.end());
     if (!ok || !err.empty()) {
         while (!err.empty() && (err.back() == '\n' || err.back() == '\r'))
             err.pop_back();

@@ -5,6 +5,7 @@
 #include "host/image/image_io.h"
 #include "host/loaders/gltf_preflight.h"
 #include "host/loaders/gltf_reader.h"
+#include "host/textures/embedded_reader.h"
 
 #include "shared/gltf.h"
 
@@ -205,18 +206,23 @@ Texture GltfReader::imageTexture(const Info& info, const std::string& where,
     Texture picture{};
     picture.type = TextureType::Standard;
     const std::string imageAt = "/images/" + std::to_string(source);
+    std::unique_ptr<OIIO::Filesystem::IOProxy> proxy; // an embedded image's reader, for `in`
     std::unique_ptr<OIIO::ImageInput> in;
     if (const auto e = embedded_.find(source); e != embedded_.end()) {
         // A name no file has, its extension telling OpenImageIO the format its bytes are (not
         // the mimeType, which a file may get wrong).
-        const std::string ext = imageFormat(e->second->substr(0, 8));
+        try {
+            proxy = embeddedReader(*e->second);
+        } catch (const std::runtime_error& x) {
+            fail(imageAt, x.what());
+        }
+        char head[8] = {};
+        const std::string ext = imageFormat(std::string(head, proxy->pread(head, 8, 0)));
         if (ext.empty()) fail(imageAt, "the embedded image is neither a PNG nor a JPEG");
         picture.path = fs::absolute(path_).lexically_normal().string() + "#image" +
                        std::to_string(source) + ext;
-        picture.bytes = e->second;
-        OIIO::Filesystem::IOMemReader proxy(const_cast<char*>(picture.bytes->data()),
-                                            picture.bytes->size());
-        in = OIIO::ImageInput::open(picture.path, nullptr, &proxy);
+        picture.embedded = e->second;
+        in = OIIO::ImageInput::open(picture.path, nullptr, proxy.get());
         if (!in || in->spec().width < 1 || in->spec().height < 1)
             fail(imageAt, "the embedded image is not one OpenImageIO can read" + imageError());
     } else {

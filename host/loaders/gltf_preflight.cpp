@@ -42,7 +42,8 @@ std::string readBytes(std::ifstream& in, size_t count) {
 
 // The JSON of a .glb: its framing checked against the file's size first (tinygltf trusts the
 // chunk lengths, and reads past the file's end where they claim more).
-std::string glbJson(const std::string& path, std::ifstream& in, std::uint64_t size) {
+std::string glbJson(const std::string& path, std::ifstream& in, std::uint64_t size,
+                    GltfDocument& out) {
     const std::string head = readBytes(in, 20);
     if (head.size() < 12 || u32(head, 0) != 0x46546C67u)
         fail(path, "", "not a GLB file: it does not start with the 'glTF' magic");
@@ -72,6 +73,8 @@ std::string glbJson(const std::string& path, std::ifstream& in, std::uint64_t si
             fail(path, "",
                  "the BIN chunk claims " + std::to_string(binLength) +
                      " bytes, past the file's end");
+        if (chunk.size() == 8 && u32(chunk, 4) == 0x004E4942u) // "BIN\0"
+            out.binOffset = 28 + jsonLength, out.binLength = binLength;
     }
     return text;
 }
@@ -275,7 +278,7 @@ std::string decodeGltfUri(const std::string& uri) {
     return out;
 }
 
-void preflightGltf(const std::string& path, const std::set<std::string>& honoured) {
+GltfDocument preflightGltf(const std::string& path, const std::set<std::string>& honoured) {
     std::error_code ec;
     const std::uint64_t size = fs::file_size(path, ec);
     std::ifstream in(path, std::ios::binary);
@@ -283,13 +286,20 @@ void preflightGltf(const std::string& path, const std::set<std::string>& honoure
     std::string ext = fs::path(path).extension().string();
     for (char& c : ext)
         c = char(std::tolower(static_cast<unsigned char>(c)));
-    const std::string text = ext == ".glb" ? glbJson(path, in, size) : readBytes(in, size_t(size));
+    GltfDocument out;
+    out.binary = ext == ".glb";
+    std::string text = out.binary ? glbJson(path, in, size, out) : readBytes(in, size_t(size));
     if (jsonNestingDepth(text, kMaxGltfJsonDepth) > kMaxGltfJsonDepth)
         fail(path, "",
              "its JSON nests deeper than " + std::to_string(kMaxGltfJsonDepth) +
                  " levels (glTF's own objects nest about 8)");
-    const json doc = json::parse(text, nullptr, false);
-    if (doc.is_discarded() || !doc.is_object()) return; // tinygltf says what is wrong
+    out.doc = json::parse(text, nullptr, false);
+    text = {};
+    const json& doc = out.doc;
+    if (doc.is_discarded() || !doc.is_object()) { // tinygltf says what is wrong
+        out.doc = json::value_t::discarded;
+        return out;
+    }
     checkVersion(path, doc);
     checkRequired(path, doc, honoured);
     checkForest(path, doc);
@@ -299,6 +309,7 @@ void preflightGltf(const std::string& path, const std::set<std::string>& honoure
             if (e.is_string()) used.insert(e.get<std::string>());
     checkDeclared(path, doc, used, "");
     checkUris(path, doc);
+    return out;
 }
 
 tinygltf::FsCallbacks regularFilesOnly() {
@@ -306,22 +317,26 @@ tinygltf::FsCallbacks regularFilesOnly() {
             &tinygltf::WriteWholeFile, nullptr};
 }
 
+std::string imageViewProblem(int index, int view, int buffer, std::uint64_t offset,
+                             std::uint64_t length, std::uint64_t have) {
+    const std::string at = "/images/" + std::to_string(index) + "/bufferView: ";
+    if (offset > have || length > have - offset)
+        return at + "buffer view " + std::to_string(view) + " (bytes " + std::to_string(offset) +
+               " + " + std::to_string(length) + ") reaches past the end of buffer " +
+               std::to_string(buffer) + " (" + std::to_string(have) + " bytes)";
+    if (length > std::uint64_t(INT_MAX))
+        return at + "an embedded image of " + std::to_string(length) +
+               " bytes; Spillway reads embedded images of up to 2 GiB";
+    return "";
+}
+
 std::string imageViewProblem(const tinygltf::Model& model, const tinygltf::Image& image,
                              int index) {
     if (image.bufferView < 0 || size_t(image.bufferView) >= model.bufferViews.size()) return "";
     const tinygltf::BufferView& v = model.bufferViews[size_t(image.bufferView)];
     if (v.buffer < 0 || size_t(v.buffer) >= model.buffers.size()) return "";
-    const size_t have = model.buffers[size_t(v.buffer)].data.size();
-    const std::string at = "/images/" + std::to_string(index) + "/bufferView: ";
-    if (v.byteOffset > have || v.byteLength > have - v.byteOffset)
-        return at + "buffer view " + std::to_string(image.bufferView) + " (bytes " +
-               std::to_string(v.byteOffset) + " + " + std::to_string(v.byteLength) +
-               ") reaches past the end of buffer " + std::to_string(v.buffer) + " (" +
-               std::to_string(have) + " bytes)";
-    if (v.byteLength > size_t(INT_MAX))
-        return at + "an embedded image of " + std::to_string(v.byteLength) +
-               " bytes; Spillway reads embedded images of up to 2 GiB";
-    return "";
+    return imageViewProblem(index, image.bufferView, v.buffer, v.byteOffset, v.byteLength,
+                            model.buffers[size_t(v.buffer)].data.size());
 }
 
 } // namespace spw

@@ -10,7 +10,10 @@
 // Every failure is a SceneError naming the file and a JSON pointer.
 #pragma once
 
+#include <nlohmann/json.hpp>
 #include <tiny_gltf.h>
+
+#include <cstdint>
 
 #include <set>
 #include <string>
@@ -25,9 +28,16 @@ constexpr int kMaxGltfJsonDepth = 64;
 // `limit` + 1 (the scan stops there): without parsing, so that no depth can overflow a stack.
 int jsonNestingDepth(const std::string& text, int limit);
 
+// A glTF file's JSON as the preflight parsed it, and where a .glb's BIN chunk lies.
+struct GltfDocument {
+    nlohmann::json doc; // discarded where the JSON does not parse (tinygltf then says why)
+    bool binary = false;
+    std::uint64_t binOffset = 0, binLength = 0; // the BIN chunk's bytes (length 0: none)
+};
+
 // Checks the file at `path` before it is parsed; `honoured` are the extensions a file may require.
 // Throws SceneError.
-void preflightGltf(const std::string& path, const std::set<std::string>& honoured);
+GltfDocument preflightGltf(const std::string& path, const std::set<std::string>& honoured);
 
 // A URI's %XX escapes decoded (glTF's URIs are RFC 3986 references): the file a relative URI
 // names, beside the glTF file.
@@ -39,5 +49,9 @@ tinygltf::FsCallbacks regularFilesOnly();
 // Whether image `image`'s buffer view (in `model`, being parsed) lies inside its buffer: "" if so,
 // else why not. Called from the image callback, before the bytes are read.
 std::string imageViewProblem(const tinygltf::Model& model, const tinygltf::Image& image, int index);
+// The same for image `index`'s buffer view `view`: `length` bytes at `offset` of buffer `buffer`,
+// which holds `have`.
+std::string imageViewProblem(int index, int view, int buffer, std::uint64_t offset,
+                             std::uint64_t length, std::uint64_t have);
 
 } // namespace spw

@@ -17,10 +17,10 @@
 
 namespace spw {
 
-// tinygltf reads every image's bytes; the pixels are left to OpenImageIO's texture cache, which
-// reads an image file itself, and an embedded image (a buffer view, a data: URI) from these
-// bytes, kept here per image.
-using ImageBytes = std::map<int, std::shared_ptr<const std::string>>;
+// Where each embedded image's encoded bytes lie (in a buffer in a file, gltf_sources.h; in memory
+// for a data: URI), per image; the pixels are left to OpenImageIO's texture cache, which reads an
+// image file itself.
+using ImageBytes = std::map<int, std::shared_ptr<const EmbeddedImage>>;
 
 class GltfReader {
   public:

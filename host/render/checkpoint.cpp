@@ -112,6 +112,25 @@ static void hashFileContents(Fnv& f, const std::string& path) {
     f.value(total);
 }
 
+// The bytes of an embedded image, read from its file as the bytes that held them in memory were
+// hashed (the same hash for the same bytes), a MiB at a time.
+static void hashEmbedded(Fnv& f, const EmbeddedImage& image) {
+    if (image.bytes) {
+        f.bytes(image.bytes->data(), image.bytes->size());
+        return;
+    }
+    std::ifstream in(image.file, std::ios::binary);
+    in.seekg(std::streamoff(image.offset));
+    std::vector<char> chunk(size_t(1) << 20);
+    for (std::uint64_t left = image.length; left > 0 && in;) {
+        const size_t n = size_t(std::min<std::uint64_t>(left, chunk.size()));
+        if (!in.read(chunk.data(), std::streamsize(n))) break;
+        f.bytes(chunk.data(), n);
+        left -= n;
+    }
+    if (!in) f.text("unreadable: " + image.file);
+}
+
 std::uint64_t environmentHash(const Scene& scene) {
     if (!scene.environment) return 0;
     const Environment& env = *scene.environment;
@@ -137,8 +156,8 @@ std::uint64_t sceneHash(const Scene& scene) {
         f.value(inst.prototype).value(inst.toWorld);
     for (const Texture& t : scene.textures) {
         if (t.type != TextureType::Standard) continue;
-        if (t.bytes) // embedded in the scene file
-            f.bytes(t.bytes->data(), t.bytes->size());
+        if (t.embedded) // embedded in the scene file
+            hashEmbedded(f, *t.embedded);
         else
             hashFileContents(f, t.path);
     }

@@ -10,6 +10,7 @@
 #include <glm/vec3.hpp>
 
 #include <array>
+#include <cstdint>
 #include <memory>
 #include <optional>
 #include <stdexcept>
@@ -123,13 +124,21 @@ const char* samplerName(SamplerType s);
 std::optional<SamplerType> parseSampler(const std::string& name);
 
 enum class TextureType { Constant, Standard, Layered };
+// Where the encoded bytes of an image embedded in a scene file lie: `length` bytes at `offset`
+// of `file` (a glTF buffer in the file or beside it), read a piece at a time and never held
+// whole; or, where `bytes` is set (a data: URI, which the file's JSON already held), in memory.
+struct EmbeddedImage {
+    std::string file;
+    std::uint64_t offset = 0, length = 0;
+    std::shared_ptr<const std::string> bytes;
+};
 struct Texture {
     TextureType type = TextureType::Constant;
     vec3 colour{1.0f};
     std::string path; // Standard: absolute path of the image
-    // Standard, an image embedded in the scene file (a glTF buffer): the encoded file itself,
-    // read from memory under `path`, a name no file has ("model.glb#image0.png").
-    std::shared_ptr<const std::string> bytes;
+    // Standard, an image embedded in the scene file (a glTF buffer or data: URI), read under
+    // `path`, a name no file has ("model.glb#image0.png"); null for an image file.
+    std::shared_ptr<const EmbeddedImage> embedded;
     // Standard: an affine map of the texture coordinates before the lookup (glTF's
     // KHR_texture_transform), and how much it stretches a footprint (its larger scale).
     bool uvTransformed = false;

@@ -28,8 +28,8 @@ constexpr size_t kMaxLevels = 32;
 
 struct TextureResolver::Impl {
     OIIO::ImageCache* cache = nullptr;
-    // The readers of embedded images (Texture::bytes), alive as long as the cache.
-    std::vector<std::unique_ptr<OIIO::Filesystem::IOMemReader>> proxies;
+    // The readers of embedded images (Texture::embedded), alive as long as the cache.
+    std::vector<std::unique_ptr<OIIO::Filesystem::IOProxy>> proxies;
     struct Level {
         int x = 0, y = 0, width = 1, height = 1; // the data window
     };

@@ -2,6 +2,7 @@
 
 #include "host/image/image_io.h"
 #include "host/image/scratch_file.h"
+#include "host/textures/embedded_reader.h"
 #include "host/textures/texel_reader.h"
 #include "host/textures/tiled_copy.h"
 #include "host/textures/wide_texels.h"
@@ -60,12 +61,11 @@ void openImage(const Scene& scene, TextureResolver::Impl& impl, const Texture& t
                TextureResolver::Impl::Image& img, bool readWhole) {
     // A file must be a regular file before the cache opens it: a FIFO would block the render.
     std::error_code ec;
-    if (!t.bytes && !std::filesystem::is_regular_file(t.path, ec))
+    if (!t.embedded && !std::filesystem::is_regular_file(t.path, ec))
         throw SceneError(scene.file, t.line, "texture file '" + t.path + "' is not a regular file");
     OIIO::ustring name(t.path);
-    if (t.bytes) { // embedded: read from memory, through a proxy the cache keeps using
-        auto& proxy = impl.proxies.emplace_back(std::make_unique<OIIO::Filesystem::IOMemReader>(
-            const_cast<char*>(t.bytes->data()), t.bytes->size()));
+    if (t.embedded) { // embedded: read through a proxy the cache keeps using
+        auto& proxy = impl.proxies.emplace_back(embeddedReader(*t.embedded));
         OIIO::ImageSpec config;
         void* ptr = proxy.get();
         config.attribute("oiio:ioproxy", OIIO::TypeDesc::PTR, &ptr);
@@ -133,20 +133,19 @@ OIIO::ImageCache::ImageHandle* TextureResolver::Impl::tiledCopy(const Texture& t
     if (found == copies.end()) {
         const auto start = std::chrono::steady_clock::now();
         OIIO::ImageSpec config;
-        std::unique_ptr<OIIO::Filesystem::IOMemReader> reader;
-        if (t.bytes) { // embedded: read from memory, as the cache does
-            reader = std::make_unique<OIIO::Filesystem::IOMemReader>(
-                const_cast<char*>(t.bytes->data()), t.bytes->size());
+        std::unique_ptr<OIIO::Filesystem::IOProxy> reader;
+        if (t.embedded) { // embedded: read through a proxy of its own, as the cache does
+            reader = embeddedReader(*t.embedded);
             void* ptr = reader.get();
             config.attribute("oiio:ioproxy", OIIO::TypeDesc::PTR, &ptr);
         }
-        auto copy =
-            std::make_unique<TiledCopy>(t.path, t.bytes ? &config : nullptr, spec, srgb, scratch);
+        auto copy = std::make_unique<TiledCopy>(t.path, t.embedded ? &config : nullptr, spec, srgb,
+                                                scratch);
         found = copies.emplace(key, std::move(copy)).first;
         tiledCopySeconds +=
             std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         // The source, opened for its header alone, is closed again: its pixels are the copy's.
-        if (!t.bytes) cache->invalidate(name);
+        if (!t.embedded) cache->invalidate(name);
     }
     return cache->get_image_handle(OIIO::ustring(found->second->path()));
 }
