@@ -201,6 +201,35 @@ void explainMissingEstimate(const RenderResult& result) {
 }
 
 // The image's R, G and B, then the passes' channels (AovFilm::channelNames).
+// Where the peak resident memory went, as far as the parts can say (--stats' `memory`): the
+// process at the end of loading (the file, the parser and the scene's arrays), after the BVH,
+// at its peak; the scene's own arrays, the texture cache's and the ray batches' peaks; and the
+// peak over the stored triangles and the instances.
+void reportMemory(RenderStats& stats, const Scene& scene, double loadPeakMiB) {
+    auto bytes = [](const auto& v) { return double(v.size() * sizeof(v[0])); };
+    double geometry = 0.0, triangles = 0.0;
+    for (const Mesh& m : scene.meshes) {
+        geometry += bytes(m.positions) + bytes(m.normals) + bytes(m.uvs) + bytes(m.colours) +
+                    bytes(m.triangles);
+        triangles += double(m.triangles.size());
+    }
+    const double peak = stats.extra.value("peak_rss_mib", 0.0) * 1048576.0;
+    nlohmann::json memory = {
+        {"peak_rss_mib", peak / 1048576.0},
+        {"after_load_mib", loadPeakMiB},
+        {"scene_geometry_bytes", geometry},
+        {"instances_bytes", double(scene.instances.size() * sizeof(Instance))},
+        {"texture_cache_peak_bytes", stats.textures ? stats.textures->peakCacheBytes : 0},
+        {"ray_batches_peak_bytes", stats.spill ? stats.spill->peakRayBytesInRam : 0},
+    };
+    if (stats.extra.contains("geometry"))
+        memory["after_bvh_mib"] = stats.extra["geometry"].value("peak_rss_mib_after_bvh", 0.0);
+    if (triangles > 0) memory["peak_bytes_per_triangle_stored"] = peak / triangles;
+    if (!scene.instances.empty())
+        memory["peak_bytes_per_instance"] = peak / double(scene.instances.size());
+    stats.extra["memory"] = memory;
+}
+
 void writeImageWithPasses(OutputFile& file, const std::string& path, const Film& film,
                           const AovFilm& aovs) {
     const std::vector<std::string> names = aovs.channelNames();
@@ -330,6 +359,7 @@ int renderCommand(const std::vector<std::string>& args, Ranks* ranks) {
     if (errorCsv) explainMissingEstimate(*result);
     result->stats.stages.add("load scene", loadSeconds);
     result->stats.extra["peak_rss_mib_after_load"] = loadPeakMiB;
+    reportMemory(result->stats, scene, loadPeakMiB);
     writeOutputs(o, scene, *result, errorCsv.get());
     return status;
 }

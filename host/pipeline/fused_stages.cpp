@@ -123,6 +123,7 @@ void shadeFused(const RenderContext& ctx, uint iteration, RayFormat format, cons
     const RenderParams rp = paramsAt(ctx, iteration);
     FusedTimes times;
     const bool inTraversalOrder = order.empty();
+    prepareTextures(ctx, hits, inTraversalOrder ? nullptr : order.data(), hitCount);
     // Tasks of up to `shading size` hits, each handing its continuation rays to the bins once.
     const size_t grain = batchGrain(hitCount, kFusedChunk, size_t(ctx.scene.settings.shadingSize));
     tbb::parallel_for(tbb::blocked_range<size_t>(0, hitCount, grain),

@@ -41,6 +41,12 @@ void setUpChunk(const RenderContext& ctx, const std::vector<RayState>& rays,
                 const std::vector<HitRecord>& hits, const SortedHit* order, size_t n,
                 ShadeInput* in);
 
+// The tiled copies of large images that a batch's hits (order[0, n), or hits[0, n) where order is
+// null) will read and that are not made yet, made in parallel before the batch's hit setup
+// (TextureResolver::prepare); nothing where none is pending.
+void prepareTextures(const RenderContext& ctx, const std::vector<HitRecord>& hits,
+                     const SortedHit* order, size_t n);
+
 // Splats gathered a few dozen at a time: each one's film line is prefetched when it joins, and
 // the adds wait until the batch is full, so that the lines' cache misses overlap instead of
 // stalling one atomic add after another (the sorted order has no pixel locality).

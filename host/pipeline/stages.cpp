@@ -262,9 +262,21 @@ void setUpChunk(const RenderContext& ctx, const std::vector<RayState>& rays,
             if (in[i].path.bounce == 0) ctx.aovs->record(in[i].path.pathId, in[i].hit);
 }
 
+void prepareTextures(const RenderContext& ctx, const std::vector<HitRecord>& hits,
+                     const SortedHit* order, size_t n) {
+    if (!ctx.textures.copiesPending()) return;
+    std::vector<bool> shaders(ctx.scene.shaders.size(), false);
+    for (size_t i = 0; i < n; ++i) {
+        const HitRecord& h = hits[order ? order[i].index : i];
+        if (h.mesh != kNoHit) shaders[size_t(ctx.scene.meshes[h.mesh].shader)] = true;
+    }
+    ctx.textures.prepare(shaders);
+}
+
 void setUpHits(const RenderContext& ctx, const std::vector<RayState>& rays,
                const std::vector<HitRecord>& hits, const std::vector<SortedHit>& order,
                size_t hitCount, ShadeInput* inputs, uvec2* paths) {
+    prepareTextures(ctx, hits, order.data(), hitCount);
     tbb::parallel_for(
         tbb::blocked_range<size_t>(0, hitCount, 1024), [&](const tbb::blocked_range<size_t>& r) {
             ShadeInput chunk[kChunk];

@@ -244,8 +244,6 @@ void RenderSession::build() {
     textures_.emplace(scene_, scene_.settings.textureCacheMiB,
                       config_.textureFilter == TextureFilter::Cone, config_.pipeline.simdShading,
                       config_.pipeline.spillDir);
-    if (const double s = textures_->statistics().tiledCopySeconds; s > 0.0)
-        stats_.stages.add("tile textures", s);
     lights_.emplace(scene_, &*textures_);
     if (lights_->emissionImages() > 0) stats_.extra["emission_maps"] = lights_->emissionImages();
     cutouts_.emplace(scene_, *textures_);
@@ -411,6 +409,9 @@ void RenderSession::report(const char* stopReason) {
             {"samples_of_full_render",
              std::uint64_t(scene_.image.width) * scene_.image.height * std::uint64_t(stats_.spp)}};
     if (textures_->active()) stats_.textures = textureCounters(*textures_);
+    // Made on first use, within hit setup's time (TextureResolver::prepare).
+    if (const double s = textures_->statistics().tiledCopySeconds; s > 0.0)
+        stats_.stages.add("tile textures", s);
     sync_.finish(stats_, sinceStart());
     if (sync_.writes() && !checkpoints_.path.empty() && done_ > first_) writeCheckpoint();
     stats_.nonFiniteSamples = film.nonFiniteSamples();

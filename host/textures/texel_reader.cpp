@@ -172,7 +172,9 @@ vec3 TexelReader::texel(int levelIndex, int x, int y) {
             thread_.holding.push_back(slot);
         }
         h = Held{};
-        h.tile = impl_.cache->get_tile(image_.handle, thread_.oiio, 0, levelIndex, x, y, 0);
+        OIIO::ImageCache::ImageHandle* handle = impl_.handleOf(image_, index_);
+        h.tile =
+            handle ? impl_.cache->get_tile(handle, thread_.oiio, 0, levelIndex, x, y, 0) : nullptr;
         if (!h.tile) {
             // The slot holds nothing now (a slot is listed while it holds a tile).
             thread_.holding.erase(std::find(thread_.holding.begin(), thread_.holding.end(), slot));

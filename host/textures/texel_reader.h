@@ -33,8 +33,22 @@ struct TextureResolver::Impl {
     struct Level {
         int x = 0, y = 0, width = 1, height = 1; // the data window
     };
+    // A tiled copy (tiled_copy.h) not made when the images are opened: made on the first lookup
+    // that reads its image, once, by whichever thread asks first; prepare() makes the copies of
+    // a batch's images in parallel before its lookups. Shared by the Standard textures that
+    // read one image in one encoding.
+    struct PendingCopy {
+        std::once_flag once;
+        const Texture* texture = nullptr;
+        OIIO::ustring name;
+        OIIO::ImageSpec spec; // the source's first level
+        bool srgb = false;
+        OIIO::ImageCache::ImageHandle* handle = nullptr; // set within `once`
+        std::string error;                               // why not, where it could not be made
+    };
     struct Image {
         OIIO::ImageCache::ImageHandle* handle = nullptr;
+        std::shared_ptr<PendingCopy> copy; // null: `handle` is the image's own
         bool srgb = false;
         bool eightBit = false;     // its texels are 8-bit integers (the wide filter reads those)
         int channels = 3;          // from Texture::channel on
@@ -45,15 +59,27 @@ struct TextureResolver::Impl {
         size_t firstHeld = 0;      // its levels' slots in ThreadState::held
     };
     std::vector<Image> images; // parallel to Scene::textures (only Standard entries are used)
-    // Tiled copies of large untiled images (tiled_copy.h), by file and encoding, and the folder
-    // they go to.
-    std::map<std::string, std::unique_ptr<TiledCopy>> copies;
+    // Tiled copies of large untiled images (tiled_copy.h): those to make, by file and encoding;
+    // those made (under copyMutex, with the time they took); the folder they go to.
+    std::map<std::string, std::shared_ptr<PendingCopy>> pending;
+    std::vector<std::unique_ptr<TiledCopy>> copies;
+    std::mutex copyMutex;
+    std::atomic<size_t> copiesTried{0}; // the pending copies makeCopy has run for
     std::string scratch;
     double tiledCopySeconds = 0.0;
-    // The cache's handle of the tiled copy of Standard texture t's image `name`, whose first
-    // level is `spec`, made on first use. Throws where it cannot be made.
-    OIIO::ImageCache::ImageHandle* tiledCopy(const Texture& t, OIIO::ustring name,
+    // The pending copy of Standard texture t's image `name` (first level `spec`) in its encoding.
+    std::shared_ptr<PendingCopy> pendingCopy(const Texture& t, OIIO::ustring name,
                                              const OIIO::ImageSpec& spec, bool srgb);
+    // Makes `copy` (within its once_flag); where it cannot be, copy.error says why.
+    void makeCopy(PendingCopy& copy);
+    // The handle lookups of Standard texture `index` read, its tiled copy made first where it
+    // has one; null (and the render failed, reported after the iteration) where it cannot be.
+    OIIO::ImageCache::ImageHandle* handleOf(const Image& img, int index) {
+        if (!img.copy) return img.handle;
+        std::call_once(img.copy->once, [&] { makeCopy(*img.copy); });
+        if (!img.copy->handle) fail(index, img.copy->error);
+        return img.copy->handle;
+    }
     // The first failed lookup, reported after the iteration (a lookup cannot throw mid-batch).
     std::atomic<bool> failed{false};
     std::mutex errorMutex;
@@ -114,11 +140,11 @@ struct TextureResolver::Impl {
             t.heldBytes = t.held[keep].bytes();
         }
     }
-    void fail(int index) {
+    void fail(int index, std::string why = "") {
         if (failed.exchange(true)) return;
         std::lock_guard<std::mutex> lock(errorMutex);
         failedTexture = index;
-        error = cache->geterror();
+        error = why.empty() ? cache->geterror() : why;
         if (error.empty()) error = "a tile could not be read";
     }
     ~Impl() {

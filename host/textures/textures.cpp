@@ -14,7 +14,9 @@
 
 #include <sys/resource.h>
 #include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <array>
@@ -96,19 +98,18 @@ void openImage(const Scene& scene, TextureResolver::Impl& impl, const Texture& t
     std::string cs = spec->get_string_attribute("oiio:ColorSpace");
     img.srgb = !t.linear && (cs == "sRGB" || (cs.empty() && spec->format == OIIO::TypeDesc::UINT8));
     const int levels = impl.cache->imagespec(img.handle, nullptr, 0, 1) ? 2 : 1;
-    if (!readWhole && needsTiledCopy(*spec, levels)) {
-        try {
-            img.handle = impl.tiledCopy(t, name, *spec, img.srgb);
-        } catch (const TiledCopy::ReadError& e) {
-            throw SceneError(scene.file, t.line,
-                             "texture file '" + t.path + "' cannot be read: " + e.what());
-        }
-        spec = img.handle ? impl.cache->imagespec(img.handle, nullptr, 0, 0) : nullptr;
-        if (!spec)
-            throw std::runtime_error("cannot read the tiled copy of texture '" + t.path +
-                                     "': " + impl.cache->geterror());
-    }
     img.finest = float(std::max(spec->width, spec->height));
+    if (!readWhole && needsTiledCopy(*spec, levels)) {
+        // Its copy is made when a lookup first reads it; its levels are the copy's, from the
+        // finest down to 1 x 1, each half the one before (tiled_copy.h).
+        img.copy = impl.pendingCopy(t, name, *spec, img.srgb);
+        for (int w = spec->width, h = spec->height;;
+             w = std::max(1, w / 2), h = std::max(1, h / 2)) {
+            img.levels.push_back({0, 0, w, h});
+            if (w == 1 && h == 1) break;
+        }
+        return;
+    }
     // Its MIP levels, as many as the file has (an image without them is its own only level).
     for (int level = 0; level < int(kMaxLevels); ++level) {
         const OIIO::ImageSpec* ls =
@@ -120,18 +121,30 @@ void openImage(const Scene& scene, TextureResolver::Impl& impl, const Texture& t
 
 } // namespace
 
-OIIO::ImageCache::ImageHandle* TextureResolver::Impl::tiledCopy(const Texture& t,
-                                                                OIIO::ustring name,
-                                                                const OIIO::ImageSpec& spec,
-                                                                bool srgb) {
+std::shared_ptr<TextureResolver::Impl::PendingCopy>
+TextureResolver::Impl::pendingCopy(const Texture& t, OIIO::ustring name,
+                                   const OIIO::ImageSpec& spec, bool srgb) {
     // One copy per image and encoding; an alpha-only lookup (channel 3) takes either, as the
     // alpha is averaged alike in both.
     const std::string key = name.string() + (srgb ? "\n1" : "\n0");
-    auto found = copies.find(key);
-    if (found == copies.end() && t.channel == 3)
-        found = copies.find(name.string() + (srgb ? "\n0" : "\n1"));
-    if (found == copies.end()) {
-        const auto start = std::chrono::steady_clock::now();
+    auto found = pending.find(key);
+    if (found == pending.end() && t.channel == 3)
+        found = pending.find(name.string() + (srgb ? "\n0" : "\n1"));
+    if (found != pending.end()) return found->second;
+    auto copy = std::make_shared<PendingCopy>();
+    copy->texture = &t, copy->name = name, copy->spec = spec, copy->srgb = srgb;
+    return pending[key] = copy;
+}
+
+bool TextureResolver::copiesPending() const {
+    return impl_ && impl_->copiesTried.load(std::memory_order_relaxed) < impl_->pending.size();
+}
+
+void TextureResolver::Impl::makeCopy(PendingCopy& p) {
+    const auto start = std::chrono::steady_clock::now();
+    ++copiesTried;
+    const Texture& t = *p.texture;
+    try {
         OIIO::ImageSpec config;
         std::unique_ptr<OIIO::Filesystem::IOProxy> reader;
         if (t.embedded) { // embedded: read through a proxy of its own, as the cache does
@@ -139,15 +152,48 @@ OIIO::ImageCache::ImageHandle* TextureResolver::Impl::tiledCopy(const Texture& t
             void* ptr = reader.get();
             config.attribute("oiio:ioproxy", OIIO::TypeDesc::PTR, &ptr);
         }
-        auto copy = std::make_unique<TiledCopy>(t.path, t.embedded ? &config : nullptr, spec, srgb,
-                                                scratch);
-        found = copies.emplace(key, std::move(copy)).first;
+        auto copy = std::make_unique<TiledCopy>(t.path, t.embedded ? &config : nullptr, p.spec,
+                                                p.srgb, scratch);
+        p.handle = cache->get_image_handle(OIIO::ustring(copy->path()));
+        if (!p.handle) p.error = "its tiled copy cannot be read: " + cache->geterror();
+        // The source, opened for its header alone, is closed again: its pixels are the copy's.
+        if (!t.embedded) cache->invalidate(p.name);
+        std::lock_guard<std::mutex> lock(copyMutex);
+        copies.push_back(std::move(copy));
         tiledCopySeconds +=
             std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-        // The source, opened for its header alone, is closed again: its pixels are the copy's.
-        if (!t.embedded) cache->invalidate(name);
+    } catch (const std::exception& e) { // TiledCopy::ReadError: the image's own pixels
+        p.handle = nullptr;
+        p.error = e.what();
     }
-    return cache->get_image_handle(OIIO::ustring(found->second->path()));
+}
+
+void TextureResolver::prepare(const std::vector<bool>& shaders) const {
+    if (!impl_ || impl_->pending.empty()) return;
+    std::vector<int> images; // the Standard textures the shaders read
+    for (size_t s = 0; s < shaders.size() && s < scene_.shaders.size(); ++s) {
+        if (!shaders[s]) continue;
+        const Shader& sh = scene_.shaders[s];
+        for (int root : {sh.texture, sh.normalTexture, sh.coatNormalTexture,
+                         sh.metallicRoughnessTexture, sh.cutout.enabled ? sh.cutout.texture : -1})
+            standardNodes(root, images);
+        for (const Shader::ExtensionMap& m : sh.extension)
+            standardNodes(m.texture, images);
+    }
+    std::vector<Impl::PendingCopy*> wanted;
+    for (int t : images)
+        if (Impl::PendingCopy* copy = impl_->images[size_t(t)].copy.get()) wanted.push_back(copy);
+    std::sort(wanted.begin(), wanted.end());
+    wanted.erase(std::unique(wanted.begin(), wanted.end()), wanted.end());
+    tbb::parallel_for(size_t(0), wanted.size(), [&](size_t k) {
+        std::call_once(wanted[k]->once, [&] { impl_->makeCopy(*wanted[k]); });
+    });
+}
+
+void TextureResolver::standardNodes(int root, std::vector<int>& out) const {
+    if (root < 0 || size_t(root) >= programs_.size()) return;
+    for (const Op& op : programs_[size_t(root)])
+        if (op.type == TextureType::Standard) out.push_back(op.texture);
 }
 
 void TextureResolver::compilePrograms() {
@@ -225,6 +271,9 @@ TextureResolver::TextureResolver(const Scene& scene, double cacheMiB, bool filte
     // The tiles the threads hold together stay within a quarter of the cache.
     const int workers = std::max(1, tbb::this_task_arena::max_concurrency());
     impl_->heldLimit = size_t(cacheMiB * 1048576.0 / 4.0) / size_t(workers);
+    // The copies are made during the render: a scratch folder that cannot hold one is named now,
+    // before the first ray (a runtime error, not the scene's).
+    if (!impl_->pending.empty()) ::close(openScratchFile(impl_->scratch, "texture tile"));
 }
 
 TextureResolver::~TextureResolver() = default;
@@ -270,9 +319,10 @@ TextureStatistics TextureResolver::statistics() const {
     s.filesReopened = s.filesOpened > unique ? s.filesOpened - unique : 0;
     s.cacheMisses = count("stat:find_tile_cache_misses");
     s.peakCacheBytes = impl_->peakCacheBytes.load();
+    std::lock_guard<std::mutex> lock(impl_->copyMutex);
     s.tiledCopies = impl_->copies.size();
     for (const auto& copy : impl_->copies)
-        s.tiledCopyBytes += copy.second->bytes();
+        s.tiledCopyBytes += copy->bytes();
     s.tiledCopySeconds = impl_->tiledCopySeconds;
     return s;
 }

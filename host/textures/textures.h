@@ -69,6 +69,13 @@ class TextureResolver {
     // read it (linear, its channels from Texture::channel on), row by row from the top, and its
     // size. Throws SceneError where its pixels cannot be read.
     std::vector<vec3> finestLevel(int texture, int& width, int& height) const;
+    // Makes, in parallel, the tiled copies (tiled_copy.h) not yet made of the images that
+    // shaders s with shaders[s] read: the sorted pipeline calls it with a batch's shaders before
+    // its lookups, which would otherwise make each copy on its first lookup, one at a time as
+    // the hits sorted by shader reach it. Only images a ray reads are ever copied.
+    void prepare(const std::vector<bool>& shaders) const;
+    // Whether some tiled copy is not made yet (prepare has work to do).
+    bool copiesPending() const;
     // True when the scene has image textures (OpenImageIO is in use).
     bool active() const { return impl_ != nullptr; }
     // True when the images hit setup reads (every MIP level, as the tile cache holds them) total
@@ -92,6 +99,8 @@ class TextureResolver {
         int texture;            // index into Scene::textures
         int upper, lower, mask; // Layered: operand slots
     };
+    // The Standard textures of the tree rooted at `root` (compiled), appended to `out`.
+    void standardNodes(int root, std::vector<int>& out) const;
     // The trees of Scene::textures that shaders read, flattened into programs_.
     void compilePrograms();
     // The tree's values for n lookups, in a per-thread buffer that the next call reuses.

@@ -262,6 +262,34 @@ TEST(Instancing, YamlInstancesRenderAsSeparateObjects) {
     EXPECT_EQ(g.instances.size(), 15u);
 }
 
+// --stats says where the memory went: the scene's arrays to the byte (the box once, 8 vertices
+// of position, normal and uv and 12 triangles, beside the floor quad), the instances' records,
+// and the peaks in the order they are reached.
+TEST(Instancing, StatsReportTheMemoryOfTheSceneAndItsPeaks) {
+    TempDir dir;
+    const std::string file = boxes(dir, "boxes.gltf", true);
+    const Scene scene = loadScene(file);
+    ASSERT_EQ(scene.instances.size(), 4u);
+    const std::string stats = dir.file("stats.json");
+    const CommandResult r =
+        runSpillway("render " + file + " --backend cpu --spp 1 --width 16 " +
+                    "--height 12 --quiet -o " + dir.file("b.exr") + " --stats " + stats);
+    ASSERT_EQ(r.status, 0) << r.output;
+    const json m = json::parse(readFile(stats))["memory"];
+    double expected = 0.0;
+    for (const Mesh& mesh : scene.meshes)
+        expected +=
+            double(mesh.positions.size() * 12 + mesh.normals.size() * 12 + mesh.uvs.size() * 8 +
+                   mesh.colours.size() * 12 + mesh.triangles.size() * 12);
+    EXPECT_EQ(m["scene_geometry_bytes"].get<double>(), expected) << m.dump();
+    EXPECT_EQ(m["instances_bytes"].get<double>(), double(4 * sizeof(Instance)));
+    EXPECT_LE(m["after_load_mib"].get<double>(), m["after_bvh_mib"].get<double>());
+    EXPECT_LE(m["after_bvh_mib"].get<double>(), m["peak_rss_mib"].get<double>());
+    EXPECT_DOUBLE_EQ(m["peak_bytes_per_instance"].get<double>(),
+                     m["peak_rss_mib"].get<double>() * 1048576.0 / 4.0);
+    EXPECT_GT(m["ray_batches_peak_bytes"].get<double>(), 0.0);
+}
+
 TEST(Instancing, MalformedPlacementsAreRefusedWithWhere) {
     TempDir dir;
     dir.write("cube.obj", insideCubeObj());

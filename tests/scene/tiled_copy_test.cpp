@@ -2,8 +2,9 @@
 // is read through a 64 x 64-tiled, MIP-mapped copy in an unnamed scratch file. Its finest level
 // is the image bit for bit; its coarser levels are averaged in linear light; a render is the
 // same image under a texture cache far smaller than the image, which the cache then keeps to;
-// no file is left in the scratch folder; a folder where no file can be made is an error naming
-// it, a truncated image a scene error naming the file. Images under the threshold are read as
+// no file is left in the scratch folder; copies are made only of the images lookups read, when
+// they first read them; a folder where no file can be made is an error naming it, a truncated
+// image a scene error naming the file. Images under the threshold are read as
 // they always were, with no copy.
 #include "host/image/image_io.h"
 #include "host/loaders/scene_loader.h"
@@ -88,11 +89,8 @@ TEST(TiledCopy, TheFinestLevelIsTheImageBitForBitAndCoarserLevelsAverageInLinear
     const std::vector<unsigned char> px = writeLargePng(dir.file("large.png"));
     const Scene scene = loadScene(planeScene(dir, "large.png"));
     const TextureResolver textures(scene, 64.0, true, true, dir.path());
-    const TextureStatistics s = textures.statistics();
-    EXPECT_EQ(s.tiledCopies, 1u);
-    // Every level, 2400 down to 1: 4/3 of the finest within the levels' rounding.
-    EXPECT_GT(s.tiledCopyBytes, px.size() * 4 / 3 - px.size() / 100);
-    EXPECT_LT(s.tiledCopyBytes, px.size() * 4 / 3 + px.size() / 100);
+    EXPECT_EQ(textures.statistics().tiledCopies, 0u) << "the copy waits for a lookup to read it";
+    EXPECT_TRUE(textures.copiesPending());
     // At the finest level every lookup is the one the same pixels give read as they are (here
     // from a TIFF of 64 x 64 tiles, one level, which needs no copy), to the bit.
     {
@@ -114,6 +112,12 @@ TEST(TiledCopy, TheFinestLevelIsTheImageBitForBitAndCoarserLevelsAverageInLinear
                   reference.albedo(direct.shaders[0], uv, 0.0f))
             << uv.x << ", " << uv.y;
     }
+    const TextureStatistics s = textures.statistics();
+    EXPECT_EQ(s.tiledCopies, 1u);
+    EXPECT_FALSE(textures.copiesPending());
+    // Every level, 2400 down to 1: 4/3 of the finest within the levels' rounding.
+    EXPECT_GT(s.tiledCopyBytes, px.size() * 4 / 3 - px.size() / 100);
+    EXPECT_LT(s.tiledCopyBytes, px.size() * 4 / 3 + px.size() / 100);
     // A footprint of the whole image reads the coarsest levels: the red checker of 0 and 1
     // averages to 0.5 in linear light (0.216 had the sRGB codes been averaged), within the
     // 8-bit rounding of the levels between.
@@ -164,7 +168,8 @@ TEST(TiledCopy, AFolderWhereNoFileCanBeMadeIsAnErrorNamingIt) {
 }
 
 // A large image whose pixels stop short of its header's size is a scene error naming the
-// texture file (exit 2), found when the copy reads it, as a lookup would have found it.
+// texture file (exit 2), found when the copy reads it: at the first lookup, reported after the
+// iteration as any failed lookup is.
 TEST(TiledCopy, ATruncatedImageIsASceneErrorNamingIt) {
     TempDir dir;
     writeLargePng(dir.file("large.png"));
@@ -175,8 +180,10 @@ TEST(TiledCopy, ATruncatedImageIsASceneErrorNamingIt) {
     // (tests/fuzz/lsan.supp names it, but only the slow unwinder reaches its frames): what it
     // allocates while reading is not LeakSanitizer's to report here.
     [[maybe_unused]] LeakCheckPause pause;
+    const TextureResolver textures(scene, 64.0, true, true, dir.path());
+    textures.albedo(scene.shaders[0], vec2(0.5f), 0.0f);
     try {
-        const TextureResolver textures(scene, 64.0, true, true, dir.path());
+        textures.checkErrors();
         ADD_FAILURE() << "no error";
     } catch (const SceneError& e) {
         EXPECT_NE(std::string(e.what()).find("texture file '" + dir.file("large.png") +
@@ -184,6 +191,47 @@ TEST(TiledCopy, ATruncatedImageIsASceneErrorNamingIt) {
                   std::string::npos)
             << e.what();
     }
+}
+
+// Copies are made for the images rays read, when they first read them: prepare() makes those of
+// the shaders it is given (in parallel, several at once) and no other; a lookup makes its own
+// image's where none was prepared. The lookups are the same to the bit either way, and an image
+// no shader of a render's hits reads is never copied.
+TEST(TiledCopy, CopiesAreMadeForTheImagesLookupsReadAndNoOther) {
+    TempDir dir;
+    writeLargePng(dir.file("large.png"));
+    std::filesystem::copy_file(dir.file("large.png"), dir.file("other.png"));
+    Scene scene = loadScene(planeScene(dir, "large.png"));
+    // A second shader reading the other file, which no object wears.
+    Texture other = scene.textures[size_t(scene.shaders[0].texture)];
+    other.path = dir.file("other.png");
+    scene.textures.push_back(other);
+    scene.shaders.push_back(scene.shaders[0]);
+    scene.shaders[1].texture = int(scene.textures.size()) - 1;
+    const TextureResolver lazy(scene, 64.0, true, true, dir.path());
+    const TextureResolver prepared(scene, 64.0, true, true, dir.path());
+    prepared.prepare({true, false});
+    EXPECT_EQ(prepared.statistics().tiledCopies, 1u);
+    EXPECT_TRUE(prepared.copiesPending());
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<float> u(0.0f, 1.0f);
+    for (int i = 0; i < 200; ++i) {
+        const vec2 uv(u(rng), u(rng));
+        const float footprint = u(rng) * 0.01f;
+        ASSERT_EQ(lazy.albedo(scene.shaders[0], uv, footprint),
+                  prepared.albedo(scene.shaders[0], uv, footprint));
+    }
+    EXPECT_EQ(lazy.statistics().tiledCopies, 1u) << "the lookup made its image's copy";
+    prepared.prepare({true, true});
+    EXPECT_EQ(prepared.statistics().tiledCopies, 2u);
+    EXPECT_FALSE(prepared.copiesPending());
+    // A render: its hits read the plane's shader, never the second one.
+    RenderConfig cfg;
+    cfg.backend = BackendKind::Cpu;
+    cfg.pipeline.spillDir = dir.path();
+    EXPECT_EQ(render(scene, cfg)->stats.toJson()["textures"]["tiled_copies"], 1);
+    lazy.checkErrors();
+    prepared.checkErrors();
 }
 
 TEST(TiledCopy, ImagesUnderTheThresholdAreReadAsTheyAre) {
