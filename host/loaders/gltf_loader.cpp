@@ -5,6 +5,7 @@
 // bounds; gltf_meshes.cpp reads accessors and meshes, gltf_materials.cpp materials and images.
 #include "host/loaders/gltf_loader.h"
 
+#include "host/loaders/gltf_nodes.h"
 #include "host/loaders/gltf_preflight.h"
 #include "host/loaders/gltf_reader.h"
 #include "host/loaders/gltf_sources.h"
@@ -115,6 +116,8 @@ void GltfReader::read(const std::vector<glm::dmat4>& transforms, bool takesCamer
                       "/scenes/" + std::to_string(sceneIndex) + "/nodes/" + std::to_string(i), pass,
                       0);
     }
+    // The graph is read: its nodes go before the meshes are placed.
+    std::vector<GltfNode>().swap(nodes_);
     placeMeshes();
     // Every accessor is read: the parser's copies of the buffers go before the BVH is built.
     for (tinygltf::Buffer& b : model_.buffers)
@@ -136,6 +139,7 @@ void GltfReader::parse() {
     bool ok = false;
     std::vector<std::string> bufferFiles;
     if (!document.doc.is_discarded()) { // tinygltf reads the buffers through gltf_sources.h
+        nodes_ = takeGltfNodes(path_, document.doc);
         GltfSources sources(path_, std::move(document));
         loader.SetFsCallbacks(sources.callbacks());
         ok = loader.LoadASCIIFromString(&model_, &err, &warnings, sources.text().data(),
@@ -176,36 +180,6 @@ void GltfReader::checkExtensions() {
         if (!kHonoured.count(e)) warn("uses the extension " + e + ", not rendered");
 }
 
-glm::dmat4 GltfReader::localTransform(const tinygltf::Node& n, const std::string& at) const {
-    if (!n.matrix.empty()) {
-        if (n.matrix.size() != 16) fail(at + "/matrix", "a matrix has 16 numbers");
-        glm::dmat4 m;
-        for (int c = 0; c < 4; ++c)
-            for (int r = 0; r < 4; ++r)
-                m[c][r] = n.matrix[size_t(4 * c + r)];
-        return finite(m, at + "/matrix");
-    }
-    glm::dmat4 m(1.0);
-    if (!n.translation.empty()) {
-        if (n.translation.size() != 3) fail(at + "/translation", "a translation has 3 numbers");
-        m = glm::translate(m, glm::dvec3(n.translation[0], n.translation[1], n.translation[2]));
-    }
-    if (!n.rotation.empty()) {
-        if (n.rotation.size() != 4) fail(at + "/rotation", "a rotation has 4 numbers");
-        // glTF's quaternions are (x, y, z, w); glm's constructor takes w first.
-        const glm::dquat q(n.rotation[3], n.rotation[0], n.rotation[1], n.rotation[2]);
-        const double len = glm::length(q);
-        if (!(len > 0.0) || !std::isfinite(len))
-            fail(at + "/rotation", "a rotation must be a non-zero quaternion");
-        m = m * glm::mat4_cast(q / len);
-    }
-    if (!n.scale.empty()) {
-        if (n.scale.size() != 3) fail(at + "/scale", "a scale has 3 numbers");
-        m = glm::scale(m, glm::dvec3(n.scale[0], n.scale[1], n.scale[2]));
-    }
-    return finite(m, at);
-}
-
 glm::dmat4 GltfReader::finite(const glm::dmat4& m, const std::string& at) const {
     for (int c = 0; c < 4; ++c)
         for (int r = 0; r < 4; ++r)
@@ -215,21 +189,20 @@ glm::dmat4 GltfReader::finite(const glm::dmat4& m, const std::string& at) const 
 
 void GltfReader::visit(int index, const glm::dmat4& parent, const std::string& at, Pass pass,
                        int depth) {
-    if (index < 0 || index >= int(model_.nodes.size()))
-        fail(at,
-             "names node " + std::to_string(index) + " of " + std::to_string(model_.nodes.size()));
+    if (index < 0 || index >= int(nodes_.size()))
+        fail(at, "names node " + std::to_string(index) + " of " + std::to_string(nodes_.size()));
     if (onPath_.count(index))
         fail("/nodes/" + std::to_string(index),
              "the node graph is recursive: this node is its own ancestor");
     if (depth > 1024) fail(at, "nodes nest more than 1024 deep");
-    const tinygltf::Node& n = model_.nodes[size_t(index)];
+    const GltfNode& n = nodes_[size_t(index)];
     const std::string self = "/nodes/" + std::to_string(index);
-    const glm::dmat4 world = finite(parent * localTransform(n, self), self);
+    const glm::dmat4 world = finite(parent * n.local, self);
     if (pass == Pass::Camera) {
         if (n.camera >= 0 && !cameraFound_) readCamera(n.camera, world, self + "/camera");
     } else {
         cameraSeen_ = cameraSeen_ || n.camera >= 0;
-        if (n.mesh >= 0) placements_.push_back({n.mesh, world, self + "/mesh"});
+        if (n.mesh >= 0) placements_.push_back({n.mesh, index, world});
         readLight(n, world, self);
         if (n.skin >= 0) warn("has skins: rendered in their bind pose");
     }
@@ -314,15 +287,12 @@ void GltfReader::include(const glm::dvec3& p) {
     bounded_ = true;
 }
 
-void GltfReader::readLight(const tinygltf::Node& n, const glm::dmat4& world,
-                           const std::string& at) {
-    const auto ext = n.extensions.find("KHR_lights_punctual");
-    if (ext == n.extensions.end()) return;
-    const tinygltf::Value& v = ext->second.Get("light");
+void GltfReader::readLight(const GltfNode& n, const glm::dmat4& world, const std::string& at) {
+    if (n.light == -1) return;
     const std::string where = at + "/extensions/KHR_lights_punctual/light";
-    if (!v.IsInt() || v.GetNumberAsInt() < 0 || v.GetNumberAsInt() >= int(model_.lights.size()))
+    if (n.light < 0 || n.light >= int(model_.lights.size()))
         fail(where, "names no light of the file's KHR_lights_punctual lights");
-    const tinygltf::Light& l = model_.lights[size_t(v.GetNumberAsInt())];
+    const tinygltf::Light& l = model_.lights[size_t(n.light)];
     vec3 colour(1.0f);
     if (!l.color.empty()) {
         if (l.color.size() != 3) fail(where, "a light's color has 3 numbers");

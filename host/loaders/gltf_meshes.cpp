@@ -246,29 +246,29 @@ void GltfReader::placeMeshes() {
         ++uses[p.mesh];
     std::map<int, int> prototypeOf; // glTF mesh -> prototype, or -1 for none (no triangles)
     for (const Placement& p : placements_) {
-        if (uses[p.mesh] < 2 || emissive(p.mesh, p.at)) {
-            readMesh(p.mesh, p.world, p.at);
+        if (uses[p.mesh] < 2 || emissive(p.mesh, p.at())) {
+            readMesh(p.mesh, p.world, p.at());
             continue;
         }
         const auto known = prototypeOf.find(p.mesh);
         const int proto = known != prototypeOf.end()
                               ? known->second
-                              : prototypeOf[p.mesh] = readPrototype(p.mesh, p.at);
+                              : prototypeOf[p.mesh] = readPrototype(p.mesh, p.at());
         if (proto < 0) continue;
         glm::dmat4 world = p.world;
         world[3] -= glm::dvec4(scene_.origin, 0.0);
         std::string error;
         const Prototype& prototype = scene_.prototypes[size_t(proto)];
         if (world[0][3] != 0.0 || world[1][3] != 0.0 || world[2][3] != 0.0 || world[3][3] != 1.0)
-            fail(p.at, "the node's transform is not affine (its last row is not 0 0 0 1)");
+            fail(p.at(), "the node's transform is not affine (its last row is not 0 0 0 1)");
         Instance inst = makeInstance(prototype, uint(proto), world, error);
         if (!error.empty()) {
-            if (error.find("singular") == std::string::npos) fail(p.at, error);
+            if (error.find("singular") == std::string::npos) fail(p.at(), error);
             warn("places a mesh with a singular transform (a zero scale): not rendered there");
             continue;
         }
         if (scene_.instances.size() >= size_t(kMaxInstances))
-            fail(p.at, "more than " + std::to_string(kMaxInstances) + " instances");
+            fail(p.at(), "more than " + std::to_string(kMaxInstances) + " instances");
         for (int k = 0; k < 8; ++k) { // the bounds a camera framing the scene sees
             const glm::dvec3 corner(k & 1 ? prototype.hi.x : prototype.lo.x,
                                     k & 2 ? prototype.hi.y : prototype.lo.y,

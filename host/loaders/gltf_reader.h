@@ -3,6 +3,7 @@
 // each implement a part of. Internal to host/loaders/.
 #pragma once
 
+#include "host/loaders/gltf_nodes.h"
 #include "host/scene/scene.h"
 
 #include <glm/mat4x4.hpp>
@@ -52,7 +53,6 @@ class GltfReader {
     void checkExtensions();
 
     // The node's local transform: its matrix, or translation x rotation x scale.
-    glm::dmat4 localTransform(const tinygltf::Node& n, const std::string& at) const;
     glm::dmat4 finite(const glm::dmat4& m, const std::string& at) const;
 
     void visit(int index, const glm::dmat4& parent, const std::string& at, Pass pass, int depth);
@@ -240,7 +240,7 @@ class GltfReader {
 
     // --- lights ----------------------------------------------------------------------------
 
-    void readLight(const tinygltf::Node& n, const glm::dmat4& world, const std::string& at);
+    void readLight(const GltfNode& n, const glm::dmat4& world, const std::string& at);
 
     void warnUnrendered() {
         if (!model_.animations.empty()) warn("has animations: rendered at rest");
@@ -251,6 +251,7 @@ class GltfReader {
     std::filesystem::path dir_;
     Scene& scene_;
     tinygltf::Model model_;
+    std::vector<GltfNode> nodes_; // the file's nodes (gltf_nodes.h), until the graph is read
     ImageBytes embedded_;
     std::set<std::string> warned_;
     std::set<int> onPath_;
@@ -265,10 +266,12 @@ class GltfReader {
     bool cameraFound_ = false, cameraSeen_ = false;
     int shaderOverride_ = -1;
     // The meshes the node graph places, in the order it names them (visit), read by placeMeshes.
+    // (A million nodes make a million of these: the node's index, not its pointer's text.)
     struct Placement {
         int mesh;
+        int node;
         glm::dmat4 world;
-        std::string at; // the node's mesh, as a JSON pointer
+        std::string at() const { return "/nodes/" + std::to_string(node) + "/mesh"; }
     };
     std::vector<Placement> placements_;
     // While a prototype's meshes are read: its index (their positions stay in the mesh's frame).

@@ -13,6 +13,8 @@
 #include <OpenImageIO/imagebuf.h>
 #include <gtest/gtest.h>
 
+#include <tuple>
+
 #include <sys/stat.h>
 
 #include <cstdint>
@@ -88,6 +90,40 @@ TEST(GltfHostile, AccessorCountsPastTheLimitAreRefusedBeforeAllocating) {
             << e;
         EXPECT_NE(e.find("at most 268435456 values"), std::string::npos) << e;
     }
+}
+
+// A node's indices are integers from 0 to 2^31 - 1 and its transform arrays of numbers: past
+// 32 bits, fractional, negative or of another JSON type, each is refused with its pointer, where a
+// cast would have read 4294967296 as mesh 0 and dropped -1 or "1" as no mesh at all.
+TEST(GltfHostile, NodeIndicesAndTransformsOfTheWrongKindAreRefused) {
+    TempDir dir;
+    const std::string index = "must be an index: an integer from 0 to 2147483647";
+    const std::vector<std::tuple<const char*, json, std::string>> cases = {
+        {"mesh", 4294967296ull, "/nodes/0/mesh: " + index},
+        {"mesh", 2147483648ull, "/nodes/0/mesh: " + index},
+        {"mesh", -1, "/nodes/0/mesh: " + index},
+        {"mesh", 0.5, "/nodes/0/mesh: " + index},
+        {"mesh", "0", "/nodes/0/mesh: " + index},
+        {"camera", 4294967297ull, "/nodes/0/camera: " + index},
+        {"children", json::array({1.0}), "/nodes/0/children/0: " + index},
+        {"children", 1, "/nodes/0/children: must be an array of node indices"},
+        {"translation", json::array({0, "1", 2}),
+         "/nodes/0/translation: a translation has 3 numbers"},
+        {"scale", json::array({1, 1}), "/nodes/0/scale: a scale has 3 numbers"},
+        {"matrix", json::object(), "/nodes/0/matrix: a matrix has 16 numbers"}};
+    for (const auto& [key, value, message] : cases) {
+        GltfBuilder b = quadScene();
+        b.doc["nodes"][0][key] = value;
+        const std::string e = loadError(b.binary(dir, "node.glb"));
+        EXPECT_NE(e.find(message), std::string::npos) << key << " = " << value.dump() << ": " << e;
+    }
+    GltfBuilder b = quadScene();
+    b.doc["nodes"][0] = 7;
+    EXPECT_NE(loadError(b.binary(dir, "node.glb")).find("/nodes/0: a node is a JSON object"),
+              std::string::npos);
+    b.doc["nodes"] = json::object();
+    EXPECT_NE(loadError(b.binary(dir, "node.glb")).find("/nodes: must be an array of nodes"),
+              std::string::npos);
 }
 
 // Indices are unsigned integers (the specification's rule), read as 32-bit values: a signed
