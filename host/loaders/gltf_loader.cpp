@@ -139,7 +139,7 @@ void GltfReader::parse() {
     bool ok = false;
     std::vector<std::string> bufferFiles;
     if (!document.doc.is_discarded()) { // tinygltf reads the buffers through gltf_sources.h
-        nodes_ = takeGltfNodes(path_, document.doc);
+        nodes_ = std::move(document.nodes);
         GltfSources sources(path_, std::move(document));
         loader.SetFsCallbacks(sources.callbacks());
         ok = loader.LoadASCIIFromString(&model_, &err, &warnings, sources.text().data(),

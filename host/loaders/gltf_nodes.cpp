@@ -13,10 +13,13 @@ namespace {
 
 using nlohmann::json;
 
+// A node's problem: its JSON pointer and what is wrong.
+struct NodeError {
+    std::string message;
+};
+
 class NodeReader {
   public:
-    explicit NodeReader(const std::string& path) : path_(path) {}
-
     GltfNode read(const json& o, const std::string& at) const {
         if (!o.is_object()) fail(at, "a node is a JSON object");
         GltfNode n;
@@ -36,8 +39,8 @@ class NodeReader {
     }
 
   private:
-    [[noreturn]] void fail(const std::string& at, const std::string& message) const {
-        throw SceneError(path_, 0, at + ": " + message);
+    [[noreturn]] static void fail(const std::string& at, const std::string& message) {
+        throw NodeError{at + ": " + message};
     }
 
     // An index: an integer JSON number from 0 to INT_MAX (not 2^32, which a cast reads as 0).
@@ -106,25 +109,38 @@ class NodeReader {
             m = glm::scale(m, glm::dvec3(v[0], v[1], v[2]));
         return finite(m, at);
     }
-
-    const std::string& path_;
 };
 
 } // namespace
 
-std::vector<GltfNode> takeGltfNodes(const std::string& path, json& doc) {
-    std::vector<GltfNode> nodes;
-    if (!doc.is_object() || !doc.contains("nodes")) return nodes;
-    if (!doc["nodes"].is_array()) throw SceneError(path, 0, "/nodes: must be an array of nodes");
-    json taken = std::move(doc["nodes"]);
-    doc.erase("nodes");
-    const NodeReader reader(path);
-    nodes.reserve(taken.size());
-    for (size_t i = 0; i < taken.size(); ++i) {
-        nodes.push_back(reader.read(taken[i], "/nodes/" + std::to_string(i)));
-        taken[i] = nullptr; // its JSON goes as it is read
+bool GltfNodeCollector::operator()(int depth, json::parse_event_t event, json& parsed) {
+    using E = json::parse_event_t;
+    if (depth == 1 && event == E::key) key_ = parsed.get<std::string>();
+    if (depth == 1 && event == E::array_start) inNodes_ = key_ == "nodes";
+    if (depth == 1 && event == E::array_end) inNodes_ = false;
+    if (!inNodes_ || depth != 2 ||
+        (event != E::object_end && event != E::array_end && event != E::value))
+        return true;
+    read(parsed);
+    return false; // read: not kept in the tree
+}
+
+void GltfNodeCollector::read(const json& node) {
+    const std::string at = "/nodes/" + std::to_string(nodes_.size());
+    try {
+        nodes_.push_back(NodeReader().read(node, at));
+    } catch (const NodeError& e) {
+        if (error_.empty()) error_ = e.message;
+        nodes_.emplace_back();
     }
-    return nodes;
+    if (node.is_object() && node.contains("extensions") && node["extensions"].is_object())
+        for (const auto& [name, body] : node["extensions"].items())
+            extensions_.emplace(name, at + "/extensions/" + name);
+}
+
+std::vector<GltfNode> GltfNodeCollector::take() {
+    if (!error_.empty()) throw SceneError(path_, 0, error_);
+    return std::move(nodes_);
 }
 
 } // namespace spw

@@ -10,6 +10,7 @@
 #include <glm/mat4x4.hpp>
 #include <nlohmann/json.hpp>
 
+#include <map>
 #include <string>
 #include <vector>
 
@@ -25,8 +26,28 @@ struct GltfNode {
     glm::dmat4 local{1.0}; // its matrix, or translation x rotation x scale
 };
 
-// The nodes of `doc` (the file at `path`), taken out of it: the document tinygltf is then handed
-// has none. Throws SceneError naming the node's JSON pointer.
-std::vector<GltfNode> takeGltfNodes(const std::string& path, nlohmann::json& doc);
+// The nodes of a glTF file's JSON, read while nlohmann's parser reads it (as its callback): each
+// node is read as its object ends and dropped from the tree, so that the nodes' JSON is never
+// held whole (a million nodes' would be 785 MB of nlohmann's tree). The document parsed is left
+// with an empty "nodes" array.
+class GltfNodeCollector {
+  public:
+    explicit GltfNodeCollector(const std::string& path) : path_(path) {}
+    // nlohmann::json::parser_callback_t: false drops `parsed` from the tree.
+    bool operator()(int depth, nlohmann::json::parse_event_t event, nlohmann::json& parsed);
+    // The nodes read. Throws the first node's SceneError (its JSON pointer), if any.
+    std::vector<GltfNode> take();
+    // The extensions the nodes use, each with the pointer of its first use.
+    const std::map<std::string, std::string>& extensions() const { return extensions_; }
+
+  private:
+    void read(const nlohmann::json& node);
+    std::string path_;
+    std::string key_;      // the top-level key last read
+    bool inNodes_ = false; // within the top-level "nodes" array
+    std::vector<GltfNode> nodes_;
+    std::string error_; // the first node's error, as SceneError's message
+    std::map<std::string, std::string> extensions_;
+};
 
 } // namespace spw

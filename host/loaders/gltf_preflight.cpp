@@ -150,19 +150,13 @@ void checkRequired(const std::string& path, const json& doc,
 
 // The node hierarchy is a set of disjoint trees (glTF 2.0, 3.5.3): a node is the child of one
 // node at most, and a scene's nodes are roots, each named once.
-void checkForest(const std::string& path, const json& doc) {
-    if (!doc.contains("nodes") || !doc["nodes"].is_array()) return;
-    const json& nodes = doc["nodes"];
+void checkForest(const std::string& path, const json& doc, const std::vector<GltfNode>& nodes) {
     std::vector<long long> parent(nodes.size(), -1);
     for (size_t i = 0; i < nodes.size(); ++i) {
-        if (!nodes[i].is_object() || !nodes[i].contains("children") ||
-            !nodes[i]["children"].is_array())
-            continue;
-        const json& children = nodes[i]["children"];
+        const std::vector<int>& children = nodes[i].children;
         for (size_t k = 0; k < children.size(); ++k) {
-            if (!children[k].is_number_integer()) continue; // tinygltf refuses it
-            const long long c = children[k].get<long long>();
-            if (c < 0 || c >= (long long)nodes.size()) continue; // the reader names it
+            const long long c = children[k];
+            if (c >= (long long)nodes.size()) continue; // the reader names it
             if (parent[size_t(c)] >= 0)
                 fail(path, "/nodes/" + std::to_string(i) + "/children/" + std::to_string(k),
                      "names node " + std::to_string(c) + ", which node " +
@@ -293,7 +287,11 @@ GltfDocument preflightGltf(const std::string& path, const std::set<std::string>&
         fail(path, "",
              "its JSON nests deeper than " + std::to_string(kMaxGltfJsonDepth) +
                  " levels (glTF's own objects nest about 8)");
-    out.doc = json::parse(text, nullptr, false);
+    GltfNodeCollector nodes(path);
+    out.doc = json::parse(
+        text,
+        [&](int depth, json::parse_event_t e, json& parsed) { return nodes(depth, e, parsed); },
+        false);
     text = {};
     const json& doc = out.doc;
     if (doc.is_discarded() || !doc.is_object()) { // tinygltf says what is wrong
@@ -302,12 +300,21 @@ GltfDocument preflightGltf(const std::string& path, const std::set<std::string>&
     }
     checkVersion(path, doc);
     checkRequired(path, doc, honoured);
-    checkForest(path, doc);
+    if (doc.contains("nodes") && !doc["nodes"].is_array())
+        fail(path, "/nodes", "must be an array of nodes");
+    out.doc.erase("nodes"); // read into `nodes`: tinygltf is handed none
+    out.nodes = nodes.take();
+    checkForest(path, doc, out.nodes);
     std::set<std::string> used;
     if (doc.contains("extensionsUsed") && doc["extensionsUsed"].is_array())
         for (const json& e : doc["extensionsUsed"])
             if (e.is_string()) used.insert(e.get<std::string>());
     checkDeclared(path, doc, used, "");
+    for (const auto& [name, at] : nodes.extensions())
+        if (!used.count(name))
+            fail(path, at,
+                 "uses the extension " + name +
+                     ", which the file's extensionsUsed does not declare");
     checkUris(path, doc);
     return out;
 }

@@ -10,6 +10,8 @@
 // Every failure is a SceneError naming the file and a JSON pointer.
 #pragma once
 
+#include "host/loaders/gltf_nodes.h"
+
 #include <nlohmann/json.hpp>
 #include <tiny_gltf.h>
 
@@ -30,7 +32,8 @@ int jsonNestingDepth(const std::string& text, int limit);
 
 // A glTF file's JSON as the preflight parsed it, and where a .glb's BIN chunk lies.
 struct GltfDocument {
-    nlohmann::json doc; // discarded where the JSON does not parse (tinygltf then says why)
+    nlohmann::json doc;          // discarded where the JSON does not parse (tinygltf then says why)
+    std::vector<GltfNode> nodes; // its nodes, taken out of `doc` (gltf_nodes.h)
     bool binary = false;
     std::uint64_t binOffset = 0, binLength = 0; // the BIN chunk's bytes (length 0: none)
 };
