@@ -45,8 +45,11 @@ class NodeReader {
 
     // An index: an integer JSON number from 0 to INT_MAX (not 2^32, which a cast reads as 0).
     int index(const json& v, const std::string& at) const {
-        if (!v.is_number_integer() || v.get<double>() < 0.0 || v.get<double>() > double(INT_MAX))
-            fail(at, "must be an index: an integer from 0 to " + std::to_string(INT_MAX));
+        if (!v.is_number_integer() || v.get<double>() < 0.0)
+            fail(at, "must be an integer of at least 0");
+        if (v.get<double>() > double(INT_MAX))
+            fail(at,
+                 "is " + v.dump() + ": must be an integer of at most " + std::to_string(INT_MAX));
         return int(v.get<double>());
     }
     int index(const json& o, const char* key, const std::string& at) const {

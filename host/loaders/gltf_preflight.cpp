@@ -207,6 +207,61 @@ void checkDeclared(const std::string& path, const json& j, const std::set<std::s
     }
 }
 
+// The properties whose values are indices or enumerations (integers from 0 to INT_MAX, which
+// tinygltf casts to int), and those that are byte offsets, lengths and counts (non-negative
+// integers, which it reads as size_t and the readers bound); the arrays and objects whose every
+// entry is an index.
+const std::set<std::string> kIndexKeys = {
+    "index",     "texCoord", "source",  "sampler",       "bufferView",
+    "buffer",    "material", "indices", "mesh",          "camera",
+    "skin",      "scene",    "node",    "light",         "input",
+    "output",    "skeleton", "mode",    "componentType", "magFilter",
+    "minFilter", "wrapS",    "wrapT",   "byteStride",    "inverseBindMatrices"};
+const std::set<std::string> kSizeKeys = {"byteOffset", "byteLength", "count"};
+const std::set<std::string> kIndexLists = {"nodes", "joints", "children", "attributes"};
+
+void checkInteger(const std::string& path, const json& v, const std::string& at,
+                  std::uint64_t most) {
+    if (!v.is_number_integer() || v.get<double>() < 0.0)
+        fail(path, at, "must be an integer of at least 0");
+    if (v.get<double>() > double(most))
+        fail(path, at,
+             "is " + v.dump() + ": must be an integer of at most " + std::to_string(most));
+}
+
+// Every index, enumeration, offset, length and count in the document is an integer JSON number
+// within the range its type holds, checked before tinygltf casts it (4294967297 would read as
+// 1, 1.5 or "1" as 0): outside `extras` and the bodies of extensions Spillway does not read,
+// which may hold anything.
+void checkIntegers(const std::string& path, const json& j, const std::string& at,
+                   const std::set<std::string>& honoured) {
+    if (j.is_array()) {
+        for (size_t i = 0; i < j.size(); ++i)
+            checkIntegers(path, j[i], at + "/" + std::to_string(i), honoured);
+        return;
+    }
+    if (!j.is_object()) return;
+    for (const auto& [key, value] : j.items()) {
+        const std::string here = at + "/" + key;
+        if (key == "extras") continue;
+        if (key == "extensions" && value.is_object()) {
+            for (const auto& [name, body] : value.items())
+                if (honoured.count(name)) checkIntegers(path, body, here + "/" + name, honoured);
+            continue;
+        }
+        if (kIndexKeys.count(key) && !(key == "indices" && value.is_object())) { // not sparse's
+            checkInteger(path, value, here, INT_MAX);
+        } else if (kSizeKeys.count(key)) {
+            checkInteger(path, value, here, ~std::uint64_t(0)); // each reader bounds its own
+        } else if (kIndexLists.count(key) && (value.is_array() || value.is_object())) {
+            for (const auto& [k, entry] : value.items())
+                checkInteger(path, entry, here + "/" + k, INT_MAX);
+        } else {
+            checkIntegers(path, value, here, honoured);
+        }
+    }
+}
+
 // ReadWholeFile for regular files only: opened without blocking (a FIFO with no writer would
 // block the open), then checked on the open descriptor, so that nothing can swap the file.
 bool readRegularFile(std::vector<unsigned char>* out, std::string* err, const std::string& path,
@@ -315,6 +370,7 @@ GltfDocument preflightGltf(const std::string& path, const std::set<std::string>&
             fail(path, at,
                  "uses the extension " + name +
                      ", which the file's extensionsUsed does not declare");
+    checkIntegers(path, doc, "", honoured);
     checkUris(path, doc);
     return out;
 }

@@ -97,15 +97,16 @@ TEST(GltfHostile, AccessorCountsPastTheLimitAreRefusedBeforeAllocating) {
 // cast would have read 4294967296 as mesh 0 and dropped -1 or "1" as no mesh at all.
 TEST(GltfHostile, NodeIndicesAndTransformsOfTheWrongKindAreRefused) {
     TempDir dir;
-    const std::string index = "must be an index: an integer from 0 to 2147483647";
+    const std::string low = "must be an integer of at least 0";
+    const std::string high = ": must be an integer of at most 2147483647";
     const std::vector<std::tuple<const char*, json, std::string>> cases = {
-        {"mesh", 4294967296ull, "/nodes/0/mesh: " + index},
-        {"mesh", 2147483648ull, "/nodes/0/mesh: " + index},
-        {"mesh", -1, "/nodes/0/mesh: " + index},
-        {"mesh", 0.5, "/nodes/0/mesh: " + index},
-        {"mesh", "0", "/nodes/0/mesh: " + index},
-        {"camera", 4294967297ull, "/nodes/0/camera: " + index},
-        {"children", json::array({1.0}), "/nodes/0/children/0: " + index},
+        {"mesh", 4294967296ull, "/nodes/0/mesh: is 4294967296" + high},
+        {"mesh", 2147483648ull, "/nodes/0/mesh: is 2147483648" + high},
+        {"mesh", -1, "/nodes/0/mesh: " + low},
+        {"mesh", 0.5, "/nodes/0/mesh: " + low},
+        {"mesh", "0", "/nodes/0/mesh: " + low},
+        {"camera", 4294967297ull, "/nodes/0/camera: is 4294967297" + high},
+        {"children", json::array({1.0}), "/nodes/0/children/0: " + low},
         {"children", 1, "/nodes/0/children: must be an array of node indices"},
         {"translation", json::array({0, "1", 2}),
          "/nodes/0/translation: a translation has 3 numbers"},
@@ -124,6 +125,57 @@ TEST(GltfHostile, NodeIndicesAndTransformsOfTheWrongKindAreRefused) {
     b.doc["nodes"] = json::object();
     EXPECT_NE(loadError(b.binary(dir, "node.glb")).find("/nodes: must be an array of nodes"),
               std::string::npos);
+}
+
+// Every index and enumeration in a file is an integer from 0 to 2^31 - 1 and every offset,
+// length and count a non-negative integer, checked before tinygltf casts them: a texCoord of
+// 4294967297 would read TEXCOORD_1, 4294967296, 1.5 or "1" TEXCOORD_0, a texture index of
+// 4294967296 texture 0. Anything goes in `extras` and in extensions Spillway does not read.
+TEST(GltfHostile, IntegersPastThirtyTwoBitsOrOfAnotherTypeAreRefused) {
+    TempDir dir;
+    const std::string base = "/materials/0/pbrMetallicRoughness/baseColorTexture";
+    const std::string transmission =
+        "/materials/0/extensions/KHR_materials_transmission/transmissionTexture";
+    const std::string high = ": must be an integer of at most 2147483647";
+    const std::string low = ": must be an integer of at least 0";
+    const struct {
+        std::string at;
+        json value;
+        std::string message;
+    } cases[] = {
+        {base + "/texCoord", 4294967297ull, base + "/texCoord: is 4294967297" + high},
+        {base + "/texCoord", 4294967296ull, base + "/texCoord: is 4294967296" + high},
+        {base + "/texCoord", 1.5, base + "/texCoord" + low},
+        {base + "/texCoord", "1", base + "/texCoord" + low},
+        {base + "/index", 4294967296ull, base + "/index: is 4294967296" + high},
+        {base + "/index", -1, base + "/index" + low},
+        {transmission + "/index", 4294967296ull, transmission + "/index: is 4294967296" + high},
+        {"/meshes/0/primitives/0/material", 4294967296ull,
+         "/meshes/0/primitives/0/material: is 4294967296" + high},
+        {"/accessors/0/count", -3, "/accessors/0/count" + low},
+        {"/accessors/0/byteOffset", "0", "/accessors/0/byteOffset" + low},
+        {"/scene", 4294967296ull, "/scene: is 4294967296" + high},
+    };
+    for (const auto& c : cases) {
+        GltfBuilder b = quadScene();
+        b.doc["extensionsUsed"] = {"KHR_materials_transmission"};
+        b.doc["materials"][0]["extensions"]["KHR_materials_transmission"] = {
+            {"transmissionFactor", 1.0}, {"transmissionTexture", {{"index", 0}}}};
+        b.doc["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"] = {{"index", 0}};
+        b.doc["textures"] = json::array({{{"source", 0}}});
+        b.doc["images"] = json::array({{{"uri", "none.png"}}});
+        b.doc[json::json_pointer(c.at)] = c.value;
+        const std::string e = loadError(b.binary(dir, "ints.glb"));
+        EXPECT_NE(e.find(c.message), std::string::npos)
+            << c.at << " = " << c.value.dump() << ": " << e;
+    }
+    // extras, and an extension not read, may hold any number.
+    GltfBuilder b = quadScene();
+    b.doc["materials"][0]["extras"] = {{"index", 4294967296ull}, {"count", "many"}};
+    b.doc["extensionsUsed"] = {"EXT_unknown"};
+    b.doc["materials"][0]["extensions"]["EXT_unknown"] = {{"index", -7}};
+    const std::string ok = loadError(b.binary(dir, "extras.glb"));
+    EXPECT_EQ(ok, "");
 }
 
 // Indices are unsigned integers (the specification's rule), read as 32-bit values: a signed
