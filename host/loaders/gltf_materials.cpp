@@ -3,6 +3,7 @@
 // normal map, emission) as textures read by OpenImageIO from the file or the bytes it embeds,
 // and KHR_texture_transform.
 #include "host/image/image_io.h"
+#include "host/image/jpeg_check.h"
 #include "host/loaders/gltf_preflight.h"
 #include "host/loaders/gltf_reader.h"
 #include "host/textures/embedded_reader.h"
@@ -219,6 +220,12 @@ Texture GltfReader::imageTexture(const Info& info, const std::string& where,
         char head[8] = {};
         const std::string ext = imageFormat(std::string(head, proxy->pread(head, 8, 0)));
         if (ext.empty()) fail(imageAt, "the embedded image is neither a PNG nor a JPEG");
+        const auto read = [&](void* out, size_t n, std::uint64_t at) {
+            return proxy->pread(out, n, std::int64_t(at));
+        };
+        if (const std::string why = jpegCutShort(read, proxy->size(), "the embedded image");
+            !why.empty())
+            fail(imageAt, why);
         picture.path = fs::absolute(path_).lexically_normal().string() + "#image" +
                        std::to_string(source) + ext;
         picture.embedded = e->second;
@@ -233,6 +240,8 @@ Texture GltfReader::imageTexture(const Info& info, const std::string& where,
         file.read(head, 8);
         if (imageFormat(std::string(head, size_t(file.gcount()))).empty())
             fail(imageAt + "/uri", "'" + picture.path + "' is neither a PNG nor a JPEG image");
+        if (const std::string why = jpegFileCutShort(picture.path); !why.empty())
+            fail(imageAt + "/uri", why);
         in = OIIO::ImageInput::open(picture.path);
         if (!in)
             fail(imageAt + "/uri",

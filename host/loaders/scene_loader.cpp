@@ -2,6 +2,7 @@
 // range where it is read, and every error names the file and line of the offending node.
 #include "host/loaders/scene_loader.h"
 #include "host/image/image_io.h"
+#include "host/image/jpeg_check.h"
 #include "host/loaders/gltf_loader.h"
 #include "host/loaders/light_loader.h"
 #include "host/loaders/obj_mesh.h"
@@ -116,7 +117,8 @@ class TextureReader {
     // A file that is not an image is the scene's error, found now rather than mid-render. Only
     // the header is read: the pixels stay lazy, for the texture system.
     void checkImage(const YAML::Node& at, const std::string& path) const {
-        if (const std::string why = exrHeaderProblem(path); !why.empty()) rd_.fail(at, why);
+        for (const std::string& why : {exrHeaderProblem(path), jpegFileCutShort(path)})
+            if (!why.empty()) rd_.fail(at, "texture file " + why);
         auto in = OIIO::ImageInput::open(path);
         if (!in) {
             std::string why = OIIO::geterror();
