@@ -72,7 +72,12 @@ void GltfReader::readTransmission(const tinygltf::Material& mat, Shader& s, cons
     if (ior == 0.0 && iorExt != mat.extensions.end())
         warn(name + ": KHR_materials_ior's ior 0 is rendered as 1.5");
     s.params.ior = float(ior == 0.0 ? 1.5 : ior);
-    if (factor == 0.0) return;
+    if (factor == 0.0) {
+        if (t != mat.extensions.end())
+            checkUnusedTextures(t->second, {"transmissionTexture"},
+                                at + "/extensions/KHR_materials_transmission");
+        return;
+    }
     if (ior > 0.0 && ior < kMinGlassIor)
         warn(name + ": an ior below " + number(kMinGlassIor) + " is rendered as " +
              number(kMinGlassIor));
@@ -135,9 +140,11 @@ void GltfReader::readClearcoat(const tinygltf::Material& mat, Shader& s, const s
     const double factor = extensionNumber(c->second, "clearcoatFactor", 0.0, 0.0, 1.0, where);
     const double roughness =
         extensionNumber(c->second, "clearcoatRoughnessFactor", 0.0, 0.0, 1.0, where);
-    if (factor == 0.0) return;
-    if (s.params.model != kModelMetallicRoughness) {
-        warn(name + ": a clear coat on glass is not rendered");
+    if (factor == 0.0 || s.params.model != kModelMetallicRoughness) {
+        if (factor != 0.0) warn(name + ": a clear coat on glass is not rendered");
+        checkUnusedTextures(
+            c->second, {"clearcoatTexture", "clearcoatRoughnessTexture", "clearcoatNormalTexture"},
+            where);
         return;
     }
     s.typeName = "CoatedMetallicRoughness";
@@ -177,10 +184,12 @@ void GltfReader::readSpecular(const tinygltf::Material& mat, Shader& s, const st
     const bool textured = e->second.Has("specularTexture") || e->second.Has("specularColorTexture");
     if (factor == 1.0 && colour == vec3(1.0f) && !textured)
         return; // the defaults: glTF's own reflection
+    const auto images = {"specularTexture", "specularColorTexture"};
     if (s.params.model == kModelDielectric ||
         s.params.model == kModelTransmissiveMetallicRoughness) {
         warn(name + ": KHR_materials_specular on glass is not rendered (its reflection follows "
                     "the ior alone)");
+        checkUnusedTextures(e->second, images, where);
         return;
     }
     s.params.flags |= kShaderSpecular;
@@ -190,6 +199,7 @@ void GltfReader::readSpecular(const tinygltf::Material& mat, Shader& s, const st
     if (s.params.model != kModelMetallicRoughness) {
         warn(name + ": KHR_materials_specular's images are not rendered on a clear coat or a "
                     "sheen (its factors are)");
+        checkUnusedTextures(e->second, images, where);
         return;
     }
     // The colour times specularColorTexture's RGB (sRGB), the weight times specularTexture's
@@ -212,11 +222,12 @@ void GltfReader::readSheen(const tinygltf::Material& mat, Shader& s, const std::
     const vec3 colour = extensionColour(e->second, "sheenColorFactor", vec3(0.0f), 1.0, where);
     const double roughness =
         extensionNumber(e->second, "sheenRoughnessFactor", 0.0, 0.0, 1.0, where);
-    if (colour == vec3(0.0f)) return;
-    if (s.params.model != kModelMetallicRoughness) {
-        warn(name + ": a sheen on " +
-             (s.params.model == kModelCoatedMetallicRoughness ? "a clear coat" : "glass") +
-             " is not rendered");
+    if (colour == vec3(0.0f) || s.params.model != kModelMetallicRoughness) {
+        if (colour != vec3(0.0f))
+            warn(name + ": a sheen on " +
+                 (s.params.model == kModelCoatedMetallicRoughness ? "a clear coat" : "glass") +
+                 " is not rendered");
+        checkUnusedTextures(e->second, {"sheenColorTexture", "sheenRoughnessTexture"}, where);
         return;
     }
     s.typeName = "SheenMetallicRoughness";

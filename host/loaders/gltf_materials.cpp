@@ -267,10 +267,8 @@ Texture GltfReader::imageTexture(const Info& info, const std::string& where,
     return picture;
 }
 
-int GltfReader::extensionTexture(const tinygltf::Value& ext, const char* key, int channel,
-                                 bool colour, const std::string& where, const std::string& what) {
-    if (!ext.Has(key)) return -1;
-    const std::string at = where + "/" + key;
+tinygltf::TextureInfo GltfReader::extensionTextureInfo(const tinygltf::Value& ext, const char* key,
+                                                       const std::string& at) const {
     const tinygltf::Value& v = ext.Get(key);
     if (!v.IsObject()) fail(at, "must be a textureInfo object");
     auto integer = [&](const char* field) {
@@ -290,7 +288,27 @@ int GltfReader::extensionTexture(const tinygltf::Value& ext, const char* key, in
         for (const std::string& name : e.Keys())
             info.extensions[name] = e.Get(name);
     }
-    Texture picture = imageTexture(info, at, what);
+    return info;
+}
+
+void GltfReader::checkUnusedTextures(const tinygltf::Value& ext,
+                                     std::initializer_list<const char*> keys,
+                                     const std::string& where) const {
+    for (const char* key : keys) {
+        if (!ext.Has(key)) continue;
+        const std::string at = where + "/" + key;
+        const int index = extensionTextureInfo(ext, key, at).index;
+        if (index >= int(model_.textures.size()))
+            fail(at, "names texture " + std::to_string(index) + " of " +
+                         std::to_string(model_.textures.size()));
+    }
+}
+
+int GltfReader::extensionTexture(const tinygltf::Value& ext, const char* key, int channel,
+                                 bool colour, const std::string& where, const std::string& what) {
+    if (!ext.Has(key)) return -1;
+    const std::string at = where + "/" + key;
+    Texture picture = imageTexture(extensionTextureInfo(ext, key, at), at, what);
     picture.channel = channel;
     picture.linear = !colour;
     scene_.textures.push_back(picture);

@@ -219,6 +219,15 @@ const std::set<std::string> kIndexKeys = {
     "minFilter", "wrapS",    "wrapT",   "byteStride",    "inverseBindMatrices"};
 const std::set<std::string> kSizeKeys = {"byteOffset", "byteLength", "count"};
 const std::set<std::string> kIndexLists = {"nodes", "joints", "children", "attributes"};
+// The numbers and arrays of numbers tinygltf reads into typed fields, dropping a value of another
+// type for the default without a word ("alphaCutoff": "0.9" read as 0.5). The extensions' own
+// values are read by Spillway, which refuses a wrong type itself.
+const std::set<std::string> kNumberKeys = {"alphaCutoff", "metallicFactor", "roughnessFactor",
+                                           "strength",    "yfov",           "aspectRatio",
+                                           "znear",       "zfar",           "xmag",
+                                           "ymag",        "innerConeAngle", "outerConeAngle",
+                                           "intensity",   "range"};
+const std::set<std::string> kNumberArrayKeys = {"baseColorFactor", "emissiveFactor", "color"};
 
 void checkInteger(const std::string& path, const json& v, const std::string& at,
                   std::uint64_t most) {
@@ -231,8 +240,9 @@ void checkInteger(const std::string& path, const json& v, const std::string& at,
 
 // Every index, enumeration, offset, length and count in the document is an integer JSON number
 // within the range its type holds, checked before tinygltf casts it (4294967297 would read as
-// 1, 1.5 or "1" as 0): outside `extras` and the bodies of extensions Spillway does not read,
-// which may hold anything.
+// 1, 1.5 or "1" as 0); every number tinygltf reads is a number; every extension Spillway reads
+// is an object. Outside `extras` and the bodies of extensions Spillway does not read, which may
+// hold anything.
 void checkIntegers(const std::string& path, const json& j, const std::string& at,
                    const std::set<std::string>& honoured) {
     if (j.is_array()) {
@@ -245,9 +255,24 @@ void checkIntegers(const std::string& path, const json& j, const std::string& at
         const std::string here = at + "/" + key;
         if (key == "extras") continue;
         if (key == "extensions" && value.is_object()) {
-            for (const auto& [name, body] : value.items())
-                if (honoured.count(name)) checkIntegers(path, body, here + "/" + name, honoured);
+            for (const auto& [name, body] : value.items()) {
+                if (!honoured.count(name)) continue;
+                if (!body.is_object()) fail(path, here + "/" + name, "must be an object");
+                checkIntegers(path, body, here + "/" + name, honoured);
+            }
             continue;
+        }
+        if (kNumberKeys.count(key) && !value.is_number()) fail(path, here, "must be a number");
+        // baseColorTexture, transmissionTexture, ...: tinygltf drops an empty object unseen.
+        if (key.size() > 7 && key.compare(key.size() - 7, 7, "Texture") == 0) {
+            if (!value.is_object()) fail(path, here, "must be a textureInfo object");
+            if (!value.contains("index")) fail(path, here, "a textureInfo needs an index");
+        }
+        if (kNumberArrayKeys.count(key)) {
+            bool numbers = value.is_array();
+            for (const json& x : numbers ? value : json::array())
+                numbers = numbers && x.is_number();
+            if (!numbers) fail(path, here, "must be an array of numbers");
         }
         if (kIndexKeys.count(key) && !(key == "indices" && value.is_object())) { // not sparse's
             checkInteger(path, value, here, INT_MAX);

@@ -10,6 +10,7 @@
 #include <tiny_gltf.h>
 
 #include <filesystem>
+#include <initializer_list>
 #include <map>
 #include <memory>
 #include <set>
@@ -214,6 +215,14 @@ class GltfReader {
     // or as data; its index, or -1 where `ext` has none.
     int extensionTexture(const tinygltf::Value& ext, const char* key, int channel, bool colour,
                          const std::string& where, const std::string& what);
+    // The texture reference ext[key], at `at`, checked for its form (an object with an index).
+    tinygltf::TextureInfo extensionTextureInfo(const tinygltf::Value& ext, const char* key,
+                                               const std::string& at) const;
+    // The texture references `keys` of an extension whose images are not rendered (a factor of
+    // 0, a model that does not take them), checked as rendered ones are: their form, and that
+    // they name a texture of the file. A factor of 0 does not make a reference to nothing valid.
+    void checkUnusedTextures(const tinygltf::Value& ext, std::initializer_list<const char*> keys,
+                             const std::string& where) const;
 
     // OpenImageIO's error after a failed open, as ": why" (or nothing). Asking also clears it:
     // OpenImageIO keeps it per thread until asked, and reports it at exit otherwise.

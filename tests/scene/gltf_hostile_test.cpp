@@ -178,6 +178,54 @@ TEST(GltfHostile, IntegersPastThirtyTwoBitsOrOfAnotherTypeAreRefused) {
     EXPECT_EQ(ok, "");
 }
 
+// A value of the wrong JSON type is refused with its pointer where tinygltf would drop it for the
+// default (an extension that is not an object, a number that is a string), and an extension's
+// texture reference is checked whatever its factor: a factor of 0 does not make texture 99 of a
+// file without textures valid.
+TEST(GltfHostile, WrongTypesAndTexturesBehindAZeroFactorAreRefused) {
+    TempDir dir;
+    const std::string mat = "/materials/0";
+    const struct {
+        std::string at;
+        json value;
+        std::string message;
+    } cases[] = {
+        {mat + "/extensions/KHR_materials_transmission", 0.5,
+         mat + "/extensions/KHR_materials_transmission: must be an object"},
+        {mat + "/pbrMetallicRoughness/baseColorTexture",
+         {{"index", 0}, {"extensions", {{"KHR_texture_transform", 5}}}},
+         mat + "/pbrMetallicRoughness/baseColorTexture/extensions/KHR_texture_transform: must be "
+               "an object"},
+        {mat + "/alphaCutoff", "0.9", mat + "/alphaCutoff: must be a number"},
+        {mat + "/pbrMetallicRoughness/baseColorFactor",
+         {1, "1", 1, 1},
+         mat + "/pbrMetallicRoughness/baseColorFactor: must be an array of numbers"},
+        {mat + "/extensions/KHR_materials_transmission",
+         {{"transmissionFactor", 0.0}, {"transmissionTexture", json::object()}},
+         mat + "/extensions/KHR_materials_transmission/transmissionTexture: a textureInfo needs "
+               "an index"},
+        {mat + "/extensions/KHR_materials_transmission",
+         {{"transmissionFactor", 0.0}, {"transmissionTexture", {{"index", 99}}}},
+         mat + "/extensions/KHR_materials_transmission/transmissionTexture: names texture 99 of 0"},
+        {mat + "/extensions/KHR_materials_clearcoat",
+         {{"clearcoatFactor", 0.0}, {"clearcoatRoughnessTexture", {{"index", 99}}}},
+         mat + "/extensions/KHR_materials_clearcoat/clearcoatRoughnessTexture: names texture 99 "
+               "of 0"},
+        {mat + "/extensions/KHR_materials_sheen",
+         {{"sheenColorTexture", {{"index", 99}}}},
+         mat + "/extensions/KHR_materials_sheen/sheenColorTexture: names texture 99 of 0"},
+    };
+    for (const auto& c : cases) {
+        GltfBuilder b = quadScene();
+        b.doc["extensionsUsed"] = {"KHR_materials_transmission", "KHR_materials_clearcoat",
+                                   "KHR_materials_sheen", "KHR_texture_transform"};
+        b.doc[json::json_pointer(c.at)] = c.value;
+        const std::string e = loadError(b.binary(dir, "types.glb"));
+        EXPECT_NE(e.find(c.message), std::string::npos)
+            << c.at << " = " << c.value.dump() << ": " << e;
+    }
+}
+
 // Indices are unsigned integers (the specification's rule), read as 32-bit values: a signed
 // type is refused at the accessor, a float type too.
 TEST(GltfHostile, IndicesOfASignedOrFloatTypeAreRefused) {
