@@ -14,7 +14,17 @@
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 dist="$root/dist"
-[ "${1:-}" = "--out" ] && dist="$(realpath -m "$2")"
+while [ $# -gt 0 ]; do
+  case "$1" in
+    -h | --help) sed -n '2,13p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    --out)
+      [ $# -ge 2 ] || { echo "bundle: --out needs a folder" >&2; exit 2; }
+      dist="$(realpath -m "$2")"
+      shift 2
+      ;;
+    *) echo "bundle: unknown argument '$1' (scripts/bundle.sh [--out DIR])" >&2; exit 2 ;;
+  esac
+done
 work="$root/build-bundle"
 limit_mib=48
 

@@ -16,12 +16,18 @@ set -euo pipefail
 
 here="$(cd "$(dirname "$0")" && pwd)"
 quick=0 out="device-bench" spillway="" mpirun=""
+# The value of option $1, the next argument $2 (refused where there is none).
+value() {
+  [ $# -ge 2 ] || { echo "device-bench: $1 needs a value" >&2; exit 2; }
+  printf '%s' "$2"
+}
 while (($#)); do
   case "$1" in
+    -h | --help) sed -n '2,13p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     --quick) quick=1 ;;
-    --out) out="$2"; shift ;;
-    --spillway) spillway="$2"; shift ;;
-    --mpirun) mpirun="$2"; shift ;;
+    --out) out="$(value "$@")"; shift ;;
+    --spillway) spillway="$(value "$@")"; shift ;;
+    --mpirun) mpirun="$(value "$@")"; shift ;;
     *) echo "device-bench: unknown option $1" >&2; exit 2 ;;
   esac
   shift

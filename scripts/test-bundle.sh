@@ -16,7 +16,10 @@
 #   scripts/test-bundle.sh [dist/spillway-VERSION-linux-x86_64.tar.zst]
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
-archive="${1:-$(ls -t "$root"/dist/spillway-*-linux-x86_64.tar.zst 2>/dev/null | head -1)}"
+case "${1:-}" in
+  -h | --help) sed -n '2,16p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+esac
+archive="${1:-$(ls -t "$root"/dist/spillway-*-linux-x86_64.tar.zst 2>/dev/null | head -1 || true)}"
 [ -f "$archive" ] || { echo "test-bundle: no release (run scripts/bundle.sh)" >&2; exit 2; }
 archive="$(realpath "$archive")"
 host_spillway="$root/build/spillway"

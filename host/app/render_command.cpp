@@ -308,6 +308,9 @@ int renderCommand(const std::vector<std::string>& args, Ranks* ranks) {
         std::chrono::duration<double>(std::chrono::steady_clock::now() - loadStart).count();
     const double loadPeakMiB = peakResidentMiB();
     applyDefaultSampling(o, scene, writes);
+    if (!o.config.adaptiveToTarget && !o.config.targetError)
+        throw UsageError("--uniform goes with --target-error (or a glTF file's default target): "
+                         "without a target every pixel takes every sample already");
     const std::unique_ptr<ErrorCsv> errorCsv = openErrorCsv(o, scene, resume);
     // Under mpirun at most four updates a second (progress.h says why).
     ProgressBar progress(progressStyle(o.progress), ranks ? 0.25 : 0.0);

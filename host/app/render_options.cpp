@@ -151,11 +151,12 @@ const std::vector<CliOption> kOwnOptions = {
      0, 0, [](O& r, const C&, const S& v) { r.errorMapPath = v; }},
     {"--aov", nullptr, "PASSES", Section::Render,
      "render passes as layers of the output EXR, named as Cycles names them: any of albedo "
-     "(\"Denoising Albedo\"), normal (\"Normal\"), depth (\"Depth\"), comma-separated",
+     "(\"Denoising Albedo\"), normal (\"Normal\"), depth (\"Depth\"), comma-separated or "
+     "repeated",
      0, 0,
      [](O& r, const C& o, const S& v) {
          try {
-             r.config.aovs = parseAovList(v);
+             r.config.aovs |= parseAovList(v); // repeated, the passes add up
          } catch (const std::invalid_argument& e) {
              throw UsageError(std::string(o.name) + " " + v + ": " + e.what());
          }
@@ -288,12 +289,12 @@ void checkRelations(RenderOptions& r) {
     if (!isSupportedOutput(r.output))
         throw UsageError("output '" + r.output + "' must end in .exr or .png");
     if (r.quiet) r.progress = "none";
-    if (!r.errorMapPath.empty() &&
-        !(r.errorMapPath.size() > 4 && r.errorMapPath.substr(r.errorMapPath.size() - 4) == ".exr"))
+    if (!r.errorMapPath.empty() && !isExrPath(r.errorMapPath))
         throw UsageError("--error-map '" + r.errorMapPath +
-                         "' must end in .exr: it holds linear values, not colours");
+                         "' must be a file name ending in .exr (a name, then .exr): it holds "
+                         "linear values, not colours");
     if (r.config.aovs != 0) {
-        if (std::filesystem::path(r.output).extension() != ".exr")
+        if (!isExrPath(r.output))
             throw UsageError("--aov writes layers of an EXR: the output '" + r.output +
                              "' must end in .exr");
         if (!r.checkpointPath.empty() || !r.resumePath.empty() || !r.partialPath.empty())

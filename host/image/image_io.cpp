@@ -34,6 +34,10 @@ bool isSupportedOutput(const std::string& path) {
     return e == ".exr" || e == ".png";
 }
 
+bool isExrPath(const std::string& path) {
+    return extension(path) == ".exr";
+}
+
 namespace {
 
 // Encodes through OpenImageIO into memory (the format by the path's extension): OpenImageIO

@@ -26,6 +26,9 @@ std::uint8_t linearToSrgb8(float v);
 
 // True for the extensions writeImage understands (.exr, .png; any case).
 bool isSupportedOutput(const std::string& path);
+// True for a path whose file name is a name followed by .exr, in any case ("a.EXR"; not ".exr",
+// which names a hidden file without an extension).
+bool isExrPath(const std::string& path);
 // The file's bytes, in the format the path's extension names (.exr float, .png 8-bit sRGB).
 std::vector<unsigned char> encodeImage(const std::string& path, const ImageRGB& image);
 class OutputFile;

@@ -108,7 +108,11 @@ const BadUsage kBadUsages[] = {
      "--stats and --error-csv name the same file"},
     {"StatsIsTheScene", "{scene} -o {out} --stats {scene} --quiet",
      "--stats and the scene name the same file"},
-    {"ErrorMapAsPng", "{scene} -o {out} --error-map {dir}/e.png --quiet", "must end in .exr"},
+    {"ErrorMapAsPng", "{scene} -o {out} --error-map {dir}/e.png --quiet", "ending in .exr"},
+    {"ErrorMapWithoutAName", "{scene} -o {out} --error-map {dir}/.exr --quiet",
+     "must be a file name ending in .exr (a name, then .exr)"},
+    {"UniformWithoutATarget", "{scene} -o {out} --spp 1 --uniform --quiet",
+     "--uniform goes with --target-error"},
     {"ErrorMapIsTheOutput", "{scene} -o {dir}/x.exr --error-map {dir}/x.exr --quiet",
      "-o and --error-map name the same file"},
 };

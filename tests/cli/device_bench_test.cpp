@@ -95,6 +95,35 @@ TEST(DeviceBench, RefusesAMissingBinaryAndAnUnknownOption) {
     r = runShell(deviceBench("--fast"));
     EXPECT_EQ(r.status, 2);
     EXPECT_NE(r.output.find("unknown option --fast"), std::string::npos) << r.output;
+    r = runShell(deviceBench("--out 2>&1"));
+    EXPECT_EQ(r.status, 2);
+    EXPECT_NE(r.output.find("device-bench: --out needs a value"), std::string::npos) << r.output;
+    r = runShell(deviceBench("--help 2>&1"));
+    EXPECT_EQ(r.status, 0);
+    EXPECT_NE(r.output.find("Measures a machine in one command"), std::string::npos) << r.output;
+}
+
+// The release scripts say what they are for on --help and refuse a missing value by name,
+// before they install or build anything; test-bundle names a release that is not there.
+TEST(ReleaseScripts, HelpAndMissingValuesAreAnsweredBeforeAnyWork) {
+    const std::string scripts = sourceDir() + "/scripts/";
+    CommandResult r = runShell(scripts + "bundle.sh --help 2>&1");
+    EXPECT_EQ(r.status, 0);
+    EXPECT_NE(r.output.find("Builds the release"), std::string::npos) << r.output;
+    EXPECT_EQ(r.output.find("installing"), std::string::npos) << "nothing installed";
+    r = runShell(scripts + "bundle.sh --out 2>&1");
+    EXPECT_EQ(r.status, 2);
+    EXPECT_NE(r.output.find("bundle: --out needs a folder"), std::string::npos) << r.output;
+    r = runShell(scripts + "bundle.sh --fast 2>&1");
+    EXPECT_EQ(r.status, 2);
+    EXPECT_NE(r.output.find("unknown argument '--fast'"), std::string::npos) << r.output;
+    r = runShell(scripts + "test-bundle.sh --help 2>&1");
+    EXPECT_EQ(r.status, 0);
+    EXPECT_NE(r.output.find("Proves a release runs on a bare Linux box"), std::string::npos);
+    TempDir dir;
+    r = runShell(scripts + "test-bundle.sh " + dir.file("none.tar.zst") + " 2>&1");
+    EXPECT_EQ(r.status, 2);
+    EXPECT_NE(r.output.find("test-bundle: no release"), std::string::npos) << r.output;
 }
 
 } // namespace

@@ -112,6 +112,21 @@ TEST(Aov, TheOutputExrHoldsThemAsCyclesNamesThem) {
     EXPECT_EQ(at(0, "Depth.Z"), 1e10f);
 }
 
+// Passes named by several --aov add up, and an output spelt .EXR takes them as .exr does.
+TEST(Aov, RepeatedAovsAddUpAndTheOutputsCaseDoesNotMatter) {
+    TempDir dir;
+    const std::string scene = quadFile(dir), out = dir.file("OUT.EXR");
+    const CommandResult r = runSpillway("render " + scene + " --width 8 --height 8 --spp 1 -o " +
+                                        out + " --aov albedo --aov depth --quiet");
+    ASSERT_EQ(r.status, 0) << r.output;
+    auto in = OIIO::ImageInput::open(out);
+    ASSERT_TRUE(in);
+    std::vector<std::string> names = in->spec().channelnames;
+    std::sort(names.begin(), names.end());
+    EXPECT_EQ(names, (std::vector<std::string>{"B", "Denoising Albedo.B", "Denoising Albedo.G",
+                                               "Denoising Albedo.R", "Depth.Z", "G", "R"}));
+}
+
 TEST(Aov, PassesThatCannotBeWrittenAreRefused) {
     TempDir dir;
     const std::string scene = quadFile(dir);
