@@ -45,6 +45,7 @@ struct TextureResolver::Impl {
         bool srgb = false;
         OIIO::ImageCache::ImageHandle* handle = nullptr; // set within `once`
         std::string error;                               // why not, where it could not be made
+        bool diskFailed = false; // it could not be written (the scratch folder), not read
     };
     struct Image {
         OIIO::ImageCache::ImageHandle* handle = nullptr;
@@ -77,7 +78,7 @@ struct TextureResolver::Impl {
     OIIO::ImageCache::ImageHandle* handleOf(const Image& img, int index) {
         if (!img.copy) return img.handle;
         std::call_once(img.copy->once, [&] { makeCopy(*img.copy); });
-        if (!img.copy->handle) fail(index, img.copy->error);
+        if (!img.copy->handle) fail(index, img.copy->error, img.copy->diskFailed);
         return img.copy->handle;
     }
     // The first failed lookup, reported after the iteration (a lookup cannot throw mid-batch).
@@ -85,6 +86,7 @@ struct TextureResolver::Impl {
     std::mutex errorMutex;
     int failedTexture = -1;
     std::string error;
+    bool failedOnDisk = false; // a runtime failure (exit 1), not the image's (exit 2)
     mutable std::atomic<std::uint64_t> peakCacheBytes{0};
     std::atomic<std::uint64_t> lookups{0};
     bool filtered = true;
@@ -140,10 +142,11 @@ struct TextureResolver::Impl {
             t.heldBytes = t.held[keep].bytes();
         }
     }
-    void fail(int index, std::string why = "") {
+    void fail(int index, std::string why = "", bool onDisk = false) {
         if (failed.exchange(true)) return;
         std::lock_guard<std::mutex> lock(errorMutex);
         failedTexture = index;
+        failedOnDisk = onDisk;
         error = why.empty() ? cache->geterror() : why;
         if (error.empty()) error = "a tile could not be read";
     }

@@ -162,9 +162,13 @@ void TextureResolver::Impl::makeCopy(PendingCopy& p) {
         copies.push_back(std::move(copy));
         tiledCopySeconds +=
             std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    } catch (const std::exception& e) { // TiledCopy::ReadError: the image's own pixels
+    } catch (const TiledCopy::ReadError& e) { // the image's own pixels
         p.handle = nullptr;
         p.error = e.what();
+    } catch (const std::exception& e) { // the copy's file (a full scratch folder)
+        p.handle = nullptr;
+        p.error = e.what();
+        p.diskFailed = true;
     }
 }
 
@@ -285,6 +289,9 @@ void TextureResolver::checkErrors() const {
     std::string why = impl_->error;
     while (!why.empty() && (why.back() == '\n' || why.back() == '\r'))
         why.pop_back();
+    if (impl_->failedOnDisk)
+        throw std::runtime_error("the tiled copy of texture file '" + t.path +
+                                 "' cannot be written: " + why);
     throw SceneError(scene_.file, t.line, "texture file '" + t.path + "' cannot be read: " + why);
 }
 

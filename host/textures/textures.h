@@ -83,7 +83,8 @@ class TextureResolver {
     // of the lookups makes them.
     bool outgrowsCache() const { return outgrowsCache_; }
     // Throws SceneError (the texture's file and scene line) if an image lookup failed since the
-    // scene loaded: a file that was readable when loaded but whose pixels are not.
+    // scene loaded: a file that was readable when loaded but whose pixels are not; or
+    // std::runtime_error where a tiled copy could not be written (the scratch folder).
     void checkErrors() const;
     // Samples the tile cache's size for peakCacheBytes (the renderer calls it per iteration).
     void noteCacheUse() const;

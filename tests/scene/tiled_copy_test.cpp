@@ -167,6 +167,30 @@ TEST(TiledCopy, AFolderWhereNoFileCanBeMadeIsAnErrorNamingIt) {
     }
 }
 
+// A scratch folder that goes away after the render has started (made at the first lookup, the
+// copy cannot be written) is a runtime error naming the texture (exit 1), not the scene's.
+TEST(TiledCopy, AFolderThatGoesAwayIsARuntimeErrorNotTheScenes) {
+    TempDir dir;
+    writeLargePng(dir.file("large.png"));
+    const Scene scene = loadScene(planeScene(dir, "large.png"));
+    const std::string folder = dir.file("scratch");
+    std::filesystem::create_directory(folder);
+    const TextureResolver textures(scene, 64.0, true, true, folder);
+    std::filesystem::remove(folder);
+    textures.albedo(scene.shaders[0], vec2(0.5f), 0.0f);
+    try {
+        textures.checkErrors();
+        ADD_FAILURE() << "no error";
+    } catch (const SceneError& e) {
+        ADD_FAILURE() << "a scene error: " << e.what();
+    } catch (const std::runtime_error& e) {
+        EXPECT_NE(std::string(e.what()).find("the tiled copy of texture file '" +
+                                             dir.file("large.png") + "' cannot be written"),
+                  std::string::npos)
+            << e.what();
+    }
+}
+
 // A large image whose pixels stop short of its header's size is a scene error naming the
 // texture file (exit 2), found when the copy reads it: at the first lookup, reported after the
 // iteration as any failed lookup is.
