@@ -44,6 +44,18 @@ vec2 wrapped(const Texture& t, int w, int h, vec2 uv) {
     return vec2(wrapAxis(t.wrapU, w, uv.x), wrapAxis(t.wrapV, h, uv.y));
 }
 
+// The roots of the texture trees shader `sh` reads (its colour's, normal maps', metallic-
+// roughness image's, extension maps' and cut-out's), each handed to `f`; -1 where it has none.
+template <class F> void forEachTree(const Shader& sh, F&& f) {
+    f(sh.texture);
+    f(sh.normalTexture);
+    f(sh.coatNormalTexture);
+    f(sh.metallicRoughnessTexture);
+    for (const Shader::ExtensionMap& m : sh.extension)
+        f(m.texture);
+    f(sh.cutout.enabled ? sh.cutout.texture : -1);
+}
+
 // Children-first order of the nodes reachable from `root`, each once.
 void visit(const Scene& scene, int t, std::vector<int>& slotOf, std::vector<int>& order) {
     if (slotOf[size_t(t)] >= 0) return;
@@ -177,12 +189,7 @@ void TextureResolver::prepare(const std::vector<bool>& shaders) const {
     std::vector<int> images; // the Standard textures the shaders read
     for (size_t s = 0; s < shaders.size() && s < scene_.shaders.size(); ++s) {
         if (!shaders[s]) continue;
-        const Shader& sh = scene_.shaders[s];
-        for (int root : {sh.texture, sh.normalTexture, sh.coatNormalTexture,
-                         sh.metallicRoughnessTexture, sh.cutout.enabled ? sh.cutout.texture : -1})
-            standardNodes(root, images);
-        for (const Shader::ExtensionMap& m : sh.extension)
-            standardNodes(m.texture, images);
+        forEachTree(scene_.shaders[s], [&](int root) { standardNodes(root, images); });
     }
     std::vector<Impl::PendingCopy*> wanted;
     for (int t : images)
@@ -217,15 +224,8 @@ void TextureResolver::compilePrograms() {
             program.push_back(op);
         }
     };
-    for (const Shader& sh : scene_.shaders) {
-        compile(sh.texture);
-        compile(sh.normalTexture);
-        compile(sh.coatNormalTexture);
-        compile(sh.metallicRoughnessTexture);
-        for (const Shader::ExtensionMap& m : sh.extension)
-            compile(m.texture);
-        if (sh.cutout.enabled) compile(sh.cutout.texture);
-    }
+    for (const Shader& sh : scene_.shaders)
+        forEachTree(sh, compile);
 }
 
 TextureResolver::TextureResolver(const Scene& scene, double cacheMiB, bool filtered, bool wide,
