@@ -376,9 +376,12 @@ int GltfReader::readTextureTransform(const Info& info, const std::string& where,
         set = int(n);
     }
     const double c = std::cos(rotation), sn = std::sin(rotation);
-    // Column by column, as the extension's GLSL writes them.
+    // Column by column. The rotation is (u, v) -> (c u + s v, -s u + c v) in glTF's V-down
+    // coordinates: the extension's sample GLSL writes the transpose (it was written for V-up),
+    // but its reference model (TextureTransformTest), Blender's importer, three.js and
+    // Babylon.js all turn this way, the image clockwise as it is seen upright.
     const glm::dmat3 t(1, 0, 0, 0, 1, 0, offset[0], offset[1], 1);
-    const glm::dmat3 r(c, sn, 0, -sn, c, 0, 0, 0, 1);
+    const glm::dmat3 r(c, -sn, 0, sn, c, 0, 0, 0, 1);
     const glm::dmat3 sc(scale[0], 0, 0, 0, scale[1], 0, 0, 0, 1);
     const glm::dmat3 flip(1, 0, 0, 0, -1, 0, 0, 1, 1); // (u, v) -> (u, 1 - v)
     picture.uvTransformed = true;

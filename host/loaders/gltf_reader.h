@@ -234,7 +234,9 @@ class GltfReader {
                      Texture& picture);
 
     // KHR_texture_transform on a texture reference: T(offset) R(rotation) S(scale) of glTF's
-    // texture coordinates, written for Spillway's (v = 1 - glTF's v) as F M F, F that flip.
+    // texture coordinates, R turning them as the extension's reference model does (the image
+    // clockwise as seen upright), written for Spillway's (v = 1 - glTF's v) as F M F, F that
+    // flip.
     // Returns the extension's texCoord override, or -1.
     template <class Info>
     int readTextureTransform(const Info& info, const std::string& where, Texture& picture);

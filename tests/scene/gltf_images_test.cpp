@@ -157,12 +157,63 @@ TEST(Gltf, TextureTransformMovesTheLookups) {
     EXPECT_GT(plain, 0.5);
     EXPECT_LT(plain, 2.0);
     EXPECT_LT(moved, 0.1);
-    // Turned a quarter counter-clockwise, then moved by (1, 0): u' = 1 - v (glTF's v, which
-    // runs down the quad), so the image's red half lies along the quad's bottom, its green
-    // along the top; turned the other way, the other way round.
+    // Turned a quarter, then moved by (1, 0): u' = v + 1, read as v under the default repeat
+    // (glTF's v runs down the quad), so the image's red half lies along the quad's top, its
+    // green along the bottom: the image turned clockwise as seen. Turned the other way, the
+    // other way round.
     const json quarter = {{"offset", {1.0, 0.0}}, {"rotation", M_PI / 2}};
-    EXPECT_LT(redOverGreen(quarter, 0, 6), 0.1);
-    EXPECT_GT(redOverGreen(quarter, 10, 16), 10.0);
+    EXPECT_GT(redOverGreen(quarter, 0, 6), 10.0);
+    EXPECT_LT(redOverGreen(quarter, 10, 16), 0.1);
+}
+
+// The arrangement of Khronos' TextureTransformTest (its bottom-left quad), made here: an image
+// black but for a red mark on its u axis near the top edge, turned 22.5 degrees about the
+// texture coordinates' origin (the image's top-left corner) and clamped to its edges. Turned as
+// the extension's reference model, Blender and three.js turn it, the mark moves clockwise as
+// seen, into the quad, where the model's green marker is; turned the other way it would leave
+// the quad (the model's red marker), and nothing red would show. On every backend.
+TEST(Gltf, TextureRotationTurnsTheImageAsTheReferenceModelDoes) {
+    TempDir dir;
+    constexpr int kSide = 40; // the mark: texels [30, 34) x [2, 6), centred on (0.8, 0.1)
+    {
+        OIIO::ImageBuf img(OIIO::ImageSpec(kSide, kSide, 3, OIIO::TypeDesc::UINT8));
+        const float black[3] = {0.0f, 0.0f, 0.0f}, red[3] = {1.0f, 0.0f, 0.0f};
+        OIIO::ImageBufAlgo::fill(img, black);
+        OIIO::ImageBufAlgo::fill(img, red, OIIO::ROI(30, 34, 2, 6));
+        ASSERT_TRUE(img.write(dir.file("halves.png"))); // the file halvesFile names
+    }
+    const double angle = 0.392699; // the model's 22.5 degrees
+    const json info = {{"extensions", {{"KHR_texture_transform", {{"rotation", angle}}}}}};
+    const json clamp = {{"wrapS", 33071}, {"wrapT", 33071}};
+    // Where the mark (0.8, 0.1) shows: the quad's (u, v) whose turned coordinates are the mark's.
+    const double c = std::cos(angle), s = std::sin(angle);
+    const double wantU = 0.8 * c - 0.1 * s, wantV = 0.8 * s + 0.1 * c; // (0.70, 0.40)
+    constexpr int kRes = 32;
+    const double halfView = 3.0 * std::tan(0.125); // the camera's yfov 0.25 at distance 3
+    for (BackendKind backend : {BackendKind::Reference, BackendKind::Cpu, BackendKind::Vulkan}) {
+        SCOPED_TRACE(backendName(backend));
+        Scene scene = loadScene(halvesFile(dir, info, clamp));
+        ASSERT_TRUE(scene.warnings.empty()) << scene.warnings.at(0);
+        scene.image.width = scene.image.height = kRes;
+        RenderConfig cfg;
+        cfg.backend = backend;
+        cfg.spp = 4;
+        const std::vector<float> img = render(scene, cfg)->film->image();
+        // The red mark's centroid, as the quad's (u, v): u = x, v = 1 - y (glTF's quad). Red
+        // over green: the black quad's grey specular reflection of the environment left out.
+        double red = 0, u = 0, v = 0;
+        for (int py = 0; py < kRes; ++py)
+            for (int px = 0; px < kRes; ++px) {
+                const size_t i = size_t(py * kRes + px) * 3;
+                const double r = double(img[i]) - double(img[i + 1]);
+                red += r;
+                u += r * (0.5 + ((px + 0.5) / kRes * 2 - 1) * halfView);
+                v += r * (0.5 + ((py + 0.5) / kRes * 2 - 1) * halfView);
+            }
+        ASSERT_GT(red, 2.0) << "the mark turned out of the quad: the other way round";
+        EXPECT_NEAR(u / red, wantU, 0.03);
+        EXPECT_NEAR(v / red, wantV, 0.03);
+    }
 }
 
 // The red-left, green-right image on the view-filling quad, u stretched to 3u - 1 (the quad's
