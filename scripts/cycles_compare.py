@@ -143,11 +143,14 @@ def run(cmd, **kw):
 def compare(spillway, file, spp, width, out):
     os.makedirs(out, exist_ok=True)
     ours, theirs, stats = (os.path.join(out, n) for n in ("spillway.exr", "cycles.exr", "stats.json"))
-    run([spillway, "render", file, "--width", str(width), "--spp", str(spp), "--sampler", "Sobol",
-         "--quiet", "-o", ours, "--stats", stats])
+    r = run([spillway, "render", file, "--width", str(width), "--spp", str(spp), "--sampler",
+             "Sobol", "--quiet", "-o", ours, "--stats", stats])
     with open(stats) as f:
         s = json.load(f)
-    render_in_cycles(file, s["width"], s["height"], [{"spp": spp, "out": os.path.abspath(theirs)}])
+    # Emitters too dim to light the file alone: Spillway adds the white world, and says so.
+    dim = "lit by that environment as well" in r.stderr
+    render_in_cycles(file, s["width"], s["height"], [{"spp": spp, "out": os.path.abspath(theirs)}],
+                     lights_itself=lit(file) and not dim)
     if not os.path.exists(theirs):
         sys.exit("Blender wrote no image (%s)" % theirs)
     r = run([spillway, "compare", ours, theirs, "--json"])
@@ -157,13 +160,18 @@ def compare(spillway, file, spp, width, out):
     return metrics, ratios
 
 
-def render_in_cycles(file, width, height, renders, environment=None, threads=None, seconds=None):
+def render_in_cycles(file, width, height, renders, environment=None, threads=None, seconds=None,
+                     lights_itself=None):
     """Renders glTF FILE in Blender's Cycles with the settings above, once for each of `renders`
     ({"spp", "out", "seed" (0)}), in one Blender process. environment: an equirectangular image
     that lights the scene (as Spillway's Environment light does); threads: Cycles' (default:
-    every core); seconds: a JSON file that gets each render's seconds."""
+    every core); seconds: a JSON file that gets each render's seconds; lights_itself: whether
+    the file's own lights light it (default: it has a light or an emissive material), else a
+    white world does."""
+    if lights_itself is None:
+        lights_itself = lit(file)
     args = {"file": os.path.abspath(file), "width": width, "height": height,
-            "fov_x": horizontal_fov(file), "lit": lit(file) or environment is not None,
+            "fov_x": horizontal_fov(file), "lit": lights_itself or environment is not None,
             "renders": renders, "threads": threads, "seconds": seconds,
             "environment": os.path.abspath(environment) if environment else None}
     blender = shutil.which("blender")
@@ -373,6 +381,14 @@ def make_test_files(out):
     write_glb(os.path.join(out, "texture-transform.glb"), [s + (0,), (pos, nor, idx, whole, 1)],
               [files["rough-plastic.glb"][0], turned], images=textured_images()[:1],
               extensions=["KHR_texture_transform"])
+    # A small glowing label (emissive, radiance 1, as decals are) standing on the floor before
+    # the sphere, and no light: too dim to light the scene alone, so both renderers light it with
+    # the white world, the label glowing on its own.
+    label = material((0.0, 0.0, 0.0), 0.0, 1.0)
+    label["emissiveFactor"] = [1.0, 0.35, 0.1]
+    write_glb(os.path.join(out, "decal.glb"),
+              [s + (0,), f + (1,), panel(-0.4, 0.4, -0.99, -0.59, 1.2) + (2,)],
+              list(files["rough-plastic.glb"]) + [label])
     # A 16-segment sphere with smooth normals under a sun from the side, across its facets: the
     # terminator.
     write_glb(os.path.join(out, "terminator.glb"), [sphere(8, 16) + (0,)],
@@ -458,7 +474,8 @@ def make_test_files(out):
               extensions=["KHR_materials_transmission", "KHR_materials_ior",
                           "KHR_materials_volume"])
     return sorted(os.path.join(out, n) for n in list(files) + [
-        "textured.glb", "emissive.glb", "uv-sets.glb", "texture-transform.glb", "terminator.glb",
+        "textured.glb", "emissive.glb", "decal.glb", "uv-sets.glb", "texture-transform.glb",
+        "terminator.glb",
         "blend.glb", "glass.glb", "half-glass.glb", "ior.glb", "specular.glb", "sheen.glb",
         "clearcoat.glb", "tinted-glass.glb", "striped-glass.glb", "metal-glass.glb"])
 

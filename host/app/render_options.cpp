@@ -4,6 +4,7 @@
 #include "host/image/aov_film.h"
 #include "host/image/image_io.h"
 #include "host/image/output_file.h"
+#include "host/loaders/light_loader.h"
 
 #include <algorithm>
 #include <cctype>
@@ -161,6 +162,14 @@ const std::vector<CliOption> kOwnOptions = {
              throw UsageError(std::string(o.name) + " " + v + ": " + e.what());
          }
      }},
+    {"--environment", nullptr, "FILE|R,G,B", Section::Render,
+     "light the scene from everywhere with this, in place of its own environment (a glTF "
+     "file's default white one, or a scene file's Environment light): a lat-long image (.hdr, "
+     ".exr, ...; row 0 straight up) or a constant radiance R,G,B, times --environment-strength",
+     0, 0, [](O& r, const C&, const S& v) { r.environment = v; }},
+    {"--environment-strength", nullptr, "X", Section::Render,
+     "multiplies --environment's radiance (default 1)", 0, kMaxRadiance,
+     [](O& r, const C& o, const S& v) { r.environmentStrength = numberValue(o, v); }},
     {"--reference", nullptr, "REF.exr", Section::Render, "the reference image for --error-csv", 0,
      0, [](O& r, const C&, const S& v) { r.referencePath = v; }},
     {"--time-limit", nullptr, "SECONDS", Section::Render,
@@ -285,6 +294,8 @@ void checkAliases(const RenderOptions& r);
 // How the options go together, checked before any work so that a mistake costs no render.
 void checkRelations(RenderOptions& r) {
     if (r.scenePath.empty()) throw UsageError("render needs a scene file");
+    if (r.environmentStrength && r.environment.empty())
+        throw UsageError("--environment-strength scales --environment, which is not given");
     if (r.output.empty()) r.output = std::filesystem::path(r.scenePath).stem().string() + ".exr";
     if (!isSupportedOutput(r.output))
         throw UsageError("output '" + r.output + "' must end in .exr or .png");
@@ -436,8 +447,64 @@ std::string renderOptionsHelp() {
            helpSection(Section::Settings);
 }
 
+namespace {
+
+// "R,G,B" as three numbers, or nothing.
+std::optional<glm::dvec3> rgbTriple(const std::string& v) {
+    std::vector<std::string> parts(1);
+    for (char ch : v) {
+        if (ch == ',')
+            parts.emplace_back();
+        else
+            parts.back().push_back(ch);
+    }
+    if (parts.size() != 3) return std::nullopt;
+    glm::dvec3 rgb;
+    for (int c = 0; c < 3; ++c) {
+        size_t used = 0;
+        try {
+            rgb[c] = std::stod(parts[size_t(c)], &used);
+        } catch (const std::exception&) {
+            return std::nullopt;
+        }
+        if (used != parts[size_t(c)].size()) return std::nullopt;
+    }
+    return rgb;
+}
+
+// --environment's value: a constant where it is R,G,B, else an image's path; either times
+// --environment-strength.
+Environment commandLineEnvironment(const RenderOptions& options) {
+    const double strength = options.environmentStrength.value_or(1.0);
+    const std::string& v = options.environment;
+    const std::optional<glm::dvec3> rgb = rgbTriple(v);
+    if (!rgb) {
+        if (v.find(',') != std::string::npos && !std::filesystem::exists(v))
+            throw UsageError("--environment takes an image or R,G,B (three numbers), not '" + v +
+                             "'");
+        try {
+            return scene_file::environmentMap(v, vec3(float(strength)));
+        } catch (const std::exception& e) {
+            throw UsageError(std::string("--environment: ") + e.what());
+        }
+    }
+    Environment env;
+    for (int c = 0; c < 3; ++c) {
+        const double radiance = (*rgb)[c] * strength;
+        if (!((*rgb)[c] >= 0.0 && radiance <= kMaxRadiance))
+            throw UsageError(
+                "--environment " + v +
+                ": each radiance, times --environment-strength, must lie in 0 .. 1e20");
+        env.radiance[c] = float(radiance);
+    }
+    return env;
+}
+
+} // namespace
+
 void applyOverrides(const RenderOptions& options, Scene& scene) {
     applySettingOverrides(scene.settings, options.settings);
+    if (!options.environment.empty()) scene.environment = commandLineEnvironment(options);
     if (options.sampler) scene.sampler = *options.sampler;
     ImageSettings& img = scene.image;
     const double aspect = double(img.width) / double(img.height);

@@ -21,9 +21,11 @@ struct RenderOptions {
     std::string statsPath, errorCsvPath, errorMapPath, referencePath;
     std::string checkpointPath, resumePath, partialPath;
     double checkpointInterval = 0;
-    std::optional<SamplerType> sampler; // --sampler: replaces the scene's
-    std::optional<int> width, height;   // --width, --height: replace the image's size
-    SettingOverrides settings;          // --seed, --bin-exponent, ...: replace the scene's
+    std::optional<SamplerType> sampler;        // --sampler: replaces the scene's
+    std::optional<int> width, height;          // --width, --height: replace the image's size
+    std::string environment;                   // --environment FILE|R,G,B: replaces the scene's
+    std::optional<double> environmentStrength; // --environment-strength
+    SettingOverrides settings;                 // --seed, --bin-exponent, ...: replace the scene's
     bool preview = false;
     std::string progress = "auto"; // auto | bar | lines | none (also after --quiet)
     bool quiet = false;
@@ -42,9 +44,10 @@ RenderOptions parseRenderOptions(const std::vector<std::string>& args);
 // The options part of `spillway --help`, made from the table.
 std::string renderOptionsHelp();
 
-// The scene's settings, sampler and image size with the command line's overrides: applied once,
-// right after loading, so that the scene then holds what the render uses. Throws UsageError for
-// a size whose samples per iteration pass 2^32 - 1.
+// The scene's settings, sampler, image size and environment with the command line's overrides:
+// applied once, right after loading, so that the scene then holds what the render uses. Throws
+// UsageError for a size whose samples per iteration pass 2^32 - 1, or an environment that cannot
+// be read.
 void applyOverrides(const RenderOptions& options, Scene& scene);
 
 } // namespace spw

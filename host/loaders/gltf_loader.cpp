@@ -9,6 +9,7 @@
 #include "host/loaders/gltf_preflight.h"
 #include "host/loaders/gltf_reader.h"
 #include "host/loaders/gltf_sources.h"
+#include "host/textures/textures.h"
 #include "shared/gltf.h"
 
 #include <glm/gtc/matrix_inverse.hpp>
@@ -17,11 +18,13 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <limits>
 #include <map>
 #include <memory>
+#include <optional>
 #include <set>
 
 namespace spw {
@@ -84,11 +87,61 @@ void GltfReader::readScene() {
     read({glm::dmat4(1.0)}, true);
     if (!cameraFound_) frameBounds();
     scene_.objectCount = int(scene_.meshes.size());
-    bool emissive = !scene_.punctualLights.empty();
-    for (const Mesh& m : scene_.meshes)
-        emissive = emissive || scene_.shaders[size_t(m.shader)].params.emission != vec3(0.0f);
-    if (!emissive) scene_.environment = Environment{}; // radiance 1 from everywhere
     if (scene_.shaders.empty()) scene_.shaders.push_back(defaultShader());
+    if (scene_.punctualLights.empty()) lightByDefault();
+}
+
+// The share of the default environment's power, at the scene's size, that a file's emissive
+// meshes must reach to light it alone.
+constexpr double kEmittersLightAlone = 0.05;
+
+void GltfReader::lightByDefault() {
+    scene_.environment = Environment{}; // radiance 1 from everywhere
+    // The emitters' power as next-event estimation weighs it: emission x area x pi a side, an
+    // emission map at its image's mean luminance.
+    std::optional<TextureResolver> textures;
+    std::map<int, double> mapMeans;
+    double power = 0.0;
+    for (const Mesh& m : scene_.meshes) {
+        const Shader& shader = scene_.shaders[size_t(m.shader)];
+        double radiance = double(luminance(shader.params.emission));
+        if (!(radiance > 0.0)) continue;
+        if (shader.params.flags & kShaderTwoSided) radiance *= 2.0;
+        if (const int t = shader.emissionTexture; t >= 0) {
+            if (!mapMeans.count(t)) {
+                if (!textures) textures.emplace(scene_, 64.0, false, false);
+                int width = 0, height = 0;
+                double sum = 0.0;
+                for (const vec3& texel : textures->finestLevel(t, width, height))
+                    sum += double(luminance(texel));
+                mapMeans[t] = sum / std::max(1.0, double(width) * double(height));
+            }
+            radiance *= mapMeans[t];
+        }
+        double area = 0.0;
+        for (const uvec3& tri : m.triangles)
+            area +=
+                0.5 * glm::length(glm::cross(glm::dvec3(m.positions[tri.y] - m.positions[tri.x]),
+                                             glm::dvec3(m.positions[tri.z] - m.positions[tri.x])));
+        power += kPi * radiance * area;
+    }
+    if (power == 0.0) return;
+    // The environment's, as the light sampler weighs it: what a disc of the scene's bounding
+    // radius r intercepts from every direction, pi r^2 x 4 pi.
+    glm::dvec3 lo, hi;
+    sceneBounds(scene_, lo, hi);
+    const double r = 0.5 * glm::length(hi - lo);
+    const double share = power / (4.0 * kPi * kPi * r * r);
+    if (share >= kEmittersLightAlone) {
+        scene_.environment.reset();
+        return;
+    }
+    char percent[32];
+    std::snprintf(percent, sizeof percent, "%.3g %%", 100.0 * share);
+    warn("has no light but its emissive materials, whose power is " + std::string(percent) +
+         " of a white environment's at the scene's size (under " +
+         std::to_string(int(100 * kEmittersLightAlone)) +
+         " %): lit by that environment as well, radiance 1 (--environment chooses another)");
 }
 
 void GltfReader::readObject(const std::vector<glm::dmat4>& transforms, int shader) {

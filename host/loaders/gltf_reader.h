@@ -68,6 +68,13 @@ class GltfReader {
     void frameBounds();
     void include(const glm::dvec3& p);
 
+    // A file without punctual lights is lit by a uniform white environment (radiance 1, as
+    // viewers light an asset) unless its emissive meshes light it alone: their power at least
+    // kEmittersLightAlone of the environment's at the scene's size. Dimmer emitters (the decals,
+    // labels and screens of an asset made for image-based lighting) glow under the environment,
+    // and a warning says so.
+    void lightByDefault();
+
     // --- accessors -------------------------------------------------------------------------
 
     // Accessor `index` as `count` elements of `components` doubles each (normalized integers

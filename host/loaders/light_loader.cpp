@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <limits>
+#include <stdexcept>
 
 namespace spw::scene_file {
 
@@ -121,24 +122,32 @@ Environment readEnvironment(const Reader& rd, const YAML::Node& n, const fs::pat
     const YAML::Node file = n["string"] ? n["string"] : n["filename"];
     if (file && n["colour"])
         rd.fail(n["colour"], "Environment light takes a colour or an image ('string'), not both");
+    const vec3 radiance = vec3(lightIntensity(rd, n, !file));
     Environment env;
-    env.line = n.Mark().line + 1;
-    env.radiance = vec3(lightIntensity(rd, n, !file));
-    if (!file) return env;
-    const fs::path p = dir / rd.string(file, "environment image");
-    if (!fs::is_regular_file(p))
-        rd.fail(file, "environment image '" + p.string() + "' does not exist");
-    env.path = fs::absolute(p).lexically_normal().string();
-    ImageRGB img;
-    try {
-        img = spw::readImage(env.path);
-    } catch (const std::exception& e) {
-        rd.fail(file, e.what());
+    if (file) {
+        try {
+            env = environmentMap(dir / rd.string(file, "environment image"), radiance);
+        } catch (const std::exception& e) {
+            rd.fail(file, e.what());
+        }
+    } else {
+        env.radiance = radiance;
     }
+    env.line = n.Mark().line + 1;
+    return env;
+}
+
+Environment environmentMap(const fs::path& p, vec3 radiance) {
+    if (!fs::is_regular_file(p))
+        throw std::runtime_error("environment image '" + p.string() + "' does not exist");
+    Environment env;
+    env.radiance = radiance;
+    env.path = fs::absolute(p).lexically_normal().string();
+    ImageRGB img = spw::readImage(env.path); // throws std::runtime_error
     if (img.width < 1 || img.height < 1 || size_t(img.width) * size_t(img.height) > (1u << 26))
-        rd.fail(file, "environment image '" + env.path + "' is " + std::to_string(img.width) +
-                          " x " + std::to_string(img.height) +
-                          "; Spillway takes maps of 1 to 2^26 texels");
+        throw std::runtime_error("environment image '" + env.path + "' is " +
+                                 std::to_string(img.width) + " x " + std::to_string(img.height) +
+                                 "; Spillway takes maps of 1 to 2^26 texels");
     // The map holds floats: a texel written as 1e20 reads as the float nearest it, a little
     // above, and is as much within the range as the scene text's 1e20.
     const double brightest = double(float(kMaxRadiance));
@@ -146,10 +155,11 @@ Environment readEnvironment(const Reader& rd, const YAML::Node& n, const fs::pat
         const double v = double(img.rgb[i]) * double(env.radiance[int(i % 3)]);
         if (!(v >= 0.0 && v <= brightest)) {
             const size_t texel = i / 3;
-            rd.fail(file, "environment image '" + env.path + "' has radiance " + Reader::fmt(v) +
-                              " at texel (" + std::to_string(texel % size_t(img.width)) + ", " +
-                              std::to_string(texel / size_t(img.width)) +
-                              "): every value must lie in 0 .. " + Reader::fmt(kMaxRadiance));
+            throw std::runtime_error(
+                "environment image '" + env.path + "' has radiance " + Reader::fmt(v) +
+                " at texel (" + std::to_string(texel % size_t(img.width)) + ", " +
+                std::to_string(texel / size_t(img.width)) + "): every value must lie in 0 .. " +
+                Reader::fmt(kMaxRadiance));
         }
     }
     env.width = img.width;

@@ -25,5 +25,9 @@ PunctualLight readPunctualLight(const Reader& rd, const YAML::Node& n, const glm
 // `colour` (a constant) or `string` / `filename` (a lat-long image), times `intensity`.
 Environment readEnvironment(const Reader& rd, const YAML::Node& n,
                             const std::filesystem::path& dir);
+// The lat-long image at `path` as an environment of `radiance` times its texels, range-checked
+// (a YAML scene's Environment light, or --environment FILE). Throws std::runtime_error naming
+// the file.
+Environment environmentMap(const std::filesystem::path& path, vec3 radiance);
 
 } // namespace spw::scene_file

@@ -113,6 +113,12 @@ const BadUsage kBadUsages[] = {
      "must be a file name ending in .exr (a name, then .exr)"},
     {"UniformWithoutATarget", "{scene} -o {out} --spp 1 --uniform --quiet",
      "--uniform goes with --target-error"},
+    {"EnvironmentStrengthAlone", "{scene} -o {out} --spp 1 --environment-strength 2 --quiet",
+     "--environment-strength scales --environment"},
+    {"EnvironmentAbsent", "{scene} -o {out} --spp 1 --environment {dir}/sky.hdr --quiet",
+     "--environment: environment image"},
+    {"EnvironmentNeitherImageNorColour", "{scene} -o {out} --spp 1 --environment 1,x,1 --quiet",
+     "an image or R,G,B"},
     {"ErrorMapIsTheOutput", "{scene} -o {dir}/x.exr --error-map {dir}/x.exr --quiet",
      "-o and --error-map name the same file"},
 };
