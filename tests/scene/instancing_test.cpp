@@ -150,8 +150,10 @@ TEST(Instancing, HitsSetUpInWorldSpaceAsTheirCopies) {
     EXPECT_GT(mirrored, 20);
 }
 
-// The compact layout (kCompactBvhTriangles) finds the same closest hits as the fast one, to the
-// bit, instances and all.
+// The compact layout (kCompactBvhTriangles) finds the same closest hits as the fast one,
+// instances and all: the same triangle of the same instance, at the same distance and
+// barycentrics up to rounding (to the bit on some CPUs; on an AMD EPYC with AVX2, Embree's two
+// layouts round u, v and t a few ulps apart).
 TEST(Instancing, ACompactBvhFindsTheSameHits) {
     TempDir dir;
     const Scene s = loadScene(boxes(dir, "shared.gltf", true));
@@ -170,9 +172,9 @@ TEST(Instancing, ACompactBvhFindsTheSameHits) {
             ++hits;
             EXPECT_EQ(a.instance, b.instance);
             EXPECT_EQ(a.prim, b.prim);
-            EXPECT_EQ(a.t, b.t);
-            EXPECT_EQ(a.u, b.u);
-            EXPECT_EQ(a.v, b.v);
+            EXPECT_NEAR(a.t, b.t, 1e-5f * a.t);
+            EXPECT_NEAR(a.u, b.u, 1e-5f);
+            EXPECT_NEAR(a.v, b.v, 1e-5f);
         }
     EXPECT_GT(hits, 1000);
 }
