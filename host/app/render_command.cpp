@@ -85,10 +85,26 @@ Scene loadForRender(const RenderOptions& o, bool writes) {
     applyOverrides(o, scene);
     for (const std::string& w : scene.warnings)
         if (writes) std::fprintf(stderr, "spillway: warning: %s\n", w.c_str());
+    // Zero-area triangles, said once for the whole scene (a CAD file drops some in most meshes).
+    long long dropped = 0;
+    int meshes = 0;
+    const Mesh* first = nullptr;
     for (const Mesh& m : scene.meshes)
-        if (m.droppedTriangles > 0 && writes)
-            std::fprintf(stderr, "spillway: warning: %s: dropped %d zero-area triangle%s\n",
-                         m.name.c_str(), m.droppedTriangles, m.droppedTriangles == 1 ? "" : "s");
+        if (m.droppedTriangles > 0) {
+            dropped += m.droppedTriangles, ++meshes;
+            if (!first) first = &m;
+        }
+    if (first && writes) {
+        const char* plural = dropped == 1 ? "" : "s";
+        if (meshes == 1)
+            std::fprintf(stderr, "spillway: warning: %s: dropped %lld zero-area triangle%s\n",
+                         first->name.c_str(), dropped, plural);
+        else
+            std::fprintf(stderr,
+                         "spillway: warning: dropped %lld zero-area triangle%s in %d meshes (the "
+                         "first: %s)\n",
+                         dropped, plural, meshes, first->name.c_str());
+    }
     return scene;
 }
 

@@ -34,10 +34,16 @@ namespace fs = std::filesystem;
 namespace {
 
 // The extensions this loader honours: a file may require them.
-const std::set<std::string> kHonoured = {
-    "KHR_lights_punctual",        "KHR_materials_clearcoat", "KHR_materials_emissive_strength",
-    "KHR_materials_ior",          "KHR_materials_sheen",     "KHR_materials_specular",
-    "KHR_materials_transmission", "KHR_materials_volume",    "KHR_texture_transform"};
+const std::set<std::string> kHonoured = {"KHR_lights_punctual",
+                                         "KHR_materials_clearcoat",
+                                         "KHR_materials_emissive_strength",
+                                         "KHR_materials_ior",
+                                         "KHR_materials_pbrSpecularGlossiness",
+                                         "KHR_materials_sheen",
+                                         "KHR_materials_specular",
+                                         "KHR_materials_transmission",
+                                         "KHR_materials_volume",
+                                         "KHR_texture_transform"};
 
 // The image of a `spillway render model.glb` without an aspect ratio: 640 pixels wide.
 constexpr int kDefaultWidth = 640;
@@ -150,6 +156,27 @@ void GltfReader::readObject(const std::vector<glm::dmat4>& transforms, int shade
     if (cameraSeen_) warn("its cameras are not used: the scene has its own");
 }
 
+void GltfReader::warnOf(const std::string& subject, const std::string& message) {
+    auto said = std::find_if(warningsOf_.begin(), warningsOf_.end(),
+                             [&](const auto& w) { return w.first == message; });
+    if (said == warningsOf_.end()) said = warningsOf_.insert(said, {message, {}});
+    if (std::find(said->second.begin(), said->second.end(), subject) == said->second.end())
+        said->second.push_back(subject);
+}
+
+void GltfReader::sayWarningsOf() {
+    constexpr size_t kNamed = 3; // the parts a warning names; the rest it counts
+    for (const auto& [message, subjects] : warningsOf_) {
+        std::string who;
+        for (size_t i = 0; i < std::min(subjects.size(), kNamed); ++i)
+            who += (i == 0 ? "" : i + 1 == subjects.size() ? " and " : ", ") + subjects[i];
+        if (subjects.size() > kNamed)
+            who += " and " + std::to_string(subjects.size() - kNamed) + " more";
+        warn(who + ": " + message);
+    }
+    warningsOf_.clear();
+}
+
 void GltfReader::read(const std::vector<glm::dmat4>& transforms, bool takesCamera) {
     parse();
     checkExtensions();
@@ -183,6 +210,8 @@ void GltfReader::parse() {
     if (!fs::is_regular_file(path_, ec))
         throw SceneError(path_, 0, "cannot open the glTF file: not a readable file");
     GltfDocument document = preflightGltf(path_, kHonoured);
+    for (const std::string& w : document.warnings)
+        warn(w);
     tinygltf::TinyGLTF loader;
     loader.SetFsCallbacks(regularFilesOnly());
     embedded_.clear();

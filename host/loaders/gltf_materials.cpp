@@ -70,10 +70,12 @@ int GltfReader::shaderFor(int material, const std::string& at) {
 }
 
 Shader GltfReader::readMaterial(int index) {
-    const tinygltf::Material& mat = model_.materials[size_t(index)];
+    const tinygltf::Material& file = model_.materials[size_t(index)];
     const std::string at = "/materials/" + std::to_string(index);
     const std::string name =
-        "material " + std::to_string(index) + (mat.name.empty() ? "" : " (" + mat.name + ")");
+        "material " + std::to_string(index) + (file.name.empty() ? "" : " (" + file.name + ")");
+    tinygltf::Material converted;
+    const tinygltf::Material& mat = readSpecularGlossiness(file, at, name, converted);
     Shader s = defaultShader();
     const tinygltf::PbrMetallicRoughness& pbr = mat.pbrMetallicRoughness;
     if (pbr.baseColorFactor.size() != 4)
@@ -123,7 +125,7 @@ void GltfReader::readImages(const tinygltf::Material& mat, Shader& s, const std:
             fail(at + "/normalTexture/scale", "must be a finite number of at most 1000");
     }
     if (mat.occlusionTexture.index >= 0)
-        warn(name + ": its occlusionTexture is ignored (a path tracer finds occlusion itself)");
+        warnOf(name, "its occlusionTexture is ignored (a path tracer finds occlusion itself)");
 }
 
 void GltfReader::readEmission(const tinygltf::Material& mat, Shader& s, const std::string& at,

@@ -148,9 +148,34 @@ void checkRequired(const std::string& path, const json& doc,
     }
 }
 
+// The nodes some scene holds: its roots and everything below them.
+std::vector<bool> nodesInScenes(const json& scenes, const std::vector<GltfNode>& nodes) {
+    std::vector<bool> held(nodes.size(), false);
+    std::vector<size_t> todo;
+    for (const json& scene : scenes) {
+        if (!scene.is_object() || !scene.contains("nodes") || !scene["nodes"].is_array()) continue;
+        for (const json& n : scene["nodes"])
+            if (n.is_number_integer() && n.get<long long>() >= 0 &&
+                n.get<long long>() < (long long)nodes.size())
+                todo.push_back(size_t(n.get<long long>()));
+    }
+    while (!todo.empty()) {
+        const size_t i = todo.back();
+        todo.pop_back();
+        if (held[i]) continue;
+        held[i] = true;
+        for (int c : nodes[i].children)
+            if (c >= 0 && c < int(nodes.size())) todo.push_back(size_t(c));
+    }
+    return held;
+}
+
 // The node hierarchy is a set of disjoint trees (glTF 2.0, 3.5.3): a node is the child of one
-// node at most, and a scene's nodes are roots, each named once.
-void checkForest(const std::string& path, const json& doc, const std::vector<GltfNode>& nodes) {
+// node at most, and a scene's nodes are roots, each named once. One leniency, as Blender's
+// importer has it: a root whose parent no scene holds (UniGLTF's VRM exports write such files)
+// is rendered as a root, and `warnings` says so.
+void checkForest(const std::string& path, const json& doc, const std::vector<GltfNode>& nodes,
+                 std::vector<std::string>& warnings) {
     std::vector<long long> parent(nodes.size(), -1);
     for (size_t i = 0; i < nodes.size(); ++i) {
         const std::vector<int>& children = nodes[i].children;
@@ -166,6 +191,7 @@ void checkForest(const std::string& path, const json& doc, const std::vector<Glt
         }
     }
     if (!doc.contains("scenes") || !doc["scenes"].is_array()) return;
+    std::vector<bool> inScenes;
     for (size_t s = 0; s < doc["scenes"].size(); ++s) {
         const json& scene = doc["scenes"][s];
         if (!scene.is_object() || !scene.contains("nodes") || !scene["nodes"].is_array()) continue;
@@ -176,10 +202,13 @@ void checkForest(const std::string& path, const json& doc, const std::vector<Glt
             const long long r = n.get<long long>();
             if (r < 0 || r >= (long long)nodes.size()) continue;
             const std::string at = "/scenes/" + std::to_string(s) + "/nodes/" + std::to_string(k);
-            if (parent[size_t(r)] >= 0)
-                fail(path, at,
-                     "names node " + std::to_string(r) + ", a child of node " +
-                         std::to_string(parent[size_t(r)]) + ": a scene's nodes are roots");
+            if (const long long p = parent[size_t(r)]; p >= 0) {
+                if (inScenes.empty()) inScenes = nodesInScenes(doc["scenes"], nodes);
+                const std::string what =
+                    "names node " + std::to_string(r) + ", a child of node " + std::to_string(p);
+                if (inScenes[size_t(p)]) fail(path, at, what + ": a scene's nodes are roots");
+                warnings.push_back(at + ": " + what + ", which no scene holds: rendered as a root");
+            }
             if (named[size_t(r)]) fail(path, at, "names node " + std::to_string(r) + " twice");
             named[size_t(r)] = true;
         }
@@ -384,7 +413,7 @@ GltfDocument preflightGltf(const std::string& path, const std::set<std::string>&
         fail(path, "/nodes", "must be an array of nodes");
     out.doc.erase("nodes"); // read into `nodes`: tinygltf is handed none
     out.nodes = nodes.take();
-    checkForest(path, doc, out.nodes);
+    checkForest(path, doc, out.nodes, out.warnings);
     std::set<std::string> used;
     if (doc.contains("extensionsUsed") && doc["extensionsUsed"].is_array())
         for (const json& e : doc["extensionsUsed"])

@@ -36,6 +36,7 @@ struct GltfDocument {
     std::vector<GltfNode> nodes; // its nodes, taken out of `doc` (gltf_nodes.h)
     bool binary = false;
     std::uint64_t binOffset = 0, binLength = 0; // the BIN chunk's bytes (length 0: none)
+    std::vector<std::string> warnings;          // what is rendered leniently ("pointer: what")
 };
 
 // Checks the file at `path` before it is parsed; `honoured` are the extensions a file may require.

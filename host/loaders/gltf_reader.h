@@ -48,6 +48,10 @@ class GltfReader {
     void warn(const std::string& message) {
         if (warned_.insert(message).second) scene_.warnings.push_back(path_ + ": " + message);
     }
+    // A warning about one part of the file (`subject`: "material 3 (Steel)"), said once when the
+    // file is read, naming every part it applies to: "material 0, material 3 and 37 more: ...".
+    void warnOf(const std::string& subject, const std::string& message);
+    void sayWarningsOf();
 
     void parse();
 
@@ -179,6 +183,12 @@ class GltfReader {
                       const std::string& name);
     void readClearcoat(const tinygltf::Material& mat, Shader& s, const std::string& at,
                        const std::string& name);
+    // KHR_materials_pbrSpecularGlossiness (older assets' workflow), where `mat` has it: the
+    // material converted to metallic-roughness into `converted` (returned), as the extension's
+    // converters do (gltf_material_extensions.cpp); else `mat` itself.
+    const tinygltf::Material& readSpecularGlossiness(const tinygltf::Material& mat,
+                                                     const std::string& at, const std::string& name,
+                                                     tinygltf::Material& converted);
     // The number at `key` of extension object `ext` (its JSON pointer `at`), or `fallback` where
     // it is absent; refused unless it is a finite number in [lo, hi] (hi may be HUGE_VAL).
     double extensionNumber(const tinygltf::Value& ext, const char* key, double fallback, double lo,
@@ -263,6 +273,7 @@ class GltfReader {
     void warnUnrendered() {
         if (!model_.animations.empty()) warn("has animations: rendered at rest");
         if (model_.scenes.size() > 1) warn("has more than one scene: the default one rendered");
+        sayWarningsOf();
     }
 
     std::string path_;
@@ -272,6 +283,8 @@ class GltfReader {
     std::vector<GltfNode> nodes_; // the file's nodes (gltf_nodes.h), until the graph is read
     ImageBytes embedded_;
     std::set<std::string> warned_;
+    // warnOf's messages in the order first said, each with the parts it was said of.
+    std::vector<std::pair<std::string, std::vector<std::string>>> warningsOf_;
     std::set<int> onPath_;
     std::vector<int> shaderOf_;
     // Per shader made from the file: the TEXCOORD_n its meshes' texture coordinates are read from.

@@ -1,0 +1,152 @@
+// What a glTF file's maker meant, where it is unambiguous: a scene root whose extra parent no
+// scene holds rendered as a root, KHR_materials_pbrSpecularGlossiness converted to
+// metallic-roughness, and a warning said once for every part it applies to.
+#include "host/loaders/scene_loader.h"
+#include "scene/gltf_builder.h"
+#include "test_util.h"
+
+#include <OpenImageIO/imagebuf.h>
+#include <OpenImageIO/imagebufalgo.h>
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+namespace spw::test {
+namespace {
+
+using nlohmann::json;
+
+// A root that is also the child of a node no scene holds (as UniGLTF's VRM exports write) is
+// rendered as a root, with a warning naming where; a parent some scene holds is still refused
+// (GltfHostile.*, Gltf.* keep those).
+TEST(GltfLenient, ARootWhoseParentNoSceneHoldsIsRenderedAsARoot) {
+    TempDir dir;
+    GltfBuilder b;
+    const int mesh = b.mesh(b.quad());
+    b.doc["nodes"] = json::array({{{"children", {1}}}, {{"mesh", mesh}}});
+    b.scene({1});
+    const Scene s = loadScene(b.embedded(dir, "vrm.gltf"));
+    ASSERT_EQ(s.meshes.size(), 1u);
+    ASSERT_EQ(s.warnings.size(), 1u);
+    EXPECT_NE(s.warnings[0].find("/scenes/0/nodes/0: names node 1, a child of node 0, which no "
+                                 "scene holds: rendered as a root"),
+              std::string::npos)
+        << s.warnings[0];
+    b.scene({0, 1}); // now a scene holds the parent
+    EXPECT_NE(loadError(b.embedded(dir, "both.gltf")).find("a scene's nodes are roots"),
+              std::string::npos);
+}
+
+// A quad under material `mat` (its extensions declared in `used`), seen by a camera; the
+// scene loaded.
+Scene quadWith(const TempDir& dir, const json& mat, const std::vector<std::string>& used = {}) {
+    GltfBuilder b;
+    b.doc["materials"] = json::array({mat});
+    if (!used.empty()) b.doc["extensionsUsed"] = used;
+    b.doc["cameras"] =
+        json::array({{{"type", "perspective"},
+                      {"perspective", {{"yfov", 0.5}, {"aspectRatio", 1.0}, {"znear", 0.1}}}}});
+    b.scene({b.node({{"mesh", b.mesh(b.quad(0))}}),
+             b.node({{"camera", 0}, {"translation", {0.5, 0.5, 2}}})});
+    Scene s = loadScene(b.embedded(dir, "q.gltf"));
+    s.image.width = s.image.height = 8;
+    return s;
+}
+
+json specularGlossiness(const json& body) {
+    return {{"extensions", {{"KHR_materials_pbrSpecularGlossiness", body}}}};
+}
+
+// A dielectric in the specular-glossiness workflow (diffuse red, specular 0.04, glossiness 0.7)
+// is the metallic-roughness material of that base colour, metallic 0 and roughness 0.3, and
+// renders as it to the bit on every backend; a black diffuse under a coloured specular is a
+// metal of that colour. The metallic-roughness values beside the extension (a fallback for
+// viewers without it) are not read.
+TEST(GltfLenient, SpecularGlossinessIsConvertedToMetallicRoughness) {
+    TempDir dir;
+    const std::vector<std::string> used = {"KHR_materials_pbrSpecularGlossiness"};
+    json plastic = specularGlossiness({{"diffuseFactor", {0.8, 0.2, 0.2, 1.0}},
+                                       {"specularFactor", {0.04, 0.04, 0.04}},
+                                       {"glossinessFactor", 0.7}});
+    plastic["pbrMetallicRoughness"] = {{"baseColorFactor", {0, 1, 0, 1}}, {"metallicFactor", 1}};
+    const Scene converted = quadWith(dir, plastic, used);
+    EXPECT_TRUE(converted.warnings.empty()) << converted.warnings.at(0);
+    const Scene direct = quadWith(dir, material(vec3(0.8f, 0.2f, 0.2f), 0.0f, 0.3f));
+    const Shader &a = converted.shaders[0], &b = direct.shaders[0];
+    EXPECT_EQ(a.params.colour, vec3(0.8f, 0.2f, 0.2f));
+    EXPECT_EQ(a.params.metallic, 0.0f);
+    EXPECT_EQ(a.roughness, b.roughness);
+    for (BackendKind backend : {BackendKind::Reference, BackendKind::Cpu, BackendKind::Vulkan}) {
+        SCOPED_TRACE(backendName(backend));
+        RenderConfig cfg;
+        cfg.backend = backend;
+        cfg.spp = 2;
+        EXPECT_EQ(render(converted, cfg)->film->image(), render(direct, cfg)->film->image());
+    }
+    const Scene gold = quadWith(dir,
+                                specularGlossiness({{"diffuseFactor", {0.0, 0.0, 0.0, 1.0}},
+                                                    {"specularFactor", {1.0, 0.75, 0.25}},
+                                                    {"glossinessFactor", 0.9}}),
+                                used);
+    EXPECT_EQ(gold.shaders[0].params.metallic, 1.0f);
+    EXPECT_NEAR(gold.shaders[0].params.colour.y, 0.75f, 1e-6f);
+    EXPECT_NEAR(gold.shaders[0].params.colour.z, 0.25f, 1e-6f);
+    EXPECT_NEAR(gold.shaders[0].roughness, 0.1f, 1e-6f);
+    // A value out of range is refused, naming where; a specularGlossinessTexture is warned
+    // about (its factors are rendered), once.
+    const json bad = specularGlossiness({{"diffuseFactor", {2.0, 0.0, 0.0, 1.0}}});
+    GltfBuilder files;
+    files.doc["materials"] = json::array({bad});
+    files.doc["extensionsUsed"] = used;
+    files.scene({files.node({{"mesh", files.mesh(files.quad(0))}})});
+    EXPECT_NE(loadError(files.embedded(dir, "bad.gltf"))
+                  .find("/materials/0/extensions/KHR_materials_pbrSpecularGlossiness/"
+                        "diffuseFactor/0: must lie in [0, 1]"),
+              std::string::npos);
+}
+
+// A 2 x 2 white PNG as a data: URI.
+std::string whitePng(const TempDir& dir) {
+    OIIO::ImageBuf img(OIIO::ImageSpec(2, 2, 3, OIIO::TypeDesc::UINT8));
+    const float white[3] = {1, 1, 1};
+    OIIO::ImageBufAlgo::fill(img, white);
+    EXPECT_TRUE(img.write(dir.file("white.png")));
+    return "data:image/png;base64," + GltfBuilder::base64(readFile(dir.file("white.png")));
+}
+
+// Five materials with an occlusionTexture (which a path tracer has no use for): one warning
+// naming three of them and counting the rest. Three meshes each with a zero-area triangle: one
+// line from the command line for all of them.
+TEST(GltfLenient, AWarningIsSaidOncePerFile) {
+    TempDir dir;
+    GltfBuilder b;
+    b.doc["images"] = json::array({{{"uri", whitePng(dir)}}});
+    b.doc["textures"] = json::array({{{"source", 0}}});
+    std::vector<int> roots;
+    for (int m = 0; m < 5; ++m) {
+        json mat = material(vec3(0.5f), 0.0f, 0.5f);
+        mat["occlusionTexture"] = {{"index", 0}};
+        b.doc["materials"].push_back(mat);
+        json prim = b.quad(m);
+        if (m < 3) prim["indices"] = b.accessor<uint16_t>({0, 1, 2, 0, 2, 2}, 5123, "SCALAR");
+        roots.push_back(b.node({{"mesh", b.mesh(prim)}, {"translation", {m, 0, 0}}}));
+    }
+    b.scene(roots);
+    const std::string file = b.embedded(dir, "many.gltf");
+    const Scene s = loadScene(file);
+    ASSERT_EQ(s.warnings.size(), 1u);
+    EXPECT_NE(s.warnings[0].find("material 0, material 1, material 2 and 2 more: its "
+                                 "occlusionTexture is ignored"),
+              std::string::npos)
+        << s.warnings[0];
+    const CommandResult r =
+        runSpillway("render " + file + " -o " + dir.file("m.exr") + " --spp 1 --width 8 --quiet");
+    EXPECT_EQ(r.status, 0) << r.output;
+    EXPECT_NE(r.output.find("dropped 3 zero-area triangles in 3 meshes (the first: " + file +
+                            ": mesh 0)"),
+              std::string::npos)
+        << r.output;
+    EXPECT_EQ(r.output.find("zero-area"), r.output.rfind("zero-area")) << r.output;
+}
+
+} // namespace
+} // namespace spw::test
