@@ -1,6 +1,7 @@
 #include "embree_backend/reference_renderer.h"
 
 #include "embree_backend/batch_traversal.h"
+#include "host/scene_view/denoising_albedo.h"
 #include "shared/path.h"
 
 #include <tbb/blocked_range2d.h>
@@ -47,7 +48,9 @@ bool ReferenceRenderer::renderIteration(uint iteration, Film& film) {
                             SurfaceHit hit;
                             ctx_.hitSetup.setUpHit(h, dir, st.cone, ctx_.textures,
                                                    st.bounce < rp.maxDepth, hit);
-                            if (ctx_.aovs && st.bounce == 0) ctx_.aovs->record(st.pathId, hit);
+                            if (ctx_.aovs && st.bounce < rp.maxDepth)
+                                recordPasses(*ctx_.aovs, ctx_.scene.shaders[hit.shader].params, st,
+                                             dir, hit);
                             ShadeResult res;
                             shadeSurface(view, rp, hit, dir, st, res);
                             if (res.flags & kShadeEmitted)

@@ -263,7 +263,7 @@ void writeImageWithPasses(OutputFile& file, const std::string& path, const Film&
                 std::copy_n(&passes[i * extra], extra, out + i * channels + 3);
             }
         },
-        names);
+        names, aovs.layerNotes());
 }
 
 // Every output is written whole, and flushed, before any is given its name: a failure in any of

@@ -152,8 +152,9 @@ const std::vector<CliOption> kOwnOptions = {
      0, 0, [](O& r, const C&, const S& v) { r.errorMapPath = v; }},
     {"--aov", nullptr, "PASSES", Section::Render,
      "render passes as layers of the output EXR, named as Cycles names them: any of albedo "
-     "(\"Denoising Albedo\"), normal (\"Normal\"), depth (\"Depth\"), comma-separated or "
-     "repeated",
+     "(\"Denoising Albedo\": what the pixel shows, through mirrors and smooth glass), normal "
+     "(\"Normal\", world space, +Y up), camera-normal (\"Camera Normal\", +Z toward the "
+     "camera), depth (\"Depth\"), comma-separated or repeated",
      0, 0,
      [](O& r, const C& o, const S& v) {
          try {

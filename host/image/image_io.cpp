@@ -136,8 +136,11 @@ std::vector<unsigned char> encodeImage(const std::string& path, const ImageRGB& 
 }
 
 void writeImageRows(OutputFile& file, const std::string& path, int width, int height,
-                    const ImageRows& rows, const std::vector<std::string>& extra) {
-    const OIIO::ImageSpec spec = outputSpec(path, width, height, extra);
+                    const ImageRows& rows, const std::vector<std::string>& extra,
+                    const std::vector<std::pair<std::string, std::string>>& attributes) {
+    OIIO::ImageSpec spec = outputSpec(path, width, height, extra);
+    for (const auto& [name, value] : attributes)
+        spec.attribute(name, value);
     const size_t channels = size_t(spec.nchannels);
     if (!file.seekable()) { // a FIFO: encoded in memory, then written in order
         std::vector<float> all(size_t(width) * size_t(height) * channels);

@@ -6,6 +6,7 @@
 #include <functional>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace spw {
@@ -37,10 +38,11 @@ using ImageRows = std::function<void(int y0, int y1, float* rgb)>;
 // Encodes a width x height image, a block of rows at a time, into `file` (not committed) in the
 // format `path`'s extension names: a 16-Mpixel render needs neither its whole float image nor
 // its encoded bytes in memory at once. `extra`: channels after R, G and B (an EXR's only), named
-// so; `rows` then writes 3 + extra.size() floats a pixel. Throws std::runtime_error naming the
-// path.
+// so; `rows` then writes 3 + extra.size() floats a pixel. `attributes`: header entries (name,
+// text) the file carries. Throws std::runtime_error naming the path.
 void writeImageRows(OutputFile& file, const std::string& path, int width, int height,
-                    const ImageRows& rows, const std::vector<std::string>& extra = {});
+                    const ImageRows& rows, const std::vector<std::string>& extra = {},
+                    const std::vector<std::pair<std::string, std::string>>& attributes = {});
 // Writes the image whole or not at all (host/image/output_file.h). Throws std::runtime_error naming
 // the path when the file cannot be written.
 void writeImage(const std::string& path, const ImageRGB& image);

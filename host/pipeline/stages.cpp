@@ -3,6 +3,7 @@
 #include "host/pipeline/parallel.h"
 #include "host/pipeline/radix_sort.h"
 #include "host/pipeline/stage_chunks.h"
+#include "host/scene_view/denoising_albedo.h"
 #include "host/simd/lanes.h"
 #include "shared/path.h"
 
@@ -257,9 +258,11 @@ void setUpChunk(const RenderContext& ctx, const std::vector<RayState>& rays,
         }
         a = b;
     }
-    if (ctx.aovs) // the camera rays' first hits, for the render passes
+    if (ctx.aovs) // the render passes: the camera rays' first hits, and the albedo's
         for (size_t i = 0; i < n; ++i)
-            if (in[i].path.bounce == 0) ctx.aovs->record(in[i].path.pathId, in[i].hit);
+            if (in[i].path.bounce < ctx.params.maxDepth)
+                recordPasses(*ctx.aovs, ctx.scene.shaders[in[i].hit.shader].params, in[i].path,
+                             in[i].rayDir, in[i].hit);
 }
 
 void prepareTextures(const RenderContext& ctx, const std::vector<HitRecord>& hits,

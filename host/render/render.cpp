@@ -274,9 +274,8 @@ void RenderSession::build() {
     stats_.extra["sampler"] = samplerName(scene_.sampler);
 
     if (config_.aovs != 0)
-        result_->aovs = std::make_unique<AovFilm>(
-            scene_.image.width, scene_.image.height, spi_, config_.aovs,
-            glm::normalize(vec3(scene_.camera.cameraToWorld * vec4(0.0f, 0.0f, -1.0f, 0.0f))));
+        result_->aovs = std::make_unique<AovFilm>(scene_.image.width, scene_.image.height, spi_,
+                                                  config_.aovs, mat3(scene_.camera.cameraToWorld));
     ctx_.emplace(RenderContext{scene_, config_, *lights_, *embree_, *hitSetup_, *textures_,
                                *camera_, params, threads_, stats_, result_->aovs.get()});
     result_->film = std::make_unique<Film>(
