@@ -43,6 +43,7 @@ bool ReferenceRenderer::renderIteration(uint iteration, Film& film) {
                                     film.splat(st.pathId, cr.filmPos, sampleIndex,
                                                escapedRadiance(view, rp, dir, st),
                                                filmKey(st.pathId, st.bounce, false));
+                                if (ctx_.aovs) recordEscape(*ctx_.aovs, view, rp, st, dir);
                                 break;
                             }
                             SurfaceHit hit;

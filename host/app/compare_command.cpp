@@ -14,13 +14,14 @@
 namespace spw {
 namespace {
 
-ImageRGB readInput(const std::string& path) {
+// The image at `path`, or its layer `layer` where one is named (--layer).
+ImageRGB readInput(const std::string& path, const std::string& layer) {
     std::error_code ec;
     if (!std::filesystem::exists(path, ec))
         throw std::runtime_error("cannot read '" + path + "': no such file");
     if (std::filesystem::is_directory(path, ec))
         throw std::runtime_error("cannot read '" + path + "': it is a folder");
-    ImageRGB img = readImage(path); // its errors name the path
+    ImageRGB img = layer.empty() ? readImage(path) : readImageLayer(path, layer); // name the path
     if (img.width <= 0 || img.height <= 0)
         throw std::runtime_error("cannot read '" + path + "': the image is empty");
     return img;
@@ -63,6 +64,7 @@ struct CompareOptions {
     std::vector<std::string> files;
     std::vector<Threshold> thresholds;
     std::string heatmapPath;
+    std::string layer; // --layer: a render pass of both EXRs instead of their image
     bool json = false;
     bool allowNonFinite = false; // thresholds judge the finite pixels alone
     bool help = false;
@@ -98,6 +100,9 @@ CompareOptions parseCompareOptions(const std::vector<std::string>& args) {
                            [](unsigned char c) { return char(std::tolower(c)); });
             if (ext != ".png")
                 throw UsageError("--heatmap '" + o.heatmapPath + "' must end in .png");
+        } else if (a == "--layer") {
+            o.layer = value();
+            if (o.layer.empty()) throw UsageError("--layer needs a layer's name");
         } else if (a == "--threshold") {
             try {
                 o.thresholds.push_back(parseThreshold(value()));
@@ -213,8 +218,8 @@ int runCompare(const std::vector<std::string>& args) {
     }
     // The heatmap's folder is checked before the images are read, as render checks its outputs.
     if (!o.heatmapPath.empty()) outputStep([&] { checkWritable(o.heatmapPath); });
-    const ImageRGB a = readInput(o.files[0]);
-    const ImageRGB b = readInput(o.files[1]);
+    const ImageRGB a = readInput(o.files[0], o.layer);
+    const ImageRGB b = readInput(o.files[1], o.layer);
     if (a.width != b.width || a.height != b.height)
         throw std::runtime_error("image sizes differ: '" + o.files[0] + "' is " +
                                  std::to_string(a.width) + "x" + std::to_string(a.height) + ", '" +
@@ -236,6 +241,7 @@ int runCompare(const std::vector<std::string>& args) {
 
 const char* compareUsage() {
     return R"(usage: spillway compare A B [--json] [--heatmap FILE.png] [--threshold METRIC=V]...
+                        [--layer NAME]
 
 Compares image A against the reference B (EXR or PNG, same size) over the pixels finite in
 both: mse, rmse, relmse (mean (a-b)^2/(b^2+0.01)), mae, maxabs, psnr (peak 1.0, linear),
@@ -247,6 +253,9 @@ per-channel means and the count of non-finite pixels in each.
                           METRIC: mse, rmse, relmse, mae, maxabs, psnr. May be repeated.
                           A non-finite pixel in A or B fails every threshold.
   --allow-nonfinite       let thresholds judge the finite pixels alone
+  --layer NAME            compare a render pass of two EXRs instead of their image: its R, G,
+                          B or X, Y, Z channels ("Denoising Albedo", "Normal"; also under a
+                          view layer's name, as Blender writes them: "ViewLayer.Normal.X")
 
 exit status: 0 within bounds, 1 a bound exceeded or the heatmap not written (disk), 2 bad
 usage or unreadable input

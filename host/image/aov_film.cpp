@@ -40,6 +40,7 @@ AovFilm::AovFilm(int width, int height, int samplesPerIteration, unsigned passes
     if (passes_ & kAovAlbedo) chain_.resize(pixels * size_t(spi_));
     sums_.resize(pixels * kValues);
     hits_.resize(pixels);
+    albedoSamples_.resize(pixels);
 }
 
 void AovFilm::beginIteration() {
@@ -71,14 +72,26 @@ void AovFilm::recordAlbedo(uint pathId, vec3 albedo, bool passesOn) {
     state = kAlbedoDone;
 }
 
+void AovFilm::recordEscape(uint pathId, vec3 radiance) {
+    if (!(passes_ & kAovAlbedo) || size_t(pathId) >= state_.size()) return;
+    std::uint8_t& state = state_[pathId];
+    if (state != kMissed && state != kThroughSpecular) return;
+    const vec3 a = state == kMissed ? radiance : chain_[pathId] * radiance;
+    float* slot = &slots_[size_t(pathId) * kValues];
+    slot[0] = a.x, slot[1] = a.y, slot[2] = a.z;
+    state = state == kMissed ? kEscaped : kAlbedoDone;
+}
+
 void AovFilm::endIteration() {
     const size_t pixels = hits_.size();
     for (size_t pixel = 0; pixel < pixels; ++pixel)
         for (size_t s = 0; s < size_t(spi_); ++s) {
             const size_t path = pixel * size_t(spi_) + s;
             if (state_[path] == kMissed) continue;
-            ++hits_[pixel];
-            for (int k = 0; k < kValues; ++k)
+            ++albedoSamples_[pixel];
+            const int values = state_[path] == kEscaped ? 3 : kValues; // an escape: albedo alone
+            if (values == kValues) ++hits_[pixel];
+            for (int k = 0; k < values; ++k)
                 sums_[pixel * kValues + size_t(k)] += double(slots_[path * kValues + size_t(k)]);
         }
 }
@@ -125,9 +138,10 @@ void AovFilm::rows(int y0, int y1, float* out) const {
             auto mean = [&](int k) {
                 return n == 0 ? 0.0f : float(sums_[pixel * kValues + size_t(k)] / n);
             };
+            const std::uint32_t seen = albedoSamples_[pixel];
             if (passes_ & kAovAlbedo)
                 for (int k = 0; k < 3; ++k)
-                    *out++ = mean(k);
+                    *out++ = seen == 0 ? 0.0f : float(sums_[pixel * kValues + size_t(k)] / seen);
             const vec3 normal(mean(3), mean(4), mean(5));
             if (passes_ & kAovNormal)
                 for (int k = 0; k < 3; ++k)

@@ -18,9 +18,10 @@
 //                  Cycles' Z)
 //
 // Each layer's convention is in the EXR's header too ("spillway/<layer>"). A pixel no sample hit
-// reads albedo 0, normal 0 and depth 1e10 (Cycles' background depth); so does the albedo of a
-// sample whose mirror chain ends in the environment. The passes are box-filtered (each sample
-// counts in its own pixel) whatever the image's filter.
+// reads normal 0 and depth 1e10 (Cycles' background depth), and as its albedo the environment's
+// radiance where its rays left the scene (Cycles' background albedo; 0 without an environment),
+// as does a sample whose mirror chain ends in the environment. The passes are box-filtered (each
+// sample counts in its own pixel) whatever the image's filter.
 //
 // Deterministic: each camera sample writes its own slot of the iteration (indexed by its path
 // id, as the film's per-sample buffer is), and endIteration() adds the slots pixel by pixel in
@@ -62,6 +63,11 @@ class AovFilm {
     // specular hit (the next hit decides, the pass weighted by this one's albedo), else it ends
     // the pass, times the albedos of the specular hits before it.
     void recordAlbedo(uint pathId, vec3 albedo, bool passesOn);
+    // Camera path `pathId` escaping with `radiance` from the environment along its ray: where
+    // the camera ray itself missed, or its hits so far were specular, the albedo pass takes
+    // that radiance (times the specular hits' albedos), as Cycles' "Denoising Albedo" takes the
+    // background; the normal and depth of a missed sample stay out of the pixel's means.
+    void recordEscape(uint pathId, vec3 radiance);
     // Adds the iteration's slots to the render's sums.
     void endIteration();
 
@@ -75,7 +81,7 @@ class AovFilm {
   private:
     static constexpr int kValues = 7; // albedo rgb, normal xyz, depth
     // A camera sample's state in the iteration.
-    enum : std::uint8_t { kMissed = 0, kHit, kThroughSpecular, kAlbedoDone };
+    enum : std::uint8_t { kMissed = 0, kEscaped, kHit, kThroughSpecular, kAlbedoDone };
     int width_, height_, spi_;
     unsigned passes_;
     mat3 cameraToWorld_;
@@ -85,6 +91,7 @@ class AovFilm {
     std::vector<std::uint8_t> state_; // per camera sample
     std::vector<double> sums_;        // per pixel: kValues
     std::vector<std::uint32_t> hits_; // per pixel: samples that hit
+    std::vector<std::uint32_t> albedoSamples_; // per pixel: samples that hit or saw the environment
 };
 
 } // namespace spw

@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
+#include <memory>
 
 namespace spw {
 namespace {
@@ -378,7 +379,11 @@ std::string exrHeaderProblem(const std::string& path) {
     }
 }
 
-ImageRGB readImage(const std::string& path) {
+namespace {
+
+// The image at `path` opened for reading, its header checked (a regular file, an EXR header
+// that claims nothing past the file, a size within kMaxImagePixels, a channel at least).
+std::unique_ptr<OIIO::ImageInput> openChecked(const std::string& path) {
     // A FIFO or a folder would block the open or read as nonsense: regular files only.
     std::error_code ec;
     if (!std::filesystem::is_regular_file(path, ec))
@@ -393,6 +398,59 @@ ImageRGB readImage(const std::string& path) {
     if (const std::string why = imageSizeProblem(path, spec.width, spec.height); !why.empty())
         throw std::runtime_error(why);
     if (spec.nchannels < 1) throw std::runtime_error("image '" + path + "' has no channel");
+    return in;
+}
+
+// The index of channel `layer`.`component` of `spec`, alone or under a view layer's name
+// ("ViewLayer.Normal.X", as Blender writes it), or -1.
+int layerChannel(const OIIO::ImageSpec& spec, const std::string& layer,
+                 const std::string& component) {
+    const std::string tail = layer + "." + component;
+    for (int c = 0; c < spec.nchannels; ++c) {
+        const std::string& n = spec.channelnames[size_t(c)];
+        if (n == tail) return c;
+        if (n.size() > tail.size() && n.compare(n.size() - tail.size(), tail.size(), tail) == 0 &&
+            n[n.size() - tail.size() - 1] == '.')
+            return c;
+    }
+    return -1;
+}
+
+} // namespace
+
+ImageRGB readImageLayer(const std::string& path, const std::string& layer) {
+    std::unique_ptr<OIIO::ImageInput> in = openChecked(path);
+    const OIIO::ImageSpec& spec = in->spec();
+    std::vector<int> picked;
+    for (const std::vector<const char*>& set :
+         std::vector<std::vector<const char*>>{{"R", "G", "B"}, {"X", "Y", "Z"}, {"Z"}, {"V"}}) {
+        picked.clear();
+        for (const char* component : set)
+            if (const int c = layerChannel(spec, layer, component); c >= 0) picked.push_back(c);
+        if (picked.size() == set.size()) break;
+        picked.clear();
+    }
+    if (picked.empty())
+        throw std::runtime_error("image '" + path + "' has no layer '" + layer + "' (channels " +
+                                 layer + ".R, .G, .B or .X, .Y, .Z, or .Z)");
+    const size_t pixels = size_t(spec.width) * size_t(spec.height);
+    std::vector<float> all(pixels * size_t(spec.nchannels));
+    if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, all.data()))
+        throw std::runtime_error("cannot read image '" + path + "': " + in->geterror());
+    ImageRGB img;
+    img.width = spec.width;
+    img.height = spec.height;
+    img.rgb.resize(pixels * 3);
+    for (size_t i = 0; i < pixels; ++i)
+        for (size_t c = 0; c < 3; ++c)
+            img.rgb[i * 3 + c] =
+                all[i * size_t(spec.nchannels) + size_t(picked[std::min(c, picked.size() - 1)])];
+    return img;
+}
+
+ImageRGB readImage(const std::string& path) {
+    std::unique_ptr<OIIO::ImageInput> in = openChecked(path);
+    const OIIO::ImageSpec& spec = in->spec();
     ImageRGB img;
     img.width = spec.width;
     img.height = spec.height;

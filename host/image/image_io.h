@@ -75,5 +75,10 @@ std::string exrHeaderProblem(const std::string& path);
 // Reads any image OpenImageIO reads (its first three channels, or its one); 8-bit sRGB data are
 // linearised. Throws on failure, and on a header larger than kMaxImagePixels before reading it.
 ImageRGB readImage(const std::string& path);
+// Reads layer `layer` of an EXR (a render pass: "Denoising Albedo"'s R, G and B, "Normal"'s X,
+// Y and Z, "Depth"'s Z as grey), its channels named as Spillway writes them or under a view
+// layer's name as Blender does ("ViewLayer.Denoising Albedo.R"), as stored (linear). Throws
+// naming the path where the file has no such layer.
+ImageRGB readImageLayer(const std::string& path, const std::string& layer);
 
 } // namespace spw

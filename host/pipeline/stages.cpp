@@ -361,6 +361,7 @@ void accumulateEscapes(const RenderContext& ctx, uint iteration, const std::vect
                               const RayState& ray = rays[order[i].index];
                               splats.push(ctx, rp, ray.path.pathId, ray.path.bounce, false,
                                           escapedRadiance(view, rp, ray.dir, ray.path));
+                              if (ctx.aovs) recordEscape(*ctx.aovs, view, rp, ray.path, ray.dir);
                           }
                       });
 }

@@ -1,6 +1,7 @@
 #include "host/scene_view/denoising_albedo.h"
 
 #include "shared/bsdf.h"
+#include "shared/environment_light.h"
 #include "shared/sampling.h"
 
 namespace spw {
@@ -39,6 +40,15 @@ void recordPasses(AovFilm& aovs, const ShaderParams& params, const PathState& pa
     if (!aovs.albedoPending(path.pathId)) return;
     const DenoisingAlbedo a = denoisingAlbedo(shaderAtHit(params, hit), hit, -rayDir);
     aovs.recordAlbedo(path.pathId, a.albedo, a.passesOn);
+}
+
+void recordEscape(AovFilm& aovs, const SceneView& view, const RenderParams& rp,
+                  const PathState& path, vec3 rayDir) {
+    if (rp.environment == kNoEmitter) return;
+    const SceneView& scene = view; // as EMITTER() names it
+    float pdf = 0.0f;
+    aovs.recordEscape(path.pathId,
+                      environmentLookUp(view, rp, EMITTER(rp.environment), rayDir, false, pdf));
 }
 
 } // namespace spw

@@ -9,6 +9,7 @@
 #pragma once
 
 #include "host/image/aov_film.h"
+#include "shared/scene_access.h"
 #include "shared/types.h"
 
 namespace spw {
@@ -29,5 +30,9 @@ constexpr int kDenoisingAlbedoSamples = 64;
 // normal and depth, and the albedo while it is pending. `params`: the hit's shader's.
 void recordPasses(AovFilm& aovs, const ShaderParams& params, const PathState& path, vec3 rayDir,
                   const SurfaceHit& hit);
+// What `path` escaping along `rayDir` gives the albedo pass: the environment's radiance there
+// (AovFilm::recordEscape); nothing without an environment.
+void recordEscape(AovFilm& aovs, const SceneView& view, const RenderParams& rp,
+                  const PathState& path, vec3 rayDir);
 
 } // namespace spw

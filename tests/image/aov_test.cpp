@@ -90,8 +90,9 @@ TEST(Aov, ThePassesAreTheFirstHitsAlbedoNormalAndDepth) {
                 EXPECT_EQ(vec3(p[3], p[4], p[5]), vec3(0.0f, 0.0f, 1.0f)) << x << " " << y;
                 EXPECT_NEAR(p[6], 3.0f, 1e-5f) << x << " " << y; // planar: 3 at every pixel
             }
-            if (outside) { // no sample hit: Cycles' background values
-                EXPECT_EQ(vec3(p[0], p[1], p[2]), vec3(0.0f));
+            if (outside) { // no sample hit: Cycles' background values, the albedo the
+                           // white environment's radiance
+                EXPECT_EQ(vec3(p[0], p[1], p[2]), vec3(1.0f));
                 EXPECT_EQ(vec3(p[3], p[4], p[5]), vec3(0.0f));
                 EXPECT_EQ(p[6], 1e10f);
             }
@@ -239,6 +240,56 @@ TEST(Aov, RepeatedAovsAddUpAndTheOutputsCaseDoesNotMatter) {
     std::sort(names.begin(), names.end());
     EXPECT_EQ(names, (std::vector<std::string>{"B", "Denoising Albedo.B", "Denoising Albedo.G",
                                                "Denoising Albedo.R", "Depth.Z", "G", "R"}));
+}
+
+// `spillway compare --layer` reads a pass of two EXRs: Spillway's own layer, and the same values
+// under a view layer's name as Blender writes them ("ViewLayer.Denoising Albedo.R", here with
+// the channels in another order), compare as identical; a file without the layer is exit 2,
+// naming it.
+TEST(Aov, CompareReadsAPassByItsLayer) {
+    TempDir dir;
+    const std::string scene = quadFile(dir), ours = dir.file("ours.exr");
+    ASSERT_EQ(runSpillway("render " + scene + " --width 8 --height 8 --spp 1 -o " + ours +
+                          " --aov albedo --quiet")
+                  .status,
+              0);
+    auto in = OIIO::ImageInput::open(ours);
+    ASSERT_TRUE(in);
+    const OIIO::ImageSpec spec = in->spec();
+    std::vector<float> pixels(size_t(64 * spec.nchannels));
+    ASSERT_TRUE(in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, pixels.data()));
+    in.reset();
+    // Blender's way: B, G, R under a view layer, then its Combined.
+    OIIO::ImageSpec theirs(8, 8, 6, OIIO::TypeDesc::FLOAT);
+    theirs.channelnames = {"ViewLayer.Denoising Albedo.B", "ViewLayer.Denoising Albedo.G",
+                           "ViewLayer.Denoising Albedo.R", "ViewLayer.Combined.R",
+                           "ViewLayer.Combined.G",         "ViewLayer.Combined.B"};
+    std::vector<float> out(64 * 6, 0.5f);
+    for (size_t i = 0; i < 64; ++i)
+        for (int c = 0; c < 3; ++c) {
+            const std::string name = std::string("Denoising Albedo.") + "RGB"[c];
+            const auto at = std::find(spec.channelnames.begin(), spec.channelnames.end(), name);
+            ASSERT_NE(at, spec.channelnames.end()) << name;
+            out[i * 6 + size_t(2 - c)] =
+                pixels[i * size_t(spec.nchannels) + size_t(at - spec.channelnames.begin())];
+        }
+    {
+        auto o = OIIO::ImageOutput::create(dir.file("blender.exr"));
+        ASSERT_TRUE(o && o->open(dir.file("blender.exr"), theirs));
+        ASSERT_TRUE(o->write_image(OIIO::TypeDesc::FLOAT, out.data()));
+        o->close();
+    }
+    const CommandResult same = runSpillway("compare " + ours + " " + dir.file("blender.exr") +
+                                           " --layer 'Denoising Albedo' --threshold mse=0");
+    EXPECT_EQ(same.status, 0) << same.output;
+    EXPECT_NE(same.output.find("images identical"), std::string::npos) << same.output;
+    // The image itself differs from the pass.
+    EXPECT_EQ(runSpillway("compare " + ours + " " + dir.file("blender.exr") + " --threshold mse=0")
+                  .status,
+              1);
+    const CommandResult none = runSpillway("compare " + ours + " " + ours + " --layer Normal");
+    EXPECT_EQ(none.status, 2) << none.output;
+    EXPECT_NE(none.output.find("has no layer 'Normal'"), std::string::npos) << none.output;
 }
 
 TEST(Aov, PassesThatCannotBeWrittenAreRefused) {
