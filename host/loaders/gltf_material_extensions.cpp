@@ -1,7 +1,6 @@
 // GltfReader's material extensions (gltf_reader.h): KHR_materials_transmission with _ior and
 // _volume, _clearcoat, _specular and _sheen, each a part of the metallic-roughness model or a
-// surface model of its own, their factors and images (the images as Shader::extension's maps);
-// and _pbrSpecularGlossiness, converted to metallic-roughness.
+// surface model of its own, their factors and images (the images as Shader::extension's maps).
 #include "host/loaders/gltf_reader.h"
 
 #include "shared/gltf.h"
@@ -20,87 +19,7 @@ std::string number(double x) {
     return out.str();
 }
 
-// The conversion of KHR_materials_pbrSpecularGlossiness's factors to metallic-roughness that
-// the extension's converters use (glTF-Transform's, Babylon.js's): the metallic that gives the
-// diffuse and specular colours' perceived brightnesses, solved from F0 = 0.04 (1 - m) + base m,
-// and the base colour blended between what the diffuse and the specular colours imply.
-struct MetallicRoughness {
-    vec3 base;
-    double metallic;
-};
-
-double perceived(vec3 c) {
-    return std::sqrt(0.299 * c.x * c.x + 0.587 * c.y * c.y + 0.114 * c.z * c.z);
-}
-
-MetallicRoughness fromSpecularGlossiness(vec3 diffuse, vec3 specular) {
-    constexpr double kDielectric = 0.04, kTiny = 1e-6;
-    const double keep = 1.0 - std::max({specular.x, specular.y, specular.z});
-    const double d = perceived(diffuse), sp = perceived(specular);
-    double m = 0.0;
-    if (sp >= kDielectric) {
-        const double a = kDielectric, b = d * keep / (1.0 - a) + sp - 2.0 * a, c = a - sp;
-        m = std::clamp((-b + std::sqrt(std::max(b * b - 4.0 * a * c, 0.0))) / (2.0 * a), 0.0, 1.0);
-    }
-    MetallicRoughness out{vec3(0.0f), m};
-    for (int k = 0; k < 3; ++k) {
-        const double fromDiffuse =
-            diffuse[k] * keep / (1.0 - kDielectric) / std::max(1.0 - m, kTiny);
-        const double fromSpecular = (specular[k] - kDielectric * (1.0 - m)) / std::max(m, kTiny);
-        out.base[k] =
-            float(std::clamp(fromDiffuse + (fromSpecular - fromDiffuse) * m * m, 0.0, 1.0));
-    }
-    return out;
-}
-
 } // namespace
-
-const tinygltf::Material& GltfReader::readSpecularGlossiness(const tinygltf::Material& mat,
-                                                             const std::string& at,
-                                                             const std::string& name,
-                                                             tinygltf::Material& converted) {
-    const auto e = mat.extensions.find("KHR_materials_pbrSpecularGlossiness");
-    if (e == mat.extensions.end()) return mat;
-    const std::string where = at + "/extensions/KHR_materials_pbrSpecularGlossiness";
-    const tinygltf::Value& sg = e->second;
-    if (!sg.IsObject()) fail(where, "must be an object");
-    double alpha = 1.0;
-    vec3 diffuse(1.0f);
-    if (sg.Has("diffuseFactor")) {
-        const tinygltf::Value& v = sg.Get("diffuseFactor");
-        if (!v.IsArray() || v.ArrayLen() != 4) fail(where + "/diffuseFactor", "needs 4 numbers");
-        for (int k = 0; k < 4; ++k) {
-            const double x = v.Get(k).IsNumber() ? v.Get(k).GetNumberAsDouble() : NAN;
-            const double y = unit(x, where + "/diffuseFactor/" + std::to_string(k));
-            if (k < 3)
-                diffuse[k] = float(y);
-            else
-                alpha = y;
-        }
-    }
-    const vec3 specular = extensionColour(sg, "specularFactor", vec3(1.0f), 1.0, where);
-    const double glossiness = extensionNumber(sg, "glossinessFactor", 1.0, 0.0, 1.0, where);
-    const MetallicRoughness mr = fromSpecularGlossiness(diffuse, specular);
-    // The metallic-roughness parameters the file may also hold are a fallback for viewers
-    // without the extension: replaced.
-    converted = mat;
-    tinygltf::PbrMetallicRoughness& pbr = converted.pbrMetallicRoughness;
-    pbr = tinygltf::PbrMetallicRoughness();
-    pbr.baseColorFactor = {mr.base.x, mr.base.y, mr.base.z, alpha};
-    pbr.metallicFactor = mr.metallic;
-    pbr.roughnessFactor = 1.0 - glossiness;
-    // The diffuse image as the base colour's: exact where the conversion is linear in the
-    // diffuse colour (a dielectric, whose specular is at most 0.04).
-    if (sg.Has("diffuseTexture"))
-        pbr.baseColorTexture =
-            extensionTextureInfo(sg, "diffuseTexture", where + "/diffuseTexture");
-    if (sg.Has("specularGlossinessTexture")) {
-        checkUnusedTextures(sg, {"specularGlossinessTexture"}, where);
-        warnOf(name, "KHR_materials_pbrSpecularGlossiness's specularGlossinessTexture is not "
-                     "rendered (its factors are, converted to metallic-roughness)");
-    }
-    return converted;
-}
 
 double GltfReader::extensionNumber(const tinygltf::Value& ext, const char* key, double fallback,
                                    double lo, double hi, const std::string& at) const {

@@ -75,7 +75,8 @@ Shader GltfReader::readMaterial(int index) {
     const std::string name =
         "material " + std::to_string(index) + (file.name.empty() ? "" : " (" + file.name + ")");
     tinygltf::Material converted;
-    const tinygltf::Material& mat = readSpecularGlossiness(file, at, name, converted);
+    std::optional<ConvertedImages> images;
+    const tinygltf::Material& mat = readSpecularGlossiness(file, at, name, converted, images);
     Shader s = defaultShader();
     const tinygltf::PbrMetallicRoughness& pbr = mat.pbrMetallicRoughness;
     if (pbr.baseColorFactor.size() != 4)
@@ -87,7 +88,7 @@ Shader GltfReader::readMaterial(int index) {
         float(unit(pbr.metallicFactor, at + "/pbrMetallicRoughness/metallicFactor"));
     s.roughness = float(unit(pbr.roughnessFactor, at + "/pbrMetallicRoughness/roughnessFactor"));
     s.params.alpha = gltfAlpha(s.roughness);
-    readImages(mat, s, at, name);
+    readImages(mat, s, at, name, images ? &*images : nullptr);
     readTransmission(mat, s, at, name);
     readVolume(mat, s, at, name);
     readClearcoat(mat, s, at, name);
@@ -101,17 +102,24 @@ Shader GltfReader::readMaterial(int index) {
 }
 
 void GltfReader::readImages(const tinygltf::Material& mat, Shader& s, const std::string& at,
-                            const std::string& name) {
+                            const std::string& name, const ConvertedImages* converted) {
     const tinygltf::PbrMetallicRoughness& pbr = mat.pbrMetallicRoughness;
-    if (pbr.baseColorTexture.index >= 0) baseColourTexture(pbr.baseColorTexture, s, at, name);
-    if (mat.alphaMode == "MASK" || mat.alphaMode == "BLEND") readCutout(mat, s, at, name);
-    if (pbr.metallicRoughnessTexture.index >= 0) {
-        Texture mr = imageTexture(pbr.metallicRoughnessTexture,
-                                  at + "/pbrMetallicRoughness/metallicRoughnessTexture",
-                                  name + ": its metallicRoughnessTexture");
-        mr.linear = true;
+    std::optional<Texture> base, mr;
+    if (converted) base = converted->base, mr = converted->metallicRoughness;
+    if (pbr.baseColorTexture.index >= 0)
+        base = imageTexture(pbr.baseColorTexture, at + "/pbrMetallicRoughness/baseColorTexture",
+                            name + ": its baseColorTexture");
+    if (pbr.metallicRoughnessTexture.index >= 0)
+        mr = imageTexture(pbr.metallicRoughnessTexture,
+                          at + "/pbrMetallicRoughness/metallicRoughnessTexture",
+                          name + ": its metallicRoughnessTexture");
+    if (base) baseColourTexture(*base, s);
+    if (mat.alphaMode == "MASK" || mat.alphaMode == "BLEND")
+        readCutout(mat, s, at, base ? &*base : nullptr);
+    if (mr) {
+        mr->linear = true;
         s.metallicRoughnessTexture = int(scene_.textures.size());
-        scene_.textures.push_back(mr);
+        scene_.textures.push_back(*mr);
         s.params.flags |= kShaderHitParams;
     }
     if (mat.normalTexture.index >= 0) {
@@ -151,10 +159,7 @@ void GltfReader::readEmission(const tinygltf::Material& mat, Shader& s, const st
     }
 }
 
-void GltfReader::baseColourTexture(const tinygltf::TextureInfo& info, Shader& s,
-                                   const std::string& at, const std::string& name) {
-    Texture picture = imageTexture(info, at + "/pbrMetallicRoughness/baseColorTexture",
-                                   name + ": its baseColorTexture");
+void GltfReader::baseColourTexture(const Texture& picture, Shader& s) {
     Texture zero{};
     zero.colour = vec3(0.0f);
     Texture factor{};
@@ -172,7 +177,7 @@ void GltfReader::baseColourTexture(const tinygltf::TextureInfo& info, Shader& s,
 }
 
 void GltfReader::readCutout(const tinygltf::Material& mat, Shader& s, const std::string& at,
-                            const std::string& name) {
+                            const Texture* base) {
     const tinygltf::PbrMetallicRoughness& pbr = mat.pbrMetallicRoughness;
     Cutout& c = s.cutout;
     c.alpha = float(unit(pbr.baseColorFactor[3], at + "/pbrMetallicRoughness/baseColorFactor"));
@@ -180,10 +185,8 @@ void GltfReader::readCutout(const tinygltf::Material& mat, Shader& s, const std:
     c.cutoff = float(mat.alphaCutoff);
     if (!(c.cutoff >= 0.0f) || !std::isfinite(mat.alphaCutoff))
         fail(at + "/alphaCutoff", "must be a non-negative number");
-    if (pbr.baseColorTexture.index >= 0) {
-        Texture alpha =
-            imageTexture(pbr.baseColorTexture, at + "/pbrMetallicRoughness/baseColorTexture",
-                         name + ": its baseColorTexture");
+    if (base) {
+        Texture alpha = *base;
         alpha.channel = 3;
         alpha.linear = true;
         c.texture = int(scene_.textures.size());
@@ -205,12 +208,37 @@ Texture GltfReader::imageTexture(const Info& info, const std::string& where,
     const int source = model_.textures[size_t(index)].source;
     if (source < 0 || source >= int(model_.images.size()))
         fail("/textures/" + std::to_string(index) + "/source", "names no image");
-    const tinygltf::Image& image = model_.images[size_t(source)];
     Texture picture{};
+    const OpenedImage opened = openImage(source, picture);
+    // Its size, from the header, before any pixel is read (a 400-byte PNG can claim 100000^2).
+    const OIIO::ImageSpec& spec = opened.in->spec();
+    if (const std::string why = imageSizeProblem(picture.path, spec.width, spec.height,
+                                                 kMaxTexturePixels, kMaxTextureSide);
+        !why.empty())
+        fail("/images/" + std::to_string(source), why);
+    const int transformSet = readTextureTransform(info, where, picture);
+    uvSetsRead_.push_back(transformSet >= 0 ? transformSet : info.texCoord);
+    if (const int sampler = model_.textures[size_t(index)].sampler; sampler >= 0) {
+        if (sampler >= int(model_.samplers.size()))
+            fail("/textures/" + std::to_string(index) + "/sampler",
+                 "names sampler " + std::to_string(sampler) + " of " +
+                     std::to_string(model_.samplers.size()));
+        readSampler(model_.samplers[size_t(sampler)], "/samplers/" + std::to_string(sampler), what,
+                    picture);
+    }
+    return picture;
+}
+
+GltfReader::OpenedImage GltfReader::openImage(int source, Texture& picture) const {
+    const tinygltf::Image& image = model_.images[size_t(source)];
     picture.type = TextureType::Standard;
     const std::string imageAt = "/images/" + std::to_string(source);
-    std::unique_ptr<OIIO::Filesystem::IOProxy> proxy; // an embedded image's reader, for `in`
-    std::unique_ptr<OIIO::ImageInput> in;
+    OpenedImage opened;
+    // The colour as stored, never premultiplied by the alpha (as the texture cache reads it).
+    OIIO::ImageSpec config;
+    config.attribute("oiio:UnassociatedAlpha", 1);
+    std::unique_ptr<OIIO::Filesystem::IOProxy>& proxy = opened.proxy;
+    std::unique_ptr<OIIO::ImageInput>& in = opened.in;
     if (const auto e = embedded_.find(source); e != embedded_.end()) {
         // A name no file has, its extension telling OpenImageIO the format its bytes are (not
         // the mimeType, which a file may get wrong).
@@ -231,7 +259,9 @@ Texture GltfReader::imageTexture(const Info& info, const std::string& where,
         picture.path = fs::absolute(path_).lexically_normal().string() + "#image" +
                        std::to_string(source) + ext;
         picture.embedded = e->second;
-        in = OIIO::ImageInput::open(picture.path, nullptr, proxy.get());
+        void* reader = proxy.get(); // with a config, OpenImageIO takes the proxy from it
+        config.attribute("oiio:ioproxy", OIIO::TypeDesc::PTR, &reader);
+        in = OIIO::ImageInput::open(picture.path, &config, proxy.get());
         if (!in || in->spec().width < 1 || in->spec().height < 1)
             fail(imageAt, "the embedded image is not one OpenImageIO can read" + imageError());
     } else {
@@ -244,29 +274,12 @@ Texture GltfReader::imageTexture(const Info& info, const std::string& where,
             fail(imageAt + "/uri", "'" + picture.path + "' is neither a PNG nor a JPEG image");
         if (const std::string why = jpegFileCutShort(picture.path); !why.empty())
             fail(imageAt + "/uri", why);
-        in = OIIO::ImageInput::open(picture.path);
+        in = OIIO::ImageInput::open(picture.path, &config);
         if (!in)
             fail(imageAt + "/uri",
                  "'" + picture.path + "' is not an image OpenImageIO can read" + imageError());
     }
-    // Its size, from the header, before any pixel is read (a 400-byte PNG can claim 100000^2).
-    const OIIO::ImageSpec& spec = in->spec();
-    if (const std::string why = imageSizeProblem(picture.path, spec.width, spec.height,
-                                                 kMaxTexturePixels, kMaxTextureSide);
-        !why.empty())
-        fail(imageAt, why);
-    in->close();
-    const int transformSet = readTextureTransform(info, where, picture);
-    uvSetsRead_.push_back(transformSet >= 0 ? transformSet : info.texCoord);
-    if (const int sampler = model_.textures[size_t(index)].sampler; sampler >= 0) {
-        if (sampler >= int(model_.samplers.size()))
-            fail("/textures/" + std::to_string(index) + "/sampler",
-                 "names sampler " + std::to_string(sampler) + " of " +
-                     std::to_string(model_.samplers.size()));
-        readSampler(model_.samplers[size_t(sampler)], "/samplers/" + std::to_string(sampler), what,
-                    picture);
-    }
-    return picture;
+    return opened;
 }
 
 tinygltf::TextureInfo GltfReader::extensionTextureInfo(const tinygltf::Value& ext, const char* key,
@@ -405,5 +418,9 @@ int GltfReader::chooseUvSet(int material) {
         }
     return chosen;
 }
+
+// Used by gltf_specular_glossiness.cpp too.
+template Texture GltfReader::imageTexture(const tinygltf::TextureInfo&, const std::string&,
+                                          const std::string&);
 
 } // namespace spw

@@ -6,13 +6,17 @@
 #include "host/loaders/gltf_nodes.h"
 #include "host/scene/scene.h"
 
+#include <OpenImageIO/filesystem.h>
+#include <OpenImageIO/imageio.h>
 #include <glm/mat4x4.hpp>
+#include <glm/vec4.hpp>
 #include <tiny_gltf.h>
 
 #include <filesystem>
 #include <initializer_list>
 #include <map>
 #include <memory>
+#include <optional>
 #include <set>
 #include <string>
 #include <vector>
@@ -149,10 +153,18 @@ class GltfReader {
 
     Shader readMaterial(int index);
 
+    // A specular-glossiness material's images converted to metallic-roughness texel by texel
+    // (gltf_specular_glossiness.cpp): its base colour (RGBA, sRGB) and metallic-roughness
+    // (linear) images, PNGs held in memory, in place of the file's.
+    struct ConvertedImages {
+        Texture base, metallicRoughness;
+    };
+
     // The material's images: base colour (and its alpha, for MASK), metallic-roughness and
-    // normal map, and what is not rendered of the rest.
+    // normal map, and what is not rendered of the rest; the base colour and metallic-roughness
+    // images `converted`'s where it is not null.
     void readImages(const tinygltf::Material& mat, Shader& s, const std::string& at,
-                    const std::string& name);
+                    const std::string& name, const ConvertedImages* converted);
 
     // KHR_materials_transmission with KHR_materials_ior: a material that transmits all the light
     // (transmissionFactor 1) and is no metal is glass, a Dielectric of that ior (1.5) and GGX
@@ -185,10 +197,25 @@ class GltfReader {
                        const std::string& name);
     // KHR_materials_pbrSpecularGlossiness (older assets' workflow), where `mat` has it: the
     // material converted to metallic-roughness into `converted` (returned), as the extension's
-    // converters do (gltf_material_extensions.cpp); else `mat` itself.
+    // converters do (gltf_specular_glossiness.cpp), and where it has a specularGlossinessTexture,
+    // or a diffuseTexture the conversion is not linear in, its images converted into `images`;
+    // else `mat` itself.
     const tinygltf::Material& readSpecularGlossiness(const tinygltf::Material& mat,
                                                      const std::string& at, const std::string& name,
-                                                     tinygltf::Material& converted);
+                                                     tinygltf::Material& converted,
+                                                     std::optional<ConvertedImages>& images);
+    // The extension's factors (diffuse RGBA).
+    struct SpecularGlossiness {
+        glm::vec4 diffuse{1.0f};
+        vec3 specular{1.0f};
+        double glossiness = 1.0;
+    };
+    // Its images and factors, texel by texel: the bake at the larger image's size, read through
+    // the specularGlossinessTexture's coordinates, transform and sampler (the diffuseTexture's
+    // where it has none). `at` is the material's JSON pointer.
+    ConvertedImages convertSpecularGlossiness(const tinygltf::Value& sg, const std::string& at,
+                                              const std::string& name,
+                                              const SpecularGlossiness& factors);
     // The number at `key` of extension object `ext` (its JSON pointer `at`), or `fallback` where
     // it is absent; refused unless it is a finite number in [lo, hi] (hi may be HUGE_VAL).
     double extensionNumber(const tinygltf::Value& ext, const char* key, double fallback, double lo,
@@ -211,22 +238,30 @@ class GltfReader {
         return x;
     }
 
-    // The base colour's image, times the factor: Layered(upper: image, lower: 0, mask: factor).
-    void baseColourTexture(const tinygltf::TextureInfo& info, Shader& s, const std::string& at,
-                           const std::string& name);
+    // The base colour's image `picture`, times the factor: Layered(upper: image, lower: 0,
+    // mask: factor).
+    void baseColourTexture(const Texture& picture, Shader& s);
 
     // alphaMode MASK: a cut-out where baseColorFactor's alpha times the base colour image's
-    // alpha channel (1 where it has none) is below alphaCutoff. A factor that decides alone is
-    // no cut-out at all (at least the cutoff) or hides the whole surface. BLEND: that alpha as
-    // stochastic transparency (Cutout::stochastic).
+    // (`base`, or none) alpha channel (1 where it has none) is below alphaCutoff. A factor that
+    // decides alone is no cut-out at all (at least the cutoff) or hides the whole surface.
+    // BLEND: that alpha as stochastic transparency (Cutout::stochastic).
     void readCutout(const tinygltf::Material& mat, Shader& s, const std::string& at,
-                    const std::string& name);
+                    const Texture* base);
 
     // A texture reference's image, as a Standard texture with its KHR_texture_transform: read
     // from memory where the file embeds it (checked readable now), else from beside the file.
     // The coordinate set it names (texCoord, or the transform's override) joins uvSetsRead_.
     template <class Info> // tinygltf::TextureInfo, NormalTextureInfo
     Texture imageTexture(const Info& info, const std::string& where, const std::string& what);
+    // Image `source` of the file opened for its header and pixels (refused unless a PNG or a
+    // JPEG, whole, that OpenImageIO reads): from its bytes where the file embeds it, else from
+    // beside the file; its path (and bytes) set in `picture`.
+    struct OpenedImage {
+        std::unique_ptr<OIIO::Filesystem::IOProxy> proxy; // an embedded image's reader, for `in`
+        std::unique_ptr<OIIO::ImageInput> in;
+    };
+    OpenedImage openImage(int source, Texture& picture) const;
     // A material extension's texture `key` of object `ext` (at JSON pointer `where`): its image
     // as a Standard texture of the scene read from `channel` on (3: alpha alone), as colour (sRGB)
     // or as data; its index, or -1 where `ext` has none.
