@@ -257,6 +257,37 @@ const std::set<std::string> kNumberKeys = {"alphaCutoff", "metallicFactor", "rou
                                            "ymag",        "innerConeAngle", "outerConeAngle",
                                            "intensity",   "range"};
 const std::set<std::string> kNumberArrayKeys = {"baseColorFactor", "emissiveFactor", "color"};
+// The strings, booleans, objects and arrays tinygltf reads, dropping a value of another type as
+// silently (a mesh whose "primitives" is an object has no primitives; "doubleSided": "yes" is
+// false).
+const std::set<std::string> kStringKeys = {"name",          "uri",        "mimeType",  "alphaMode",
+                                           "type",          "path",       "generator", "version",
+                                           "interpolation", "minVersion", "copyright"};
+const std::set<std::string> kBoolKeys = {"doubleSided", "normalized"};
+const std::set<std::string> kObjectKeys = {"pbrMetallicRoughness", "asset",  "perspective",
+                                           "orthographic",         "sparse", "spot"};
+const std::set<std::string> kArrayKeys = {"primitives", "targets", "channels", "samplers"};
+
+// The JSON type of a value tinygltf reads into a typed field.
+void checkType(const std::string& path, const std::string& key, const json& value,
+               const std::string& at) {
+    if (kNumberKeys.count(key) && !value.is_number()) fail(path, at, "must be a number");
+    if (kStringKeys.count(key) && !value.is_string()) fail(path, at, "must be a string");
+    if (kBoolKeys.count(key) && !value.is_boolean()) fail(path, at, "must be true or false");
+    if (kObjectKeys.count(key) && !value.is_object()) fail(path, at, "must be an object");
+    if (kArrayKeys.count(key) && !value.is_array()) fail(path, at, "must be an array");
+    // baseColorTexture, transmissionTexture, ...: tinygltf drops an empty object unseen.
+    if (key.size() > 7 && key.compare(key.size() - 7, 7, "Texture") == 0) {
+        if (!value.is_object()) fail(path, at, "must be a textureInfo object");
+        if (!value.contains("index")) fail(path, at, "a textureInfo needs an index");
+    }
+    if (kNumberArrayKeys.count(key)) {
+        bool numbers = value.is_array();
+        for (const json& x : numbers ? value : json::array())
+            numbers = numbers && x.is_number();
+        if (!numbers) fail(path, at, "must be an array of numbers");
+    }
+}
 
 void checkInteger(const std::string& path, const json& v, const std::string& at,
                   std::uint64_t most) {
@@ -269,9 +300,9 @@ void checkInteger(const std::string& path, const json& v, const std::string& at,
 
 // Every index, enumeration, offset, length and count in the document is an integer JSON number
 // within the range its type holds, checked before tinygltf casts it (4294967297 would read as
-// 1, 1.5 or "1" as 0); every number tinygltf reads is a number; every extension Spillway reads
-// is an object. Outside `extras` and the bodies of extensions Spillway does not read, which may
-// hold anything.
+// 1, 1.5 or "1" as 0); every number, string, boolean, object and array tinygltf reads is one;
+// every extension Spillway reads is an object. Outside `extras` and the bodies of extensions
+// Spillway does not read, which may hold anything.
 void checkIntegers(const std::string& path, const json& j, const std::string& at,
                    const std::set<std::string>& honoured) {
     if (j.is_array()) {
@@ -291,18 +322,7 @@ void checkIntegers(const std::string& path, const json& j, const std::string& at
             }
             continue;
         }
-        if (kNumberKeys.count(key) && !value.is_number()) fail(path, here, "must be a number");
-        // baseColorTexture, transmissionTexture, ...: tinygltf drops an empty object unseen.
-        if (key.size() > 7 && key.compare(key.size() - 7, 7, "Texture") == 0) {
-            if (!value.is_object()) fail(path, here, "must be a textureInfo object");
-            if (!value.contains("index")) fail(path, here, "a textureInfo needs an index");
-        }
-        if (kNumberArrayKeys.count(key)) {
-            bool numbers = value.is_array();
-            for (const json& x : numbers ? value : json::array())
-                numbers = numbers && x.is_number();
-            if (!numbers) fail(path, here, "must be an array of numbers");
-        }
+        checkType(path, key, value, here);
         if (kIndexKeys.count(key) && !(key == "indices" && value.is_object())) { // not sparse's
             checkInteger(path, value, here, INT_MAX);
         } else if (kSizeKeys.count(key)) {

@@ -214,6 +214,15 @@ TEST(GltfHostile, WrongTypesAndTexturesBehindAZeroFactorAreRefused) {
         {mat + "/extensions/KHR_materials_sheen",
          {{"sheenColorTexture", {{"index", 99}}}},
          mat + "/extensions/KHR_materials_sheen/sheenColorTexture: names texture 99 of 0"},
+        // assimp's wrongTypes models, and what tinygltf would read as a default.
+        {"/meshes/0/primitives", {{"a", json::object()}}, "/meshes/0/primitives: must be an array"},
+        {mat + "/pbrMetallicRoughness", "steel", mat + "/pbrMetallicRoughness: must be an object"},
+        {mat + "/doubleSided", "yes", mat + "/doubleSided: must be true or false"},
+        {mat + "/alphaMode", 3, mat + "/alphaMode: must be a string"},
+        {mat + "/name", 5, mat + "/name: must be a string"},
+        {mat + "/pbrMetallicRoughness/baseColorTexture",
+         {{"index", -1}},
+         mat + "/pbrMetallicRoughness/baseColorTexture/index: must be an integer of at least 0"},
     };
     for (const auto& c : cases) {
         GltfBuilder b = quadScene();
