@@ -4,7 +4,9 @@
 #include <cstdlib>
 #include <cstring>
 #include <fcntl.h>
+#include <sstream>
 #include <stdexcept>
+#include <sys/statvfs.h>
 #include <unistd.h>
 #include <vector>
 
@@ -34,6 +36,19 @@ int openScratchFile(const std::string& dir, const char* what) {
         throw std::runtime_error(std::string("cannot create a ") + what + " file in '" + dir +
                                  "': " + std::strerror(errno));
     return fd;
+}
+
+std::string fullFolder(const std::string& dir, std::uint64_t bytes, const char* what) {
+    struct statvfs st {};
+    if (::statvfs(dir.c_str(), &st) != 0) return "";
+    const std::uint64_t free = std::uint64_t(st.f_bavail) * st.f_frsize;
+    if (free >= bytes) return "";
+    std::ostringstream out;
+    out.precision(1);
+    out << std::fixed << "the scratch folder '" << dir << "' is full (" << double(free) / 1048576.0
+        << " MiB free, the " << what << " needs " << double(bytes) / 1048576.0
+        << " MiB; --spill-dir chooses another)";
+    return out.str();
 }
 
 } // namespace spw

@@ -5,6 +5,7 @@
 // SIGTERM or SIGKILL, the kernel frees it and no file is left behind.
 #pragma once
 
+#include <cstdint>
 #include <string>
 
 namespace spw {
@@ -16,5 +17,9 @@ std::string scratchFolder(const std::string& configured);
 // A new unnamed file in `dir`, open for reading and writing (close-on-exec). Throws
 // std::runtime_error "cannot create a WHAT file in 'DIR': why".
 int openScratchFile(const std::string& dir, const char* what);
+
+// Where folder `dir` has fewer than `bytes` bytes free: "the scratch folder 'DIR' is full (F MiB
+// free, the WHAT needs N MiB; --spill-dir chooses another)"; else "".
+std::string fullFolder(const std::string& dir, std::uint64_t bytes, const char* what);
 
 } // namespace spw

@@ -53,7 +53,7 @@ BackendChoice resolveBackend(const RenderConfig& config) {
             throw std::runtime_error(std::string("--backend vulkan: ") + e.what());
         // The user asked for Vulkan (--device, or the driver variables) and has none.
         if (wanted || vk::driverVariablesSet())
-            std::fprintf(stderr, "spillway: no Vulkan device; rendering on cpu\n");
+            std::fprintf(stderr, "spillway: no Vulkan device (%s); rendering on cpu\n", e.what());
         choice.kind = BackendKind::Cpu;
         choice.fallbackWhy = e.what();
     }

@@ -161,11 +161,21 @@ TiledCopy::TiledCopy(const std::string& name, const OIIO::ImageSpec* config,
     std::vector<unsigned char> finest = readFinest(name, config, spec);
     fd_ = openScratchFile(folder, "texture tile");
     path_ = "/proc/self/fd/" + std::to_string(fd_);
+    // Its levels take a third more than the finest alone; a folder without the room is said
+    // to be full, before a tile is written and after one fails (another process may fill it).
+    const std::uint64_t needed = spec.image_bytes() / 3 * 4 + (std::uint64_t(1) << 16);
+    if (std::string full = fullFolder(folder, needed, "copy"); !full.empty())
+        throw std::runtime_error(full);
     auto out = OIIO::ImageOutput::create("tiff");
     if (!out) throw std::runtime_error("cannot write tiled textures: " + OIIO::geterror());
     auto fail = [&] {
-        return std::runtime_error("cannot write a tiled copy of texture '" + name + "' in '" +
-                                  folder + "': " + out->geterror());
+        std::string why = fullFolder(folder, needed - std::min<std::uint64_t>(needed, bytes_),
+                                     "rest of the copy");
+        if (why.empty()) { // OpenImageIO's first line (it says one per tile)
+            why = out->geterror();
+            why = "in '" + folder + "': " + why.substr(0, why.find('\n'));
+        }
+        return std::runtime_error(why);
     };
     auto levelSpec = [&](int lw, int lh) {
         OIIO::ImageSpec s(lw, lh, spec.nchannels, spec.format);

@@ -2,13 +2,17 @@
 
 #include "host/vk/check.h"
 
+#include <nlohmann/json.hpp>
+
 #include <algorithm>
 #include <cctype>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <memory>
+#include <sstream>
 
 namespace spw::vk {
 namespace {
@@ -73,7 +77,48 @@ bool validationRequested(const VulkanConfig& config) {
 }
 
 // Creates the instance, or throws NoDeviceError when the loader finds no driver.
+// The driver manifests the loader is told to read (VK_DRIVER_FILES, or VK_ICD_FILENAMES, the
+// older name it replaces) that it cannot use, as "VK_ICD_FILENAMES names '/a.json', which does
+// not exist" ("" where each is a folder or a file that reads as a manifest: JSON whose ICD
+// object has a library_path); `usable` is whether any other entry is left. The loader itself
+// reports a truncated manifest as VK_ERROR_OUT_OF_HOST_MEMORY, and a missing one not at all.
+std::string unusableDriverFiles(bool& usable) {
+    usable = true;
+    const char* var = "VK_DRIVER_FILES";
+    const char* value = std::getenv(var);
+    if (!value || !*value) var = "VK_ICD_FILENAMES", value = std::getenv(var);
+    if (!value || !*value) return "";
+    std::string bad;
+    int good = 0;
+    std::stringstream entries(value);
+    for (std::string entry; std::getline(entries, entry, ':');) {
+        if (entry.empty()) continue;
+        std::error_code ec;
+        std::string why;
+        if (!std::filesystem::exists(entry, ec)) {
+            why = "which does not exist";
+        } else if (!std::filesystem::is_directory(entry, ec)) {
+            std::ifstream in(entry);
+            const nlohmann::json m = nlohmann::json::parse(in, nullptr, false);
+            if (m.is_discarded() || !m.is_object() || !m.contains("ICD") || !m["ICD"].is_object() ||
+                !m["ICD"].contains("library_path") || !m["ICD"]["library_path"].is_string())
+                why = "which is not a Vulkan driver manifest (JSON whose ICD object names a "
+                      "library_path)";
+        }
+        if (why.empty()) {
+            ++good;
+            continue;
+        }
+        bad += (bad.empty() ? std::string(var) + " names '" : ", '") + entry + "', " + why;
+    }
+    usable = good > 0;
+    return bad;
+}
+
 VkInstance createInstance(bool validation, std::atomic<std::uint64_t>* counter) {
+    bool usable = true;
+    const std::string unusable = unusableDriverFiles(usable);
+    if (!usable) throw NoDeviceError(unusable);
     uint32_t loaderVersion = VK_API_VERSION_1_0;
     if (vkEnumerateInstanceVersion(&loaderVersion) != VK_SUCCESS || loaderVersion < kApiVersion)
         throw NoDeviceError("the Vulkan loader supports only Vulkan " +
@@ -120,10 +165,14 @@ VkInstance createInstance(bool validation, std::atomic<std::uint64_t>* counter) 
     VkResult r = vkCreateInstance(&info, nullptr, &instance);
     if (r == VK_ERROR_INCOMPATIBLE_DRIVER || r == VK_ERROR_INITIALIZATION_FAILED) {
         const char* files = std::getenv("VK_DRIVER_FILES");
-        throw NoDeviceError(
-            std::string("no Vulkan driver found (vkCreateInstance returned ") + resultName(r) +
-            (files ? std::string("; VK_DRIVER_FILES=") + files : std::string()) + ")");
+        throw NoDeviceError(std::string("no Vulkan driver found (vkCreateInstance returned ") +
+                            resultName(r) +
+                            (files ? std::string("; VK_DRIVER_FILES=") + files : std::string()) +
+                            ")" + (unusable.empty() ? "" : "; " + unusable));
     }
+    if (r != VK_SUCCESS && !unusable.empty())
+        throw NoDeviceError(std::string("vkCreateInstance returned ") + resultName(r) + "; " +
+                            unusable);
     SPW_VK_CHECK(r);
     return instance;
 }

@@ -27,6 +27,7 @@
 #include <sanitizer/lsan_interface.h>
 #endif
 
+#include <algorithm>
 #include <filesystem>
 #include <random>
 #include <stdexcept>
@@ -165,6 +166,30 @@ TEST(TiledCopy, AFolderWhereNoFileCanBeMadeIsAnErrorNamingIt) {
                   std::string::npos)
             << e.what();
     }
+}
+
+// A scratch folder without room for the copy (a 1 MiB file system, mounted in a namespace of its
+// own) is exit 1 saying so: the folder, that it is full, what is free and what the copy needs,
+// and the option that chooses another; one line, not one per tile. Where namespaces are not
+// allowed (an unprivileged container), skipped.
+TEST(TiledCopy, AFullScratchFolderIsSaidToBeFull) {
+    TempDir dir;
+    writeLargePng(dir.file("large.png"));
+    const std::string scene = planeScene(dir, "large.png"), full = dir.file("full");
+    std::filesystem::create_directory(full);
+    const std::string mount = "unshare -m sh -c 'mount -t tmpfs -o size=1m tmpfs " + full;
+    if (runShell(mount + "'").status != 0) GTEST_SKIP() << "no mount namespace here";
+    const CommandResult r = runShell(mount + " && exec " + binary() + " render " + scene + " -o " +
+                                     dir.file("o.exr") + " --spill-dir " + full + "'");
+    EXPECT_EQ(r.status, 1) << r.output;
+    EXPECT_NE(r.output.find("the tiled copy of texture file '" + dir.file("large.png") +
+                            "' cannot be written: the scratch folder '" + full +
+                            "' is full (1.0 MiB free, the copy needs 22.0 MiB; --spill-dir "
+                            "chooses another)"),
+              std::string::npos)
+        << r.output;
+    EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << r.output;
+    EXPECT_FALSE(std::filesystem::exists(dir.file("o.exr")));
 }
 
 // A scratch folder that goes away after the render has started (made at the first lookup, the

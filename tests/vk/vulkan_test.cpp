@@ -670,13 +670,16 @@ TEST(VulkanCli, NoDriverVisibleVulkanExitsOneAndAutoRendersOnCpu) {
     CommandResult v = runWithEnv(noDriver, "render " + scene + " --quiet --backend vulkan -o " +
                                                dir.file("v.exr"));
     EXPECT_EQ(v.status, 1) << v.output;
-    EXPECT_TRUE(contains(v.output, "--backend vulkan: no Vulkan driver found")) << v.output;
+    const std::string why =
+        "VK_DRIVER_FILES names '" + dir.file("no-such-icd.json") + "', which does not exist";
+    EXPECT_TRUE(contains(v.output, "--backend vulkan: " + why)) << v.output;
     EXPECT_FALSE(std::filesystem::exists(dir.file("v.exr")));
 
     CommandResult a = runWithEnv(noDriver, "render " + scene + " --quiet -o " + dir.file("a.exr") +
                                                " --stats " + dir.file("a.json"));
     ASSERT_EQ(a.status, 0) << a.output;
-    EXPECT_TRUE(contains(a.output, "spillway: no Vulkan device; rendering on cpu\n")) << a.output;
+    EXPECT_TRUE(contains(a.output, "spillway: no Vulkan device (" + why + "); rendering on cpu\n"))
+        << a.output;
     nlohmann::json stats = nlohmann::json::parse(std::ifstream(dir.file("a.json")));
     EXPECT_EQ(stats["backend"], "cpu");
     EXPECT_FALSE(stats.contains("vulkan"));
@@ -685,7 +688,7 @@ TEST(VulkanCli, NoDriverVisibleVulkanExitsOneAndAutoRendersOnCpu) {
     EXPECT_EQ(d.status, 1) << d.output;
     EXPECT_TRUE(contains(d.output, "no Vulkan")) << d.output;
     // It still says what --backend auto does, and why.
-    EXPECT_TRUE(contains(d.output, "--backend auto takes cpu: no Vulkan device (no Vulkan driver"))
+    EXPECT_TRUE(contains(d.output, "--backend auto takes cpu: no Vulkan device (" + why))
         << d.output;
 
     // cpu never touches Vulkan: no fallback line.
@@ -693,6 +696,22 @@ TEST(VulkanCli, NoDriverVisibleVulkanExitsOneAndAutoRendersOnCpu) {
         runWithEnv(noDriver, "render " + scene + " --quiet --backend cpu -o " + dir.file("c.exr"));
     EXPECT_EQ(c.status, 0) << c.output;
     EXPECT_FALSE(contains(c.output, "Vulkan")) << c.output;
+
+    // A manifest cut short (which the loader reports as VK_ERROR_OUT_OF_HOST_MEMORY), under the
+    // older variable: the same fallback, naming it.
+    const std::string cut =
+        dir.write("cut.json", "{\"file_format_version\": \"1.0.0\", \"ICD\": {");
+    const std::string env = "VK_ICD_FILENAMES=" + cut;
+    CommandResult t = runWithEnv(env, "render " + scene + " --quiet -o " + dir.file("t.exr"));
+    EXPECT_EQ(t.status, 0) << t.output;
+    EXPECT_TRUE(contains(t.output, "spillway: no Vulkan device (VK_ICD_FILENAMES names '" + cut +
+                                       "', which is not a Vulkan driver manifest"))
+        << t.output;
+    CommandResult tv =
+        runWithEnv(env, "render " + scene + " --quiet --backend vulkan -o " + dir.file("tv.exr"));
+    EXPECT_EQ(tv.status, 1) << tv.output;
+    EXPECT_TRUE(contains(tv.output, "--backend vulkan: VK_ICD_FILENAMES names '" + cut))
+        << tv.output;
 }
 
 // The loader's own log (VK_LOADER_DEBUG=all) shows whether an instance was made: it searches for
