@@ -1,10 +1,13 @@
 #include "host/app/render_options.h"
 
 #include "host/app/usage_error.h"
+#include "host/cpu/simd_shading.h"
 #include "host/image/aov_film.h"
 #include "host/image/image_io.h"
 #include "host/image/output_file.h"
 #include "host/loaders/light_loader.h"
+#include "host/pipeline/stage_chunks.h"
+#include "host/scene/surface_models.h"
 
 #include <algorithm>
 #include <cctype>
@@ -247,7 +250,7 @@ const std::vector<CliOption> kOwnOptions = {
      }},
     {"--stages", nullptr, "MODE", Section::Pipeline,
      "fused (default; cpu: hit setup, shade, shadow, accumulate and bin run chunk by chunk "
-     "of 128 hits, in cache; vulkan: shadow, accumulate and bin, after the device shaded the "
+     "of {chunk} hits, in cache; vulkan: shadow, accumulate and bin, after the device shaded the "
      "batch) or separate (each stage over the whole batch in turn)",
      0, 0,
      [](O& r, const C& o, const S& v) {
@@ -255,9 +258,8 @@ const std::vector<CliOption> kOwnOptions = {
              oneOf(o, v, "fused|separate", "fused or separate") == "fused";
      }},
     {"--simd-shading", nullptr, "on|off", Section::Pipeline,
-     "cpu: shade Lambert hits 4, 8 or 16 at a time in SIMD registers (default on, where every "
-     "light is a triangle), and filter runs of 8-bit texture lookups so; the image is the same "
-     "either way",
+     "cpu: shade the hits of {wide models} 4, 8 or 16 at a time in SIMD registers (default "
+     "on), and filter runs of 8-bit texture lookups so; the image is the same either way",
      0, 0,
      [](O& r, const C& o, const S& v) {
          r.config.pipeline.simdShading = oneOf(o, v, "on|off", "on or off") == "on";
@@ -387,6 +389,23 @@ std::string wrap(const std::string& text, size_t indent, size_t width) {
     return out + line + "\n";
 }
 
+// A help text with its placeholders filled from what they describe: {chunk}, the fused stages'
+// chunk of hits; {wide models}, the surface models with a SIMD twin.
+std::string filled(std::string help) {
+    std::string wide;
+    std::vector<std::string> names;
+    for (uint model = 0; model < kModelCount; ++model)
+        if (kWideTwins[model].kernel) names.push_back(surfaceModel(model)->name);
+    for (size_t k = 0; k < names.size(); ++k)
+        wide += (k == 0 ? "" : k + 1 == names.size() ? " and " : ", ") + names[k];
+    for (const auto& [key, value] :
+         {std::pair<std::string, std::string>{"{chunk}", std::to_string(kChunk)},
+          {"{wide models}", wide}})
+        for (size_t at; (at = help.find(key)) != std::string::npos;)
+            help.replace(at, key.size(), value);
+    return help;
+}
+
 std::string helpSection(Section section) {
     constexpr size_t column = 24, width = 94;
     std::string out;
@@ -397,7 +416,7 @@ std::string helpSection(Section section) {
             if (o.alias) head += std::string(o.alias) + ", ";
             head += o.name;
             if (o.value) head += std::string(" ") + o.value;
-            std::string help = o.help;
+            std::string help = filled(o.help);
             if (section == Section::Settings)
                 help += std::string(" (settings: ") + settingForFlag(o.name)->key + ")";
             head += head.size() < column ? std::string(column - head.size(), ' ')

@@ -268,7 +268,7 @@ void Film::splat(const Splat* splats, size_t n) {
     // is the value itself; the weight's add is not used.
     static_assert(kSplatBatch <= simd::kBlock, "a batch is one block of lanes");
     const bool sums = sumsSamples();
-    FootprintLanes lanes;
+    FootprintLanes lanes{}; // (zeroed: GCC cannot see that roundLanes reads only what is set)
     std::atomic<std::int64_t>* target[simd::kBlock]; // the three sums the splat adds to
     size_t count = 0;
     for (size_t k = 0; k < n; ++k) {

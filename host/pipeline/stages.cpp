@@ -64,7 +64,9 @@ void CameraRays::generate(const RenderContext& ctx, size_t count, Film& film,
         // The tile's rays a block at a time, made SIMD-wide with their random numbers
         // (CameraModel::generateMany).
         constexpr size_t kBlock = 64;
-        uint x[kBlock], y[kBlock], pixel[kBlock], sampleIndex[kBlock], sample[kBlock];
+        // (Zeroed: GCC cannot see that flush() reads only the `pending` entries set.)
+        uint x[kBlock] = {}, y[kBlock] = {}, pixel[kBlock] = {}, sampleIndex[kBlock] = {},
+             sample[kBlock] = {};
         std::uint64_t ray[kBlock];
         CameraRay made[kBlock];
         size_t pending = 0;

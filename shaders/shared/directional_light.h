@@ -11,6 +11,10 @@ SHARED_BEGIN
 // ray goes to infinity (the light is outside the scene).
 SHARED_FN LightSample directional_lightSample(SCENE_PARAM RenderParams rp, Emitter e,
                                               SurfaceHit hit, vec2 u) {
+    SCENE_UNUSED;
+    UNUSED(rp);
+    UNUSED(hit);
+    UNUSED(u);
     LightSample ls;
     ls.wi = -e.normal;
     ls.radiance = e.radiance;

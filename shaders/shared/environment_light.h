@@ -149,6 +149,7 @@ SHARED_FN vec3 environmentSample(SCENE_PARAM RenderParams rp, vec2 u, OUT(uvec2)
 // texel whose density drew it.
 SHARED_FN LightSample environment_lightSample(SCENE_PARAM RenderParams rp, Emitter e,
                                               SurfaceHit hit, vec2 u) {
+    UNUSED(hit);
     LightSample ls;
     uvec2 texel;
     ls.wi = environmentSample(SCENE_ARG rp, u, texel);

@@ -8,6 +8,9 @@ SHARED_BEGIN
 // Radiance is intensity / r^2, the pdf the pick probability alone.
 SHARED_FN LightSample point_lightSample(SCENE_PARAM RenderParams rp, Emitter e, SurfaceHit hit,
                                         vec2 u) {
+    SCENE_UNUSED;
+    UNUSED(rp);
+    UNUSED(u);
     LightSample ls = noLightSample();
     vec3 d = e.p0 - hit.p;
     float dist = length(d);

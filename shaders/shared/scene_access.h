@@ -2,7 +2,7 @@
 // the environment's and emitters' maps). In C++ they are
 // spans passed as the first argument of every function that needs them; in GLSL they are
 // storage buffers declared by the kernel before it includes the shared headers, and the
-// SCENE_PARAM / SCENE_ARG macros vanish.
+// SCENE_PARAM / SCENE_ARG (and SCENE_UNUSED) macros vanish.
 #ifndef SPILLWAY_SHARED_SCENE_ACCESS_H
 #define SPILLWAY_SHARED_SCENE_ACCESS_H
 #include "types.h"
@@ -22,6 +22,8 @@ struct SceneView {
 } // namespace spw
 #define SCENE_PARAM const SceneView &scene,
 #define SCENE_ARG scene,
+// In a function that takes the scene for its signature's sake (a light kind's sample reads none).
+#define SCENE_UNUSED UNUSED(scene)
 #define SHADER(i) scene.shaders[i]
 #define EMITTER(i) scene.emitters[i]
 #define EMITTER_CDF(i) scene.emitterCdf[i]
@@ -29,6 +31,7 @@ struct SceneView {
 #else
 #define SCENE_PARAM
 #define SCENE_ARG
+#define SCENE_UNUSED
 #endif
 
 #endif

@@ -18,6 +18,9 @@ SHARED_FN float spotFalloff(Emitter e, float cosTheta) {
 // Radiance is I(theta) / r^2, the pdf the pick probability alone.
 SHARED_FN LightSample spot_lightSample(SCENE_PARAM RenderParams rp, Emitter e, SurfaceHit hit,
                                        vec2 u) {
+    SCENE_UNUSED;
+    UNUSED(rp);
+    UNUSED(u);
     LightSample ls = noLightSample();
     vec3 d = e.p0 - hit.p;
     float dist = length(d);

@@ -8,6 +8,7 @@ SHARED_BEGIN
 
 SHARED_FN LightSample triangle_lightSample(SCENE_PARAM RenderParams rp, Emitter e, SurfaceHit hit,
                                            vec2 u) {
+    UNUSED(rp);
     LightSample ls = noLightSample();
     vec3 q = emitterPoint(e, u);
     vec3 d = q - hit.p;

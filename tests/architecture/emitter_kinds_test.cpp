@@ -50,11 +50,12 @@ TEST(EmitterKinds, TheLoaderTakesEachPunctualKindWithExactlyItsKeys) {
         EXPECT_EQ(scene.punctualLights[0].kind, k.kind) << k.name;
         // A key of the other punctual shape is refused, and so is a missing one.
         const std::string other = positioned ? ", direction: [0, -1, 0]" : ", position: [0, 1, 0]";
-        if (!(positioned && directed))
+        if (!(positioned && directed)) {
             EXPECT_THROW(loadScene(dir.write("bad.yaml", "image: {width: 4, height: 4}\nlight: " +
                                                              light + other + "}\n")),
                          SceneError)
                 << k.name;
+        }
         EXPECT_THROW(loadScene(dir.write("bad.yaml", std::string("image: {width: 4, height: 4}\n"
                                                                  "light: {type: ") +
                                                          k.scene + "}\n")),

@@ -170,7 +170,9 @@ TEST(MetallicRoughness, SpecularDefaultsChangeNothingAndItsF0IsTheReflectance) {
                 const bool okB = bsdfSample(flagged.sh, flagged.albedo, flagged.ng, flagged.ns,
                                             flagged.wo, r, wiB, wB, pdfB, sB);
                 ASSERT_EQ(okA, okB);
-                if (okA) ASSERT_TRUE(wiA == wiB && wA == wB && pdfA == pdfB);
+                if (okA) {
+                    ASSERT_TRUE(wiA == wiB && wA == wB && pdfA == pdfB);
+                }
             }
         }
     BsdfUnderTest black =

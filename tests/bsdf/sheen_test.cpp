@@ -93,7 +93,9 @@ TEST(SheenMetallicRoughness, ASheenOfColourZeroIsTheBaseBitForBit) {
                 const bool okA = bsdfSample(m.sh, m.albedo, m.ng, m.ns, m.wo, r, wiA, wA, pdfA, sA);
                 const bool okB = bsdfSample(base, m.albedo, m.ng, m.ns, m.wo, r, wiB, wB, pdfB, sB);
                 ASSERT_EQ(okA, okB);
-                if (okA) ASSERT_TRUE(wiA == wiB && wA == wB && pdfA == pdfB);
+                if (okA) {
+                    ASSERT_TRUE(wiA == wiB && wA == wB && pdfA == pdfB);
+                }
             }
         }
 }

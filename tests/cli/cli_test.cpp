@@ -1,6 +1,9 @@
 // The spillway command line: usage and version, exit status 2 for every kind of bad usage, the
 // Cornell box rendered to both output formats, the --stats JSON, and --seed reproducibility.
+#include "host/cpu/simd_shading.h"
 #include "host/image/image_io.h"
+#include "host/pipeline/stage_chunks.h"
+#include "host/scene/surface_models.h"
 #include "test_util.h"
 
 #include <gtest/gtest.h>
@@ -29,6 +32,28 @@ TEST(Cli, HelpPrintsUsage) {
     EXPECT_EQ(r.status, 0) << r.output;
     EXPECT_TRUE(contains(r.output, "usage")) << r.output;
     EXPECT_TRUE(contains(r.output, "render")) << r.output;
+}
+
+// The help texts that describe constants and lists are made from them: the fused stages' chunk
+// (kChunk), the surface models with a SIMD twin (kWideTwins). Wrapped lines are joined first.
+TEST(Cli, HelpTextsSayWhatTheCodeDoes) {
+    CommandResult r = runSpillway("render --help");
+    EXPECT_EQ(r.status, 0) << r.output;
+    std::string text;
+    for (char c : r.output)
+        if (c != '\n' && !(c == ' ' && !text.empty() && text.back() == ' '))
+            text += c;
+        else if (c == '\n' && !text.empty() && text.back() != ' ')
+            text += ' ';
+    EXPECT_TRUE(contains(text, "chunk by chunk of " + std::to_string(kChunk) + " hits")) << text;
+    std::vector<std::string> wide;
+    for (uint model = 0; model < kModelCount; ++model)
+        if (kWideTwins[model].kernel) wide.push_back(surfaceModel(model)->name);
+    ASSERT_GE(wide.size(), 2u);
+    std::string list = wide[0];
+    for (size_t k = 1; k < wide.size(); ++k)
+        list += (k + 1 == wide.size() ? " and " : ", ") + wide[k];
+    EXPECT_TRUE(contains(text, "shade the hits of " + list + " 4, 8 or 16 at a time")) << text;
 }
 
 TEST(Cli, VersionExitsZero) {

@@ -174,7 +174,9 @@ TEST(Adaptive, TowardATargetTheTilesShareTheSamplesByTheirNoise) {
                         result->stats.extra["stop_reason"].get<std::string>().c_str(),
                         result->film->halfBufferRelMse(), m.mean, m.stderror);
             EXPECT_EQ(result->stats.extra["stop_reason"], "target error");
-            if (scene == &even) EXPECT_NEAR(m.mean, 2.0, 4.0 * m.stderror);
+            if (scene == &even) {
+                EXPECT_NEAR(m.mean, 2.0, 4.0 * m.stderror);
+            }
         }
         EXPECT_NEAR(means[1].mean, means[0].mean,
                     4.0 * std::hypot(means[0].stderror, means[1].stderror));

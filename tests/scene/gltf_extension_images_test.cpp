@@ -197,7 +197,9 @@ TEST(GltfExtensionImages, TheCoatsNormalMapTiltsTheCoatAloneAndTheBasesTheBase) 
             const std::vector<float> image = renderOn(s, backend);
             EXPECT_TRUE(std::all_of(image.begin(), image.end(),
                                     [](float x) { return std::isfinite(x) && x >= 0.0f; }));
-            if (coatTilted) EXPECT_NE(image, renderOn(plain, backend));
+            if (coatTilted) {
+                EXPECT_NE(image, renderOn(plain, backend));
+            }
         }
     }
     coatMap["extensions"]["KHR_materials_clearcoat"]["clearcoatNormalTexture"]["scale"] = "a";
