@@ -3,8 +3,8 @@
 #   scripts/check-identical.sh [REVISION]     (default: HEAD)
 # For a change that must not alter any image (a refactoring, a move, a rename). It builds
 # REVISION once in a cached copy (under ${SPILLWAY_IDENTICAL_CACHE:-/tmp/spillway-identical}),
-# builds the working tree in build/, renders the Cornell box, scenes/every-model.yaml (every
-# surface model, a Layered image texture, thin lens, Gaussian filter), scenes/open-box-lights.yaml
+# builds the working tree in build/, renders the Cornell box, scenes/every-model.yaml (Lambert,
+# Conductor and Dielectric, a Layered image texture, thin lens, Gaussian filter), scenes/open-box-lights.yaml
 # and, where they have been made, the in-core benchmark's textured scene and the glTF test files
 # (out/gltf/*.glb) with both binaries on
 # every backend and pipeline variant below, and compares the pixels (`spillway compare` says

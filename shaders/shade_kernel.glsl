@@ -1,7 +1,8 @@
 // The body of every shading kernel: one thread shades one hit with shared/path.h's
 // shadeSurface(), the very function the cpu and reference backends compile as C++. Which math
-// is shared: the whole bounce (path.h), the BSDFs (bsdf.h's dispatch and one header per model:
-// lambert.h, conductor.h, dielectric.h over ggx.h), light sampling (lights.h), the MIS weight
+// is shared: the whole bounce (path.h), the BSDFs (bsdf.h's dispatch and one header per model of
+// the registry, surface_models.h: lambert.h, conductor.h, dielectric.h, gltf.h, clearcoat.h,
+// transmission.h and sheen.h, over ggx.h), light sampling (lights.h), the MIS weight
 // (sampling.h: powerHeuristic), ray offsets (offset.h) and the random numbers (rng.h: pcg4d).
 // Why: each then exists once, so the Vulkan image can differ from the cpu image only by how the
 // two compilers round floats (tests/vk/vulkan_test.cpp measures how much), never by a second

@@ -74,8 +74,8 @@ struct PipelineConfig {
     // The cpu engine's per-hit stages fused chunk by chunk (stages.h: shadeFused); false runs
     // them one whole batch after another, as the Vulkan engine must (the ablation).
     bool fuseStages = true;
-    // The cpu engine shades Lambert hits SIMD-wide (simd_shading.h); false: shadeSurface() hit by
-    // hit (the ablation; the image is the same to the bit).
+    // The cpu engine shades the hits of every model with a SIMD twin (kWideTwins, simd_shading.h)
+    // SIMD-wide; false: shadeSurface() hit by hit (the ablation; the image is the same to the bit).
     bool simdShading = true;
 };
 

@@ -1,7 +1,8 @@
-// The C++ shading engine: the same shadeSurface() the Vulkan kernels run (its Lambert hits in
-// SIMD registers, simd_shading.h), on the host's threads: fused with the other per-hit stages
-// chunk by chunk (stages.h: shadeFused), or, with --stages separate, in TBB tasks of `shading
-// size` hits through one slot (TBB already keeps every core busy: nothing to overlap).
+// The C++ shading engine: the same shadeSurface() the Vulkan kernels run (the hits of each model
+// with a SIMD twin in SIMD registers, simd_shading.h), on the host's threads: fused with the
+// other per-hit stages chunk by chunk (stages.h: shadeFused), or, with --stages separate, in TBB
+// tasks of `shading size` hits through one slot (TBB already keeps every core busy: nothing to
+// overlap).
 #pragma once
 
 #include "host/backend/backend.h"

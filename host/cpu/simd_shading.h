@@ -1,11 +1,11 @@
 // Shading a run of hits SIMD-wide: the cpu engine's shade step, where the sort has made the work
-// homogeneous. Hits of each model with a kernel (Lambert, Conductor, Dielectric: kWideTwins) go
-// through a structure-of-arrays kernel that runs shadeSurface()'s arithmetic on 4, 8 or 16 hits
-// of that model at once, in the widest instruction set the processor has (Google Highway's
-// dynamic dispatch: SSE4, AVX2 or AVX-512); a hit of a model without one would go through
-// shadeSurfaceWith(), with its random numbers made SIMD-wide too (the scrambled Sobol sequence
-// is most of a rand4's cost). Unsorted hits fill one block per model, so interleaved models
-// still make full vectors.
+// homogeneous. Hits of each model with a kernel (Lambert, Conductor, Dielectric and
+// MetallicRoughness: kWideTwins) go through a structure-of-arrays kernel that runs
+// shadeSurface()'s arithmetic on 4, 8 or 16 hits of that model at once, in the widest
+// instruction set the processor has (Google Highway's dynamic dispatch: SSE4, AVX2 or AVX-512); a
+// hit of a model without one goes through shadeSurfaceWith(), with its random numbers made
+// SIMD-wide too (the scrambled Sobol sequence is most of a rand4's cost). Unsorted hits fill one
+// block per model, so interleaved models still make full vectors.
 //
 // The kernel is shadeSurface() to the bit: the same operations in the same order, each rounded
 // once (no fused multiply-add), so an image does not depend on which hits were shaded

@@ -67,7 +67,7 @@ size_t sortHits(const Scene& scene, const ShaderOrder& shaders, const std::vecto
                 std::vector<SortedHit>& scratch);
 
 // hit setup: inputs[i] and paths[i] (pathId, bounce) for the i-th hit in `order`. Chunk by
-// chunk of 128 hits; within a chunk, each run of one shader's hits looks its textures up
+// chunk of kChunk (256) hits; within a chunk, each run of one shader's hits looks its textures up
 // texture by texture (TextureResolver::albedos).
 void setUpHits(const RenderContext& ctx, const std::vector<RayState>& rays,
                const std::vector<HitRecord>& hits, const std::vector<SortedHit>& order,
@@ -97,7 +97,7 @@ void binContinuations(const RenderContext& ctx, uint iteration, RayFormat format
                       const ShadeResult* results, size_t hitCount, DirectionalBins& bins);
 
 // The per-hit stages fused, for an engine that shades on the host's own threads (cpu): hit setup,
-// shade, shadow, accumulate and bin run one after another on chunks of 128 sorted hits, so that
+// shade, shadow, accumulate and bin run one after another on chunks of kChunk sorted hits, so that
 // a chunk's inputs and results stay in L1/L2 between stages instead of streaming through RAM
 // (the staged path writes and reads 224 bytes per hit). Same per-hit functions, same arithmetic,
 // same image bit for bit. Each stage's --stats seconds: the loop's wall time shared in
@@ -114,9 +114,9 @@ void shadeFused(const RenderContext& ctx, uint iteration, RayFormat format, cons
                 DirectionalBins& bins);
 
 // The stages after shading fused, for an engine that shades elsewhere (vulkan): shadow, accumulate
-// and bin run one after another on chunks of 128 results, as in shadeFused, instead of each
+// and bin run one after another on chunks of kChunk results, as in shadeFused, instead of each
 // stage streaming over the whole batch (gatherShadowRays, accumulate, binContinuations: the
-// staged path, kept for --fuse-stages off). Same image bit for bit.
+// staged path, kept for --stages separate). Same image bit for bit.
 void finishFused(const RenderContext& ctx, uint iteration, RayFormat format,
                  const ShadeResult* results, const uvec2* paths, size_t hitCount, Film& film,
                  DirectionalBins& bins);

@@ -145,7 +145,7 @@ SHARED_FN void addShadowRay(SCENE_PARAM RenderParams rp, ShaderParams sh, Surfac
 
 // shadeSurface with the path's random numbers for this bounce given: uLight = rand4(kDimLight),
 // uBsdf = rand4(kDimBsdf) (read only where shadeGoesOn), so that a caller can make them many at
-// a time (host/pipeline/simd_shading.cpp).
+// a time (host/cpu/simd_shading.cpp).
 SHARED_FN void shadeSurfaceWith(SCENE_PARAM RenderParams rp, SurfaceHit hit, vec3 rayDir,
                                 PathState st, vec4 uLight, vec4 uBsdf, OUT(ShadeResult) r) {
     r.flags = 0u;

@@ -43,7 +43,7 @@ SHARED_FN vec3 toWorld(vec3 local, vec3 n) {
 
 // sin and cos of x in [-pi/4, pi/4], as the polynomials of Cephes' sinf and cosf (Moshier
 // 1992; within 2 ulp of the true values there): multiplies and adds alone, so that the
-// scalar shading, the SIMD kernel (host/pipeline/simd_shading.cpp) and the Vulkan kernels
+// scalar shading, the SIMD kernels (host/cpu/simd_shading.cpp) and the Vulkan kernels
 // compute the same thing, without a libm call.
 // sin x = x + x z (S3 + z (S5 + z S7)) and cos x = 1 - z / 2 + z^2 (C4 + z (C6 + z C8)),
 // z = x^2, evaluated as written below (the SIMD kernel repeats the order).

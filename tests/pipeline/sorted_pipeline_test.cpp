@@ -139,8 +139,8 @@ TEST(SortedPipeline, CompactRaysAgreeWithReferenceOnClosedEnclosure) {
 }
 
 // The film must not depend on how rays were batched, sorted, spilled or scheduled, nor on
-// whether the per-hit stages ran fused or one after another, nor on whether the Lambert hits
-// were shaded SIMD-wide or one at a time (the box is all Lambert). The Cornell
+// whether the per-hit stages ran fused or one after another, nor on whether the hits were shaded
+// SIMD-wide or one at a time (the box is all Lambert, which has a SIMD twin). The Cornell
 // box at max depth 16: bounce rays go through the bins, the queue and (with a small budget) the
 // spill file and back many times, so a read-back that corrupted one bit would change the image.
 TEST(SortedPipeline, ImageIsIndependentOfBatchingSortingBudgetAndThreads) {
@@ -194,7 +194,7 @@ TEST(SortedPipeline, ImageIsIndependentOfBatchingSortingBudgetAndThreads) {
         c.threads = 2;
         c.pipeline.hitSort = HitSortMode::On;
     });
-    // shadeSurface() hit by hit instead of the SIMD kernel for the Lambert hits.
+    // shadeSurface() hit by hit instead of the SIMD kernels.
     variant("scalar shading", [](RenderConfig& c) { c.pipeline.simdShading = false; });
     variant("scalar shading, separate stages", [](RenderConfig& c) {
         c.pipeline.simdShading = false;
