@@ -15,6 +15,7 @@
 #include <cstdio>
 #include <exception>
 #include <memory>
+#include <new>
 #include <string>
 #include <vector>
 
@@ -78,6 +79,12 @@ int main(int argc, char** argv) {
     } catch (const spw::RenderRefused& e) {
         std::fprintf(stderr, "spillway: %s%s\n", gRankLabel.c_str(), e.what());
         return 2;
+    } catch (const std::bad_alloc&) { // one that no part of the render said more of
+        std::fprintf(stderr,
+                     "spillway: %serror: out of memory: the render needs more than this process "
+                     "may take (a ulimit, a container's limit or the machine's memory)\n",
+                     gRankLabel.c_str());
+        return 1;
     } catch (const std::exception& e) {
         std::fprintf(stderr, "spillway: %serror: %s\n", gRankLabel.c_str(), e.what());
         return 1;

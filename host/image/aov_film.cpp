@@ -30,8 +30,8 @@ unsigned parseAovList(const std::string& list) {
 
 AovFilm::AovFilm(int width, int height, int samplesPerIteration, unsigned passes,
                  mat3 cameraToWorld)
-    : width_(width), height_(height), spi_(samplesPerIteration), passes_(passes),
-      cameraToWorld_(cameraToWorld), viewAxis_(-glm::normalize(cameraToWorld[2])) {
+    : width_(width), spi_(samplesPerIteration), passes_(passes), cameraToWorld_(cameraToWorld),
+      viewAxis_(-glm::normalize(cameraToWorld[2])) {
     for (int k = 0; k < 3; ++k)
         cameraToWorld_[k] = glm::normalize(cameraToWorld_[k]);
     const size_t pixels = size_t(width) * size_t(height);

@@ -82,7 +82,7 @@ class AovFilm {
     static constexpr int kValues = 7; // albedo rgb, normal xyz, depth
     // A camera sample's state in the iteration.
     enum : std::uint8_t { kMissed = 0, kEscaped, kHit, kThroughSpecular, kAlbedoDone };
-    int width_, height_, spi_;
+    int width_, spi_;
     unsigned passes_;
     mat3 cameraToWorld_;
     vec3 viewAxis_;                   // -cameraToWorld_[2]: depth is along it

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <memory>
@@ -23,6 +24,14 @@ std::string extension(const std::string& path) {
 }
 
 } // namespace
+
+std::string outOfMemory(const std::string& path, long long width, long long height,
+                        std::uint64_t bytes) {
+    char need[32];
+    std::snprintf(need, sizeof need, "%.1f GiB", double(bytes) / double(1ull << 30));
+    return "not enough memory for image '" + path + "' (" + std::to_string(width) + " x " +
+           std::to_string(height) + "): it needs " + need + ", more than this process may take";
+}
 
 std::uint8_t linearToSrgb8(float v) {
     if (!(v > 0.0f)) return 0; // also maps NaN to black
@@ -434,7 +443,8 @@ ImageRGB readImageLayer(const std::string& path, const std::string& layer) {
         throw std::runtime_error("image '" + path + "' has no layer '" + layer + "' (channels " +
                                  layer + ".R, .G, .B or .X, .Y, .Z, or .Z)");
     const size_t pixels = size_t(spec.width) * size_t(spec.height);
-    std::vector<float> all(pixels * size_t(spec.nchannels));
+    std::vector<float> all =
+        pixelBuffer<float>(pixels * size_t(spec.nchannels), path, spec.width, spec.height);
     if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, all.data()))
         throw std::runtime_error("cannot read image '" + path + "': " + in->geterror());
     ImageRGB img;
@@ -457,7 +467,7 @@ ImageRGB readImage(const std::string& path) {
     // RGB, or grey (grey and alpha: the grey); never the file's other channels.
     const int nc = spec.nchannels == 2 ? 1 : std::min(spec.nchannels, 3);
     const size_t pixels = size_t(spec.width) * size_t(spec.height);
-    std::vector<float> all(pixels * size_t(nc));
+    std::vector<float> all = pixelBuffer<float>(pixels * size_t(nc), path, spec.width, spec.height);
     if (!in->read_image(0, 0, 0, nc, OIIO::TypeDesc::FLOAT, all.data()))
         throw std::runtime_error("cannot read image '" + path + "': " + in->geterror());
     std::string cs = spec.get_string_attribute("oiio:ColorSpace");

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdint>
 #include <functional>
+#include <new>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -65,6 +66,23 @@ std::string imageSizeProblem(const std::string& path, long long width, long long
                              long long maxPixels = kMaxImagePixels,
                              long long maxSide = kMaxImagePixels);
 
+// The message of a pixel buffer that cannot be allocated: "not enough memory for image 'PATH' (W x
+// H): it needs N GiB, more than this process may take".
+std::string outOfMemory(const std::string& path, long long width, long long height,
+                        std::uint64_t bytes);
+
+// `count` values of T for the pixels of image `path` (width x height), zeroed; where the process
+// may not take that much memory (a std::bad_alloc), throws std::runtime_error saying so with the
+// image, its size and the memory it needs, a runtime failure rather than the image's.
+template <class T>
+std::vector<T> pixelBuffer(size_t count, const std::string& path, long long width,
+                           long long height) {
+    try {
+        return std::vector<T>(count);
+    } catch (const std::bad_alloc&) {
+        throw std::runtime_error(outOfMemory(path, width, height, count * sizeof(T)));
+    }
+}
 // Whether an OpenEXR file's header can be handed to OpenEXR: "" if so (or if the file is not an
 // EXR), else why not, naming `path`. OpenEXR allocates what a header claims before reading it: an
 // attribute's size, the data window's offset table. A 200-byte file can claim gigabytes (found

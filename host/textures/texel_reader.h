@@ -45,7 +45,7 @@ struct TextureResolver::Impl {
         bool srgb = false;
         OIIO::ImageCache::ImageHandle* handle = nullptr; // set within `once`
         std::string error;                               // why not, where it could not be made
-        bool diskFailed = false; // it could not be written (the scratch folder), not read
+        bool diskFailed = false; // it could not be made (the scratch folder, memory), not read
     };
     struct Image {
         OIIO::ImageCache::ImageHandle* handle = nullptr;

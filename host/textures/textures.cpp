@@ -26,6 +26,7 @@
 #include <cstring>
 #include <filesystem>
 #include <mutex>
+#include <new>
 #include <stdexcept>
 
 namespace spw {
@@ -177,6 +178,13 @@ void TextureResolver::Impl::makeCopy(PendingCopy& p) {
     } catch (const TiledCopy::ReadError& e) { // the image's own pixels
         p.handle = nullptr;
         p.error = e.what();
+    } catch (const std::bad_alloc&) { // its pixels, and its first coarser level in float
+        p.handle = nullptr;
+        const std::uint64_t level = std::uint64_t(p.spec.width / 2) *
+                                    std::uint64_t(p.spec.height / 2) *
+                                    std::uint64_t(p.spec.nchannels) * 4u;
+        p.error = outOfMemory(t.path, p.spec.width, p.spec.height, p.spec.image_bytes() + level);
+        p.diskFailed = true;            // a runtime failure, as the scratch folder's
     } catch (const std::exception& e) { // the copy's file (a full scratch folder)
         p.handle = nullptr;
         p.error = e.what();
@@ -291,7 +299,7 @@ void TextureResolver::checkErrors() const {
         why.pop_back();
     if (impl_->failedOnDisk)
         throw std::runtime_error("the tiled copy of texture file '" + t.path +
-                                 "' cannot be written: " + why);
+                                 "' cannot be made: " + why);
     throw SceneError(scene_.file, t.line, "texture file '" + t.path + "' cannot be read: " + why);
 }
 

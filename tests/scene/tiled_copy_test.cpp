@@ -183,12 +183,56 @@ TEST(TiledCopy, AFullScratchFolderIsSaidToBeFull) {
                                      dir.file("o.exr") + " --spill-dir " + full + "'");
     EXPECT_EQ(r.status, 1) << r.output;
     EXPECT_NE(r.output.find("the tiled copy of texture file '" + dir.file("large.png") +
-                            "' cannot be written: the scratch folder '" + full +
+                            "' cannot be made: the scratch folder '" + full +
                             "' is full (1.0 MiB free, the copy needs 22.0 MiB; --spill-dir "
                             "chooses another)"),
               std::string::npos)
         << r.output;
     EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << r.output;
+    EXPECT_FALSE(std::filesystem::exists(dir.file("o.exr")));
+}
+
+// An image whose copy needs more memory than the process may take (a PNG header claiming 30000²
+// under a 1.5 GB address-space limit) is exit 1 naming the image, its size and the memory its
+// copy needs, not a bare std::bad_alloc. (Not under the sanitizers, whose shadow memory a
+// limit on the address space leaves no room for.)
+TEST(TiledCopy, AnImageTooLargeForTheMemoryIsSaidToBe) {
+#if SPILLWAY_LSAN
+    GTEST_SKIP() << "an address-space limit and AddressSanitizer do not mix";
+#endif
+    TempDir dir;
+    // IHDR 30000 x 30000, 8-bit RGB, and no pixels: the header is all the loader reads.
+    const auto be32 = [](std::uint32_t v) {
+        std::string out;
+        for (int k = 3; k >= 0; --k)
+            out += char((v >> (8 * k)) & 0xff);
+        return out;
+    };
+    const auto chunk = [&](const std::string& type, const std::string& data) {
+        std::uint32_t crc = 0xffffffffu; // PNG's CRC-32, bit by bit
+        for (unsigned char c : type + data) {
+            crc ^= c;
+            for (int bit = 0; bit < 8; ++bit)
+                crc = (crc >> 1) ^ (0xedb88320u & (0u - (crc & 1u)));
+        }
+        return be32(std::uint32_t(data.size())) + type + data + be32(~crc);
+    };
+    const std::string ihdr = be32(30000) + be32(30000) + std::string("\x08\x02\x00\x00\x00", 5);
+    const std::string noPixels("\x78\x9c\x03\x00\x00\x00\x00\x01", 8); // zlib's empty stream
+    dir.write("huge.png", std::string("\x89PNG\r\n\x1a\n", 8) + chunk("IHDR", ihdr) +
+                              chunk("IDAT", noPixels) + chunk("IEND", ""));
+    const std::string scene = planeScene(dir, "huge.png");
+    const CommandResult r =
+        runShell("ulimit -v 1500000 && MALLOC_ARENA_MAX=2 " + binary() + " render " + scene +
+                 " -o " + dir.file("o.exr") + " --backend cpu --threads 2 --quiet");
+    EXPECT_EQ(r.status, 1) << r.output;
+    EXPECT_NE(r.output.find("the tiled copy of texture file '" + dir.file("huge.png") +
+                            "' cannot be made: not enough memory for image '" +
+                            dir.file("huge.png") +
+                            "' (30000 x 30000): it needs 5.0 GiB, more "
+                            "than this process may take"),
+              std::string::npos)
+        << r.output;
     EXPECT_FALSE(std::filesystem::exists(dir.file("o.exr")));
 }
 
@@ -210,7 +254,7 @@ TEST(TiledCopy, AFolderThatGoesAwayIsARuntimeErrorNotTheScenes) {
         ADD_FAILURE() << "a scene error: " << e.what();
     } catch (const std::runtime_error& e) {
         EXPECT_NE(std::string(e.what()).find("the tiled copy of texture file '" +
-                                             dir.file("large.png") + "' cannot be written"),
+                                             dir.file("large.png") + "' cannot be made"),
                   std::string::npos)
             << e.what();
     }
