@@ -7,13 +7,32 @@
 # OpenVDB and codec closure that Debian's binary package links.
 #
 #   scripts/build-lean-oiio.sh PREFIX      # installs into PREFIX (lib/, include/, lib/cmake/)
+#   scripts/build-lean-oiio.sh --mirrors   # prints the archive roots it fetches from, in order
 #
-# The source is Debian's openimageio package. Bookworm's own source (2.4.7.1) is tried first; the
-# Debian mirror this project's machines reach serves only trixie's (2.5.18.0), so that one is
-# the fallback, pinned by its SHA-256 from trixie's Sources index. Either builds against
-# bookworm's libraries. Set OIIO_TARBALL to a Debian orig tarball already on disk to skip the
-# download. Idempotent: a PREFIX that already holds this build is left alone.
+# The source is Debian's openimageio package, fetched from the Debian mirrors apt is configured
+# with (its sources.list and sources.list.d, as `apt-config` names them: a company mirror or a
+# local cache works as apt does), then from deb.debian.org. Bookworm's own source (2.4.7.1) is
+# tried first; the Debian mirror this project's machines reach serves only trixie's (2.5.18.0),
+# so that one is the fallback, pinned by its SHA-256 from trixie's Sources index. Either builds
+# against bookworm's libraries. Set OIIO_TARBALL to a Debian orig tarball already on disk to skip
+# the download. Idempotent: a PREFIX that already holds this build is left alone.
 set -euo pipefail
+# The archive roots apt fetches from, in its configuration's order, the security archive aside
+# (it holds no source of this package); deb.debian.org last.
+apt_mirrors() {
+  local list="/etc/apt/sources.list" parts="/etc/apt/sources.list.d/"
+  eval "$(apt-config shell list Dir::Etc::sourcelist/f parts Dir::Etc::sourceparts/d \
+    2>/dev/null)" || true
+  local one_line='s/^deb(-src)?[[:space:]]+(\[[^]]*\][[:space:]]+)?([^[:space:]]+).*/\3/p'
+  {
+    cat "$list" "$parts"/*.list 2>/dev/null | sed -nE "$one_line"
+    cat "$parts"/*.sources 2>/dev/null | sed -n 's/^URIs:[[:space:]]*//p' | tr ' ' '\n'
+    echo "http://deb.debian.org/debian"
+  } | grep -E '^(https?|file)://' | grep -v -- '-security/*$' | sed 's:/*$::' |
+    awk '!seen[$0]++' || true
+}
+mapfile -t mirrors < <(apt_mirrors)
+if [ "${1:-}" = "--mirrors" ]; then printf '%s\n' "${mirrors[@]}"; exit 0; fi
 prefix="$(realpath -m "${1:?usage: build-lean-oiio.sh PREFIX}")"
 work="$prefix.build"
 stamp="$prefix/.spillway-lean-oiio"
@@ -27,7 +46,6 @@ if [ -f "$stamp" ] && [ "$(tail -1 "$stamp")" = "$formats | $flags" ]; then
   exit 0
 fi
 
-pool="http://deb.debian.org/debian/pool/main/o/openimageio"
 candidates=(
   # version                 sha256 of openimageio_VERSION.orig.tar.xz (bookworm's and trixie's .dsc)
   "2.4.7.1+dfsg  9c9cfe65acd55e14d12344009f30515c0d336b96976af2a2ea18a695a5a1c930"
@@ -39,18 +57,21 @@ if [ -z "$tarball" ]; then
   for c in "${candidates[@]}"; do
     read -r version sha <<<"$c"
     file="$work/openimageio_${version}.orig.tar.xz"
-    if [ ! -f "$file" ]; then
-      url="$pool/openimageio_${version/+/%2b}.orig.tar.xz"
+    for mirror in "${mirrors[@]}"; do
+      [ -f "$file" ] && break
+      url="$mirror/pool/main/o/openimageio/openimageio_${version/+/%2b}.orig.tar.xz"
       curl -fsS -o "$file.part" "$url" 2>/dev/null && mv "$file.part" "$file" || {
-        rm -f "$file.part"; echo "build-lean-oiio: $url is not served; trying the next" >&2; continue; }
-    fi
+        rm -f "$file.part"; echo "build-lean-oiio: $url is not served; trying the next" >&2; }
+    done
+    [ -f "$file" ] || continue
     if [ "$(sha256sum "$file" | cut -d' ' -f1)" != "$sha" ]; then
       echo "build-lean-oiio: $file does not match its SHA-256 $sha" >&2; rm -f "$file"; exit 1
     fi
     tarball="$file"; break
   done
 fi
-[ -n "$tarball" ] || { echo "build-lean-oiio: no OpenImageIO source package could be fetched" >&2; exit 1; }
+[ -n "$tarball" ] || {
+  echo "build-lean-oiio: no OpenImageIO source package could be fetched" >&2; exit 1; }
 
 src="$work/src"
 rm -rf "$src" "$work/build" "$prefix" && mkdir -p "$src"
