@@ -7,7 +7,9 @@ The scenes, written here as .glb files (numpy makes their arrays):
     names the one mesh);
   - unique-M: one mesh of M triangles of its own (a displaced grid), under the same sun;
   - textures-K-S: K quads, each with its own material whose base colour is an S x S PNG
-    embedded in the file (noise: it compresses as badly as photographs do).
+    embedded in the file (noise: it compresses as badly as photographs do);
+  - uris-K-S: the same as a .gltf, each image written out in the JSON as a data: URI and the
+    buffer too (as Blender's "glTF Embedded" format writes a scene).
 Each is rendered at 320x240, 16 spp, 2 threads, `--backend cpu` (Spillway; the textures scenes
 under `--texture-cache 64`) and by Blender's
 Cycles (its glTF importer, scripts/cycles_compare.py's settings, 16 samples, 2 threads). The
@@ -19,6 +21,7 @@ its render call (Blender's start and its glTF importer).
 --quick: small counts, no Cycles; it checks that the benchmark runs (the suite's
 Bench.ScaleQuickRuns). Writes out/bench/scale.json.
 """
+import base64
 import json
 import os
 import shutil
@@ -79,11 +82,12 @@ class Glb:
         self.doc["meshes"].append({"primitives": [prim]})
         return len(self.doc["meshes"]) - 1
 
-    def material(self, colour, roughness=0.8, image=None):
+    def material(self, colour, roughness=0.8, image=None, uri=False):
         m = {"pbrMetallicRoughness": {"baseColorFactor": list(colour) + [1.0],
                                       "metallicFactor": 0.0, "roughnessFactor": roughness}}
         if image is not None:
             self.doc.setdefault("images", []).append(
+                {"uri": "data:image/png;base64," + base64.b64encode(image).decode()} if uri else
                 {"bufferView": self.view(image), "mimeType": "image/png"})
             self.doc.setdefault("textures", []).append({"source": len(self.doc["images"]) - 1})
             m["pbrMetallicRoughness"]["baseColorTexture"] = {"index": len(self.doc["textures"]) - 1}
@@ -107,7 +111,18 @@ class Glb:
         self.node(rotation=[np.sin(a / 2), 0.0, 0.0, np.cos(a / 2)],
                   extensions={"KHR_lights_punctual": {"light": 0}})
 
+    def write_gltf(self, path):
+        """As a .gltf, its buffer a data: URI (as Blender's "glTF Embedded" writes one)."""
+        self.doc["scenes"] = [{"nodes": list(range(len(self.doc["nodes"])))}]
+        data = base64.b64encode(b"".join(self.chunks)).decode()
+        self.doc["buffers"] = [{"byteLength": self.size,
+                                "uri": "data:application/octet-stream;base64," + data}]
+        with open(path, "w") as f:
+            json.dump(self.doc, f)
+
     def write(self, path):
+        if path.endswith(".gltf"):
+            return self.write_gltf(path)
         self.doc["scenes"] = [{"nodes": list(range(len(self.doc["nodes"])))}]
         self.doc["buffers"] = [{"byteLength": self.size}]
         text = json.dumps(self.doc).encode()
@@ -203,7 +218,9 @@ def noise_png(size, rng):
             chunk(b"IDAT", zlib.compress(rows.tobytes(), 1)) + chunk(b"IEND", b""))
 
 
-def textures(path, count, size):
+def textures(path, count, size, uri=False):
+    """`count` quads, each with its own `size`^2 PNG of noise: in the .glb's buffer, or (uri)
+    written out in a .gltf as data: URIs."""
     rng = np.random.default_rng(3)
     g = Glb()
     side = int(np.ceil(np.sqrt(count)))
@@ -212,7 +229,8 @@ def textures(path, count, size):
     uv = np.array([[0, 1], [1, 1], [1, 0], [0, 0]], float)
     idx = np.array([[0, 1, 2], [0, 2, 3]])
     for k in range(count):
-        m = g.mesh(pos, nor, idx, g.material((1.0, 1.0, 1.0), image=noise_png(size, rng)), uv)
+        material = g.material((1.0, 1.0, 1.0), image=noise_png(size, rng), uri=uri)
+        m = g.mesh(pos, nor, idx, material, uv)
         g.node(mesh=m, translation=[k % side - side / 2, k // side - side / 2, 0.0])
     g.camera_and_sun((0.0, 0.0, 1.3 * side + 1.0), 0.0)
     g.write(path)
@@ -222,13 +240,14 @@ def textures(path, count, size):
 def scenes(quick):
     if quick:
         return [("forest-10", forest, (10, 2000)), ("forest-100", forest, (100, 2000)),
-                ("unique-20k", unique, (20000,)), ("textures-4-256", textures, (4, 256))]
+                ("unique-20k", unique, (20000,)), ("textures-4-256", textures, (4, 256)),
+                ("uris-4-256", textures, (4, 256, True))]
     return [("forest-100", forest, (100, 20000)), ("forest-1000", forest, (1000, 20000)),
             ("forest-10000", forest, (10000, 20000)), ("forest-100000", forest, (100000, 20000)),
             ("unique-1M", unique, (1_000_000,)), ("unique-5M", unique, (5_000_000,)),
             ("unique-20M", unique, (20_000_000,)), ("forest-1000000", forest, (1_000_000, 20000)),
             ("textures-64-2048", textures, (64, 2048)), ("textures-256-2048", textures, (256, 2048)),
-            ("textures-64-4096", textures, (64, 4096))]
+            ("textures-64-4096", textures, (64, 4096)), ("uris-64-2048", textures, (64, 2048, True))]
 
 
 # --- renders ----------------------------------------------------------------------------------
@@ -326,7 +345,7 @@ def main(spillway, quick, only=(), cycles=True):
         for name, _, _ in scenes(quick):
             if only and name not in only:
                 continue
-            glb = os.path.join(folder, name + ".glb")
+            glb = os.path.join(folder, name + (".gltf" if name.startswith("uris-") else ".glb"))
             info = make_apart(name, glb, quick)
             info["file_mib"] = os.path.getsize(glb) / 2 ** 20
             # Textures under a budget far below their texels: the cache's, not the images'.

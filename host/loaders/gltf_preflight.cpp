@@ -1,5 +1,6 @@
 #include "host/loaders/gltf_preflight.h"
 
+#include "host/loaders/gltf_text_scan.h"
 #include "host/scene/scene.h"
 
 #include <nlohmann/json.hpp>
@@ -365,25 +366,9 @@ bool readRegularFile(std::vector<unsigned char>* out, std::string* err, const st
 } // namespace
 
 int jsonNestingDepth(const std::string& text, int limit) {
-    int depth = 0, deepest = 0;
-    bool inString = false;
-    for (size_t i = 0; i < text.size(); ++i) {
-        const char c = text[i];
-        if (inString) {
-            if (c == '\\')
-                ++i;
-            else if (c == '"')
-                inString = false;
-        } else if (c == '"') {
-            inString = true;
-        } else if (c == '[' || c == '{') {
-            deepest = std::max(deepest, ++depth);
-            if (deepest > limit) return deepest;
-        } else if (c == ']' || c == '}') {
-            --depth;
-        }
-    }
-    return deepest;
+    JsonTextScan scan(limit, 0);
+    scan.feed(text.data(), text.size());
+    return scan.depth();
 }
 
 std::string decodeGltfUri(const std::string& uri) {
@@ -411,17 +396,46 @@ GltfDocument preflightGltf(const std::string& path, const std::set<std::string>&
         c = char(std::tolower(static_cast<unsigned char>(c)));
     GltfDocument out;
     out.binary = ext == ".glb";
-    std::string text = out.binary ? glbJson(path, in, size, out) : readBytes(in, size_t(size));
-    if (jsonNestingDepth(text, kMaxGltfJsonDepth) > kMaxGltfJsonDepth)
+    // The JSON's text, scanned (gltf_text_scan.h), then read again with the images' data: URIs
+    // cut out: from the file a piece at a time (a .gltf), or from memory (a .glb's JSON chunk).
+    std::string text;
+    JsonTextScan scan(kMaxGltfJsonDepth, out.binary ? 20 : 0);
+    JsonTextScan::Reader read;
+    if (out.binary) {
+        text = glbJson(path, in, size, out);
+        scan.feed(text.data(), text.size());
+        read = [&text](std::uint64_t at, size_t n, std::string& into) {
+            into.append(text, size_t(at - 20), n);
+        };
+    } else {
+        std::string chunk(size_t(1) << 20, '\0');
+        while (in.read(chunk.data(), std::streamsize(chunk.size())) || in.gcount() > 0)
+            scan.feed(chunk.data(), size_t(in.gcount()));
+        read = [&in](std::uint64_t at, size_t n, std::string& into) {
+            in.clear();
+            in.seekg(std::streamoff(at));
+            const size_t had = into.size();
+            into.resize(had + n);
+            in.read(into.data() + had, std::streamsize(n));
+            into.resize(had + size_t(std::max<std::streamsize>(in.gcount(), 0)));
+        };
+    }
+    if (scan.depth() > kMaxGltfJsonDepth)
         fail(path, "",
              "its JSON nests deeper than " + std::to_string(kMaxGltfJsonDepth) +
                  " levels (glTF's own objects nest about 8)");
+    std::string cut = scan.cutPayloads(out.binary ? text.size() : size, read);
     GltfNodeCollector nodes(path);
+    GltfDataUris uris(path, scan, read);
     out.doc = json::parse(
-        text,
-        [&](int depth, json::parse_event_t e, json& parsed) { return nodes(depth, e, parsed); },
+        cut,
+        [&](int depth, json::parse_event_t e, json& parsed) {
+            uris(depth, e, parsed);
+            return nodes(depth, e, parsed);
+        },
         false);
-    text = {};
+    text = cut = {};
+    out.dataUris = uris.take();
     const json& doc = out.doc;
     if (doc.is_discarded() || !doc.is_object()) { // tinygltf says what is wrong
         out.doc = json::value_t::discarded;

@@ -11,12 +11,15 @@
 #pragma once
 
 #include "host/loaders/gltf_nodes.h"
+#include "host/scene/scene.h"
 
 #include <nlohmann/json.hpp>
 #include <tiny_gltf.h>
 
 #include <cstdint>
 
+#include <map>
+#include <memory>
 #include <set>
 #include <string>
 
@@ -37,6 +40,9 @@ struct GltfDocument {
     bool binary = false;
     std::uint64_t binOffset = 0, binLength = 0; // the BIN chunk's bytes (length 0: none)
     std::vector<std::string> warnings;          // what is rendered leniently ("pointer: what")
+    // The images written out as data: URIs, read from their text in the file (gltf_text_scan.h),
+    // by index; their URIs in `doc` are GltfDataUris::kPlaceholder.
+    std::map<int, std::shared_ptr<const EmbeddedImage>> dataUris;
 };
 
 // Checks the file at `path` before it is parsed; `honoured` are the extensions a file may require.

@@ -65,6 +65,7 @@ using nlohmann::json;
 
 GltfSources::GltfSources(const std::string& path, GltfDocument document) : path_(path) {
     json& doc = document.doc;
+    embedded_ = std::move(document.dataUris); // in the file's text (gltf_text_scan.h)
     locateBuffers(doc, document);
     readImages(doc);
     for (auto& [index, buffer] : buffers_) {
@@ -122,7 +123,11 @@ void GltfSources::readImages(json& doc) {
         const std::string marker = kImageMarker + std::to_string(i);
         if (entry.contains("uri") && entry["uri"].is_string()) {
             const std::string uri = entry["uri"].get<std::string>();
-            if (uri.rfind("data:", 0) == 0 || entry.contains("bufferView")) continue;
+            if (entry.contains("bufferView")) continue;
+            if (uri.rfind("data:", 0) == 0) { // read from its text in the file, where it was found
+                if (embedded_.count(int(i))) entry["uri"] = marker;
+                continue;
+            }
             imageFiles_[int(i)] = uri;
             entry["uri"] = marker;
             continue;

@@ -9,8 +9,10 @@
 //   that tinygltf reads through these callbacks: only the byte ranges of the buffer views that
 //   are not an image's alone, read from the file in pieces and laid end to end (each at its
 //   original offset modulo 16, so accessors stay aligned), the views' offsets moved to match.
-// Data: URIs (an image or buffer written out in the JSON) are left as they are: the JSON already
-// held their bytes. The markers never name a file: the JSON is the loader's own.
+// - every image written out as a data: URI that the preflight found in the file's text
+//   (gltf_text_scan.h) is renamed to a marker too, and read from that text.
+// Other data: URIs (buffers, images whose text has a JSON escape) are left as they are: the JSON
+// already held their bytes. The markers never name a file: the JSON is the loader's own.
 #pragma once
 
 #include "host/loaders/gltf_preflight.h"

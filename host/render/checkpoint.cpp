@@ -113,7 +113,7 @@ static void hashFileContents(Fnv& f, const std::string& path) {
 }
 
 // The bytes of an embedded image, read from its file as the bytes that held them in memory were
-// hashed (the same hash for the same bytes), a MiB at a time.
+// hashed (the same hash for the same bytes), a MiB at a time; a data: URI's as its base64 text.
 static void hashEmbedded(Fnv& f, const EmbeddedImage& image) {
     if (image.bytes) {
         f.bytes(image.bytes->data(), image.bytes->size());
@@ -122,7 +122,7 @@ static void hashEmbedded(Fnv& f, const EmbeddedImage& image) {
     std::ifstream in(image.file, std::ios::binary);
     in.seekg(std::streamoff(image.offset));
     std::vector<char> chunk(size_t(1) << 20);
-    for (std::uint64_t left = image.length; left > 0 && in;) {
+    for (std::uint64_t left = image.stored(); left > 0 && in;) {
         const size_t n = size_t(std::min<std::uint64_t>(left, chunk.size()));
         if (!in.read(chunk.data(), std::streamsize(n))) break;
         f.bytes(chunk.data(), n);

@@ -126,11 +126,16 @@ std::optional<SamplerType> parseSampler(const std::string& name);
 enum class TextureType { Constant, Standard, Layered };
 // Where the encoded bytes of an image embedded in a scene file lie: `length` bytes at `offset`
 // of `file` (a glTF buffer in the file or beside it), read a piece at a time and never held
-// whole; or, where `bytes` is set (a data: URI, which the file's JSON already held), in memory.
+// whole; where `base64` is set, written out as base64 text from `offset` on (a data: URI in the
+// file's JSON: 4 characters for every 3 bytes, decoded as they are read); or, where `bytes` is
+// set (an image Spillway made, or a data: URI not found as it is in the file), in memory.
 struct EmbeddedImage {
     std::string file;
     std::uint64_t offset = 0, length = 0;
     std::shared_ptr<const std::string> bytes;
+    bool base64 = false;
+    // The bytes `file` holds from `offset`: `length`, or its base64 text's characters.
+    std::uint64_t stored() const { return base64 ? (length + 2) / 3 * 4 : length; }
 };
 struct Texture {
     TextureType type = TextureType::Constant;

@@ -164,6 +164,81 @@ TEST(GltfSources, AnEmbeddedImagePastItsFilesEndIsRefusedByName) {
     EXPECT_EQ(reader->size(), 10u);
 }
 
+// An image written out as a data: URI is read from its base64 text in the file, never held in
+// memory, in a .gltf and in a .glb's JSON chunk: it renders as the same bytes in a buffer do,
+// PNG and JPEG. A URI whose '/'s the writer escaped ("\/", legal JSON) is not the file's text
+// as it is: it is decoded into memory, as before, and renders the same.
+TEST(GltfSources, AnImageInADataUriIsReadFromItsTextInTheFile) {
+    for (const std::string ext : {".png", ".jpg"}) { // a JPEG is decoded while it is read
+        SCOPED_TRACE(ext);
+        TempDir dir;
+        const std::string png = pngBytes(dir, 40, 24, ext);
+        GltfBuilder b = texturedQuad(png);
+        const std::vector<float> expected = renderSmall(loadScene(b.binary(dir, "view.glb")));
+        const std::string text = GltfBuilder::base64(png);
+        const std::string mime = ext == ".png" ? "image/png" : "image/jpeg";
+        b.doc["images"] = json::array({{{"uri", "data:" + mime + ";base64," + text}}});
+        for (const std::string& file : {b.external(dir, "uri.gltf"), b.binary(dir, "uri.glb")}) {
+            const Scene scene = loadScene(file);
+            const std::shared_ptr<const EmbeddedImage> embedded = image(scene).embedded;
+            ASSERT_TRUE(embedded) << file;
+            EXPECT_FALSE(embedded->bytes) << file << ": the image is left in the file's text";
+            EXPECT_TRUE(embedded->base64) << file;
+            EXPECT_EQ(embedded->file, file);
+            EXPECT_EQ(embedded->length, png.size());
+            EXPECT_EQ(readFile(file).substr(size_t(embedded->offset), size_t(embedded->stored())),
+                      text)
+                << file;
+            EXPECT_EQ(renderSmall(scene), expected) << file;
+        }
+        ASSERT_NE(text.find('/'), std::string::npos) << "the escaped file below escapes some";
+        std::string escaped = readFile(dir.file("uri.gltf"));
+        const size_t at = escaped.find(text);
+        ASSERT_NE(at, std::string::npos);
+        std::string written;
+        for (const char c : text)
+            written += c == '/' ? std::string("\\/") : std::string(1, c);
+        escaped.replace(at, text.size(), written);
+        const Scene scene = loadScene(dir.write("escaped.gltf", escaped));
+        ASSERT_TRUE(image(scene).embedded && image(scene).embedded->bytes);
+        EXPECT_EQ(*image(scene).embedded->bytes, png);
+        EXPECT_EQ(renderSmall(scene), expected);
+    }
+}
+
+// Base64 text in a file decodes to its bytes over any range read (each of 0, 1 and 2 padding
+// characters; reads that start and end inside a group of 4), and stops short at a character
+// that is not base64 (a file changed since it was loaded).
+TEST(GltfSources, Base64TextInAFileDecodesOverAnyRange) {
+    TempDir dir;
+    for (const size_t n : {1u, 2u, 3u, 4u, 5u, 200000u}) {
+        SCOPED_TRACE(n);
+        std::string bytes(n, '\0');
+        for (size_t i = 0; i < n; ++i)
+            bytes[i] = char((i * 2654435761u) >> 13);
+        const std::string text = GltfBuilder::base64(bytes);
+        const std::string file = dir.write("b64.txt", "<" + text + ">");
+        EmbeddedImage image{file, 1, n, nullptr, true};
+        ASSERT_EQ(image.stored(), text.size());
+        auto reader = embeddedReader(image);
+        EXPECT_EQ(reader->size(), n);
+        for (const size_t from : {size_t(0), size_t(1), size_t(2), n / 2, n - 1})
+            for (const size_t count : {size_t(1), size_t(2), size_t(4), n, size_t(70000)}) {
+                if (from >= n) continue;
+                std::string got(count, '\0');
+                const size_t read = reader->pread(got.data(), count, std::int64_t(from));
+                EXPECT_EQ(got.substr(0, read), bytes.substr(from, count))
+                    << "from " << from << ", " << count;
+            }
+        EXPECT_EQ(reader->pread(&bytes[0], 1, std::int64_t(n)), 0u) << "past the end";
+    }
+    const std::string file = dir.write("bad.txt", "QUJD" + std::string("QU*D") + "QUJD");
+    auto reader = embeddedReader({file, 0, 9, nullptr, true});
+    char got[9] = {};
+    EXPECT_EQ(reader->pread(got, 9, 0), 3u) << "the 3 bytes before the character '*'";
+    EXPECT_EQ(std::string(got, 3), "ABC");
+}
+
 // A buffer file whose size is not the buffer's byteLength is refused by pointer, as is a .glb
 // whose buffer claims more than its BIN chunk holds.
 TEST(GltfSources, BufferFilesOfTheWrongSizeAreRefusedByPointer) {
