@@ -330,7 +330,8 @@ int renderCommand(const std::vector<std::string>& args, Ranks* ranks) {
     const std::unique_ptr<ErrorCsv> errorCsv = openErrorCsv(o, scene, resume);
     // Under mpirun at most four updates a second (progress.h says why).
     ProgressBar progress(progressStyle(o.progress), ranks ? 0.25 : 0.0);
-    const SamplingPlan plan = planSampling(scene.image, o.config.spp);
+    const SamplingPlan plan =
+        planSampling(scene.image, o.config.spp, resume ? resume->key.sampleBase : 0);
     const int sppPerIteration = plan.sampleBase * plan.sampleBase;
     if (const std::string why = partialRenderProblem(scene, o.config, plan); !why.empty())
         throw UsageError(why); // before any work, for exit 2

@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -41,6 +42,20 @@ const char* filterName(TextureFilter f) {
     throw std::runtime_error("'" + path + "' is not a Spillway checkpoint: " + why);
 }
 
+// A double as text that reads back as the same double (17 significant digits).
+std::string exactText(double v) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%.17g", v);
+    return text;
+}
+
+// A double as a message says it ("1e-12", "0.002").
+std::string shortText(double v) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%g", v);
+    return text;
+}
+
 // A digest of everything a resume or a merge reads: the key, the progress and the film's exact
 // state (not the RGB preview, which nothing reads back). Written as spillway:checksum; a file
 // whose contents do not match it was damaged (a flipped bit near its end used to resume into an
@@ -53,6 +68,9 @@ std::uint64_t checkpointChecksum(const Checkpoint& c) {
     f.value(k.sampleBase).value(k.strategy).value(k.adaptiveMinSamples);
     // The doubles as the file holds them (text), so that the reader's digest is the writer's.
     f.text(std::to_string(k.adaptiveThreshold));
+    // Only where there is one: checkpoints without a target (all before it was kept) digest as
+    // they always did.
+    if (k.adaptiveTarget != 0) f.text(exactText(k.adaptiveTarget));
     f.text(std::to_string(c.renderSeconds));
     f.text(k.rayFormat);
     f.text(k.textureFilter);
@@ -164,6 +182,13 @@ std::uint64_t sceneHash(const Scene& scene) {
     return f.h;
 }
 
+double adaptiveTarget(const Scene& scene, const RenderConfig& config) {
+    if (!config.targetError || !config.adaptiveToTarget || config.sampleRange ||
+        scene.settings.adaptiveThreshold > 0.0)
+        return 0;
+    return *config.targetError;
+}
+
 CheckpointKey checkpointKey(const Scene& scene, const RenderConfig& config, int sampleBase) {
     CheckpointKey k;
     k.version = SPILLWAY_VERSION;
@@ -182,6 +207,7 @@ CheckpointKey checkpointKey(const Scene& scene, const RenderConfig& config, int 
     k.sampler = samplerName(scene.sampler);
     k.adaptiveThreshold = scene.settings.adaptiveThreshold;
     k.adaptiveMinSamples = scene.settings.adaptiveMinSamples;
+    k.adaptiveTarget = adaptiveTarget(scene, config);
     return k;
 }
 
@@ -209,6 +235,13 @@ std::string checkpointMismatch(const CheckpointKey& e, const CheckpointKey& f) {
     differs("sampler", e.sampler, f.sampler);
     differs("adaptive threshold", e.adaptiveThreshold, f.adaptiveThreshold);
     differs("adaptive min samples", e.adaptiveMinSamples, f.adaptiveMinSamples);
+    if (e.adaptiveTarget != f.adaptiveTarget)
+        why << (why.tellp() > 0 ? "; " : "") << "samples shared by the tiles toward "
+            << (f.adaptiveTarget > 0 ? "relMSE " + shortText(f.adaptiveTarget)
+                                     : std::string("no target (--uniform, or none)"))
+            << " where this render shares them toward "
+            << (e.adaptiveTarget > 0 ? "relMSE " + shortText(e.adaptiveTarget)
+                                     : std::string("none (--uniform, or no --target-error)"));
     return why.str();
 }
 
@@ -248,6 +281,7 @@ void writeCheckpoint(const std::string& path, const Checkpoint& c,
     spec.attribute("spillway:sampler", c.key.sampler);
     spec.attribute("spillway:adaptive_threshold", std::to_string(c.key.adaptiveThreshold));
     spec.attribute("spillway:adaptive_min_samples", c.key.adaptiveMinSamples);
+    spec.attribute("spillway:adaptive_target", exactText(c.key.adaptiveTarget));
     spec.attribute("spillway:iterations", c.iterations);
     spec.attribute("spillway:first_iteration", c.firstIteration);
     spec.attribute("spillway:total_iterations", c.totalIterations);
@@ -365,6 +399,9 @@ Checkpoint readCheckpoint(const std::string& path) {
         c.film.saturated = std::stoull(spec.get_string_attribute("spillway:saturated_samples"));
         c.key.adaptiveThreshold =
             std::stod(spec.get_string_attribute("spillway:adaptive_threshold"));
+        // Absent: no target (checkpoints made before it was kept had none that resumed alike).
+        const std::string target = spec.get_string_attribute("spillway:adaptive_target");
+        c.key.adaptiveTarget = target.empty() ? 0.0 : std::stod(target);
     } catch (const std::exception&) {
         notACheckpoint(path, "its spillway:* metadata is incomplete");
     }

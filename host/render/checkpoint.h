@@ -39,6 +39,8 @@ struct CheckpointKey {
     std::string sampler;          // Independent | Grid | Stratified | Sobol
     double adaptiveThreshold = 0; // 0: off
     int adaptiveMinSamples = 0;
+    double adaptiveTarget =
+        0; // the relMSE the tiles share samples toward (adaptiveTarget); 0: none
 };
 
 struct Checkpoint {
@@ -76,6 +78,12 @@ struct Fnv {
 std::uint64_t sceneHash(const Scene& scene);
 // The environment as rendered: its radiance and every texel of its map (0 without one).
 std::uint64_t environmentHash(const Scene& scene);
+
+// The relMSE toward which a render's tiles share its samples by their noise
+// (Film::setAdaptiveTarget), or 0 where every pixel samples alike: --target-error without
+// --uniform, but not in a partial render (whose samples are the whole render's range, not its
+// own to share) nor under an adaptive threshold.
+double adaptiveTarget(const Scene& scene, const RenderConfig& config);
 
 // The key of a render of `scene` with `config` (sampleBase from the sampling plan).
 CheckpointKey checkpointKey(const Scene& scene, const RenderConfig& config, int sampleBase);

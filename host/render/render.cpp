@@ -18,6 +18,7 @@
 #include <tbb/info.h>
 
 #include <chrono>
+#include <climits>
 #include <cstdio>
 #include <optional>
 #include <stdexcept>
@@ -62,7 +63,13 @@ std::string partialRenderProblem(const Scene& scene, const RenderConfig& config,
     return "";
 }
 
-SamplingPlan planSampling(const ImageSettings& image, std::optional<int> spp) {
+SamplingPlan planSampling(const ImageSettings& image, std::optional<int> spp, int resumedBase) {
+    // A resume keeps its checkpoint's samples an iteration where they divide the samples asked
+    // for (more --spp than the checkpoint's render, or the scene's own after an --spp).
+    const long long total = spp ? *spp : (long long)image.samplesPerIteration() * image.iterations;
+    const long long resumed = (long long)resumedBase * resumedBase;
+    if (resumedBase > 0 && total % resumed == 0 && total / resumed <= INT_MAX)
+        return {resumedBase, int(total / resumed)};
     if (!spp) return {image.sampleBase, image.iterations};
     const int n2 = image.samplesPerIteration();
     // Keep the scene's n x n pattern when it divides the request; otherwise one sample per pass.
@@ -94,8 +101,9 @@ class RenderSession {
     RenderSession(const Scene& scene, const RenderConfig& config,
                   const CheckpointOptions& checkpoints, RankPolicy& sync)
         : scene_(scene), config_(config), checkpoints_(checkpoints), sync_(sync),
-          plan_(planSampling(scene.image, config.spp)), spi_(plan_.sampleBase * plan_.sampleBase),
-          stop_(config) {}
+          plan_(planSampling(scene.image, config.spp,
+                             checkpoints.resume ? checkpoints.resume->key.sampleBase : 0)),
+          spi_(plan_.sampleBase * plan_.sampleBase), stop_(config) {}
 
     std::unique_ptr<RenderResult> run(const ProgressCallback& onIteration);
 
@@ -302,9 +310,8 @@ void RenderSession::startAt() {
                                scene_.settings.adaptiveMinSamples);
     // Toward a target the tiles share the samples by their noise; not in a partial render,
     // whose samples are the whole render's range and not its own to share.
-    if (config_.targetError && config_.adaptiveToTarget && !config_.sampleRange &&
-        !(scene_.settings.adaptiveThreshold > 0.0))
-        result_->film->setAdaptiveTarget(*config_.targetError);
+    if (const double target = adaptiveTarget(scene_, config_); target > 0)
+        result_->film->setAdaptiveTarget(target);
     sync_.share(*result_->film);
     key_ = checkpoints_.key;
     if (!key_ && (!checkpoints_.path.empty() || checkpoints_.resume))
@@ -350,7 +357,7 @@ const char* RenderSession::iterate(const ProgressCallback& onIteration) {
     for (int ran = 0; done_ < end_; ++ran) {
         const Ranks::Agreement agreed =
             sync_.agreeBefore(stop_.stopAsked(), stop_.timeUp(ran, renderSeconds_), stats_.stages);
-        if (const char* why = stop_.before(ran, agreed, film)) return why;
+        if (const char* why = stop_.before(done_ > first_, agreed, film)) return why;
         const auto iterationStart = std::chrono::steady_clock::now();
         {
             StageTimer t(stats_.stages, "accumulate");

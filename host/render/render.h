@@ -40,7 +40,9 @@ struct SamplingPlan {
     int sampleBase;
     int iterations;
 };
-SamplingPlan planSampling(const ImageSettings& image, std::optional<int> spp);
+// `resumedBase`: the sample base of the checkpoint a render resumes (0: none), kept where it
+// divides the samples asked for.
+SamplingPlan planSampling(const ImageSettings& image, std::optional<int> spp, int resumedBase = 0);
 
 // Why a checkpoint (found) cannot be resumed by a render keyed `expected`, or "". Where the only
 // cause is an --spp the scene's n x n pattern does not divide (this render would take one sample

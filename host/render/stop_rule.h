@@ -23,13 +23,15 @@ class StopRule {
         return ran > 0 && config_.timeLimitSeconds && renderSeconds >= *config_.timeLimitSeconds;
     }
 
-    // Why the render stops before iteration `ran`, given what the processes agreed, or nullptr
-    // to go on. The film's own decisions (adaptive, target error) are the same on every rank.
-    const char* before(int ran, const Ranks::Agreement& agreed, const Film& film) const {
+    // Why the render stops before its next iteration, given what the processes agreed, or
+    // nullptr to go on; `filmHolds`: whether the film holds whole iterations (this run's, or a
+    // checkpoint's: a render resumed after it stopped on its target stops again, at once). The
+    // film's own decisions (adaptive, target error) are the same on every rank.
+    const char* before(bool filmHolds, const Ranks::Agreement& agreed, const Film& film) const {
         if (agreed.timeUp) return "time limit";
         if (agreed.stop) return bySignal();
-        if (ran > 0 && !film.anySampling()) return "adaptive"; // every tile below the threshold
-        if (ran > 0 && config_.targetError) {
+        if (filmHolds && !film.anySampling()) return "adaptive"; // every tile below threshold
+        if (filmHolds && config_.targetError) {
             const std::optional<double> estimate = film.halfBufferRelMseEstimate();
             if (estimate && *estimate <= *config_.targetError) return "target error";
         }
