@@ -20,29 +20,28 @@ namespace {
 class CpuShading : public SlottedEngine {
   public:
     CpuShading(const RenderContext& ctx, bool simd)
-        : SlottedEngine(ctx, sortRule(ctx.config.pipeline, ctx.textures.active())),
+        : SlottedEngine(ctx, chooseHitOrder(rule(ctx), ctx.textures.active(),
+                                            ctx.params.environment != kNoEmitter)),
           view_(ctx.lights.view()), params_(ctx.params),
           chunk_(size_t(ctx.scene.settings.shadingSize)), simd_(simd),
           fused_(ctx.config.pipeline.fuseStages) {}
 
     // Sorted hits pay on the cpu only where textures are read (coherent tile reads); elsewhere it
     // shades the same function whatever the order, and the sort measured a pure cost (0.25 s of
-    // a 4 s render on the Cornell box).
-    static bool sortRule(const PipelineConfig& p, bool textured) {
-        return p.sortsHits() && (p.hitSort == HitSortMode::On || textured);
-    }
-    // Sorted by shader alone, a shader's hits read its images together (texture by texture, the
-    // 8-bit lookups SIMD-wide); object and texture order within it pay only where the images
-    // outgrow the tile cache (neighbouring lookups then share tiles before they are evicted:
-    // ProductionScene.* reads a third of the tiles), or where --hit-sort on asks for them. Where
-    // the cache holds the images they cost more than they gain. Measured (docs/performance.md,
-    // "Time to Cycles' error"): the shader alone 4-12 % faster than the whole key on 2 textured
-    // shaders (64^2 and 1024^2 images) and on 4, 16 and 64 shaders of 7 images each.
-    bool ordersByTexture() const override {
-        return ctx_.config.pipeline.hitSort == HitSortMode::On || ctx_.textures.outgrowsCache();
-    }
-    bool takesTraversalOrder() const override {
-        return fused_ && !sortsHits() && ctx_.params.environment == kNoEmitter;
+    // a 4 s render on the Cornell box). Sorted by shader alone, a shader's hits read its images
+    // together (texture by texture, the 8-bit lookups SIMD-wide); object and texture order within
+    // it pay only where the images outgrow the tile cache (neighbouring lookups then share tiles
+    // before they are evicted: ProductionScene.* reads a third of the tiles), or where --hit-sort
+    // on asks for them. Where the cache holds the images they cost more than they gain. Measured
+    // (docs/performance.md, "Time to Cycles' error"): the shader alone 4-12 % faster than the
+    // whole key on 2 textured shaders (64^2 and 1024^2 images) and on 4, 16 and 64 shaders of 7
+    // images each. The fused loop takes unsorted hits straight from traversal (shadeFused); the
+    // separate stages set up a slot through the order.
+    static HitOrderRule rule(const RenderContext& ctx) {
+        const PipelineConfig& p = ctx.config.pipeline;
+        const bool asked = p.hitSort == HitSortMode::On;
+        return {p.sortsHits() && (asked || ctx.textures.active()),
+                asked || ctx.textures.outgrowsCache(), p.fuseStages};
     }
     void beginIteration(uint iteration) override {
         SlottedEngine::beginIteration(iteration);

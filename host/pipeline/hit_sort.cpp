@@ -32,6 +32,27 @@ uint textureOrder(const Mesh& mesh, uint primitive, float u, float v) {
     return spreadBits(wrapped16(uv.x)) | spreadBits(wrapped16(uv.y)) << 1;
 }
 
+const char* hitOrderName(HitOrder order) {
+    switch (order) {
+    case HitOrder::AsTraced:
+        return "as traced";
+    case HitOrder::MissesLast:
+        return "misses last";
+    case HitOrder::ByShader:
+        return "shader";
+    case HitOrder::ByShaderObjectTexture:
+        return "shader, object, texture order";
+    }
+    return "?";
+}
+
+HitOrder chooseHitOrder(const HitOrderRule& rule, bool readsImages, bool hasEnvironment) {
+    if (rule.byShader)
+        return readsImages && rule.textureOrderPays ? HitOrder::ByShaderObjectTexture
+                                                    : HitOrder::ByShader;
+    return rule.takesMissesInPlace && !hasEnvironment ? HitOrder::AsTraced : HitOrder::MissesLast;
+}
+
 ShaderOrder::ShaderOrder(const Scene& scene) : shaderAt(scene.shaders.size()) {
     std::iota(shaderAt.begin(), shaderAt.end(), 0u);
     std::stable_sort(shaderAt.begin(), shaderAt.end(), [&](uint a, uint b) {

@@ -39,6 +39,34 @@ inline uint shaderOfKey(std::uint64_t key) {
     return uint(key >> 52);
 }
 
+// How a batch's hits are ordered before they are shaded: decided once a render, by
+// chooseHitOrder() from the engine's rule (ShadingEngine::hitOrder), and followed by the hit
+// sort (stages.h: sortHits), the shading ranges (shadeRanges) and --stats.
+enum class HitOrder {
+    AsTraced,              // traversal order, misses in place: no sort at all
+    MissesLast,            // traversal order, the misses moved behind the hits
+    ByShader,              // by shader rank (ShaderOrder), traversal order within a shader
+    ByShaderObjectTexture, // by shader rank, then object, then textureOrder()
+};
+// What --stats and the messages call it.
+const char* hitOrderName(HitOrder order);
+// Whether the hits are sorted by shader: each surface model's hits one contiguous range.
+inline bool sortsByShader(HitOrder order) {
+    return order == HitOrder::ByShader || order == HitOrder::ByShaderObjectTexture;
+}
+
+// What a shading engine wants of the order.
+struct HitOrderRule {
+    bool byShader;           // its hits sorted by shader (each model's range one dispatch)
+    bool textureOrderPays;   // within a shader, object and texture order pay where images are read
+    bool takesMissesInPlace; // it can shade unsorted hits with the misses among them
+};
+// The one decision: by shader where the engine asks for it (with object and texture order where
+// the scene reads images and that pays); otherwise traversal order, the misses moved out only
+// where an environment gives them something to add (accumulateEscapes reads them behind the
+// hits) or the engine cannot leave them in place.
+HitOrder chooseHitOrder(const HitOrderRule& rule, bool readsImages, bool hasEnvironment);
+
 // The shaders' places in the hit sort: by surface model, then by index.
 struct ShaderOrder {
     explicit ShaderOrder(const Scene& scene);

@@ -30,8 +30,7 @@ struct ShadeRange {
 constexpr uint kMixedModels = 0xFFFFFFFFu;
 
 // One traced batch: its rays, their hits, and the hits in shading order (the first `hitCount`
-// of `order`; `order` is empty where the engine takes the hits in traversal order,
-// takesTraversalOrder()).
+// of `order`; `order` is empty where the engine takes them as traced, HitOrder::AsTraced).
 struct TracedBatch {
     const std::vector<RayState>& rays;
     const std::vector<HitRecord>& hits;
@@ -42,16 +41,9 @@ struct TracedBatch {
 class ShadingEngine {
   public:
     virtual ~ShadingEngine() = default;
-    // Whether the hits are sorted by (shader, object, texture order) before shading: the
-    // engine's rule for --hit-sort auto (render_config.h: HitSortMode).
-    virtual bool sortsHits() const = 0;
-    // Whether, within a shader, sorted hits follow object and texture order where the scene reads
-    // image textures (neighbouring lookups share tiles); otherwise they keep traversal order, and
-    // the radix sort takes one pass instead of three or four.
-    virtual bool ordersByTexture() const { return true; }
-    // Whether, where the scene has no environment for the misses to see, the engine takes the
-    // hits unsorted, in traversal order, misses in place (no hit sort at all).
-    virtual bool takesTraversalOrder() const { return false; }
+    // How the engine takes a batch's hits (hit_sort.h: chooseHitOrder), the same for every batch
+    // of the render.
+    HitOrder hitOrder() const { return hitOrder_; }
     virtual void beginIteration(uint iteration) = 0;
     // The batch's per-hit stages, hit setup to bin: contributions into `film`, continuation rays
     // into `bins`. The batch's rays and hits may be reused once this returns; its shading may
@@ -64,6 +56,12 @@ class ShadingEngine {
     virtual void abandon() {}
     // Adds the engine's own counters and decisions to the stats (at the end of every iteration).
     virtual void publishStats(RenderStats& /*stats*/) {}
+
+  protected:
+    explicit ShadingEngine(HitOrder order) : hitOrder_(order) {}
+
+  private:
+    HitOrder hitOrder_;
 };
 
 } // namespace spw

@@ -24,8 +24,7 @@ struct ShadeSlot {
 
 class SlottedEngine : public ShadingEngine {
   public:
-    SlottedEngine(const RenderContext& ctx, bool sortsHits);
-    bool sortsHits() const override { return sortHits_; }
+    SlottedEngine(const RenderContext& ctx, HitOrder order);
     void beginIteration(uint iteration) override {
         iteration_ = iteration;
         next_ = 0;
@@ -63,7 +62,6 @@ class SlottedEngine : public ShadingEngine {
         std::vector<uvec2> paths; // (pathId, bounce) per hit: the film needs them, and the
                                   // inputs may sit in write-combined device memory
     };
-    bool sortHits_;
     ShaderOrder shaderOrder_; // the shaders' ranks in the hit sort (hit_sort.h)
     InFlight inFlight_[2];
     int pending_ = -1; // the slot whose batch is being shaded

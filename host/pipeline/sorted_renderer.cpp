@@ -122,18 +122,15 @@ size_t SortedRenderer::traceBatch(bool camera) {
         policy_.record(mode != RaySortMode::Off, since(sortStart), n);
         ctx_.stats.bounceRays += n;
     }
-    if (shading_->takesTraversalOrder()) {
+    const HitOrder order = shading_->hitOrder();
+    if (order == HitOrder::AsTraced) {
         // Nothing to sort and no miss to shade: the fused loop takes the hits in traversal
         // order and leaves out the misses chunk by chunk (stages.h: shadeFused).
         s.order.clear();
         return n;
     }
     StageTimer t(times, "sort hits");
-    // Within a shader, texture order only where textures are read and the engine takes it:
-    // otherwise the traversal order stays, and the radix sort needs one pass instead of three or
-    // four.
-    return sortHits(ctx_.scene, shaderOrder_, s.hits, shading_->sortsHits(), textureOrder(),
-                    s.order, s.keyTmp);
+    return sortHits(ctx_.scene, shaderOrder_, s.hits, order, s.order, s.keyTmp);
 }
 
 void SortedRenderer::escapes(uint iteration, size_t hitCount, Film& film) {
@@ -156,11 +153,12 @@ void SortedRenderer::publishStats() {
     x["ray_format"] = rayFormatName(config_.rayFormat);
     x["ray_record_bytes"] = rayRecordBytes(config_.rayFormat);
     x["ray_sort"] = raySortName(config_.raySort);
-    x["hit_sort"] = shading_->sortsHits();
-    if (shading_->sortsHits())
-        x["hit_sort_key"] = textureOrder() ? "shader, object, texture order" : "shader";
+    const HitOrder order = shading_->hitOrder();
+    x["hit_order"] = hitOrderName(order);
+    x["hit_sort"] = sortsByShader(order);
+    if (sortsByShader(order)) x["hit_sort_key"] = hitOrderName(order);
     x["shading"] =
-        shadingModeName(shading_->sortsHits() ? ShadingMode::Sorted : ShadingMode::Megakernel);
+        shadingModeName(sortsByShader(order) ? ShadingMode::Sorted : ShadingMode::Megakernel);
     x["batches_ray_sorted"] = policy_.sortedBatches();
     x["batches_ray_unsorted_measured"] = policy_.unsortedBatches();
     shading_->publishStats(ctx_.stats);

@@ -33,9 +33,6 @@ class SortedRenderer : public Backend {
     // escape: the batch's misses see the environment (stages.h: accumulateEscapes).
     void escapes(uint iteration, size_t hitCount, Film& film);
     void publishStats();
-    // Whether sorted hits take object and texture order within a shader: where the scene reads
-    // image textures and the engine takes that order (ShadingEngine::ordersByTexture).
-    bool textureOrder() const { return ctx_.textures.active() && shading_->ordersByTexture(); }
 
     RenderContext ctx_;
     PipelineConfig config_;

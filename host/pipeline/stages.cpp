@@ -136,9 +136,14 @@ void traverse(const EmbreeScene& embree, const std::vector<RayState>& rays, bool
 }
 
 size_t sortHits(const Scene& scene, const ShaderOrder& shaders, const std::vector<HitRecord>& hits,
-                bool byShader, bool inTextureOrder, std::vector<SortedHit>& order,
-                std::vector<SortedHit>& scratch) {
+                HitOrder how, std::vector<SortedHit>& order, std::vector<SortedHit>& scratch) {
     const size_t n = hits.size();
+    if (how == HitOrder::AsTraced) {
+        order.clear();
+        return n;
+    }
+    const bool byShader = sortsByShader(how);
+    const bool inTextureOrder = how == HitOrder::ByShaderObjectTexture;
     order.resize(n);
     // Sorted, the misses take the rank after the last shader's: behind every hit, and varying
     // no byte of the keys that the hits' ranks do not (the all-ones key would make all eight
@@ -299,10 +304,10 @@ void setUpHits(const RenderContext& ctx, const std::vector<RayState>& rays,
 }
 
 void shadeRanges(const Scene& scene, const ShaderOrder& shaders,
-                 const std::vector<SortedHit>& order, size_t hitCount, bool byShader,
+                 const std::vector<SortedHit>& order, size_t hitCount, HitOrder how,
                  std::vector<ShadeRange>& ranges) {
     ranges.clear();
-    if (byShader) {
+    if (sortsByShader(how)) {
         // The sort keys carry the shader's rank in their top bits, and the ranks put the shaders
         // of one surface model next to each other: their runs make one range.
         for (const ShaderRun& run : shaderRuns(order, hitCount)) {

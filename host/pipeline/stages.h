@@ -58,13 +58,11 @@ void decompressRays(const RayBatch& batch, std::vector<RayState>& rays);
 void traverse(const EmbreeScene& embree, const std::vector<RayState>& rays, bool coherent,
               std::vector<HitRecord>& hits);
 
-// sort hits: one SortedHit per ray, the hits first, the misses after them. With `byShader` the
-// hits go by shader rank (ShaderOrder), then by object and texture order where
-// `inTextureOrder`, else in traversal order within a shader; without, in traversal order.
-// Returns the number of hits.
+// sort hits: the hits in `how` (hit_sort.h: HitOrder), one SortedHit per ray, the hits first,
+// the misses after them; with HitOrder::AsTraced, `order` empty (no sort). Returns the number of
+// hits.
 size_t sortHits(const Scene& scene, const ShaderOrder& shaders, const std::vector<HitRecord>& hits,
-                bool byShader, bool inTextureOrder, std::vector<SortedHit>& order,
-                std::vector<SortedHit>& scratch);
+                HitOrder how, std::vector<SortedHit>& order, std::vector<SortedHit>& scratch);
 
 // hit setup: inputs[i] and paths[i] (pathId, bounce) for the i-th hit in `order`. Chunk by
 // chunk of kChunk (256) hits; within a chunk, each run of one shader's hits looks its textures up
@@ -73,9 +71,10 @@ void setUpHits(const RenderContext& ctx, const std::vector<RayState>& rays,
                const std::vector<HitRecord>& hits, const std::vector<SortedHit>& order,
                size_t hitCount, ShadeInput* inputs, uvec2* paths);
 
-// shade: the ranges the engine shades, one per surface model (by shader) or one over every hit.
+// shade: the ranges the engine shades, one per surface model (hits sorted by shader) or one over
+// every hit.
 void shadeRanges(const Scene& scene, const ShaderOrder& shaders,
-                 const std::vector<SortedHit>& order, size_t hitCount, bool byShader,
+                 const std::vector<SortedHit>& order, size_t hitCount, HitOrder how,
                  std::vector<ShadeRange>& ranges);
 
 // shadow: the shadow rays the shading made, and for each the hit it belongs to.

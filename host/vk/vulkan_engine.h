@@ -101,8 +101,7 @@ class VulkanShading : public SlottedEngine {
     };
 
     // The constructor's steps, in order.
-    std::vector<std::string> chooseKernels(const RenderContext& ctx,
-                                           const PipelineConfig& pipeline);
+    std::vector<std::string> chooseKernels(const RenderContext& ctx);
     void sizeWindows();
     void createCommandObjects();
     std::unique_ptr<HostArray> uploadTable(const void* data, size_t bytes, size_t texelBytes,

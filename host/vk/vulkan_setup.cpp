@@ -1,14 +1,25 @@
 #include "host/vk/vulkan_engine.h"
 
 namespace spw::vk_engine {
+namespace {
+
+// Sorted by shader where the pipeline sorts (each model's range one dispatch), in object and
+// texture order where images are read (neighbouring invocations share tiles); hit setup into a
+// slot reads the hits through the order, so unsorted ones still have their misses moved out.
+HitOrder vulkanHitOrder(const RenderContext& ctx, const PipelineConfig& pipeline) {
+    return chooseHitOrder({pipeline.sortsHits(), true, false}, ctx.textures.active(),
+                          ctx.params.environment != kNoEmitter);
+}
+
+} // namespace
 
 VulkanShading::VulkanShading(const RenderContext& ctx, const PipelineConfig& pipeline,
                              vk::Context& context)
-    : SlottedEngine(ctx, pipeline.sortsHits()), vk_(context), device_(context.device()),
+    : SlottedEngine(ctx, vulkanHitOrder(ctx, pipeline)), vk_(context), device_(context.device()),
       params_(ctx.params), config_(ctx.config.vulkan), stages_(ctx.stats.stages) {
     std::fill(std::begin(modelPipeline_), std::end(modelPipeline_), -1);
     try {
-        const std::vector<std::string> kernels = chooseKernels(ctx, pipeline);
+        const std::vector<std::string> kernels = chooseKernels(ctx);
         sizeWindows();
         createCommandObjects();
         uploadTables(ctx);
@@ -21,8 +32,7 @@ VulkanShading::VulkanShading(const RenderContext& ctx, const PipelineConfig& pip
 
 // What the scene needs: the models its meshes use, emitters, textures; the kernels to build
 // (one per model used, or the megakernel) and what they are specialised on.
-std::vector<std::string> VulkanShading::chooseKernels(const RenderContext& ctx,
-                                                      const PipelineConfig& pipeline) {
+std::vector<std::string> VulkanShading::chooseKernels(const RenderContext& ctx) {
     const Scene& scene = ctx.scene;
     bool used[kModelCount] = {};
     bool textured = false;
@@ -45,7 +55,7 @@ std::vector<std::string> VulkanShading::chooseKernels(const RenderContext& ctx,
         spec_.emissionMaps = spec_.emissionMaps || e.map != kNoEmissionMap;
     }
     std::vector<std::string> kernels;
-    if (pipeline.sortsHits()) {
+    if (sortsByShader(hitOrder())) {
         for (const SurfaceModelInfo& m : kSurfaceModels)
             if (used[m.model]) {
                 modelPipeline_[m.model] = int(kernels.size());

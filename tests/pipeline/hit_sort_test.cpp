@@ -141,5 +141,29 @@ TEST(HitSort, TextureOrderIsTheMortonCodeOfTheWrappedTextureCoordinates) {
     EXPECT_EQ(textureOrder(mesh, 0, 0.0f, 1.5f / 65536), a + 2);
 }
 
+// The one routing decision, case by case: by shader only where the engine's rule asks for it,
+// with object and texture order only where images are read and that pays; unsorted hits as
+// traced only where the engine can leave the misses in place and no environment reads them.
+TEST(HitOrder, ChooseHitOrderFollowsTheRule) {
+    using O = HitOrder;
+    for (bool pays : {false, true})
+        for (bool inPlace : {false, true})
+            for (bool env : {false, true}) {
+                const HitOrderRule sorted{true, pays, inPlace};
+                EXPECT_EQ(chooseHitOrder(sorted, false, env), O::ByShader);
+                EXPECT_EQ(chooseHitOrder(sorted, true, env),
+                          pays ? O::ByShaderObjectTexture : O::ByShader);
+                const HitOrderRule unsorted{false, pays, inPlace};
+                for (bool images : {false, true})
+                    EXPECT_EQ(chooseHitOrder(unsorted, images, env),
+                              inPlace && !env ? O::AsTraced : O::MissesLast);
+            }
+    EXPECT_FALSE(sortsByShader(O::AsTraced));
+    EXPECT_FALSE(sortsByShader(O::MissesLast));
+    EXPECT_TRUE(sortsByShader(O::ByShader));
+    EXPECT_TRUE(sortsByShader(O::ByShaderObjectTexture));
+    EXPECT_STREQ(hitOrderName(O::ByShaderObjectTexture), "shader, object, texture order");
+}
+
 } // namespace
 } // namespace spw

@@ -215,6 +215,7 @@ TEST(SortedPipeline, HitSortAutoSortsForTexturesOnlyAndByTextureOrderForABusyCac
     on.pipeline.hitSort = HitSortMode::On;
     auto r = render(plain, cfg), rOn = render(plain, on);
     EXPECT_EQ(r->stats.extra["hit_sort"], false);
+    EXPECT_EQ(r->stats.extra["hit_order"], "as traced"); // no environment: misses left in place
     EXPECT_EQ(rOn->stats.extra["hit_sort"], true);
     EXPECT_TRUE(sameBits(r->film->image(), rOn->film->image()));
     const std::string whole = "shader, object, texture order";
