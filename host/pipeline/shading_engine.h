@@ -1,10 +1,11 @@
 // The shading engine: what the sorted pipeline hands over once a batch is traced and its hits
 // are sorted, in one call (shadeBatch). The engine does the per-hit stages from there, hit setup
-// to bin (stages.h), its own way, and says how it wants the hits ordered. Two engines: C++ on the
-// host's threads (cpu_shading.h), fusing the stages chunk by chunk, and Vulkan compute
-// (host/vk/vulkan_shading.h), overlapping a batch's shading with the next batch's traversal.
-// Both shade contiguous ranges of hits, one surface model each (ShadeRange), through a slot's
-// inputs and results (SlottedEngine, slotted_engine.h).
+// to bin (stages.h), its own way, and says how it wants the hits ordered (hitOrder). Three
+// engines: C++ on the host's threads fusing the stages chunk by chunk (the default) or running
+// each over the whole batch (--stages separate), both in host/cpu/cpu_shading.cpp, and Vulkan
+// compute (host/vk/vulkan_shading.h), overlapping a batch's shading with the next batch's
+// traversal. All shade contiguous ranges of hits, one surface model each (ShadeRange); the last
+// two through a slot's inputs and results (SlottedEngine, slotted_engine.h).
 #pragma once
 
 #include "host/backend/stats.h"

@@ -373,6 +373,7 @@ PerHit shadeSameHits(ShadingMode mode) {
     cfg.backend = BackendKind::Vulkan;
     cfg.vulkan.validation = true;
     cfg.pipeline.shading = mode;
+    cfg.pipeline.fuseStages = false; // the cpu engine with a slot to feed (--stages separate)
     RenderParams params{};
     params.seed = 7;
     params.samplesPerIteration = 4;
