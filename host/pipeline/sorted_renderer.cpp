@@ -67,7 +67,7 @@ bool SortedRenderer::renderIteration(uint iteration, Film& film) {
             shading_->finish(film, *bins_); // its continuation rays may refill the queue
             continue;
         }
-        const size_t hitCount = traceBatch(camera);
+        const size_t hitCount = traceAndSortBatch(camera);
         escapes(iteration, hitCount, film);
         shading_->shadeBatch({s.rays, s.hits, s.order, hitCount}, film, *bins_);
     }
@@ -96,7 +96,7 @@ bool SortedRenderer::nextBatch(Film& film, bool flush, bool& camera) {
     return true;
 }
 
-size_t SortedRenderer::traceBatch(bool camera) {
+size_t SortedRenderer::traceAndSortBatch(bool camera) {
     Scratch& s = *scratch_;
     StageTimes& times = ctx_.stats.stages;
     const size_t n = s.rays.size();

@@ -29,7 +29,7 @@ class SortedRenderer : public Backend {
     // (DirectionalBins::flush). False when none.
     bool nextBatch(Film& film, bool flush, bool& camera);
     // sort rays .. sort hits: the batch's hits in shading order in the scratch; their count.
-    size_t traceBatch(bool camera);
+    size_t traceAndSortBatch(bool camera);
     // escape: the batch's misses see the environment (stages.h: accumulateEscapes).
     void escapes(uint iteration, size_t hitCount, Film& film);
     void publishStats();
