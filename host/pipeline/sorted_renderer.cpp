@@ -68,7 +68,7 @@ bool SortedRenderer::renderIteration(uint iteration, Film& film) {
             continue;
         }
         const size_t hitCount = traceAndSortBatch(camera);
-        escapes(iteration, hitCount, film);
+        addEscapedRadiance(iteration, hitCount, film);
         shading_->shadeBatch({s.rays, s.hits, s.order, hitCount}, film, *bins_);
     }
     publishStats();
@@ -133,7 +133,7 @@ size_t SortedRenderer::traceAndSortBatch(bool camera) {
     return sortHits(ctx_.scene, shaderOrder_, s.hits, order, s.order, s.keyTmp);
 }
 
-void SortedRenderer::escapes(uint iteration, size_t hitCount, Film& film) {
+void SortedRenderer::addEscapedRadiance(uint iteration, size_t hitCount, Film& film) {
     if (ctx_.params.environment == kNoEmitter) return; // a miss sees black: nothing to add
     StageTimer t(ctx_.stats.stages, "escape");
     accumulateEscapes(ctx_, iteration, scratch_->rays, scratch_->order, hitCount, film);

@@ -31,7 +31,7 @@ class SortedRenderer : public Backend {
     // sort rays .. sort hits: the batch's hits in shading order in the scratch; their count.
     size_t traceAndSortBatch(bool camera);
     // escape: the batch's misses see the environment (stages.h: accumulateEscapes).
-    void escapes(uint iteration, size_t hitCount, Film& film);
+    void addEscapedRadiance(uint iteration, size_t hitCount, Film& film);
     void publishStats();
 
     RenderContext ctx_;
