@@ -53,7 +53,7 @@ HitOrder chooseHitOrder(const HitOrderRule& rule, bool readsImages, bool hasEnvi
     return rule.takesMissesInPlace && !hasEnvironment ? HitOrder::AsTraced : HitOrder::MissesLast;
 }
 
-ShaderOrder::ShaderOrder(const Scene& scene) : shaderAt(scene.shaders.size()) {
+ShaderRanks::ShaderRanks(const Scene& scene) : shaderAt(scene.shaders.size()) {
     std::iota(shaderAt.begin(), shaderAt.end(), 0u);
     std::stable_sort(shaderAt.begin(), shaderAt.end(), [&](uint a, uint b) {
         return scene.shaders[a].params.model < scene.shaders[b].params.model;

@@ -2,7 +2,7 @@
 // so that a radix sort of the keys groups a batch's hits by surface model and shader, and within
 // a shader by object and then by where they fall in texture space (coherent texture reads);
 // misses sort last (stages.h: sortHits gives them the rank after the last shader's; kMissKey, the
-// all-ones key, where hits are not sorted). The shader's rank (ShaderOrder) puts the shaders
+// all-ones key, where hits are not sorted). The shader's rank (ShaderRanks) puts the shaders
 // of one surface model next to each other: each model's hits are one contiguous range, one
 // dispatch of its kernel on the vulkan backend, whatever the order of the scene's shaders. Object
 // and texture order only pay where textures are read; elsewhere the pipeline keys (shader rank,
@@ -45,7 +45,7 @@ inline uint shaderOfKey(std::uint64_t key) {
 enum class HitOrder {
     AsTraced,              // traversal order, misses in place: no sort at all
     MissesLast,            // traversal order, the misses moved behind the hits
-    ByShader,              // by shader rank (ShaderOrder), traversal order within a shader
+    ByShader,              // by shader rank (ShaderRanks), traversal order within a shader
     ByShaderObjectTexture, // by shader rank, then object, then textureOrder()
 };
 // What --stats and the messages call it.
@@ -68,15 +68,15 @@ struct HitOrderRule {
 HitOrder chooseHitOrder(const HitOrderRule& rule, bool readsImages, bool hasEnvironment);
 
 // The shaders' places in the hit sort: by surface model, then by index.
-struct ShaderOrder {
-    explicit ShaderOrder(const Scene& scene);
+struct ShaderRanks {
+    explicit ShaderRanks(const Scene& scene);
     std::vector<uint> rank;     // rank[shader]: what the sort key holds
     std::vector<uint> shaderAt; // shaderAt[rank]: the shader
 };
 
 // A run of sorted hits that share one shader: [begin, begin + count).
 struct ShaderRun {
-    uint shader; // what the keys hold: the shader's rank where they were made by ShaderOrder
+    uint shader; // what the keys hold: the shader's rank where they were made by ShaderRanks
     size_t begin, count;
 };
 

@@ -5,7 +5,7 @@
 namespace spw {
 
 SlottedEngine::SlottedEngine(const RenderContext& ctx, HitOrder order)
-    : ShadingEngine(order), ctx_(ctx), shaderOrder_(ctx.scene) {}
+    : ShadingEngine(order), ctx_(ctx), shaderRanks_(ctx.scene) {}
 
 void SlottedEngine::shadeBatch(const TracedBatch& batch, Film& film, DirectionalBins& bins) {
     start(batch, next_);
@@ -51,7 +51,7 @@ void SlottedEngine::start(const TracedBatch& batch, int slot) {
     }
     {
         StageTimer t(times, "shade");
-        shadeRanges(ctx_.scene, shaderOrder_, batch.order, flight.hitCount, hitOrder(), ranges_);
+        shadeRanges(ctx_.scene, shaderRanks_, batch.order, flight.hitCount, hitOrder(), ranges_);
         submit(slot, ranges_);
     }
 }

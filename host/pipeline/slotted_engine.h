@@ -62,7 +62,7 @@ class SlottedEngine : public ShadingEngine {
         std::vector<uvec2> paths; // (pathId, bounce) per hit: the film needs them, and the
                                   // inputs may sit in write-combined device memory
     };
-    ShaderOrder shaderOrder_; // the shaders' ranks in the hit sort (hit_sort.h)
+    ShaderRanks shaderRanks_; // the shaders' ranks in the hit sort (hit_sort.h)
     InFlight inFlight_[2];
     int pending_ = -1; // the slot whose batch is being shaded
     int next_ = 0;

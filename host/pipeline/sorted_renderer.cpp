@@ -25,7 +25,7 @@ SortedRenderer::SortedRenderer(const RenderContext& ctx, const PipelineConfig& c
                                std::unique_ptr<ShadingEngine> shading)
     : ctx_(ctx), config_(config), shading_(std::move(shading)),
       policy_(config.raySort, size_t(1) << uint(ctx.scene.settings.binExponent)),
-      scratch_(std::make_unique<Scratch>()), shaderOrder_(ctx.scene) {
+      scratch_(std::make_unique<Scratch>()), shaderRanks_(ctx.scene) {
     const double budgetMiB = ctx.scene.settings.memoryBudgetMiB;
     const uint exponent = uint(ctx.scene.settings.binExponent);
     // The budget covers every ray waiting in RAM: the six bins fill up to one batch each, and
@@ -130,7 +130,7 @@ size_t SortedRenderer::traceAndSortBatch(bool camera) {
         return n;
     }
     StageTimer t(times, "sort hits");
-    return sortHits(ctx_.scene, shaderOrder_, s.hits, order, s.order, s.keyTmp);
+    return sortHits(ctx_.scene, shaderRanks_, s.hits, order, s.order, s.keyTmp);
 }
 
 void SortedRenderer::addEscapedRadiance(uint iteration, size_t hitCount, Film& film) {

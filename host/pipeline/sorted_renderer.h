@@ -43,7 +43,7 @@ class SortedRenderer : public Backend {
     size_t batchRays_; // 2^(bin exponent)
     RaySortPolicy policy_;
     std::unique_ptr<Scratch> scratch_;
-    ShaderOrder shaderOrder_; // the shaders' ranks in the hit sort (hit_sort.h)
+    ShaderRanks shaderRanks_; // the shaders' ranks in the hit sort (hit_sort.h)
     std::uint64_t batchesProcessed_ = 0;
 };
 

@@ -135,7 +135,7 @@ void traverse(const EmbreeScene& embree, const std::vector<RayState>& rays, bool
                    coherent, hits);
 }
 
-size_t sortHits(const Scene& scene, const ShaderOrder& shaders, const std::vector<HitRecord>& hits,
+size_t sortHits(const Scene& scene, const ShaderRanks& shaders, const std::vector<HitRecord>& hits,
                 HitOrder how, std::vector<SortedHit>& order, std::vector<SortedHit>& scratch) {
     const size_t n = hits.size();
     if (how == HitOrder::AsTraced) {
@@ -303,7 +303,7 @@ void setUpHits(const RenderContext& ctx, const std::vector<RayState>& rays,
         });
 }
 
-void shadeRanges(const Scene& scene, const ShaderOrder& shaders,
+void shadeRanges(const Scene& scene, const ShaderRanks& shaders,
                  const std::vector<SortedHit>& order, size_t hitCount, HitOrder how,
                  std::vector<ShadeRange>& ranges) {
     ranges.clear();

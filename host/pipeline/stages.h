@@ -61,7 +61,7 @@ void traverse(const EmbreeScene& embree, const std::vector<RayState>& rays, bool
 // sort hits: the hits in `how` (hit_sort.h: HitOrder), one SortedHit per ray, the hits first,
 // the misses after them; with HitOrder::AsTraced, `order` empty (no sort). Returns the number of
 // hits.
-size_t sortHits(const Scene& scene, const ShaderOrder& shaders, const std::vector<HitRecord>& hits,
+size_t sortHits(const Scene& scene, const ShaderRanks& shaders, const std::vector<HitRecord>& hits,
                 HitOrder how, std::vector<SortedHit>& order, std::vector<SortedHit>& scratch);
 
 // hit setup: inputs[i] and paths[i] (pathId, bounce) for the i-th hit in `order`. Chunk by
@@ -73,7 +73,7 @@ void setUpHits(const RenderContext& ctx, const std::vector<RayState>& rays,
 
 // shade: the ranges the engine shades, one per surface model (hits sorted by shader) or one over
 // every hit.
-void shadeRanges(const Scene& scene, const ShaderOrder& shaders,
+void shadeRanges(const Scene& scene, const ShaderRanks& shaders,
                  const std::vector<SortedHit>& order, size_t hitCount, HitOrder how,
                  std::vector<ShadeRange>& ranges);
 

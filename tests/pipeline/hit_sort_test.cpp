@@ -52,7 +52,7 @@ TEST(HitSort, ShaderRanksGroupEachSurfaceModel) {
         sh.params.model = m;
         scene.shaders.push_back(sh);
     }
-    const ShaderOrder order(scene);
+    const ShaderRanks order(scene);
     ASSERT_EQ(order.shaderAt.size(), scene.shaders.size());
     for (size_t r = 0; r < order.shaderAt.size(); ++r) {
         EXPECT_EQ(order.rank[order.shaderAt[r]], r);
