@@ -5,7 +5,7 @@ The guide adds a model called Velvet (stem velvet). Read against the registry
 (shaders/shared/surface_models.h) and the dispatch (shaders/shared/bsdf.h), it must:
 - list the registered models by name, in registry order, with their ids ("ids 0u to Nu");
 - give the next free id in its registry line (`X(Velvet, <count>u, velvet,`);
-- name as the model's functions exactly those bsdf.h dispatches to (`<stem>Bsdf<Suffix>`);
+- name as the model's functions exactly those bsdf.h dispatches to (`<fn>Bsdf<Suffix>`);
 - list, in its table of files, files that every registered model has with its own stem, and a
   test file holding `TEST(<Name>,` for each.
 Each finding is printed as `docs/adding-a-surface-model.md: message`; exits 1 if any.
@@ -43,7 +43,7 @@ def problems(root):
     line = re.search(r"`X\(Velvet, (\d+)u, velvet,", guide)
     if not line or int(line.group(1)) != len(models):
         yield "the registry line must give the next id, %du" % len(models)
-    dispatched = set(re.findall(r"stem##Bsdf(\w+)\(", read(root, "shaders/shared/bsdf.h")))
+    dispatched = set(re.findall(r"fn##Bsdf(\w+)\(", read(root, "shaders/shared/bsdf.h")))
     named = set(re.findall(r"`velvetBsdf(\w+)`", guide))
     if named != dispatched:
         yield "names the functions %s; bsdf.h dispatches to %s" % (

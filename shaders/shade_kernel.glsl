@@ -1,9 +1,10 @@
 // The body of every shading kernel: one thread shades one hit with shared/path.h's
 // shadeSurface(), the very function the cpu and reference backends compile as C++. Which math
 // is shared: the whole bounce (path.h), the BSDFs (bsdf.h's dispatch and one header per model of
-// the registry, surface_models.h: lambert.h, conductor.h, dielectric.h, gltf.h, clearcoat.h,
-// transmission.h and sheen.h, over ggx.h), light sampling (lights.h), the MIS weight
-// (sampling.h: powerHeuristic), ray offsets (offset.h) and the random numbers (rng.h: pcg4d).
+// the registry, surface_models.h, each named after its model: null.h, lambert.h, conductor.h,
+// dielectric.h, metallic_roughness.h, coated_metallic_roughness.h,
+// transmissive_metallic_roughness.h and sheen_metallic_roughness.h, over ggx.h), light sampling
+// (lights.h), the MIS weight (sampling.h: powerHeuristic), ray offsets (offset.h) and the random numbers (rng.h: pcg4d).
 // Why: each then exists once, so the Vulkan image can differ from the cpu image only by how the
 // two compilers round floats (tests/vk/vulkan_test.cpp measures how much), never by a second
 // copy of the math drifting. shared/compat.h gives the rules that let one source compile as

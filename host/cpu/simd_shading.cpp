@@ -3,7 +3,7 @@
 // itself through foreach_target.h) and picks the best the processor has at the first call.
 //
 // Each kernel is shadeSurface() (shared/path.h) for one surface model (shared/lambert.h,
-// conductor.h, dielectric.h, gltf.h): shadeLanes() is its control flow, and a
+// conductor.h, dielectric.h, metallic_roughness.h): shadeLanes() is its control flow, and a
 // small struct per model supplies bsdfEval, bsdfSample and bsdfIsDelta as the SIMD twins of the
 // model's shared functions (host/simd/simd_math-inl.h and simd_bsdf-inl.h, each checked against its
 // scalar function lane by lane).
@@ -44,9 +44,9 @@ struct SurfaceLanes {
     Floats offset, lift;
     Floats alpha, ior, metallic; // the shader's GGX width, index of refraction and metalness
     Vec3s f0d;                   // MetallicRoughness: the dielectric part's F0 colour
-    Floats f90d;                 // and its F90 (shared/gltf.h); zeros for other models
-    Uints live;                  // bounce < max depth: the path goes on from here
-    Uints roulette;              // bounce >= min depth
+    Floats f90d;    // and its F90 (shared/metallic_roughness.h); zeros for other models
+    Uints live;     // bounce < max depth: the path goes on from here
+    Uints roulette; // bounce >= min depth
     RandomLanes random;
     Vec3s e0, e1, e2, eNormal, eRadiance; // the picked emitter (a triangle)
     Floats ePickPdf, eArea;
@@ -163,7 +163,8 @@ struct DielectricLanesModel {
 
 struct MetallicRoughnessLanesModel {
     Frame frame;
-    V alpha; // max(alpha, kGltfMinAlpha), as gltfBsdfEval and gltfBsdfSample take it
+    V alpha; // max(alpha, kGltfMinAlpha), as metallicRoughnessBsdfEval and
+             // metallicRoughnessBsdfSample take it
     explicit MetallicRoughnessLanesModel(const HitVector& h)
         : frame(shadingFrame(h.n)), alpha(gmax(h.alpha, hn::Set(D(), kGltfMinAlpha))) {}
     M delta(const HitVector&) const { return hn::FirstN(D(), 0); }

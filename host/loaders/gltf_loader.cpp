@@ -10,7 +10,7 @@
 #include "host/loaders/gltf_reader.h"
 #include "host/loaders/gltf_sources.h"
 #include "host/textures/textures.h"
-#include "shared/gltf.h"
+#include "shared/metallic_roughness.h"
 
 #include <glm/gtc/matrix_inverse.hpp>
 #include <glm/gtc/quaternion.hpp>

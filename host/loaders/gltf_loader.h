@@ -1,7 +1,7 @@
 // glTF 2.0 files as scenes (docs/scene-format.md, "glTF files"): `.gltf` (JSON, with external or
 // embedded buffers) and `.glb` (binary), read with tinygltf. The default scene's meshes become
-// triangle meshes with MetallicRoughness shaders (shared/gltf.h), one per material; its first
-// perspective camera is the camera (else one that frames the scene's bounds); its
+// triangle meshes with MetallicRoughness shaders (shared/metallic_roughness.h), one per material;
+// its first perspective camera is the camera (else one that frames the scene's bounds); its
 // KHR_lights_punctual point and directional lights and its emissive materials light it (else a
 // uniform environment of radiance 1). What the file holds that Spillway does not render is listed
 // in Scene::warnings, once each; an extension the file requires that Spillway cannot honour is an

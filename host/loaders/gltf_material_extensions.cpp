@@ -3,7 +3,7 @@
 // surface model of its own, their factors and images (the images as Shader::extension's maps).
 #include "host/loaders/gltf_reader.h"
 
-#include "shared/gltf.h"
+#include "shared/metallic_roughness.h"
 
 #include <algorithm>
 #include <cmath>
@@ -70,7 +70,7 @@ void GltfReader::readTransmission(const tinygltf::Material& mat, Shader& s, cons
                                                 at + "/extensions/KHR_materials_transmission");
     const bool textured = t != mat.extensions.end() && t->second.Has("transmissionTexture");
     // Opaque, the ior sets the dielectric reflection's F0 ((ior - 1) / (ior + 1))^2
-    // (shared/gltf.h's gltfDielectricF0); 0 keeps glTF's 0.04.
+    // (shared/metallic_roughness.h's gltfDielectricF0); 0 keeps glTF's 0.04.
     if (ior == 0.0 && iorExt != mat.extensions.end())
         warnOf(name, "KHR_materials_ior's ior 0 is rendered as 1.5");
     s.params.ior = float(ior == 0.0 ? 1.5 : ior);
@@ -84,7 +84,8 @@ void GltfReader::readTransmission(const tinygltf::Material& mat, Shader& s, cons
         warnOf(name,
                "an ior below " + number(kMinGlassIor) + " is rendered as " + number(kMinGlassIor));
     // Below 1, where an image may make it so, or on a metal, glass mixed with the opaque material
-    // (shared/transmission.h); the image's red channel times the factor at each hit.
+    // (shared/transmissive_metallic_roughness.h); the image's red channel times the factor at each
+    // hit.
     const bool metal = s.params.metallic > 0.0f || s.metallicRoughnessTexture >= 0;
     const bool partial = factor < 1.0 || textured || metal;
     s.typeName = partial ? "TransmissiveMetallicRoughness" : "Dielectric";

@@ -8,7 +8,7 @@
 #include "host/loaders/gltf_reader.h"
 #include "host/textures/embedded_reader.h"
 
-#include "shared/gltf.h"
+#include "shared/metallic_roughness.h"
 
 #include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>

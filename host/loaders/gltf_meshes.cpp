@@ -3,7 +3,7 @@
 // coordinates, vertex colours and triangles into a Mesh in the camera-relative world.
 #include "host/loaders/gltf_reader.h"
 
-#include "shared/gltf.h"
+#include "shared/metallic_roughness.h"
 
 #include <glm/gtc/matrix_inverse.hpp>
 #include <glm/gtc/quaternion.hpp>

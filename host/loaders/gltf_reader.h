@@ -172,7 +172,7 @@ class GltfReader {
     // it: a refracting solid, not the specification's thin wall, its base colour tinting what it
     // refracts. Transmitting part of it (0 < transmissionFactor < 1, a transmissionTexture, or a
     // metallic above 0), a TransmissiveMetallicRoughness: that glass mixed with the opaque
-    // material by the factor times 1 - metallic (shared/transmission.h).
+    // material by the factor times 1 - metallic (shared/transmissive_metallic_roughness.h).
     void readTransmission(const tinygltf::Material& mat, Shader& s, const std::string& at,
                           const std::string& name);
     // KHR_materials_volume on glass, whole or partial: attenuationColor left after
@@ -181,11 +181,12 @@ class GltfReader {
     void readVolume(const tinygltf::Material& mat, Shader& s, const std::string& at,
                     const std::string& name);
     // KHR_materials_clearcoat: a material with a coat of weight clearcoatFactor > 0 is a
-    // CoatedMetallicRoughness shader (shared/clearcoat.h), its coat's GGX alpha
+    // CoatedMetallicRoughness shader (shared/coated_metallic_roughness.h), its coat's GGX alpha
     // clearcoatRoughnessFactor^2, each factor times its image where it has one; the coat's normal
     // map is warned about and not rendered.
     // KHR_materials_sheen: a material with a sheen of colour above 0 is a SheenMetallicRoughness
-    // shader (shared/sheen.h), colour and roughness each times its image where it has one.
+    // shader (shared/sheen_metallic_roughness.h), colour and roughness each times its image where
+    // it has one.
     void readSheen(const tinygltf::Material& mat, Shader& s, const std::string& at,
                    const std::string& name);
     // KHR_materials_specular: the dielectric reflection's weight and F0 colour, each times its

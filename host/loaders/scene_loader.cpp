@@ -10,7 +10,7 @@
 #include "host/loaders/yaml_reader.h"
 #include "host/scene/scene.h"
 #include "host/scene/surface_models.h"
-#include "shared/gltf.h"
+#include "shared/metallic_roughness.h"
 
 #include <OpenImageIO/imageio.h>
 #include <glm/gtc/matrix_transform.hpp>
@@ -139,8 +139,8 @@ class TextureReader {
     std::map<std::size_t, std::vector<Seen>> seen_;
 };
 
-// The metallic-roughness models' keys (shared/gltf.h, shared/clearcoat.h), and the Dielectric's
-// absorption.
+// The metallic-roughness models' keys (shared/metallic_roughness.h,
+// shared/coated_metallic_roughness.h), and the Dielectric's absorption.
 void readGltfParams(const Reader& rd, const YAML::Node& n, uint takes, ShaderParams& p) {
     if (takes & kTakesMetallic) // glass that transmits part of the light is no metal unless told
         p.metallic = n["metallic"] ? float(rd.number(n["metallic"], "metallic", 0.0, 1.0))

@@ -1,5 +1,5 @@
 // The SIMD twins of the surface models built on GGX (shared/ggx.h, shared/conductor.h,
-// shared/dielectric.h, shared/gltf.h), one Highway helper each, to the bit as
+// shared/dielectric.h, shared/metallic_roughness.h), one Highway helper each, to the bit as
 // simd_math-inl.h's are (its opening comment gives the rules). The scalar side carries the tag
 // "// SIMD twin: host/simd/simd_bsdf-inl.h" on the line above its definition.
 //
@@ -259,7 +259,8 @@ HWY_INLINE BsdfSample dielectricSample(V ior, V alpha, V3 ng, V go, const Frame&
     return s;
 }
 
-// --- MetallicRoughness (shared/gltf.h) -----------------------------------------------------------
+// --- MetallicRoughness (shared/metallic_roughness.h)
+// -----------------------------------------------------------
 
 // glm's mix(vec3(a), b, t): a (1 - t) + b t.
 HWY_INLINE V3 mix(V a, V3 b, V t) {
@@ -273,14 +274,14 @@ HWY_INLINE V3 mix(V3 a, V3 b, V t) {
     return {hn::Add(hn::Mul(a.x, s), hn::Mul(b.x, t)), hn::Add(hn::Mul(a.y, s), hn::Mul(b.y, t)),
             hn::Add(hn::Mul(a.z, s), hn::Mul(b.z, t))};
 }
-// Twin of gltfFresnel (shared/gltf.h).
+// Twin of gltfFresnel (shared/metallic_roughness.h).
 HWY_INLINE V3 gltfFresnel(V3 f0, V f90, V cosTheta) {
     const V one = hn::Set(D(), 1.0f);
     const V m = clamp01(hn::Sub(one, cosTheta));
     const V m2 = hn::Mul(m, m);
     return add(f0, mul(sub(V3{f90, f90, f90}, f0), hn::Mul(hn::Mul(m2, m2), m)));
 }
-// gltfF90 (shared/gltf.h): 1 - (1 - f90d) (1 - metallic).
+// gltfF90 (shared/metallic_roughness.h): 1 - (1 - f90d) (1 - metallic).
 HWY_INLINE V gltfF90(V f90d, V metallic) {
     const V one = hn::Set(D(), 1.0f);
     return hn::Sub(one, hn::Mul(hn::Sub(one, f90d), hn::Sub(one, metallic)));
@@ -288,7 +289,7 @@ HWY_INLINE V gltfF90(V f90d, V metallic) {
 HWY_INLINE V mean(V3 v) {
     return hn::Div(hn::Add(hn::Add(v.x, v.y), v.z), hn::Set(D(), 3.0f));
 }
-// Twin of gltfSpecularProbability (shared/gltf.h).
+// Twin of gltfSpecularProbability (shared/metallic_roughness.h).
 HWY_INLINE V gltfSpecularProbability(V3 f0, V f90, V3 cDiff, V cosO, V alpha) {
     const D d;
     const V one = hn::Set(d, 1.0f);
@@ -300,7 +301,7 @@ HWY_INLINE V gltfSpecularProbability(V3 f0, V f90, V3 cDiff, V cosO, V alpha) {
     const V p = gmin(gmax(hn::Div(fs, hn::Add(fs, fd)), floor), hn::Set(d, 0.9f));
     return hn::IfThenElse(hn::Gt(fd, hn::Zero(d)), p, one);
 }
-// Twin of gltfEval (shared/gltf.h), given dot(ng, wo) and shadingFrame's frame.
+// Twin of gltfEval (shared/metallic_roughness.h), given dot(ng, wo) and shadingFrame's frame.
 HWY_INLINE V3 gltfEval(V3 colour, V metallic, V alpha, V3 f0d, V f90d, V3 ng, V ngDotWo,
                        const Frame& f, V3 wo, V3 wi, V& pdf) {
     const D d;
@@ -330,7 +331,7 @@ HWY_INLINE V3 gltfEval(V3 colour, V metallic, V alpha, V3 f0d, V f90d, V3 ng, V 
                                      hn::Mul(hn::Sub(one, pSpecular), hn::Mul(li.z, invPi))));
     return select(evaluated, add(specular, diffuse), V3{zero, zero, zero});
 }
-// Twin of gltfSample (shared/gltf.h), given dot(ng, wo) and shadingFrame's frame.
+// Twin of gltfSample (shared/metallic_roughness.h), given dot(ng, wo) and shadingFrame's frame.
 HWY_INLINE BsdfSample gltfSample(V3 colour, V metallic, V alpha, V3 f0d, V f90d, V3 ng, V ngDotWo,
                                  const Frame& f, V3 wo, V ux, V uy, V uz) {
     const D d;

@@ -89,8 +89,8 @@ void runRandomTwin(Twin twin, const TwinLanes& in, size_t i, TwinResults& out) {
     }
 }
 
-// The BSDF twins (shared/ggx.h, conductor.h, dielectric.h, gltf.h) on the vector of lanes
-// starting at i; the others to runRandomTwin.
+// The BSDF twins (shared/ggx.h, conductor.h, dielectric.h, metallic_roughness.h) on the vector of
+// lanes starting at i; the others to runRandomTwin.
 void runBsdfTwin(Twin twin, const TwinLanes& in, size_t i, TwinResults& out) {
     auto f = [&](int row) { return load(in.f[row], i); };
     switch (twin) {

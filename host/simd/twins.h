@@ -40,10 +40,10 @@
     X(fresnelDielectric, "dielectric.h")                                                           \
     X(dielectricEval, "dielectric.h")                                                              \
     X(dielectricSample, "dielectric.h")                                                            \
-    X(gltfFresnel, "gltf.h")                                                                       \
-    X(gltfSpecularProbability, "gltf.h")                                                           \
-    X(gltfEval, "gltf.h")                                                                          \
-    X(gltfSample, "gltf.h")                                                                        \
+    X(gltfFresnel, "metallic_roughness.h")                                                         \
+    X(gltfSpecularProbability, "metallic_roughness.h")                                             \
+    X(gltfEval, "metallic_roughness.h")                                                            \
+    X(gltfSample, "metallic_roughness.h")                                                          \
     X(pcg4d, "rng.h")                                                                              \
     X(laineKarrasPermutation, "rng.h")                                                             \
     X(scrambledSobol4, "rng.h")                                                                    \

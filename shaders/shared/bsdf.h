@@ -2,14 +2,15 @@
 // point away from the surface; `fcos` means f(wo, wi) * |cos(ns, wi)|.
 //
 // The models are the registry's (shared/surface_models.h); each one's header <stem>.h defines
-// the three functions dispatched to below, with these signatures:
-//   bool <stem>BsdfIsDelta(ShaderParams sh)
-//   float <stem>BsdfConeSpread(ShaderParams sh)  the angle (radians) its lobe adds to a ray
-//                                                cone's spread (shared/cone.h)
-//   vec3 <stem>BsdfEval(ShaderParams sh, vec3 albedo, vec3 ng, vec3 ns, vec3 wo, vec3 wi,
-//                       OUT(float) pdf)
-//   bool <stem>BsdfSample(ShaderParams sh, vec3 albedo, vec3 ng, vec3 ns, vec3 wo, vec3 u,
-//                         OUT(vec3) wi, OUT(vec3) weight, OUT(float) pdf, OUT(bool) specular)
+// the four functions dispatched to below (<fn> the registry's function prefix), with these
+// signatures:
+//   bool <fn>BsdfIsDelta(ShaderParams sh)
+//   float <fn>BsdfConeSpread(ShaderParams sh)  the angle (radians) its lobe adds to a ray cone's
+//                                              spread (shared/cone.h)
+//   vec3 <fn>BsdfEval(ShaderParams sh, vec3 albedo, vec3 ng, vec3 ns, vec3 wo, vec3 wi,
+//                     OUT(float) pdf)
+//   bool <fn>BsdfSample(ShaderParams sh, vec3 albedo, vec3 ng, vec3 ns, vec3 wo, vec3 u,
+//                       OUT(vec3) wi, OUT(vec3) weight, OUT(float) pdf, OUT(bool) specular)
 // The headers are included through generated/surface_model_headers.h, which CMake writes from
 // the registry.
 //
@@ -57,8 +58,8 @@ SHARED_FN ShaderParams shaderAtHit(ShaderParams sh, SurfaceHit hit) {
 // True when the shader's BSDF is nothing but delta lobes: light sampling can never hit them,
 // so next-event estimation is skipped.
 SHARED_FN bool bsdfIsDelta(ShaderParams sh) {
-#define SPW_BSDF_IS_DELTA(Name, id, stem, params)                                                  \
-    if (sh.model == kModel##Name) return stem##BsdfIsDelta(sh);
+#define SPW_BSDF_IS_DELTA(Name, id, stem, fn, params)                                              \
+    if (sh.model == kModel##Name) return fn##BsdfIsDelta(sh);
     SPW_SURFACE_MODELS(SPW_BSDF_IS_DELTA)
 #undef SPW_BSDF_IS_DELTA
     return false;
@@ -68,8 +69,8 @@ SHARED_FN bool bsdfIsDelta(ShaderParams sh) {
 // the model's lobe width otherwise (shared/cone.h).
 SHARED_FN float bsdfConeSpread(ShaderParams sh, bool specular) {
     if (specular) return 0.0f;
-#define SPW_BSDF_CONE_SPREAD(Name, id, stem, params)                                               \
-    if (sh.model == kModel##Name) return stem##BsdfConeSpread(sh);
+#define SPW_BSDF_CONE_SPREAD(Name, id, stem, fn, params)                                           \
+    if (sh.model == kModel##Name) return fn##BsdfConeSpread(sh);
     SPW_SURFACE_MODELS(SPW_BSDF_CONE_SPREAD)
 #undef SPW_BSDF_CONE_SPREAD
     return 0.0f;
@@ -80,8 +81,8 @@ SHARED_FN float bsdfConeSpread(ShaderParams sh, bool specular) {
 SHARED_FN vec3 bsdfEval(ShaderParams sh, vec3 albedo, vec3 ng, vec3 ns, vec3 wo, vec3 wi,
                         OUT(float) pdf) {
     pdf = 0.0f;
-#define SPW_BSDF_EVAL(Name, id, stem, params)                                                      \
-    if (sh.model == kModel##Name) return stem##BsdfEval(sh, albedo, ng, ns, wo, wi, pdf);
+#define SPW_BSDF_EVAL(Name, id, stem, fn, params)                                                  \
+    if (sh.model == kModel##Name) return fn##BsdfEval(sh, albedo, ng, ns, wo, wi, pdf);
     SPW_SURFACE_MODELS(SPW_BSDF_EVAL)
 #undef SPW_BSDF_EVAL
     return vec3(0.0f);
@@ -95,9 +96,9 @@ SHARED_FN bool bsdfSample(ShaderParams sh, vec3 albedo, vec3 ng, vec3 ns, vec3 w
     pdf = 0.0f;
     weight = vec3(0.0f);
     wi = vec3(0.0f);
-#define SPW_BSDF_SAMPLE(Name, id, stem, params)                                                    \
+#define SPW_BSDF_SAMPLE(Name, id, stem, fn, params)                                                \
     if (sh.model == kModel##Name)                                                                  \
-        return stem##BsdfSample(sh, albedo, ng, ns, wo, u, wi, weight, pdf, specular);
+        return fn##BsdfSample(sh, albedo, ng, ns, wo, u, wi, weight, pdf, specular);
     SPW_SURFACE_MODELS(SPW_BSDF_SAMPLE)
 #undef SPW_BSDF_SAMPLE
     return false;

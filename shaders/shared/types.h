@@ -11,10 +11,10 @@ SHARED_BEGIN
 
 // Surface models: kModel<Name> for every line of the registry (shared/surface_models.h), and
 // their count.
-#define SPW_MODEL_CONSTANT(Name, id, stem, params) const uint kModel##Name = id;
+#define SPW_MODEL_CONSTANT(Name, id, stem, fn, params) const uint kModel##Name = id;
 SPW_SURFACE_MODELS(SPW_MODEL_CONSTANT)
 #undef SPW_MODEL_CONSTANT
-#define SPW_MODEL_ONE(Name, id, stem, params) +1u
+#define SPW_MODEL_ONE(Name, id, stem, fn, params) +1u
 const uint kModelCount = 0u SPW_SURFACE_MODELS(SPW_MODEL_ONE);
 #undef SPW_MODEL_ONE
 

@@ -10,10 +10,11 @@
 #include "host/scene/surface_models.h"
 #include "test_util.h"
 
-#include "shared/gltf.h"
+#include "shared/metallic_roughness.h"
 
 #include <gtest/gtest.h>
 
+#include <cctype>
 #include <filesystem>
 #include <string>
 
@@ -27,6 +28,27 @@ std::string shaderScene(const std::string& shader) {
            "shaders:\n  - {" +
            shader + "}\nobjects:\n  - {filename: " + sourceDir() +
            "/scenes/cornell-box/white.obj, shader: 0}\n";
+}
+
+// A model's name in snake_case: SheenMetallicRoughness is sheen_metallic_roughness.
+std::string snakeCase(const std::string& name) {
+    std::string s;
+    for (char c : name) {
+        if (std::isupper(static_cast<unsigned char>(c))) {
+            if (!s.empty()) s += '_';
+            c = char(std::tolower(static_cast<unsigned char>(c)));
+        }
+        s += c;
+    }
+    return s;
+}
+
+// Each model's files are named after it: a reader looking for SheenMetallicRoughness finds
+// shaders/shared/sheen_metallic_roughness.h.
+TEST(SurfaceModels, EveryModelsFilesAreNamedAfterIt) {
+    EXPECT_EQ(snakeCase("SheenMetallicRoughness"), "sheen_metallic_roughness");
+    for (const SurfaceModelInfo& m : kSurfaceModels)
+        EXPECT_EQ(std::string(m.kernel), snakeCase(m.name)) << m.name;
 }
 
 TEST(SurfaceModels, EveryRegisteredModelHasItsHeaderItsKernelAndItsTest) {

@@ -11,7 +11,7 @@
 #include "test_util.h"
 
 #include "shared/bsdf.h"
-#include "shared/gltf.h"
+#include "shared/metallic_roughness.h"
 #include "shared/types.h"
 
 #include <OpenImageIO/imagebuf.h>
@@ -157,8 +157,8 @@ TEST(GltfExtensionImages, AnImageVariesItsParameterAcrossTheSurface) {
 // KHR_materials_clearcoat's clearcoatNormalTexture tilts the interpolated normal for the coat
 // alone; without it the coat takes the interpolated normal even where the base is normal-mapped,
 // as the specification says. Hit setup carries the coat's normal (kShaderCoatNormal), checked
-// here hit by hit; what the coat does with it is tests/bsdf/clearcoat_test.cpp's. Every backend
-// renders the map.
+// here hit by hit; what the coat does with it is tests/bsdf/coated_metallic_roughness_test.cpp's.
+// Every backend renders the map.
 TEST(GltfExtensionImages, TheCoatsNormalMapTiltsTheCoatAloneAndTheBasesTheBase) {
     TempDir dir;
     writeUniform(dir.file("tilt.png"), vec4(1.0f, 0.0f, 1.0f, 1.0f)); // (1, -1, 1), tangent space

@@ -18,8 +18,8 @@
 #include "scene/gltf_spheres.h"
 #include "test_util.h"
 
-#include "shared/gltf.h"
-#include "shared/sheen.h"
+#include "shared/metallic_roughness.h"
+#include "shared/sheen_metallic_roughness.h"
 #include "shared/types.h"
 
 #include <gtest/gtest.h>

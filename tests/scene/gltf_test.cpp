@@ -9,7 +9,7 @@
 #include "scene/gltf_builder.h"
 #include "test_util.h"
 
-#include "shared/gltf.h"
+#include "shared/metallic_roughness.h"
 
 #include <OpenImageIO/imagebuf.h>
 #include <OpenImageIO/imagebufalgo.h>

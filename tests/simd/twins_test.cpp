@@ -9,8 +9,8 @@
 
 #include "shared/conductor.h"
 #include "shared/dielectric.h"
-#include "shared/gltf.h"
 #include "shared/lambert.h"
+#include "shared/metallic_roughness.h"
 #include "shared/path.h"
 
 #include <gtest/gtest.h>
@@ -487,7 +487,7 @@ std::set<std::string> taggedFunctions() {
     static const std::regex tag("^// SIMD twin: (host/simd/simd_(math|bsdf)-inl\\.h)$");
     for (const char* header : {"sampling.h", "offset.h", "light_sample.h", "lights.h", "lambert.h",
                                "rng.h", "path.h", "bsdf.h", "ggx.h", "conductor.h", "dielectric.h",
-                               "gltf.h", "cone.h", "types.h", "compat.h"}) {
+                               "metallic_roughness.h", "cone.h", "types.h", "compat.h"}) {
         std::ifstream in(test::sourceDir() + "/shaders/shared/" + header);
         EXPECT_TRUE(in) << header;
         std::string line;

@@ -1,12 +1,12 @@
-// CoatedMetallicRoughness (shared/clearcoat.h), glTF's metallic-roughness material under a clear
-// coat (KHR_materials_clearcoat): its sampling against its pdf (chi-square) over coat weights and
-// roughnesses on dielectric and metal bases, at normal, oblique and grazing incidence; without
-// weight it is MetallicRoughness bit for bit; the coat's reflectance at normal incidence in
+// CoatedMetallicRoughness (shared/coated_metallic_roughness.h), glTF's metallic-roughness material
+// under a clear coat (KHR_materials_clearcoat): its sampling against its pdf (chi-square) over coat
+// weights and roughnesses on dielectric and metal bases, at normal, oblique and grazing incidence;
+// without weight it is MetallicRoughness bit for bit; the coat's reflectance at normal incidence in
 // closed form; energy in a white furnace; a coat normal of its own (kShaderCoatNormal) moves the
 // coat's lobe and not the base's.
 #include "bsdf_test_util.h"
 
-#include "shared/clearcoat.h"
+#include "shared/coated_metallic_roughness.h"
 
 namespace spw::test {
 namespace {

@@ -1,12 +1,12 @@
-// MetallicRoughness (shared/gltf.h), glTF 2.0's metallic-roughness material: its sampling
-// against its pdf (chi-square) from dielectric to metal, smooth to rough, at normal, oblique and
-// grazing incidence; the pdf and f |cos| integrated by quadrature; a pure metal is the Conductor
-// bit for bit; energy in a white furnace; closed forms at the narrow-lobe limit; and
+// MetallicRoughness (shared/metallic_roughness.h), glTF 2.0's metallic-roughness material: its
+// sampling against its pdf (chi-square) from dielectric to metal, smooth to rough, at normal,
+// oblique and grazing incidence; the pdf and f |cos| integrated by quadrature; a pure metal is the
+// Conductor bit for bit; energy in a white furnace; closed forms at the narrow-lobe limit; and
 // KHR_materials_specular's weight and F0 colour (kShaderSpecular): sampled as the pdf says, their
 // defaults glTF's own material to the bit, their F0 at the narrow-lobe limit.
 #include "bsdf_test_util.h"
 
-#include "shared/gltf.h"
+#include "shared/metallic_roughness.h"
 
 namespace spw::test {
 namespace {

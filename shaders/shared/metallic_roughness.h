@@ -161,21 +161,22 @@ SHARED_FN bool gltfSample(vec3 colour, float metallic, float alpha, vec3 f0d, fl
 }
 
 // The registry's interface (shared/bsdf.h dispatches here).
-SHARED_FN bool gltfBsdfIsDelta(ShaderParams sh) {
+SHARED_FN bool metallicRoughnessBsdfIsDelta(ShaderParams sh) {
     UNUSED(sh);
     return false;
 }
 // A pure metal spreads a cone by about alpha, as the conductor; with a diffuse lobe, as Lambert.
-SHARED_FN float gltfBsdfConeSpread(ShaderParams sh) {
+SHARED_FN float metallicRoughnessBsdfConeSpread(ShaderParams sh) {
     return sh.metallic >= 1.0f ? max(sh.alpha, kGltfMinAlpha) : 1.0f;
 }
-SHARED_FN vec3 gltfBsdfEval(ShaderParams sh, vec3 albedo, vec3 ng, vec3 ns, vec3 wo, vec3 wi,
-                            OUT(float) pdf) {
+SHARED_FN vec3 metallicRoughnessBsdfEval(ShaderParams sh, vec3 albedo, vec3 ng, vec3 ns, vec3 wo,
+                                         vec3 wi, OUT(float) pdf) {
     return gltfEval(albedo, sh.metallic, max(sh.alpha, kGltfMinAlpha), gltfDielectricF0Colour(sh),
                     gltfDielectricF90(sh), ng, ns, wo, wi, pdf);
 }
-SHARED_FN bool gltfBsdfSample(ShaderParams sh, vec3 albedo, vec3 ng, vec3 ns, vec3 wo, vec3 u,
-                              OUT(vec3) wi, OUT(vec3) weight, OUT(float) pdf, OUT(bool) specular) {
+SHARED_FN bool metallicRoughnessBsdfSample(ShaderParams sh, vec3 albedo, vec3 ng, vec3 ns, vec3 wo,
+                                           vec3 u, OUT(vec3) wi, OUT(vec3) weight, OUT(float) pdf,
+                                           OUT(bool) specular) {
     return gltfSample(albedo, sh.metallic, max(sh.alpha, kGltfMinAlpha), gltfDielectricF0Colour(sh),
                       gltfDielectricF90(sh), ng, ns, wo, u, wi, weight, pdf, specular);
 }

@@ -1,11 +1,11 @@
-// SheenMetallicRoughness (shared/sheen.h), glTF's metallic-roughness material under a sheen
-// (KHR_materials_sheen): its sampling against its pdf (chi-square) over dielectric and metal
-// bases, smooth and rough sheens, normal to grazing incidence; a sheen of colour 0 is the base
-// bit for bit; the albedo table (sheen_albedo.h) is the sheen lobe's own albedo by quadrature;
+// SheenMetallicRoughness (shared/sheen_metallic_roughness.h), glTF's metallic-roughness material
+// under a sheen (KHR_materials_sheen): its sampling against its pdf (chi-square) over dielectric
+// and metal bases, smooth and rough sheens, normal to grazing incidence; a sheen of colour 0 is the
+// base bit for bit; the albedo table (sheen_albedo.h) is the sheen lobe's own albedo by quadrature;
 // over a base that reflects nothing, the material's albedo is the sheen's.
 #include "bsdf_test_util.h"
 
-#include "shared/sheen.h"
+#include "shared/sheen_metallic_roughness.h"
 
 namespace spw::test {
 namespace {
@@ -32,7 +32,7 @@ ExpectedLobes lobes(const BsdfUnderTest& m) {
 }
 
 // The sheen lobe's albedo at cosine mu, by the midpoint rule over the half vector (as
-// scripts/make_sheen_table.py integrates it), from sheen.h's own D and V.
+// scripts/make_sheen_table.py integrates it), from sheen_metallic_roughness.h's own D and V.
 double sheenLobeAlbedo(double mu, float roughness) {
     const float alpha = sheenAlpha(roughness);
     const vec3 wo(float(std::sqrt(1.0 - mu * mu)), 0.0f, float(mu));

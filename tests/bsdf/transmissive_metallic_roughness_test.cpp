@@ -1,12 +1,12 @@
-// TransmissiveMetallicRoughness (shared/transmission.h), glTF's dielectric transmitting part of
-// the light: rough glass mixed with the opaque material sampled against the pdf (chi-square),
-// from outside and inside; transmission 0 and 1 are MetallicRoughness and the Dielectric bit for
-// bit; over smooth glass, the delta lobes are sampled with probability transmission and keep the
-// glass's weights; energy at the narrow-lobe limit; on a metal, the glass's weight is
-// transmission (1 - metallic), and metallic 1 is the opaque metal.
+// TransmissiveMetallicRoughness (shared/transmissive_metallic_roughness.h), glTF's dielectric
+// transmitting part of the light: rough glass mixed with the opaque material sampled against the
+// pdf (chi-square), from outside and inside; transmission 0 and 1 are MetallicRoughness and the
+// Dielectric bit for bit; over smooth glass, the delta lobes are sampled with probability
+// transmission and keep the glass's weights; energy at the narrow-lobe limit; on a metal, the
+// glass's weight is transmission (1 - metallic), and metallic 1 is the opaque metal.
 #include "bsdf_test_util.h"
 
-#include "shared/gltf.h"
+#include "shared/metallic_roughness.h"
 
 namespace spw::test {
 namespace {

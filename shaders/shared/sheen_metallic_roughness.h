@@ -23,7 +23,7 @@
 //   is the paper's, not energy-conserving there): the base's scale is floored at 0.
 #ifndef SPILLWAY_SHARED_SHEEN_H
 #define SPILLWAY_SHARED_SHEEN_H
-#include "gltf.h"
+#include "metallic_roughness.h"
 #include "sheen_albedo.h"
 
 SHARED_BEGIN
@@ -147,23 +147,24 @@ SHARED_FN bool gltfSheenSample(vec3 colour, float metallic, float alpha, vec3 f0
 }
 
 // The registry's interface (shared/bsdf.h dispatches here).
-SHARED_FN bool sheenBsdfIsDelta(ShaderParams sh) {
+SHARED_FN bool sheenMetallicRoughnessBsdfIsDelta(ShaderParams sh) {
     UNUSED(sh);
     return false;
 }
 // The sheen's lobe is as wide as Lambert's.
-SHARED_FN float sheenBsdfConeSpread(ShaderParams sh) {
+SHARED_FN float sheenMetallicRoughnessBsdfConeSpread(ShaderParams sh) {
     UNUSED(sh);
     return 1.0f;
 }
-SHARED_FN vec3 sheenBsdfEval(ShaderParams sh, vec3 albedo, vec3 ng, vec3 ns, vec3 wo, vec3 wi,
-                             OUT(float) pdf) {
+SHARED_FN vec3 sheenMetallicRoughnessBsdfEval(ShaderParams sh, vec3 albedo, vec3 ng, vec3 ns,
+                                              vec3 wo, vec3 wi, OUT(float) pdf) {
     return gltfSheenEval(albedo, sh.metallic, max(sh.alpha, kGltfMinAlpha),
                          gltfDielectricF0Colour(sh), gltfDielectricF90(sh), sh.sheenColour,
                          sh.sheenRoughness, ng, ns, wo, wi, pdf);
 }
-SHARED_FN bool sheenBsdfSample(ShaderParams sh, vec3 albedo, vec3 ng, vec3 ns, vec3 wo, vec3 u,
-                               OUT(vec3) wi, OUT(vec3) weight, OUT(float) pdf, OUT(bool) specular) {
+SHARED_FN bool sheenMetallicRoughnessBsdfSample(ShaderParams sh, vec3 albedo, vec3 ng, vec3 ns,
+                                                vec3 wo, vec3 u, OUT(vec3) wi, OUT(vec3) weight,
+                                                OUT(float) pdf, OUT(bool) specular) {
     return gltfSheenSample(albedo, sh.metallic, max(sh.alpha, kGltfMinAlpha),
                            gltfDielectricF0Colour(sh), gltfDielectricF90(sh), sh.sheenColour,
                            sh.sheenRoughness, ng, ns, wo, u, wi, weight, pdf, specular);

@@ -1,5 +1,5 @@
-// CoatedMetallicRoughness: glTF's metallic-roughness material (shared/gltf.h) under a clear coat,
-// as KHR_materials_clearcoat defines it (the extension's specification, "Clearcoat" and
+// CoatedMetallicRoughness: glTF's metallic-roughness material (shared/metallic_roughness.h) under a
+// clear coat, as KHR_materials_clearcoat defines it (the extension's specification, "Clearcoat" and
 // "Implementation").
 //   parameters: those of MetallicRoughness (colour or texture, metallic, roughness, ior,
 //   specular, specular colour), and
@@ -22,7 +22,7 @@
 //   Not rendered: the coat dims nothing the surface emits.
 #ifndef SPILLWAY_SHARED_CLEARCOAT_H
 #define SPILLWAY_SHARED_CLEARCOAT_H
-#include "gltf.h"
+#include "metallic_roughness.h"
 
 SHARED_BEGIN
 
@@ -117,23 +117,23 @@ SHARED_FN bool gltfCoatSample(vec3 colour, float metallic, float alpha, vec3 f0d
 }
 
 // The registry's interface (shared/bsdf.h dispatches here).
-SHARED_FN bool clearcoatBsdfIsDelta(ShaderParams sh) {
+SHARED_FN bool coatedMetallicRoughnessBsdfIsDelta(ShaderParams sh) {
     UNUSED(sh);
     return false;
 }
-SHARED_FN float clearcoatBsdfConeSpread(ShaderParams sh) {
-    return gltfBsdfConeSpread(sh);
+SHARED_FN float coatedMetallicRoughnessBsdfConeSpread(ShaderParams sh) {
+    return metallicRoughnessBsdfConeSpread(sh);
 }
-SHARED_FN vec3 clearcoatBsdfEval(ShaderParams sh, vec3 albedo, vec3 ng, vec3 ns, vec3 wo, vec3 wi,
-                                 OUT(float) pdf) {
+SHARED_FN vec3 coatedMetallicRoughnessBsdfEval(ShaderParams sh, vec3 albedo, vec3 ng, vec3 ns,
+                                               vec3 wo, vec3 wi, OUT(float) pdf) {
     return gltfCoatEval(albedo, sh.metallic, max(sh.alpha, kGltfMinAlpha),
                         gltfDielectricF0Colour(sh), gltfDielectricF90(sh), sh.coat,
                         max(sh.coatAlpha, kGltfMinAlpha), ng, ns, gltfCoatNormal(sh, ns), wo, wi,
                         pdf);
 }
-SHARED_FN bool clearcoatBsdfSample(ShaderParams sh, vec3 albedo, vec3 ng, vec3 ns, vec3 wo, vec3 u,
-                                   OUT(vec3) wi, OUT(vec3) weight, OUT(float) pdf,
-                                   OUT(bool) specular) {
+SHARED_FN bool coatedMetallicRoughnessBsdfSample(ShaderParams sh, vec3 albedo, vec3 ng, vec3 ns,
+                                                 vec3 wo, vec3 u, OUT(vec3) wi, OUT(vec3) weight,
+                                                 OUT(float) pdf, OUT(bool) specular) {
     return gltfCoatSample(albedo, sh.metallic, max(sh.alpha, kGltfMinAlpha),
                           gltfDielectricF0Colour(sh), gltfDielectricF90(sh), sh.coat,
                           max(sh.coatAlpha, kGltfMinAlpha), ng, ns, gltfCoatNormal(sh, ns), wo, u,
