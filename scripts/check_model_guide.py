@@ -7,7 +7,9 @@ The guide adds a model called Velvet (stem velvet). Read against the registry
 - give the next free id in its registry line (`X(Velvet, <count>u, velvet,`);
 - name as the model's functions exactly those bsdf.h dispatches to (`<fn>Bsdf<Suffix>`);
 - list, in its table of files, files that every registered model has with its own stem, and a
-  test file holding `TEST(<Name>,` for each.
+  test file holding `TEST(<Name>,` for each;
+- give the line of host/cpu/wide_models.h (`X(Velvet, velvet)`) and the one lanes file of a SIMD
+  twin, which every model that list names has, holding its `struct <Name>LanesModel`.
 Each finding is printed as `docs/adding-a-surface-model.md: message`; exits 1 if any.
 
     scripts/check_model_guide.py [REPO_ROOT]
@@ -23,6 +25,10 @@ GUIDE = "docs/adding-a-surface-model.md"
 def read(root, path):
     with open(os.path.join(root, path), encoding="utf-8") as f:
         return f.read()
+
+
+def models_stems(models):
+    return [(name, stem) for name, _, stem in models]
 
 
 def problems(root):
@@ -48,10 +54,31 @@ def problems(root):
     if named != dispatched:
         yield "names the functions %s; bsdf.h dispatches to %s" % (
             sorted("velvetBsdf" + s for s in named), sorted("velvetBsdf" + s for s in dispatched))
-    files = re.findall(r"^\| \d+ \| `([^`]*velvet[^`]*)` \|", guide, re.M)
+    files = [f for f in re.findall(r"^\| \d+ \| `([^`]*velvet[^`]*)` \|", guide, re.M)
+             if not f.startswith("host/cpu/")]  # a SIMD twin's, checked above
     if len(files) < 3:
         yield "its table of files names %d files of the model (a header, a kernel, a test)" % len(
             files)
+    wide = re.findall(r"^\s*X\((\w+), (\w+)\)", read(root, "host/cpu/wide_models.h"), re.M)
+    if not wide or [n for n, _ in wide] != [n for n in names if n in dict(wide)]:
+        yield "host/cpu/wide_models.h lists %s: models of the registry, in its order" % wide
+    if "`X(Velvet, velvet)`" not in guide:
+        yield "no `X(Velvet, velvet)` line for host/cpu/wide_models.h"
+    lanes = re.findall(r"^\| \d+ \| `(host/cpu/velvet[^`]*)` \|", guide, re.M)
+    if len(lanes) != 1:
+        yield "its table of a twin's files names %d lanes files (one: host/cpu/velvet_lanes-inl.h)" % (
+            len(lanes))
+    stems = dict(models_stems(models))
+    for name, stem in wide:
+        if stems.get(name) != stem:
+            yield "host/cpu/wide_models.h gives %s the stem %s; the registry %s" % (
+                name, stem, stems.get(name))
+        for pattern in lanes:
+            path = pattern.replace("velvet", stem)
+            if not os.path.isfile(os.path.join(root, path)):
+                yield "names %s for each SIMD-wide model; %s has no %s" % (pattern, name, path)
+            elif "struct %sLanesModel" % name not in read(root, path):
+                yield "%s holds no struct %sLanesModel" % (path, name)
     for name, _, stem in models:
         for pattern in files:
             path = pattern.replace("velvet", stem)

@@ -28,6 +28,7 @@ BRACES = re.compile(r"\.\{([\w,]+)\}")
 EXAMPLES = {
     # The guide's worked example: the files of a new model called Velvet.
     "shaders/shared/velvet.h", "shaders/velvet.comp", "tests/bsdf/velvet_test.cpp",
+    "host/cpu/velvet_lanes-inl.h",
     # Carried by a release only: scripts/bundle.sh writes it into the release's scenes/.
     "scenes/textured/",
 }

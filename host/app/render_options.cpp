@@ -395,7 +395,7 @@ std::string filled(std::string help) {
     std::string wide;
     std::vector<std::string> names;
     for (uint model = 0; model < kModelCount; ++model)
-        if (kWideTwins[model].kernel) names.push_back(surfaceModel(model)->name);
+        if (kWideTwins[model].shade) names.push_back(surfaceModel(model)->name);
     for (size_t k = 0; k < names.size(); ++k)
         wide += (k == 0 ? "" : k + 1 == names.size() ? " and " : ", ") + names[k];
     for (const auto& [key, value] :

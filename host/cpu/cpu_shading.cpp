@@ -42,7 +42,7 @@ void publishCpuStats(const Scene& scene, bool simd, RenderStats& stats) {
         used.insert(shader.params.model);
     nlohmann::json wide = nlohmann::json::array(), scalar = nlohmann::json::array();
     for (uint model : used)
-        (simd && kWideTwins[model].kernel ? wide : scalar).push_back(surfaceModel(model)->name);
+        (simd && kWideTwins[model].shade ? wide : scalar).push_back(surfaceModel(model)->name);
     stats.extra["wide_models"] = wide;
     stats.extra["scalar_models"] = scalar;
 }

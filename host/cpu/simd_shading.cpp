@@ -8,6 +8,7 @@
 // model's shared functions (host/simd/simd_math-inl.h and simd_bsdf-inl.h, each checked against its
 // scalar function lane by lane).
 #include "host/cpu/simd_shading.h"
+#include "host/cpu/wide_models.h"
 
 #include "host/cpu/simd_light_pick.h"
 
@@ -15,6 +16,7 @@
 #include "shared/path.h"
 
 #include <algorithm>
+#include <array>
 #include <cstdint>
 #include <cstring>
 
@@ -78,6 +80,7 @@ struct SurfaceResults {
 #include <hwy/highway.h>
 
 #include "host/simd/simd_bsdf-inl.h" // and simd_math-inl.h
+#include "wide_model_lanes.h"        // each SIMD-wide model's <Name>LanesModel (wide_models.h)
 
 HWY_BEFORE_NAMESPACE();
 namespace spw::HWY_NAMESPACE {
@@ -98,85 +101,6 @@ void MakeRandomNumbers(simd_shading::RandomLanes& lanes, size_t count, uint samp
         store(uintToUnit(bsdf.z), lanes.uBsdfZ, i);
     }
 }
-
-// One vector of hits: what every model's eval and sample read.
-struct HitVector {
-    V3 ng, albedo, wo;
-    V ngDotWo, alpha, ior, metallic;
-    V3 f0d; // MetallicRoughness: the dielectric part's F0 colour and F90
-    V f90d;
-    V3 ns; // the interpolated shading normal
-    V3 n;  // facingShadingNormal
-};
-
-// Each model's eval, sample and delta test on a vector of hits, as the twins of its registry
-// functions (shared/bsdf.h): bsdfEval's fcos and pdf, bsdfSample, bsdfIsDelta.
-struct LambertLanesModel {
-    explicit LambertLanesModel(const HitVector&) {}
-    M delta(const HitVector&) const { return hn::FirstN(D(), 0); }
-    V3 eval(const HitVector& h, V3 wi, V& pdf) const {
-        return lambertEval(h.albedo, h.ng, h.ngDotWo, h.n, wi, pdf);
-    }
-    BsdfSample sample(const HitVector& h, V ux, V uy, V /*uz*/) const { // lambertSample
-        const V zero = hn::Zero(D());
-        const V3 local = sampleCosineHemisphere(ux, uy);
-        BsdfSample s;
-        s.wi = normalize(toWorld(local, h.n));
-        s.ok = hn::Not(
-            hn::Or(hn::Le(hn::Mul(h.ngDotWo, dot(h.ng, s.wi)), zero), hn::Le(local.z, zero)));
-        s.specular = hn::FirstN(D(), 0);
-        s.weight = h.albedo;
-        s.pdf = hn::Mul(local.z, hn::Set(D(), kInvPi));
-        return s;
-    }
-};
-struct ConductorLanesModel {
-    Frame frame;
-    explicit ConductorLanesModel(const HitVector& h) : frame(shadingFrame(h.n)) {}
-    M delta(const HitVector& h) const { return ggxIsSmooth(h.alpha); }
-    V3 eval(const HitVector& h, V3 wi, V& pdf) const {
-        return conductorEval(h.albedo, h.alpha, h.ng, h.ngDotWo, frame, h.wo, wi, pdf);
-    }
-    BsdfSample sample(const HitVector& h, V ux, V uy, V /*uz*/) const {
-        return conductorSample(h.albedo, h.alpha, h.ng, h.ngDotWo, frame, h.wo, ux, uy);
-    }
-};
-struct DielectricLanesModel {
-    Frame frame;
-    explicit DielectricLanesModel(const HitVector& h) : frame(shadingFrame(h.n)) {}
-    M delta(const HitVector& h) const { return ggxIsSmooth(h.alpha); }
-    V3 eval(const HitVector& h, V3 wi, V& pdf) const {
-        const V3 fcos = dielectricEval(h.ior, h.alpha, h.ng, h.ngDotWo, frame, h.wo, wi, pdf);
-        return select(refracts(h, wi), mul(fcos, h.albedo), fcos);
-    }
-    BsdfSample sample(const HitVector& h, V ux, V uy, V uz) const {
-        BsdfSample s = dielectricSample(h.ior, h.alpha, h.ng, h.ngDotWo, frame, h.wo, ux, uy, uz);
-        s.weight = select(refracts(h, s.wi), mul(s.weight, h.albedo), s.weight);
-        return s;
-    }
-    // dielectricBsdfEval's and dielectricBsdfSample's test: wi on the other side of ng from wo,
-    // where the albedo tints.
-    static M refracts(const HitVector& h, V3 wi) {
-        return hn::Lt(hn::Mul(h.ngDotWo, dot(h.ng, wi)), hn::Zero(D()));
-    }
-};
-
-struct MetallicRoughnessLanesModel {
-    Frame frame;
-    V alpha; // max(alpha, kGltfMinAlpha), as metallicRoughnessBsdfEval and
-             // metallicRoughnessBsdfSample take it
-    explicit MetallicRoughnessLanesModel(const HitVector& h)
-        : frame(shadingFrame(h.n)), alpha(gmax(h.alpha, hn::Set(D(), kGltfMinAlpha))) {}
-    M delta(const HitVector&) const { return hn::FirstN(D(), 0); }
-    V3 eval(const HitVector& h, V3 wi, V& pdf) const {
-        return gltfEval(h.albedo, h.metallic, alpha, h.f0d, h.f90d, h.ng, h.ngDotWo, frame, h.wo,
-                        wi, pdf);
-    }
-    BsdfSample sample(const HitVector& h, V ux, V uy, V uz) const {
-        return gltfSample(h.albedo, h.metallic, alpha, h.f0d, h.f90d, h.ng, h.ngDotWo, frame, h.wo,
-                          ux, uy, uz);
-    }
-};
 
 // Twin of terminatorEval (shared/path.h) for the lanes `candidates` selects (those whose BSDF
 // gave nothing toward wi): fcos and toward replaced where it applies.
@@ -305,33 +229,23 @@ void shadeLanes(const simd_shading::SurfaceLanes& in, size_t count, bool nee, bo
     }
 }
 
-// The wide twins kWideTwins names.
-void ShadeLambertLanes(const simd_shading::SurfaceLanes& in, size_t count, bool nee, bool mis,
-                       float threshold, simd_shading::SurfaceResults& out) {
-    shadeLanes<LambertLanesModel>(in, count, nee, mis, threshold, out);
-}
-void ShadeConductorLanes(const simd_shading::SurfaceLanes& in, size_t count, bool nee, bool mis,
-                         float threshold, simd_shading::SurfaceResults& out) {
-    shadeLanes<ConductorLanesModel>(in, count, nee, mis, threshold, out);
-}
-void ShadeDielectricLanes(const simd_shading::SurfaceLanes& in, size_t count, bool nee, bool mis,
-                          float threshold, simd_shading::SurfaceResults& out) {
-    shadeLanes<DielectricLanesModel>(in, count, nee, mis, threshold, out);
-}
-void ShadeMetallicRoughnessLanes(const simd_shading::SurfaceLanes& in, size_t count, bool nee,
-                                 bool mis, float threshold, simd_shading::SurfaceResults& out) {
-    shadeLanes<MetallicRoughnessLanesModel>(in, count, nee, mis, threshold, out);
-}
+// Each SIMD-wide model's kernel: Shade<Name>Lanes, shadeLanes over its <Name>LanesModel.
+#define SPW_SHADE_LANES(Name, stem)                                                                \
+    void Shade##Name##Lanes(const simd_shading::SurfaceLanes& in, size_t count, bool nee,          \
+                            bool mis, float threshold, simd_shading::SurfaceResults& out) {        \
+        shadeLanes<Name##LanesModel>(in, count, nee, mis, threshold, out);                         \
+    }
+SPW_WIDE_MODELS(SPW_SHADE_LANES)
+#undef SPW_SHADE_LANES
 
 } // namespace spw::HWY_NAMESPACE
 HWY_AFTER_NAMESPACE();
 
 #if HWY_ONCE
 namespace spw {
-HWY_EXPORT(ShadeLambertLanes);
-HWY_EXPORT(ShadeConductorLanes);
-HWY_EXPORT(ShadeDielectricLanes);
-HWY_EXPORT(ShadeMetallicRoughnessLanes);
+#define SPW_EXPORT_LANES(Name, stem) HWY_EXPORT(Shade##Name##Lanes);
+SPW_WIDE_MODELS(SPW_EXPORT_LANES)
+#undef SPW_EXPORT_LANES
 HWY_EXPORT(MakeRandomNumbers);
 
 using simd::kBlock;
@@ -466,18 +380,29 @@ void takeLane(const ShaderParams& sh, const SurfaceResults& res, size_t k, const
 
 } // namespace
 
-const WideTwin kWideTwins[] = {
-    {kModelNull, nullptr}, // a Null hit only passes the path on (and emits, for a quad light)
-    {kModelLambert, "ShadeLambertLanes"},
-    {kModelConductor, "ShadeConductorLanes"},
-    {kModelDielectric, "ShadeDielectricLanes"},
-    {kModelMetallicRoughness, "ShadeMetallicRoughnessLanes"},
-    {kModelCoatedMetallicRoughness, nullptr},       // shadeSurfaceWith, one hit at a time
-    {kModelTransmissiveMetallicRoughness, nullptr}, // as CoatedMetallicRoughness
-    {kModelSheenMetallicRoughness, nullptr},        // as CoatedMetallicRoughness
-};
-static_assert(sizeof(kWideTwins) / sizeof(kWideTwins[0]) == kModelCount,
-              "every registered surface model names its wide twin, or nullptr for none");
+namespace {
+// Each SIMD-wide model's kernel in the best instruction set the processor has.
+#define SPW_DISPATCH_LANES(Name, stem)                                                             \
+    void shade##Name##Lanes(const SurfaceLanes& in, size_t count, bool nee, bool mis,              \
+                            float threshold, SurfaceResults& out) {                                \
+        HWY_DYNAMIC_DISPATCH(Shade##Name##Lanes)(in, count, nee, mis, threshold, out);             \
+    }
+SPW_WIDE_MODELS(SPW_DISPATCH_LANES)
+#undef SPW_DISPATCH_LANES
+
+// Every model's entry, empty but for the SIMD-wide ones'.
+constexpr std::array<WideTwin, kModelCount> wideTwins() {
+    std::array<WideTwin, kModelCount> twins{};
+    for (uint model = 0; model < kModelCount; ++model)
+        twins[model] = {model, nullptr};
+#define SPW_WIDE_TWIN(Name, stem) twins[kModel##Name].shade = &shade##Name##Lanes;
+    SPW_WIDE_MODELS(SPW_WIDE_TWIN)
+#undef SPW_WIDE_TWIN
+    return twins;
+}
+} // namespace
+
+const std::array<WideTwin, kModelCount> kWideTwins = wideTwins();
 
 namespace {
 // A block of hits per model with a kernel, filled as the hits come: runs of one shader where the
@@ -502,21 +427,7 @@ void shadeBlock(const SceneView& view, const RenderParams& rp, bool nee, bool mi
     for (size_t k = 0; k < end; ++k) // padding lanes are lane 0's copies
         pickLaneEmitter(view, rp, picked[k], pickPdf[k], in[b.hitOf[k < b.count ? k : 0]].hit,
                         b.lanes, k);
-    switch (model) {
-    case kModelLambert:
-        HWY_DYNAMIC_DISPATCH(ShadeLambertLanes)(b.lanes, end, nee, mis, rp.threshold, results);
-        break;
-    case kModelConductor:
-        HWY_DYNAMIC_DISPATCH(ShadeConductorLanes)(b.lanes, end, nee, mis, rp.threshold, results);
-        break;
-    case kModelDielectric:
-        HWY_DYNAMIC_DISPATCH(ShadeDielectricLanes)(b.lanes, end, nee, mis, rp.threshold, results);
-        break;
-    case kModelMetallicRoughness:
-        HWY_DYNAMIC_DISPATCH(ShadeMetallicRoughnessLanes)
-        (b.lanes, end, nee, mis, rp.threshold, results);
-        break;
-    }
+    kWideTwins[model].shade(b.lanes, end, nee, mis, rp.threshold, results);
     for (size_t k = 0; k < b.count; ++k) {
         const ShadeInput& hit = in[b.hitOf[k]];
         takeLane(shaderAtHit(view.shaders[hit.hit.shader], hit.hit), results, k, hit,
@@ -560,7 +471,7 @@ void shadeHits(const SceneView& view, const RenderParams& rp, bool simd, const S
     };
     for (size_t i = 0; i < n; ++i) {
         const ShaderParams& sh = view.shaders[in[i].hit.shader];
-        if (!kWideTwins[sh.model].kernel) { // shadeSurfaceWith, one hit at a time
+        if (!kWideTwins[sh.model].shade) { // shadeSurfaceWith, one hit at a time
             if (!shadeGoesOn(rp, sh, in[i].path)) {
                 shadeSurfaceWith(view, rp, in[i].hit, in[i].rayDir, in[i].path, vec4(0.0f),
                                  vec4(0.0f), out[i]);

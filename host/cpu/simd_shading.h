@@ -1,6 +1,6 @@
 // Shading a run of hits SIMD-wide: the cpu engine's shade step, where the sort has made the work
-// homogeneous. Hits of each model with a kernel (Lambert, Conductor, Dielectric and
-// MetallicRoughness: kWideTwins) go through a structure-of-arrays kernel that runs
+// homogeneous. Hits of each model with a kernel (host/cpu/wide_models.h: Lambert, Conductor,
+// Dielectric and MetallicRoughness) go through a structure-of-arrays kernel that runs
 // shadeSurface()'s arithmetic on 4, 8 or 16 hits of that model at once, in the widest
 // instruction set the processor has (Google Highway's dynamic dispatch: SSE4, AVX2 or AVX-512); a
 // hit of a model without one goes through shadeSurfaceWith(), with its random numbers made
@@ -21,21 +21,28 @@
 #include "shared/scene_access.h"
 #include "shared/shade_io.h"
 
+#include <array>
 #include <cstddef>
 
 namespace spw {
 
-// Each registered surface model's wide twin in this engine, in the registry's order
-// (shaders/shared/surface_models.h): the kernel that shades a run of its hits SIMD-wide, or
-// nullptr where its hits go through shadeSurfaceWith() one at a time (their random numbers still
-// made SIMD-wide). A model added to the registry must be added here too (a static_assert counts
-// them), and the cpu backend's --stats names the scene's models that have no twin
+namespace simd_shading {
+struct SurfaceLanes;   // a block of one model's hits, as the kernels read them
+struct SurfaceResults; // what they write
+} // namespace simd_shading
+
+// Each registered surface model's wide twin in this engine, indexed by kModel*: the kernel that
+// shades a run of its hits SIMD-wide (the models host/cpu/wide_models.h lists), or nullptr where
+// its hits go through shadeSurfaceWith() one at a time (their random numbers still made
+// SIMD-wide). The cpu backend's --stats names the scene's models that have none
 // (`scalar_models`), so that a model without one is never silently scalar.
+using ShadeLanesFn = void (*)(const simd_shading::SurfaceLanes& in, size_t count, bool nee,
+                              bool mis, float threshold, simd_shading::SurfaceResults& out);
 struct WideTwin {
     uint model;         // kModel*
-    const char* kernel; // nullptr: none
+    ShadeLanesFn shade; // nullptr: none
 };
-extern const WideTwin kWideTwins[kModelCount];
+extern const std::array<WideTwin, kModelCount> kWideTwins;
 
 // out[i] = shadeSurface(view, rp, in[i]) for i in [0, n); `simd` false shades every hit with
 // shadeSurface() (--simd-shading off, and to compare). Light samples toward a triangle without

@@ -48,7 +48,7 @@ TEST(Cli, HelpTextsSayWhatTheCodeDoes) {
     EXPECT_TRUE(contains(text, "chunk by chunk of " + std::to_string(kChunk) + " hits")) << text;
     std::vector<std::string> wide;
     for (uint model = 0; model < kModelCount; ++model)
-        if (kWideTwins[model].kernel) wide.push_back(surfaceModel(model)->name);
+        if (kWideTwins[model].shade) wide.push_back(surfaceModel(model)->name);
     ASSERT_GE(wide.size(), 2u);
     std::string list = wide[0];
     for (size_t k = 1; k < wide.size(); ++k)
