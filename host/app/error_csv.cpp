@@ -13,6 +13,7 @@ ErrorCsv::ErrorCsv(const std::string& path, std::optional<ImageRGB> reference,
     : out_(path), reference_(std::move(reference)) {
     std::string header = "iteration,spp,seconds,relmse_estimate,relmse_estimate_stderr";
     if (reference_) header += ",mse,rmse,relmse,mae,psnr,maxabs";
+    header += ",subject_relmse_estimate,subject_fraction"; // what the stop judges
     out_.write(header + "\n");
     std::error_code ec;
     if (!resumedIterations || !std::filesystem::is_regular_file(path, ec)) return;
@@ -46,6 +47,12 @@ void ErrorCsv::addRow(int iteration, int spp, double seconds, const Film& film) 
             << (std::isinf(m.psnr) ? std::string("inf") : std::to_string(m.psnr)) << ","
             << m.maxAbs;
     }
+    row << ",";
+    if (const std::optional<double> subject =
+            error.subjectRelMse ? error.subjectRelMse : error.relMse)
+        row << *subject << "," << error.subjectFraction;
+    else
+        row << ",";
     row << "\n";
     out_.write(row.str());
 }

@@ -75,8 +75,8 @@ void applyDefaultSampling(RenderOptions& o, const Scene& scene, bool writes) {
     if (writes)
         std::fprintf(stderr,
                      "spillway: %s carries no sampling setting: rendering until the relMSE "
-                     "estimate reaches %g, at most %d spp (--spp, --target-error or "
-                     "--time-limit choose)\n",
+                     "estimate over the pixels that hold noise reaches %g, at most %d spp "
+                     "(--spp, --target-error or --time-limit choose)\n",
                      scene.file.c_str(), kDefaultTargetError, kDefaultSppCap);
 }
 
@@ -343,7 +343,8 @@ int renderCommand(const std::vector<std::string>& args, Ranks* ranks) {
     auto onIteration = [&](const IterationInfo& info, const Film& film) {
         if (errorCsv) errorCsv->addRow(info.done, info.spp, info.renderSeconds, film);
         if (o.progress == "none" && !preview) return;
-        const std::optional<double> relMse = film.halfBufferRelMseEstimate(); // O(pixels)
+        // What the stop judges (the pixels that hold noise); O(pixels).
+        const std::optional<double> relMse = film.subjectRelMseEstimate();
         progress.update(info.done, info.total, info.spp, info.total * sppPerIteration, relMse);
         if (preview) {
             char status[96];

@@ -180,8 +180,9 @@ const std::vector<CliOption> kOwnOptions = {
      "stop after the iteration that crosses this render time", 1e-3, 1e9,
      [](O& r, const C& o, const S& v) { r.config.timeLimitSeconds = numberValue(o, v); }},
     {"--target-error", nullptr, "E", Section::Render,
-     "stop after the first iteration whose relMSE, estimated from two half buffers (the "
-     "--error-csv estimate), is at or below E",
+     "stop after the first iteration whose relMSE over the pixels that hold noise (a flat "
+     "background left out), estimated from two half buffers (--error-csv's "
+     "subject_relmse_estimate), is at or below E",
      0, 1e9, [](O& r, const C& o, const S& v) { r.config.targetError = numberValue(o, v); }},
     {"--uniform", nullptr, nullptr, Section::Render,
      "with --target-error, every pixel takes every sample (by default the image's 8 x 8 tiles "

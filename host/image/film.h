@@ -150,12 +150,25 @@ class Film {
     // The same, or nothing while no pixel has samples in both halves (one iteration of one
     // sample per pixel): then there is no estimate yet, rather than an estimate of 0.
     std::optional<double> halfBufferRelMseEstimate() const;
-    // Both in one pass over the image (each of the three above is one pass).
+    // Both in one pass over the image (each of the three above is one pass), and the same over
+    // the subject: the pixels that hold noise, leaving out those whose halves agree to float
+    // precision (a term below kFlatTerm: black, or a constant environment seen directly, which a
+    // user does not look at for noise and which would dilute the mean in proportion to how much
+    // of the frame they fill). The stop judges the subject (subjectError()).
     struct ErrorEstimate {
         std::optional<double> relMse;
-        double standardError;
+        double standardError = 0.0;
+        std::optional<double> subjectRelMse; // nothing while no pixel holds noise
+        double subjectStandardError = 0.0;
+        double subjectFraction = 0.0; // of the pixels with an estimate, those that hold noise
     };
     ErrorEstimate halfBufferError() const;
+    // What the stop (--target-error and the default target) reads: the subject's relMSE, or the
+    // whole image's while no pixel holds noise; nothing before any pixel has an estimate.
+    std::optional<double> subjectRelMseEstimate() const;
+    // A pixel whose three terms sum below this holds no noise: its halves agree to float
+    // precision, (2^-24)^2 in relative error squared.
+    static constexpr double kFlatTerm = 0x1p-48;
     // The last completed iteration alone (for per-iteration statistics), between endIteration()
     // and the next beginIteration() (throws std::logic_error otherwise).
     std::vector<float> lastIterationImage() const;
@@ -238,6 +251,8 @@ class Film {
     struct ErrorSums {
         double total = 0.0, squares = 0.0;
         size_t count = 0;
+        double subjectTotal = 0.0, subjectSquares = 0.0; // over the pixels that hold noise
+        size_t subjectCount = 0;
         void add(const double* terms, size_t n);
         ErrorEstimate estimate() const;
     };

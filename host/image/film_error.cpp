@@ -153,8 +153,11 @@ void Film::decideAdaptiveTiles() {
     active_.assign(tiles, 1);
     activeTiles_ = tiles;
     // Each tile's mean half-buffer term over its values, and how many; not ready (-1) before its
-    // minimum samples or while a pixel has no estimate. The same terms give the image's
-    // estimate, which the stop asks for next: one pass over them, not two.
+    // minimum samples or while a pixel has no estimate. Toward a target, as the stop judges the
+    // subject (halfBufferError), over the values of its pixels that hold noise: a tile of flat
+    // pixels alone has nothing to reach (mean 0). The same terms give the image's estimate, which
+    // the stop asks for next: one pass over them, not two.
+    const bool subject = !(adaptiveThreshold_ > 0.0);
     std::vector<double> mean(tiles, -1.0);
     std::vector<size_t> count(tiles, 0);
     ErrorSums error;
@@ -165,7 +168,7 @@ void Film::decideAdaptiveTiles() {
                 const size_t tile = size_t(ty) * size_t(tilesX_) + size_t(tx);
                 double total = 0.0;
                 size_t values = 0;
-                bool ready = tileSamples_[tile] >= std::uint32_t(adaptiveMinSamples_);
+                bool flat = false, ready = tileSamples_[tile] >= std::uint32_t(adaptiveMinSamples_);
                 for (int y = ty * kAdaptiveTile; y < std::min(y1, (ty + 1) * kAdaptiveTile); ++y)
                     for (int x = tx * kAdaptiveTile; x < std::min(width_, (tx + 1) * kAdaptiveTile);
                          ++x) {
@@ -174,11 +177,16 @@ void Film::decideAdaptiveTiles() {
                             ready = false;
                             continue;
                         }
+                        if (subject && t[0] + t[1] + t[2] < kFlatTerm) {
+                            flat = true;
+                            continue;
+                        }
                         for (int c = 0; c < 3; ++c) // one at a time, as the sum always was
                             total += t[c];
                         values += 3;
                     }
                 if (ready && values > 0) mean[tile] = total / double(values);
+                if (ready && values == 0 && flat) mean[tile] = 0.0;
                 count[tile] = values;
             }
     });
@@ -255,6 +263,11 @@ void Film::ErrorSums::add(const double* terms, size_t n) {
         const double p = t[0] + t[1] + t[2];
         squares += p * p;
         count += 3;
+        if (p < kFlatTerm) continue;
+        for (int c = 0; c < 3; ++c)
+            subjectTotal += t[c];
+        subjectSquares += p * p;
+        subjectCount += 3;
     }
 }
 
@@ -263,8 +276,21 @@ Film::ErrorEstimate Film::ErrorSums::estimate() const {
     // shared) is a scaled chi-square of one degree of freedom where the halves' difference is
     // Gaussian: its variance is 2/3 of E[P^2], and P^2 estimates E[P^2] from the pixel alone.
     // Pixels are independent (up to the filter's reach), so the variances add.
-    if (count == 0) return {std::nullopt, 0.0};
-    return {total / double(count), std::sqrt(2.0 / 3.0 * squares) / double(count)};
+    ErrorEstimate e;
+    if (count == 0) return e;
+    e.relMse = total / double(count);
+    e.standardError = std::sqrt(2.0 / 3.0 * squares) / double(count);
+    if (subjectCount > 0) {
+        e.subjectRelMse = subjectTotal / double(subjectCount);
+        e.subjectStandardError = std::sqrt(2.0 / 3.0 * subjectSquares) / double(subjectCount);
+        e.subjectFraction = double(subjectCount) / double(count);
+    }
+    return e;
+}
+
+std::optional<double> Film::subjectRelMseEstimate() const {
+    const ErrorEstimate e = halfBufferError();
+    return e.subjectRelMse ? e.subjectRelMse : e.relMse;
 }
 
 Film::ErrorEstimate Film::halfBufferError() const {

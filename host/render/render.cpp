@@ -408,6 +408,16 @@ void RenderSession::report(const char* stopReason) {
     stats_.extra["render_seconds"] = renderSeconds_;
     stats_.extra["peak_rss_mib"] = peakResidentMiB();
     stats_.extra["samples_taken"] = film.samplesTaken();
+    if (config_.targetError) {
+        const Film::ErrorEstimate e = film.halfBufferError();
+        stats_.extra["target_error"] = {
+            {"target", *config_.targetError},
+            {"rule", "relMSE estimate over the pixels that hold noise (halves differing by more "
+                     "than float precision)"},
+            {"estimate", e.subjectRelMse ? *e.subjectRelMse : e.relMse.value_or(0.0)},
+            {"whole_image_estimate", e.relMse.value_or(0.0)},
+            {"subject_fraction", e.subjectFraction}};
+    }
     if (scene_.settings.adaptiveThreshold > 0.0)
         stats_.extra["adaptive"] = {
             {"threshold", scene_.settings.adaptiveThreshold},

@@ -1,7 +1,8 @@
 // When a render stops early, decided between iterations. In the order checked: the time limit,
 // a stop asked for (a signal, or the preview window closing), every tile converged (adaptive
-// sampling), and the target error reached. Running out of iterations is the render loop's own
-// end ("spp").
+// sampling), and the target error reached: the relMSE estimate over the pixels that hold noise
+// (the subject; a flat background is left out, Film::halfBufferError). Running out of iterations is
+// the render loop's own end ("spp").
 #pragma once
 
 #include "host/backend/backend.h"
@@ -32,7 +33,8 @@ class StopRule {
         if (agreed.stop) return bySignal();
         if (filmHolds && !film.anySampling()) return "adaptive"; // every tile below threshold
         if (filmHolds && config_.targetError) {
-            const std::optional<double> estimate = film.halfBufferRelMseEstimate();
+            // The subject's error: the pixels that hold noise (Film::subjectRelMseEstimate).
+            const std::optional<double> estimate = film.subjectRelMseEstimate();
             if (estimate && *estimate <= *config_.targetError) return "target error";
         }
         return nullptr;

@@ -202,8 +202,9 @@ TEST(Checkpoint, TheErrorCsvOfAResumedRenderKeepsTheFirstRunsRows) {
     const std::string resumed = withoutSeconds(readFile(dir.file("e.csv")));
     EXPECT_EQ(resumed, withoutSeconds(readFile(dir.file("whole.csv"))));
     EXPECT_EQ(std::count(resumed.begin(), resumed.end(), '\n'), 7); // the header and 6 rows
-    // The first row (one sample: one half buffer empty) has no estimate: empty cells, not 0.
-    EXPECT_EQ(resumed.substr(resumed.find('\n') + 1, 6), "1,1,,\n");
+    // The first row (one sample: one half buffer empty) has no estimate: empty cells, not 0
+    // (the whole image's and its standard error, the subject's and its share).
+    EXPECT_EQ(resumed.substr(resumed.find('\n') + 1, 8), "1,1,,,,\n");
 }
 
 TEST(Checkpoint, ACheckpointOfAnotherRenderIsRefused) {

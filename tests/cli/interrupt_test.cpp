@@ -100,23 +100,29 @@ TEST(Interrupt, SecondSignalExitsAtOnceLeavingNoFile) {
     }
 }
 
-// --target-error stops after the first iteration whose estimate is at or below the target: the
-// same iteration the --error-csv of a full render says (the renders are deterministic, so it
-// is that iteration exactly, not merely close).
+// --target-error stops after the first iteration whose estimate over the subject (the pixels
+// that hold noise) is at or below the target: the same iteration the --error-csv of a full render
+// says in its subject_relmse_estimate column (the renders are deterministic, so it is that
+// iteration exactly, not merely close).
 TEST(Interrupt, TargetErrorStopsWhereTheErrorCsvCrossesIt) {
     TempDir dir;
     const std::string scene = smallCornellBox(dir, 48, 48);
     ChildResult full = runChild({"render", scene, "--backend", "cpu", "--quiet", "--spp", "16",
                                  "--error-csv", dir.file("full.csv"), "-o", dir.file("full.exr")});
     ASSERT_EQ(full.status, 0) << full.output;
-    std::vector<double> relMse; // per iteration, from the CSV's fourth column
+    std::vector<double> relMse; // per iteration, from the CSV's subject_relmse_estimate column
     std::istringstream csv(readFile(dir.file("full.csv")));
     std::string line;
     std::getline(csv, line); // header
+    int column = 0;
+    for (std::istringstream header(line);
+         std::getline(header, line, ',') && line != "subject_relmse_estimate";)
+        ++column;
+    ASSERT_EQ(column, 5) << "the header names no subject_relmse_estimate after its five columns";
     while (std::getline(csv, line)) {
         std::istringstream row(line);
         std::string cell;
-        for (int c = 0; c < 4; ++c)
+        for (int c = 0; c <= column; ++c)
             std::getline(row, cell, ',');
         // Empty where no estimate exists yet (iteration 1: one half buffer has no sample).
         relMse.push_back(cell.empty() ? std::nan("") : std::stod(cell));

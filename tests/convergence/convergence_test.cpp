@@ -321,9 +321,15 @@ TEST(ErrorCsv, OneRowPerIterationWithAndWithoutReference) {
         double t = std::stod(rows[i]["seconds"]);
         EXPECT_GT(t, last);
         last = t;
-        for (const char* k : {"relmse_estimate", "relmse_estimate_stderr", "mse", "rmse", "relmse",
-                              "mae", "psnr", "maxabs"})
+        for (const char* k :
+             {"relmse_estimate", "relmse_estimate_stderr", "mse", "rmse", "relmse", "mae", "psnr",
+              "maxabs", "subject_relmse_estimate", "subject_fraction"})
             EXPECT_TRUE(std::isfinite(std::stod(rows[i][k]))) << k;
+        // The subject leaves out flat pixels, whose terms are 0: its mean is the larger.
+        EXPECT_GE(std::stod(rows[i]["subject_relmse_estimate"]),
+                  std::stod(rows[i]["relmse_estimate"]));
+        EXPECT_GT(std::stod(rows[i]["subject_fraction"]), 0.0);
+        EXPECT_LE(std::stod(rows[i]["subject_fraction"]), 1.0);
     }
     // The last row's metrics are the final image's, as `spillway compare` computes them.
     ImageMetrics m = compareImages(readImage(dir.file("a.exr")), readImage(dir.file("ref.exr")));

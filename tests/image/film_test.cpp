@@ -311,5 +311,78 @@ TEST(Film, TheAdaptiveDecisionsEstimateIsTheEstimateAfresh) {
     }
 }
 
+// The stop judges the subject: pixels whose halves agree to float precision (a flat background,
+// black or a constant environment) are left out of the subject's estimate. A 32 x 32 film whose
+// centre 8 x 8 is noisy and whose rest reads a constant (and, in a second film, black): the
+// subject's estimate is the mean of the centre's terms alone, the whole image's the same terms
+// over every pixel, so the one is the other over the subject's share of the frame (1/16); and
+// toward a target, the flat tiles rest while the subject's samples on.
+TEST(Film, TheSubjectIsThePixelsThatHoldNoise) {
+    const int w = 32, h = 32;
+    for (float background : {0.5f, 0.0f}) {
+        SCOPED_TRACE(background);
+        Film film(w, h, Filter{}, 8.0f, 4);
+        film.setAdaptiveTarget(1e-6);
+        std::mt19937 rng(11);
+        std::exponential_distribution<float> radiance(1.0f);
+        uint key = 1;
+        auto subject = [](int x, int y) { return x >= 12 && x < 20 && y >= 12 && y < 20; };
+        for (int it = 0; it < 4; ++it) {
+            if (it > 0) film.beginIteration();
+            for (int y = 0; y < h; ++y)
+                for (int x = 0; x < w; ++x) {
+                    if (!film.sampling(x, y)) continue;
+                    for (uint s = 0; s < 4; ++s) {
+                        const uint path = uint(y * w + x) * 4 + s, index = uint(it) * 4 + s;
+                        const vec2 at(float(x) + 0.5f, float(y) + 0.5f);
+                        film.addSample(path, at, index);
+                        const float v = subject(x, y) ? radiance(rng) : background;
+                        film.splat(path, at, index, vec3(v), key++);
+                    }
+                }
+            film.endIteration();
+        }
+        const Film::ErrorEstimate e = film.halfBufferError();
+        ASSERT_TRUE(e.relMse && e.subjectRelMse);
+        EXPECT_DOUBLE_EQ(e.subjectFraction, 64.0 / 1024.0);
+        EXPECT_NEAR(*e.relMse, *e.subjectRelMse * e.subjectFraction, *e.relMse * 1e-9);
+        EXPECT_GT(*e.subjectRelMse, 1e-3); // 16 exponential samples: far from converged
+        EXPECT_EQ(film.subjectRelMseEstimate(), e.subjectRelMse);
+        std::vector<float> terms(size_t(w) * h * 3);
+        film.errorRows(0, h, terms.data());
+        double sum = 0.0;
+        for (int y = 12; y < 20; ++y)
+            for (int x = 12; x < 20; ++x)
+                for (int c = 0; c < 3; ++c)
+                    sum += terms[(size_t(y) * w + x) * 3 + c];
+        EXPECT_NEAR(*e.subjectRelMse, sum / (64.0 * 3.0), *e.subjectRelMse * 1e-6);
+        for (int ty = 0; ty < h / Film::kAdaptiveTile; ++ty)
+            for (int tx = 0; tx < w / Film::kAdaptiveTile; ++tx) {
+                const int x = tx * Film::kAdaptiveTile, y = ty * Film::kAdaptiveTile;
+                // The centre's 8 x 8 falls on the four middle tiles.
+                const bool noisy = tx >= 1 && tx <= 2 && ty >= 1 && ty <= 2;
+                EXPECT_EQ(film.sampling(x, y), noisy) << tx << ", " << ty;
+            }
+    }
+    // An image that is all flat has no subject: the stop reads the whole image's estimate.
+    Film flat(16, 16, Filter{}, 1.0f, 4);
+    uint key = 1;
+    for (int it = 0; it < 2; ++it) {
+        if (it > 0) flat.beginIteration();
+        for (uint p = 0; p < 16 * 16; ++p)
+            for (uint s = 0; s < 4; ++s) {
+                const vec2 at(float(p % 16) + 0.5f, float(p / 16) + 0.5f);
+                flat.addSample(p * 4 + s, at, uint(it) * 4 + s);
+                flat.splat(p * 4 + s, at, uint(it) * 4 + s, vec3(0.25f), key++);
+            }
+        flat.endIteration();
+    }
+    const Film::ErrorEstimate f = flat.halfBufferError();
+    EXPECT_FALSE(f.subjectRelMse.has_value());
+    ASSERT_TRUE(f.relMse.has_value());
+    EXPECT_EQ(flat.subjectRelMseEstimate(), f.relMse);
+    EXPECT_LT(*f.relMse, Film::kFlatTerm);
+}
+
 } // namespace
 } // namespace spw

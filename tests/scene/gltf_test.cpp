@@ -260,10 +260,18 @@ TEST(Gltf, AFileWithoutSamplingRendersToADefaultErrorAndSaysSo) {
                                       dir.file(backend + ".exr") + " --stats " + stats);
         ASSERT_EQ(r.status, 0) << r.output;
         EXPECT_NE(r.output.find(glb + " carries no sampling setting: rendering until the relMSE "
-                                      "estimate reaches 0.002, at most 1024 spp"),
+                                      "estimate over the pixels that hold noise reaches 0.002, "
+                                      "at most 1024 spp"),
                   std::string::npos)
             << r.output;
         const json s = json::parse(readFile(stats));
+        // The stop's rule and what it read, in --stats.
+        EXPECT_EQ(s["target_error"]["target"], 0.002) << s.dump();
+        EXPECT_NE(s["target_error"]["rule"].get<std::string>().find("pixels that hold noise"),
+                  std::string::npos);
+        const double fraction = s["target_error"]["subject_fraction"];
+        EXPECT_GT(fraction, 0.0);
+        EXPECT_LE(fraction, 1.0);
         const std::string reason = s["stop_reason"];
         // 16 samples a pixel an iteration (kGltfSampleBase); the estimate exists from the first.
         EXPECT_EQ(s["iterations"].get<int>() * kGltfSampleBase * kGltfSampleBase, s["spp"])
