@@ -20,7 +20,8 @@ import re
 import sys
 
 # The folders a path must start with to be read as a path into this repository.
-TOP = ("host", "shaders", "embree_backend", "tests", "scripts", "docs", "scenes", "cmake", ".ci")
+TOP = ("host", "shaders", "embree_backend", "tests", "scripts", "docs", "scenes", "cmake", ".ci",
+       "blender")
 PATH = re.compile(r"(?<![\w./-])((?:%s)/[\w./-]*[\w/])" % "|".join(re.escape(t) for t in TOP))
 PLACEHOLDER = re.compile(r"[<>*]|\.\.\.|/[A-Z]+(/|$)")
 BRACES = re.compile(r"\.\{([\w,]+)\}")

@@ -1,0 +1,219 @@
+#!/usr/bin/env python3
+"""The Blender add-on (blender/spillway_render), headless, as a farm would run it.
+
+    tests/blender/addon_test.py SPILLWAY_BINARY
+
+Builds a .blend from a script (Blender's default cube on a plane, a camera with depth of field,
+an area light, a sun, a uniform world) and renders the file with `blender -b FILE.blend
+-E SPILLWAY -f 1`, the add-on registered from this tree first (an expression before -E: the
+user's own add-ons are left as they are). It checks:
+- the add-on's image is `spillway render` of the scene the add-on exported, bit for bit;
+- what that scene carries of what glTF drops: the area light as a quad, the sun, the world as
+  an environment, the camera's depth of field, the resolution and percentage;
+- a feature it cannot carry (a disc area light) is reported by name, and the rest still renders;
+- a missing binary is Blender's error report, naming it;
+- a world of an equirectangular image, seen by the camera alone, is Cycles' image: relMSE
+  below 0.01 and every channel's mean within 3 % (the map's orientation, strength and the field
+  of view all show in it).
+Prints what failed and exits 1, or exits 0; 77 (skipped) without Blender.
+"""
+import json
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+
+MAKE_BLEND = r"""
+import bpy, math, sys
+out, disc = sys.argv[sys.argv.index("--") + 1:]
+scene = bpy.context.scene
+bpy.ops.mesh.primitive_plane_add(size=8, location=(0, 0, -1))
+cam = scene.camera
+cam.location = (6, -6, 4)
+cam.rotation_euler = (math.radians(63), 0, math.radians(45))
+cam.data.dof.use_dof = True
+cam.data.dof.focus_distance = 9.0
+cam.data.dof.aperture_fstop = 2.8
+for o in list(scene.objects):
+    if o.type == "LIGHT":
+        bpy.data.objects.remove(o)
+area = bpy.data.lights.new("Panel", "AREA")
+area.shape, area.size, area.size_y, area.energy = "RECTANGLE", 2.0, 1.0, 400.0
+o = bpy.data.objects.new("Panel", area)
+o.location = (0, 0, 4)
+scene.collection.objects.link(o)
+sun = bpy.data.lights.new("Sun", "SUN")
+sun.energy, sun.angle = 2.0, 0.0
+o = bpy.data.objects.new("Sun", sun)
+o.rotation_euler = (math.radians(30), 0, math.radians(20))
+scene.collection.objects.link(o)
+if disc == "1":
+    d = bpy.data.lights.new("Disc", "AREA")
+    d.shape = "DISK"
+    o = bpy.data.objects.new("Disc", d)
+    o.location = (2, 2, 3)
+    scene.collection.objects.link(o)
+world = bpy.data.worlds.new("Sky")
+world.use_nodes = True
+bg = world.node_tree.nodes["Background"]
+bg.inputs["Color"].default_value = (0.2, 0.3, 0.5, 1.0)
+bg.inputs["Strength"].default_value = 0.5
+scene.world = world
+scene.render.resolution_x, scene.render.resolution_y = 96, 64
+scene.render.resolution_percentage = 50
+scene.render.image_settings.file_format = "OPEN_EXR"
+scene.render.image_settings.color_depth = "32"
+scene.render.image_settings.exr_codec = "ZIP"
+scene.render.engine = "SPILLWAY"
+scene.spillway.stop = "SAMPLES"
+scene.spillway.samples = 8
+scene.spillway.backend = "cpu"
+scene.spillway.filter = "Box"
+bpy.ops.wm.save_as_mainfile(filepath=out)
+"""
+
+
+# A world of an equirectangular image and nothing else: the camera sees the map alone, which
+# Cycles and Spillway must then show alike (no BSDF in between): the map's orientation, its
+# strength and the camera's field of view all show in where its texels land.
+MAKE_WORLD = r"""
+import bpy, math, sys
+out, image_path = sys.argv[sys.argv.index("--") + 1:]
+scene = bpy.context.scene
+for o in list(scene.objects):
+    if o.type != "CAMERA":
+        bpy.data.objects.remove(o)
+w, h = 64, 32
+img = bpy.data.images.new("map", w, h, float_buffer=True)
+px = []
+for y in range(h):
+    for x in range(w):
+        q = (x * 4) // w  # four quarters of azimuth, each its own colour, brighter upward
+        base = ((1.0, 0.2, 0.1), (0.1, 1.0, 0.2), (0.2, 0.1, 1.0), (1.0, 1.0, 0.2))[q]
+        k = 0.25 + y / h
+        px += [base[0] * k, base[1] * k, base[2] * k, 1.0]
+img.pixels = px
+img.filepath_raw = image_path
+img.file_format = "OPEN_EXR"
+img.save()
+world = bpy.data.worlds.new("Map")
+world.use_nodes = True
+nodes = world.node_tree.nodes
+tex = nodes.new("ShaderNodeTexEnvironment")
+tex.image = bpy.data.images.load(image_path)
+tex.interpolation = "Closest"
+world.node_tree.links.new(tex.outputs["Color"], nodes["Background"].inputs["Color"])
+nodes["Background"].inputs["Strength"].default_value = 2.0
+scene.world = world
+cam = scene.camera
+cam.location = (0, 0, 0)
+cam.rotation_euler = (math.radians(80), 0, math.radians(-30))
+cam.data.lens = 18
+scene.render.resolution_x, scene.render.resolution_y = 64, 48
+scene.render.resolution_percentage = 100
+scene.render.image_settings.file_format = "OPEN_EXR"
+scene.render.image_settings.color_depth = "32"
+scene.render.filter_size = 0.01
+scene.cycles.samples = 64
+scene.cycles.use_denoising = False
+scene.cycles.use_adaptive_sampling = False
+scene.view_settings.view_transform = "Standard"
+scene.spillway.samples = 64
+scene.spillway.backend = "cpu"
+scene.spillway.filter = "Box"
+bpy.ops.wm.save_as_mainfile(filepath=out)
+"""
+
+
+def blender(args, env=None, check=True):
+    r = subprocess.run(["blender", "-b", "--factory-startup"] + args, capture_output=True,
+                       text=True, env=env, timeout=600)
+    if check and r.returncode != 0:
+        raise SystemExit("blender %s failed (%d):\n%s%s" % (args, r.returncode, r.stdout, r.stderr))
+    return r
+
+
+def main():
+    if len(sys.argv) != 2:
+        raise SystemExit(__doc__)
+    spillway = os.path.abspath(sys.argv[1])
+    if not shutil.which("blender"):
+        print("no Blender: skipped")
+        return 77
+    failures = []
+    tmp = tempfile.mkdtemp(prefix="spillway-addon-test-")
+    try:
+        # Blender's Python finds its standard library from the first python3 on PATH: a
+        # pyenv one (a developer's shell) would hide Debian's, and numpy, which the glTF
+        # exporter imports.
+        path = os.pathsep.join(p for p in os.environ.get("PATH", "").split(os.pathsep)
+                               if ".pyenv" not in p)
+        env = dict(os.environ, SPILLWAY_BINARY=spillway, PATH=path)
+        addon = ["--python-expr", "import sys; sys.path.insert(0, %r); import spillway_render; "
+                 "spillway_render.register()" % os.path.join(ROOT, "blender")]
+        for disc in ("0", "1"):
+            blend = os.path.join(tmp, "scene%s.blend" % disc)
+            blender(addon + ["--python-expr", MAKE_BLEND, "--", blend, disc], env=env)
+            keep = os.path.join(tmp, "export" + disc)
+            r = blender([blend] + addon + ["-E", "SPILLWAY", "-o",
+                         os.path.join(tmp, "out%s_" % disc), "-F", "OPEN_EXR", "-f", "1"],
+                        env=dict(env, SPILLWAY_KEEP_EXPORT=keep))
+            said = r.stdout + r.stderr
+            if disc == "1":
+                if "Spillway cannot carry: light Disc: a disk area light" not in said:
+                    failures.append("the disc light is not reported by name:\n" + said)
+                continue
+            image = os.path.join(tmp, "out0_0001.exr")
+            if not os.path.exists(image):
+                failures.append("no image from the add-on:\n" + said)
+                continue
+            yaml = open(os.path.join(keep, "scene.yaml"), encoding="utf-8").read()
+            for what in ("type: Quad", "type: Directional", "type: Environment", "ThinLens",
+                         "aperture radius", "focal distance: 9.0", "width: 48, height: 32",
+                         "type: Gltf"):
+                if what not in yaml:
+                    failures.append("the exported scene lacks %r:\n%s" % (what, yaml))
+            direct = os.path.join(tmp, "direct.exr")
+            subprocess.run([spillway, "render", os.path.join(keep, "scene.yaml"), "--spp", "8",
+                            "--backend", "cpu", "--quiet", "-o", direct], check=True)
+            c = subprocess.run([spillway, "compare", image, direct], capture_output=True,
+                               text=True)
+            if "images identical" not in c.stdout:
+                failures.append("the add-on's image is not spillway render's:\n" + c.stdout)
+        world = os.path.join(tmp, "world.blend")
+        blender(addon + ["--python-expr", MAKE_WORLD, "--", world, os.path.join(tmp, "map.exr")],
+                env=env)
+        for engine in ("SPILLWAY", "CYCLES"):
+            blender([world] + addon + ["-E", engine, "-o", os.path.join(tmp, engine + "_"), "-F",
+                                       "OPEN_EXR", "-f", "1"], env=env)
+        c = subprocess.run([spillway, "compare", os.path.join(tmp, "SPILLWAY_0001.exr"),
+                            os.path.join(tmp, "CYCLES_0001.exr"), "--json"], capture_output=True,
+                           text=True, check=True)
+        metrics = json.loads(c.stdout)
+        print("world map, Spillway against Cycles:", json.dumps(metrics))
+        if not metrics["relmse"] < 0.01:
+            failures.append("the world map differs from Cycles': relMSE %g" % metrics["relmse"])
+        for channel in range(3):
+            a, b = metrics["mean_a"][channel], metrics["mean_b"][channel]
+            if abs(a / b - 1.0) > 0.03:
+                failures.append("the world map's channel %d mean %g where Cycles' is %g"
+                                % (channel, a, b))
+        r = blender([os.path.join(tmp, "scene0.blend")] + addon +
+                    ["-E", "SPILLWAY", "-o", os.path.join(tmp, "missing_"), "-f", "1"],
+                    env=dict(env, SPILLWAY_BINARY="/nonexistent/spillway"), check=False)
+        if "no spillway binary" not in r.stdout + r.stderr or \
+                "/nonexistent/spillway" not in r.stdout + r.stderr:
+            failures.append("a missing binary is not reported:\n" + r.stdout + r.stderr)
+    finally:
+        if not os.environ.get("SPILLWAY_ADDON_TEST_KEEP"):
+            shutil.rmtree(tmp, ignore_errors=True)
+    for f in failures:
+        print("FAIL:", f)
+    return 1 if failures else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
