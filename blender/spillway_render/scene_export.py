@@ -10,9 +10,12 @@ strength), the resolution and the filter. Anything it cannot carry is listed by 
 
 Axes: glTF, and so the YAML, is Y-up: Blender's (x, y, z) is (x, z, -y) there.
 
-Units, as Cycles defines its lights: a point or spot light of power P watts sends P / (4 pi)
-W/sr; a sun's strength is its irradiance in W/m^2; an area light of power P and area A is
-one-sided with radiance P / (pi A).
+Units, as Cycles renders its lights (tests/blender/addon_test.py measures each against Cycles):
+a point or spot light of power P watts sends P / (4 pi) W/sr; a sun's strength is its
+irradiance in W/m^2; an area light of power P and area A is one-sided with radiance P / (4 A).
+A spot's blend b puts its inner cone's cosine at cos(outer) + b (1 - cos(outer)): Spillway's
+falloff between them is glTF's t^2, not Cycles' smoothstep. Seen from behind, an area light is
+black in Spillway, where Cycles' lets the ray through.
 """
 import json
 import math
@@ -107,6 +110,7 @@ def light_yaml(obj, problems):
         outer = light.spot_size / 2.0
         cos_outer = math.cos(outer)
         inner = math.acos(min(1.0, cos_outer + light.spot_blend * (1.0 - cos_outer)))
+        inner = min(inner, outer * (1.0 - 1e-6))  # Spillway's inner angle is below the outer
         return ("  - {type: Spot, position: %s, direction: %s, intensity: %r, colour: %s, "
                 "inner angle: %r, outer angle: %r}" % (
                     _vec(_point(m)), _vec(-_axis(m, 2)), intensity, _vec(colour),
@@ -126,7 +130,10 @@ def light_yaml(obj, problems):
         sy = light.size_y if light.shape == "RECTANGLE" else light.size
         scale = m.to_scale()
         sx, sy = sx * scale.x, sy * scale.y
-        radiance = light.energy / (math.pi * sx * sy)
+        radiance = light.energy / (4.0 * sx * sy)  # Cycles': measured, tests/blender
+        if light.spread < math.pi - 1e-6:
+            problems.append("light %s: a spread of %.3g degrees (Spillway's quads spread 180)"
+                            % (obj.name, math.degrees(light.spread)))
         # Spillway's quad emits along its local +Z, Blender's area light along its local -Z: turn
         # it half round its X axis (the rectangle is symmetric under it).
         r = (TO_GLTF @ m).to_3x3().normalized() @ mathutils.Matrix.Rotation(math.pi, 3, "X")

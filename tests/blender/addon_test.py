@@ -14,7 +14,9 @@ user's own add-ons are left as they are). It checks:
 - a missing binary is Blender's error report, naming it;
 - a world of an equirectangular image, seen by the camera alone, is Cycles' image: relMSE
   below 0.01 and every channel's mean within 3 % (the map's orientation, strength and the field
-  of view all show in it).
+  of view all show in it);
+- a point, a spot, an area light and a sun each light a diffuse plane as Cycles' does, within
+  2 % (their units).
 Prints what failed and exits 1, or exits 0; 77 (skipped) without Blender.
 """
 import json
@@ -128,6 +130,60 @@ bpy.ops.wm.save_as_mainfile(filepath=out)
 """
 
 
+# One light over a white diffuse plane (Principled, roughness 1, no specular), seen from where
+# the light is not in view, through a narrow lens: the plane's brightness is the light's
+# irradiance, which the add-on must carry in Cycles' units (at normal incidence Cycles' diffuse
+# and glTF's are the same).
+MAKE_LIGHT = r"""
+import bpy, math, sys, mathutils
+kind, out = sys.argv[sys.argv.index("--") + 1:]
+scene = bpy.context.scene
+for o in list(scene.objects):
+    if o.type != "CAMERA":
+        bpy.data.objects.remove(o)
+bpy.ops.mesh.primitive_plane_add(size=20, location=(0, 0, 0))
+mat = bpy.data.materials.new("white")
+mat.use_nodes = True
+p = mat.node_tree.nodes["Principled BSDF"]
+p.inputs["Base Color"].default_value = (0.8, 0.8, 0.8, 1)
+p.inputs["Roughness"].default_value = 1.0
+p.inputs["Specular"].default_value = 0.0
+bpy.context.active_object.data.materials.append(mat)
+cam = scene.camera
+cam.location = (6, 0.001, 6)
+cam.rotation_euler = (-mathutils.Vector(cam.location)).to_track_quat("-Z", "Y").to_euler()
+cam.data.lens = 2000
+if kind == "SUN":
+    light = bpy.data.lights.new("L", "SUN")
+    light.energy, light.angle = 3.0, 0.0
+elif kind == "AREA":
+    light = bpy.data.lights.new("L", "AREA")
+    light.size, light.energy = 0.5, 50.0
+else:
+    light = bpy.data.lights.new("L", kind)
+    light.energy, light.shadow_soft_size = 50.0, 0.0
+    if kind == "SPOT":
+        light.spot_size, light.spot_blend = math.radians(60), 0.1
+o = bpy.data.objects.new("L", light)
+o.location = (0, 0, 2)
+scene.collection.objects.link(o)
+world = bpy.data.worlds.new("Dark")
+world.use_nodes = True
+world.node_tree.nodes["Background"].inputs["Strength"].default_value = 0.0
+scene.world = world
+scene.render.resolution_x = scene.render.resolution_y = 16
+scene.render.resolution_percentage = 100
+scene.render.image_settings.file_format = "OPEN_EXR"
+scene.render.image_settings.color_depth = "32"
+scene.cycles.samples = 64
+scene.cycles.use_denoising = False
+scene.view_settings.view_transform = "Standard"
+scene.spillway.samples = 64
+scene.spillway.backend = "cpu"
+bpy.ops.wm.save_as_mainfile(filepath=out)
+"""
+
+
 def blender(args, env=None, check=True):
     r = subprocess.run(["blender", "-b", "--factory-startup"] + args, capture_output=True,
                        text=True, env=env, timeout=600)
@@ -201,6 +257,20 @@ def main():
             if abs(a / b - 1.0) > 0.03:
                 failures.append("the world map's channel %d mean %g where Cycles' is %g"
                                 % (channel, a, b))
+        for kind in ("POINT", "SPOT", "AREA", "SUN"):
+            blend = os.path.join(tmp, kind + ".blend")
+            blender(addon + ["--python-expr", MAKE_LIGHT, "--", kind, blend], env=env)
+            for engine in ("SPILLWAY", "CYCLES"):
+                blender([blend] + addon + ["-E", engine, "-o", os.path.join(tmp, kind + engine + "_"),
+                                           "-F", "OPEN_EXR", "-f", "1"], env=env)
+            c = subprocess.run([spillway, "compare", os.path.join(tmp, kind + "SPILLWAY_0001.exr"),
+                                os.path.join(tmp, kind + "CYCLES_0001.exr"), "--json"],
+                               capture_output=True, text=True, check=True)
+            a, b = json.loads(c.stdout)["mean_a"][0], json.loads(c.stdout)["mean_b"][0]
+            print("%s light, Spillway against Cycles: %.5f and %.5f" % (kind.lower(), a, b))
+            if abs(a / b - 1.0) > 0.02:
+                failures.append("a %s light lights the plane %.5f where Cycles' does %.5f"
+                                % (kind.lower(), a, b))
         r = blender([os.path.join(tmp, "scene0.blend")] + addon +
                     ["-E", "SPILLWAY", "-o", os.path.join(tmp, "missing_"), "-f", "1"],
                     env=dict(env, SPILLWAY_BINARY="/nonexistent/spillway"), check=False)
