@@ -8,6 +8,8 @@ The guide adds a model called Velvet (stem velvet). Read against the registry
 - name as the model's functions exactly those bsdf.h dispatches to (`<fn>Bsdf<Suffix>`);
 - list, in its table of files, files that every registered model has with its own stem, and a
   test file holding `TEST(<Name>,` for each;
+- have every registered model's line in docs/scene-format.md's table of shaders, as it tells
+  a model's author to write one;
 - give the line of host/cpu/wide_models.h (`X(Velvet, velvet)`) and the one lanes file of a SIMD
   twin, which every model that list names has, holding its `struct <Name>LanesModel`.
 Each finding is printed as `docs/adding-a-surface-model.md: message`; exits 1 if any.
@@ -79,6 +81,11 @@ def problems(root):
                 yield "names %s for each SIMD-wide model; %s has no %s" % (pattern, name, path)
             elif "struct %sLanesModel" % name not in read(root, path):
                 yield "%s holds no struct %sLanesModel" % (path, name)
+    shader_table = re.findall(r"^\| `(\w+)` \|", read(root, "docs/scene-format.md"), re.M)
+    for name in names:
+        if name not in shader_table:
+            yield ("tells a model's author to give it a line in docs/scene-format.md; %s has none "
+                   "(| `%s` | its keys | what it is |)" % (name, name))
     for name, _, stem in models:
         for pattern in files:
             path = pattern.replace("velvet", stem)
