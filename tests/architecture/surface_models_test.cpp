@@ -64,6 +64,20 @@ TEST(SurfaceModels, EveryRegisteredModelHasItsHeaderItsKernelAndItsTest) {
     }
 }
 
+// scenes/every-model.yaml holds a shader of every registered model (its quad light's emissive
+// Null among them), so that scripts/check-identical.sh and the backend tests that render it
+// cover each one.
+TEST(SurfaceModels, EveryModelYamlHoldsEveryRegisteredModel) {
+    const Scene scene = loadScene(sourceDir() + "/scenes/every-model.yaml");
+    for (const SurfaceModelInfo& m : kSurfaceModels) {
+        bool used = false;
+        for (const Shader& shader : scene.shaders)
+            used = used || shader.params.model == m.model;
+        EXPECT_TRUE(used) << "scenes/every-model.yaml has no shader of " << m.name
+                          << ": add one (and an object that takes it)";
+    }
+}
+
 // The loader takes `type: <Name>`, gives the registry's constant, and takes each optional key
 // exactly when the registry line names it.
 TEST(SurfaceModels, TheLoaderTakesEachModelWithExactlyItsRegisteredKeys) {
