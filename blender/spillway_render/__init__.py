@@ -173,9 +173,9 @@ class SpillwayRenderEngine(bpy.types.RenderEngine):
             for line in messages[read:]:
                 m = PROGRESS.search(line)
                 if m and int(m.group(2)) > 0:
-                    self.update_progress(min(1.0, int(m.group(1)) / int(m.group(2))))
+                    self._progress(min(1.0, int(m.group(1)) / int(m.group(2))))
             read = len(messages)
-            if self.test_break() and not stopping:
+            if self._stop_requested() and not stopping:
                 child.send_signal(signal.SIGINT)  # as Ctrl-C: the iterations so far are kept
                 stopping = True
             if os.path.exists(checkpoint) and os.path.getmtime(checkpoint) > shown:
@@ -189,6 +189,14 @@ class SpillwayRenderEngine(bpy.types.RenderEngine):
             self.report({"ERROR"}, "Spillway failed (exit %d): %s" % (child.returncode, text))
             return
         self._show(out, directory, width, height, passes)
+
+    # Blender's progress bar and Esc, behind methods of the add-on's own (Blender's own methods
+    # cannot be replaced on an engine: the add-on's test replaces these to press Esc).
+    def _progress(self, fraction):
+        self.update_progress(fraction)
+
+    def _stop_requested(self):
+        return self.test_break()
 
     def _show(self, exr, directory, width, height, passes):
         """The EXR `exr` into the render result: its image as Combined, and the passes named
