@@ -85,6 +85,26 @@ bpy.ops.wm.save_as_mainfile(filepath=out)
 """
 
 
+# The end of a .blend script whose image Spillway and Cycles must agree on: 64 x 48, SAMPLES
+# samples in both, no denoising or adaptive sampling in Cycles, a box filter in both (Cycles'
+# of width 0.01 pixel), no view transform.
+ALIKE = r"""
+scene.render.resolution_x, scene.render.resolution_y = 64, 48
+scene.render.resolution_percentage = 100
+scene.render.image_settings.file_format = "OPEN_EXR"
+scene.render.image_settings.color_depth = "32"
+scene.render.filter_size = 0.01
+scene.cycles.samples = SAMPLES
+scene.cycles.use_denoising = False
+scene.cycles.use_adaptive_sampling = False
+scene.view_settings.view_transform = "Standard"
+scene.spillway.samples = SAMPLES
+scene.spillway.backend = "cpu"
+scene.spillway.filter = "Box"
+bpy.ops.wm.save_as_mainfile(filepath=out)
+"""
+
+
 # A world of an equirectangular image and nothing else: the camera sees the map alone, which
 # Cycles and Spillway must then show alike (no BSDF in between): the map's orientation, its
 # strength and the camera's field of view all show in where its texels land.
@@ -121,20 +141,8 @@ cam = scene.camera
 cam.location = (0, 0, 0)
 cam.rotation_euler = (math.radians(80), 0, math.radians(-30))
 cam.data.lens = 18
-scene.render.resolution_x, scene.render.resolution_y = 64, 48
-scene.render.resolution_percentage = 100
-scene.render.image_settings.file_format = "OPEN_EXR"
-scene.render.image_settings.color_depth = "32"
-scene.render.filter_size = 0.01
-scene.cycles.samples = 64
-scene.cycles.use_denoising = False
-scene.cycles.use_adaptive_sampling = False
-scene.view_settings.view_transform = "Standard"
-scene.spillway.samples = 64
-scene.spillway.backend = "cpu"
-scene.spillway.filter = "Box"
-bpy.ops.wm.save_as_mainfile(filepath=out)
-"""
+SAMPLES = 64
+""" + ALIKE
 
 
 # One light over a white diffuse plane (Principled, roughness 1, no specular), seen from where
@@ -223,20 +231,8 @@ world = bpy.data.worlds.new("Dark")
 world.use_nodes = True
 world.node_tree.nodes["Background"].inputs["Strength"].default_value = 0.0
 scene.world = world
-scene.render.resolution_x, scene.render.resolution_y = 64, 48
-scene.render.resolution_percentage = 100
-scene.render.image_settings.file_format = "OPEN_EXR"
-scene.render.image_settings.color_depth = "32"
-scene.render.filter_size = 0.01
-scene.cycles.samples = 256
-scene.cycles.use_denoising = False
-scene.cycles.use_adaptive_sampling = False
-scene.view_settings.view_transform = "Standard"
-scene.spillway.samples = 256
-scene.spillway.backend = "cpu"
-scene.spillway.filter = "Box"
-bpy.ops.wm.save_as_mainfile(filepath=out)
-"""
+SAMPLES = 256
+""" + ALIKE
 
 # Registered after the add-on: its engine's Esc answers yes once a first iteration is reported,
 # as a user pressing Esc while the image converges.
