@@ -6,6 +6,8 @@ The scenes, written here as .glb files (numpy makes their arrays):
     nodes, each turned and scaled, on a ground quad under a sun (glTF's instancing: every node
     names the one mesh);
   - unique-M: one mesh of M triangles of its own (a displaced grid), under the same sun;
+  - lanterns-N: N trees of 2,000 triangles, each with an emissive lantern of 176 beside it (a
+    second mesh the N nodes name: its triangles are lights at every placement);
   - textures-K-S: K quads, each with its own material whose base colour is an S x S PNG
     embedded in the file (noise: it compresses as badly as photographs do);
   - uris-K-S: the same as a .gltf, each image written out in the JSON as a data: URI and the
@@ -195,6 +197,31 @@ def forest(path, count, triangles):
     return {"instances": count, "triangles": count * len(tree(triangles, np.random.default_rng(1))[2])}
 
 
+def lanterns(path, count, triangles):
+    """forest-N's trees (of 2,000 triangles) with an emissive lantern of `triangles` beside each:
+    a mesh of its own, placed by N nodes too, whose every triangle is a light at every placement."""
+    rng = np.random.default_rng(4)
+    g = Glb()
+    leaf, soil = g.material((0.2, 0.5, 0.15)), g.material((0.4, 0.3, 0.2))
+    glow = g.material((0.9, 0.8, 0.6))
+    g.doc["materials"][glow]["emissiveFactor"] = [1.0, 0.8, 0.5]
+    side = int(np.ceil(np.sqrt(count)))
+    spacing = 3.0
+    half = spacing * side / 2
+    gp, gn, gi = grid(1, half + 4, 0.0, rng)
+    g.node(mesh=g.mesh(gp, gn, gi, soil))
+    one = g.mesh(*tree(2000, rng), leaf)
+    lantern = g.mesh(*tree(triangles, rng), glow)
+    emitters = len(tree(triangles, np.random.default_rng(4))[2])
+    for k in range(count):
+        x, z = (k % side) * spacing - half, (k // side) * spacing - half
+        g.node(mesh=one, translation=[x, 0.0, z])
+        g.node(mesh=lantern, translation=[x + 1.2, 0.0, z + 0.4], scale=[0.2, 0.2, 0.2])
+    g.camera_and_sun((0.0, 0.6 * half + 6.0, half + 8.0), 0.5)
+    g.write(path)
+    return {"instances": 2 * count, "triangles": count * (2000 + emitters), "emitters": count * emitters}
+
+
 def unique(path, triangles):
     rng = np.random.default_rng(2)
     g = Glb()
@@ -240,12 +267,14 @@ def textures(path, count, size, uri=False):
 def scenes(quick):
     if quick:
         return [("forest-10", forest, (10, 2000)), ("forest-100", forest, (100, 2000)),
-                ("unique-20k", unique, (20000,)), ("textures-4-256", textures, (4, 256)),
+                ("unique-20k", unique, (20000,)), ("lanterns-100", lanterns, (100, 200)),
+                ("textures-4-256", textures, (4, 256)),
                 ("uris-4-256", textures, (4, 256, True))]
     return [("forest-100", forest, (100, 20000)), ("forest-1000", forest, (1000, 20000)),
             ("forest-10000", forest, (10000, 20000)), ("forest-100000", forest, (100000, 20000)),
             ("unique-1M", unique, (1_000_000,)), ("unique-5M", unique, (5_000_000,)),
             ("unique-20M", unique, (20_000_000,)), ("forest-1000000", forest, (1_000_000, 20000)),
+            ("lanterns-10000", lanterns, (10000, 200)), ("lanterns-100000", lanterns, (100000, 200)),
             ("textures-64-2048", textures, (64, 2048)), ("textures-256-2048", textures, (256, 2048)),
             ("textures-64-4096", textures, (64, 4096)), ("uris-64-2048", textures, (64, 2048, True))]
 

@@ -124,12 +124,22 @@ void GltfReader::lightByDefault() {
             }
             radiance *= mapMeans[t];
         }
-        double area = 0.0;
-        for (const uvec3& tri : m.triangles)
-            area +=
-                0.5 * glm::length(glm::cross(glm::dvec3(m.positions[tri.y] - m.positions[tri.x]),
-                                             glm::dvec3(m.positions[tri.z] - m.positions[tri.x])));
-        power += kPi * radiance * area;
+        // A prototype's mesh lights at each of its instances, with the area each gives it.
+        auto area = [&](const glm::dmat3& linear) {
+            double sum = 0.0;
+            for (const uvec3& tri : m.triangles)
+                sum += 0.5 * glm::length(glm::cross(
+                                 linear * glm::dvec3(m.positions[tri.y] - m.positions[tri.x]),
+                                 linear * glm::dvec3(m.positions[tri.z] - m.positions[tri.x])));
+            return sum;
+        };
+        if (m.prototype < 0) {
+            power += kPi * radiance * area(glm::dmat3(1.0));
+            continue;
+        }
+        for (const Instance& inst : scene_.instances)
+            if (int(inst.prototype) == m.prototype)
+                power += kPi * radiance * area(glm::dmat3(glm::mat3(inst.toWorld)));
     }
     if (power == 0.0) return;
     // The environment's, as the light sampler weighs it: what a disc of the scene's bounding

@@ -208,16 +208,6 @@ void GltfReader::readPrimitive(const tinygltf::Primitive& prim, const glm::dmat4
     scene_.meshes.push_back(std::move(m));
 }
 
-bool GltfReader::emissive(int index, const std::string& at) {
-    if (index < 0 || index >= int(model_.meshes.size())) return false; // readMesh names it
-    for (size_t p = 0; p < model_.meshes[size_t(index)].primitives.size(); ++p) {
-        const tinygltf::Primitive& prim = model_.meshes[size_t(index)].primitives[p];
-        const int shader = shaderFor(prim.material, at + "/primitives/" + std::to_string(p));
-        if (scene_.shaders[size_t(shader)].params.emission != vec3(0.0f)) return true;
-    }
-    return false;
-}
-
 int GltfReader::readPrototype(int index, const std::string& at) {
     Prototype proto;
     const size_t first = scene_.meshes.size();
@@ -246,7 +236,7 @@ void GltfReader::placeMeshes() {
         ++uses[p.mesh];
     std::map<int, int> prototypeOf; // glTF mesh -> prototype, or -1 for none (no triangles)
     for (const Placement& p : placements_) {
-        if (uses[p.mesh] < 2 || emissive(p.mesh, p.at())) {
+        if (uses[p.mesh] < 2) {
             readMesh(p.mesh, p.world, p.at());
             continue;
         }
@@ -269,6 +259,11 @@ void GltfReader::placeMeshes() {
         }
         if (scene_.instances.size() >= size_t(kMaxInstances))
             fail(p.at(), "more than " + std::to_string(kMaxInstances) + " instances");
+        instancedEmitters_ += emissiveTriangles(scene_, prototype);
+        if (instancedEmitters_ > kMaxInstancedEmitters)
+            fail(p.at(), "the emissive triangles instances place (one light each, at each "
+                         "placement) are more than " +
+                             std::to_string(kMaxInstancedEmitters));
         for (int k = 0; k < 8; ++k) { // the bounds a camera framing the scene sees
             const glm::dvec3 corner(k & 1 ? prototype.hi.x : prototype.lo.x,
                                     k & 2 ? prototype.hi.y : prototype.lo.y,

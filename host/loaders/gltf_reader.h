@@ -110,16 +110,14 @@ class GltfReader {
 
     void readMesh(int index, const glm::dmat4& world, const std::string& at);
 
-    // Every mesh the node graph placed (placements_), once it is all walked: a mesh placed once,
-    // or emissive (the light table holds world-space triangles), is read into world space at
-    // each placement; one placed more often is read once, in its own frame, as a prototype, and
-    // each placement is an instance of it.
+    // Every mesh the node graph placed (placements_), once it is all walked: a mesh placed once
+    // is read into world space; one placed more often is read once, in its own frame, as a
+    // prototype, and each placement is an instance of it (an emissive one too: SceneLights makes
+    // its emitters per instance).
     void placeMeshes();
     // Mesh `index` read in its own frame as a new prototype: its index, or -1 when it has no
     // triangles.
     int readPrototype(int index, const std::string& at);
-    // Whether any primitive of mesh `index` takes an emissive shader.
-    bool emissive(int index, const std::string& at);
 
     void readPrimitive(const tinygltf::Primitive& prim, const glm::dmat4& world,
                        const std::string& at, const std::string& name);
@@ -343,6 +341,7 @@ class GltfReader {
     std::vector<Placement> placements_;
     // While a prototype's meshes are read: its index (their positions stay in the mesh's frame).
     int prototype_ = -1;
+    size_t instancedEmitters_ = 0; // emissive triangles counted once per instance (placeMeshes)
 };
 
 } // namespace spw

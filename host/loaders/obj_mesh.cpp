@@ -266,8 +266,9 @@ class MeshBuilder {
                 const glm::dvec3& origin, const std::string& path, const std::string& sceneFile,
                 int sceneLine)
         : obj_(obj), a_(a), objectToWorld_(objectToWorld),
-          normalXf_(glm::transpose(glm::inverse(glm::dmat3(objectToWorld)))), origin_(origin),
-          path_(path), sceneFile_(sceneFile), sceneLine_(sceneLine) {
+          normalXf_(glm::transpose(glm::inverse(glm::dmat3(objectToWorld)))),
+          mirrors_(glm::determinant(glm::dmat3(objectToWorld)) < 0.0), origin_(origin), path_(path),
+          sceneFile_(sceneFile), sceneLine_(sceneLine) {
         mesh_.name = path;
     }
 
@@ -275,6 +276,9 @@ class MeshBuilder {
         uvec3 tri;
         for (int k = 0; k < 3; ++k)
             tri[k] = vertex(corners[k]);
+        // A mirroring transform turns the winding: keep the front faces the file's (as glTF's
+        // loader and a mirroring instance do).
+        if (mirrors_) std::swap(tri.y, tri.z);
         // Zero area as the renderer sees it: it normalises cross(e1, e2) in float, so |c|^2
         // must be a normal float (not 0, not a denormal that flush-to-zero turns into 0).
         vec3 e1 = mesh_.positions[tri.y] - mesh_.positions[tri.x];
@@ -340,6 +344,7 @@ class MeshBuilder {
     const tinyobj::attrib_t& a_;
     const glm::dmat4 objectToWorld_;
     const glm::dmat3 normalXf_;
+    const bool mirrors_;
     const glm::dvec3 origin_;
     const std::string &path_, &sceneFile_;
     const int sceneLine_;

@@ -258,7 +258,7 @@ struct PendingGltf {
 };
 
 // An OBJ placed by `instances:`: read once, in its own frame (Scene::meshes[mesh]), and made a
-// prototype once the shaders are known (an emissive one is copied at each placement instead).
+// prototype once the shaders are known.
 struct PendingInstances {
     size_t mesh;
     std::string path;
@@ -470,21 +470,9 @@ class SceneReader {
 };
 
 void SceneReader::placeInstances() {
+    size_t emitters = 0; // emissive triangles, once per instance, over every object's instances
     for (const PendingInstances& o : instanced_) {
         Mesh& mesh = scene_.meshes[o.mesh];
-        if (scene_.shaders[size_t(mesh.shader)].params.emission != vec3(0.0f)) {
-            // An emitter: a copy at each placement (the light table holds world triangles).
-            const int shader = mesh.shader;
-            for (size_t i = 0; i < o.transforms.size(); ++i) {
-                Mesh copy = loadObjMesh(o.path, o.transforms[i], scene_.origin, rd_.file(), o.line);
-                copy.shader = shader;
-                if (i == 0)
-                    scene_.meshes[o.mesh] = std::move(copy);
-                else
-                    scene_.meshes.push_back(std::move(copy));
-            }
-            continue;
-        }
         Prototype proto;
         proto.name = mesh.name;
         proto.meshes = {uint(o.mesh)};
@@ -498,6 +486,11 @@ void SceneReader::placeInstances() {
         scene_.prototypes.push_back(std::move(proto));
         if (scene_.instances.size() + o.transforms.size() > size_t(kMaxInstances))
             rd_.fail(o.line, "more than " + std::to_string(kMaxInstances) + " instances");
+        emitters += emissiveTriangles(scene_, scene_.prototypes.back()) * o.transforms.size();
+        if (emitters > kMaxInstancedEmitters)
+            rd_.fail(o.line, "the emissive triangles instances place (one light each, at each "
+                             "placement) are more than " +
+                                 std::to_string(kMaxInstancedEmitters));
         for (const glm::dmat4& t : o.transforms) {
             glm::dmat4 world = t;
             world[3] -= glm::dvec4(scene_.origin, 0.0);

@@ -80,6 +80,14 @@ void includeBox(const glm::dmat4& m, vec3 lo, vec3 hi, glm::dvec3& blo, glm::dve
 }
 } // namespace
 
+size_t emissiveTriangles(const Scene& scene, const Prototype& proto) {
+    size_t n = 0;
+    for (uint m : proto.meshes)
+        if (scene.shaders[size_t(scene.meshes[m].shader)].params.emission != vec3(0.0f))
+            n += scene.meshes[m].triangles.size();
+    return n;
+}
+
 Instance makeInstance(const Prototype& proto, uint prototype, const glm::dmat4& toWorld,
                       std::string& error) {
     Instance inst;

@@ -60,6 +60,9 @@ constexpr int kMaxObjects = 1 << 20;
 // memory a glTF placement costs (docs/performance.md, "Production scale") 2^26 instances are
 // over 100 GB, past any machine this renders on.
 constexpr int kMaxInstances = 1 << 26;
+// Emitters (SceneLights' light table), an emissive prototype's triangles counted once for each
+// instance placing it: 2^26 records of 64 bytes are 4 GiB, over 5 GiB with their powers and CDF.
+constexpr size_t kMaxInstancedEmitters = size_t(1) << 26;
 // A glTF accessor holds at most this many values (elements x components): 2 GiB as the doubles
 // the loader reads them into, and 2^28 / 3 vertices a primitive, far past what one mesh needs.
 constexpr size_t kMaxGltfAccessorValues = size_t(1) << 28;
@@ -261,14 +264,17 @@ struct Mesh {
 };
 
 // Meshes placed many times without copies (glTF's nodes naming one mesh, a YAML object's
-// `instances:`): one Embree scene of their own, placed in the world by instances. A prototype
-// is never emissive (emitters are copied where they are placed: the light table holds world-space
-// triangles).
+// `instances:`): one Embree scene of their own, placed in the world by instances. An emissive
+// prototype's triangles are lights at each placement (SceneLights makes a world-space emitter per
+// triangle per instance; the geometry stays one).
 struct Prototype {
     std::vector<uint> meshes; // indices into Scene::meshes, each with Mesh::prototype this one
     vec3 lo{0.0f}, hi{0.0f};  // the meshes' bounds, in the prototype's frame
     std::string name;         // the file and mesh, for messages and --stats
 };
+
+// Where an index into Scene::instances is expected: none (a mesh placed in world space itself).
+constexpr uint kNoInstance = 0xFFFFFFFFu;
 
 // One placement of a prototype: its frame to the camera-relative world (an affine map, made in
 // double and rounded once) and what hit setup needs of it: the inverse transpose that takes
@@ -352,6 +358,8 @@ struct Scene {
     double renderedTriangles() const;
 };
 
+// The triangles of `proto`'s meshes whose shaders emit: the emitters each instance of it adds.
+size_t emissiveTriangles(const Scene& scene, const Prototype& proto);
 // The bounds of every vertex the scene renders, in double: world-space meshes' vertices, and
 // each instance's prototype bounds moved to world space; lo > hi where the scene has none.
 void sceneBounds(const Scene& scene, glm::dvec3& lo, glm::dvec3& hi);

@@ -59,7 +59,7 @@ template <class Triangle> void placeHit(const Triangle& c, float t, SurfaceHit& 
 void HitSetup::surfaceHit(const HitRecord& h, SurfaceHit& hit) const {
     onHitTriangle(src_, h, [&](const auto& c) { placeHit(c, h.t, hit); });
     hit.shader = uint(src_.meshes[h.mesh].shader);
-    hit.emitter = lights_.emitterOf(h.mesh, h.prim);
+    hit.emitter = lights_.emitterOf(h.instance, h.mesh, h.prim);
     hit.albedo = vec3(0.0f);
     hit.material = 0u;
     hit.extension = uvec2(0u);
@@ -277,7 +277,7 @@ void HitSetup::setUpHits(size_t n, const HitRecord* const* hits, const vec3* dir
         hit.ng = lane(l.ng, j);
         hit.shader = uint(mesh.shader);
         hit.ns = lane(l.ns, j);
-        hit.emitter = lights_.emitterOf(h.mesh, h.prim);
+        hit.emitter = lights_.emitterOf(h.instance, h.mesh, h.prim);
         hit.albedo = vec3(0.0f);
         hit.offset = l.offset.v[j];
         hit.material = 0u;

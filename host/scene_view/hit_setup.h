@@ -14,7 +14,6 @@ namespace spw {
 // (Embree's geometry id), the triangle, Embree's barycentric u and v, the distance, and the
 // instance that placed the mesh (Scene::instances), or kNoInstance for a world-space mesh.
 constexpr uint kNoHit = 0xFFFFFFFFu;
-constexpr uint kNoInstance = 0xFFFFFFFFu;
 struct HitRecord {
     uint mesh; // kNoHit: the ray missed
     uint prim;

@@ -57,6 +57,7 @@ SceneLights::SceneLights(const Scene& scene, const TextureResolver* textures) {
     emitterBase_.assign(scene.meshes.size(), -1);
     for (size_t m = 0; m < scene.meshes.size(); ++m)
         addTriangles(scene, m, textures, powers);
+    addInstances(scene, textures, powers);
 
     // The lights with a place first, behind the triangles: the light tree's emitters lead the
     // table (shared/light_tree.h).
@@ -89,12 +90,12 @@ SceneLights::SceneLights(const Scene& scene, const TextureResolver* textures) {
 void SceneLights::placeEmissionMaps() {
     if (maps_.empty()) return;
     const uint base = uint(lightData_.size());
+    for (uint record : mapRecords_) {     // once each, however many instances' emitters share it
+        float& image = maps_[record + 6]; // the record's image offset (emission_map.h)
+        image = glm::uintBitsToFloat(glm::floatBitsToUint(image) + base);
+    }
     for (Emitter& e : emitters_)
-        if (e.map != kNoEmissionMap) {
-            float& image = maps_[e.map + 6]; // the record's image offset (emission_map.h)
-            image = glm::uintBitsToFloat(glm::floatBitsToUint(image) + base);
-            e.map += base;
-        }
+        if (e.map != kNoEmissionMap) e.map += base;
     lightData_.insert(lightData_.end(), maps_.begin(), maps_.end());
     maps_.clear();
 }
@@ -127,19 +128,18 @@ void SceneLights::buildCdf(const std::vector<double>& powers, size_t meshes) {
     } else {
         emitters_.clear(); // nothing emits: nothing to sample
         emitterBase_.assign(meshes, -1);
+        instanceBase_.clear();
     }
 }
 
-// Every triangle of mesh m, if its shader emits: an emitter each, with its power.
-void SceneLights::addTriangles(const Scene& scene, size_t m, const TextureResolver* textures,
-                               std::vector<double>& powers) {
-    const Mesh& mesh = scene.meshes[m];
+// Whether mesh m's shader emits, with its emission map's image in `image` (null: none); notes
+// its brightest emission for the film.
+bool SceneLights::emits(const Scene& scene, const Mesh& mesh, const TextureResolver* textures,
+                        const EmissionImage*& image) {
     const Shader& shader = scene.shaders[size_t(mesh.shader)];
     const ShaderParams& sp = shader.params;
-    if (maxComponent(sp.emission) <= 0.0f) return;
-    if (mesh.prototype >= 0) // the loaders copy emitters where they are placed (Prototype)
-        throw std::logic_error(mesh.name + ": an emissive mesh placed by instances");
-    const EmissionImage* image = nullptr;
+    image = nullptr;
+    if (maxComponent(sp.emission) <= 0.0f) return false;
     if (shader.emissionTexture >= 0) {
         if (!textures || !textures->active())
             throw std::logic_error("an emission map's image needs the scene's texture resolver");
@@ -147,27 +147,116 @@ void SceneLights::addTriangles(const Scene& scene, size_t m, const TextureResolv
     }
     brightest_ =
         std::max(brightest_, maxComponent(sp.emission) * (image ? image->brightest : 1.0f));
+    return true;
+}
+
+namespace {
+
+// The emitter of the world-space triangle (p0, p1, p2) of an emissive shader.
+Emitter triangleEmitter(const ShaderParams& sp, const vec3& p0, const vec3& p1, const vec3& p2) {
+    Emitter e{};
+    e.type = kEmitterTriangle;
+    e.p0 = p0;
+    e.e1 = p1 - p0;
+    e.e2 = p2 - p0;
+    const vec3 c = glm::cross(e.e1, e.e2);
+    e.area = 0.5f * glm::length(c);
+    e.normal = glm::normalize(c);
+    e.twoSided = (sp.flags & kShaderTwoSided) != 0 ? 1u : 0u;
+    e.radiance = sp.emission;
+    return e;
+}
+
+// Power = L * area * pi per emitting side, L the emission times its map's mean over the triangle.
+double trianglePower(const ShaderParams& sp, const Emitter& e, double mapped) {
+    return double(luminance(sp.emission)) * mapped * double(e.area) * kPi *
+           (e.twoSided ? 2.0 : 1.0);
+}
+
+} // namespace
+
+// Every triangle of world-space mesh m, if its shader emits: an emitter each, with its power.
+void SceneLights::addTriangles(const Scene& scene, size_t m, const TextureResolver* textures,
+                               std::vector<double>& powers) {
+    const Mesh& mesh = scene.meshes[m];
+    const EmissionImage* image = nullptr;
+    if (mesh.prototype >= 0 || !emits(scene, mesh, textures, image)) return;
+    const Shader& shader = scene.shaders[size_t(mesh.shader)];
     emitterBase_[m] = int(emitters_.size());
-    bool twoSided = (sp.flags & kShaderTwoSided) != 0;
     for (const uvec3& t : mesh.triangles) {
-        Emitter e{};
-        e.type = kEmitterTriangle;
-        e.p0 = mesh.positions[t.x];
-        e.e1 = mesh.positions[t.y] - e.p0;
-        e.e2 = mesh.positions[t.z] - e.p0;
-        vec3 c = glm::cross(e.e1, e.e2);
-        e.area = 0.5f * glm::length(c);
-        e.normal = glm::normalize(c);
-        e.twoSided = twoSided ? 1u : 0u;
-        e.radiance = sp.emission;
-        // Power = L * area * pi per emitting side, L the map's mean over the triangle.
+        Emitter e = triangleEmitter(shader.params, mesh.positions[t.x], mesh.positions[t.y],
+                                    mesh.positions[t.z]);
         double mapped = 1.0;
         if (image)
             mapped =
                 addEmissionMap(mesh, t, scene.textures[size_t(shader.emissionTexture)], *image, e);
-        powers.push_back(double(luminance(sp.emission)) * mapped * double(e.area) * kPi *
-                         (twoSided ? 2.0 : 1.0));
+        powers.push_back(trianglePower(shader.params, e, mapped));
         emitters_.push_back(e);
+    }
+}
+
+// Every emissive triangle of a prototype, at each instance placing it: a world-space emitter per
+// triangle per instance, as Cycles 3.x lists an instanced mesh's triangles once per object. The
+// geometry stays one; the emission maps' records and means are made once per prototype triangle
+// and corner order. A mirroring instance takes its triangles' corners as a copy of it does (the
+// loaders turn a mirrored copy's winding, keeping its front faces the file's), so its emitters
+// are the copy's, corner for corner.
+void SceneLights::addInstances(const Scene& scene, const TextureResolver* textures,
+                               std::vector<double>& powers) {
+    struct Emissive {
+        const Mesh* mesh;
+        const EmissionImage* image;
+        // Per corner order (0: the prototype's, 1: a mirroring instance's) and triangle, where
+        // there is an image: its record in maps_, and the map's mean over it.
+        std::vector<uint> maps[2];
+        std::vector<double> mapped[2];
+    };
+    auto corners = [](const uvec3& t, bool mirrors) { return mirrors ? uvec3(t.x, t.z, t.y) : t; };
+    std::vector<int> orders(scene.prototypes.size(), 0); // bit k: an instance of order k
+    for (const Instance& inst : scene.instances)
+        orders[inst.prototype] |= inst.mirrors ? 2 : 1;
+    std::vector<std::vector<Emissive>> byPrototype(scene.prototypes.size());
+    bool any = false;
+    for (size_t p = 0; p < scene.prototypes.size(); ++p) {
+        int offset = 0;
+        for (uint m : scene.prototypes[p].meshes) {
+            Emissive em{&scene.meshes[m], nullptr, {}, {}};
+            if (!emits(scene, *em.mesh, textures, em.image)) continue;
+            emitterBase_[m] = offset;
+            offset += int(em.mesh->triangles.size());
+            const int map = scene.shaders[size_t(em.mesh->shader)].emissionTexture;
+            const Texture* texture = em.image ? &scene.textures[size_t(map)] : nullptr;
+            for (int order = 0; texture && order < 2; ++order)
+                if (orders[p] & (1 << order))
+                    for (const uvec3& t : em.mesh->triangles) {
+                        Emitter e{};
+                        em.mapped[order].push_back(addEmissionMap(*em.mesh, corners(t, order == 1),
+                                                                  *texture, *em.image, e));
+                        em.maps[order].push_back(e.map);
+                    }
+            byPrototype[p].push_back(std::move(em));
+            any = true;
+        }
+    }
+    if (!any) return;
+    instanceBase_.assign(scene.instances.size(), 0u);
+    for (size_t i = 0; i < scene.instances.size(); ++i) {
+        const Instance& inst = scene.instances[i];
+        instanceBase_[i] = uint(emitters_.size());
+        const int order = inst.mirrors ? 1 : 0;
+        for (const Emissive& em : byPrototype[inst.prototype]) {
+            const ShaderParams& sp = scene.shaders[size_t(em.mesh->shader)].params;
+            auto world = [&](uint v) {
+                return vec3(inst.toWorld * vec4(em.mesh->positions[v], 1.0f));
+            };
+            for (size_t k = 0; k < em.mesh->triangles.size(); ++k) {
+                const uvec3 t = corners(em.mesh->triangles[k], inst.mirrors);
+                Emitter e = triangleEmitter(sp, world(t.x), world(t.y), world(t.z));
+                if (em.image) e.map = em.maps[order][k];
+                powers.push_back(trianglePower(sp, e, em.image ? em.mapped[order][k] : 1.0));
+                emitters_.push_back(e);
+            }
+        }
     }
 }
 
@@ -203,6 +292,7 @@ double SceneLights::addEmissionMap(const Mesh& mesh, const uvec3& t, const Textu
     }
     const vec2 d1 = st[1] - st[0], d2 = st[2] - st[0];
     e.map = uint(maps_.size());
+    mapRecords_.push_back(e.map);
     auto sized = [](int texels, Texture::Wrap wrap) { // a side and its wrap mode, in one word
         return glm::uintBitsToFloat(uint(texels) | wrapMode(wrap) << 30u);
     };

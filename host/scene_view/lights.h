@@ -41,10 +41,12 @@ class SceneLights {
     float brightestEmission() const { return brightest_; }
     // How many images the emission maps read (each baked once, however many meshes use it).
     size_t emissionImages() const { return emissionImages_.size(); }
-    // The emitter index of a mesh's triangle, or kNoEmitter.
-    uint emitterOf(uint mesh, uint triangle) const {
+    // The emitter index of a mesh's triangle where `instance` places it (kNoInstance: the mesh
+    // is in world space), or kNoEmitter.
+    uint emitterOf(uint instance, uint mesh, uint triangle) const {
         const int base = emitterBase_[mesh];
-        return base >= 0 ? uint(base) + triangle : kNoEmitter;
+        if (base < 0) return kNoEmitter;
+        return uint(base) + triangle + (instance == kNoInstance ? 0u : instanceBase_[instance]);
     }
 
   private:
@@ -56,7 +58,11 @@ class SceneLights {
         double meanLuminance = 0.0;
         float brightest = 0.0f;
     };
+    bool emits(const Scene& scene, const Mesh& mesh, const TextureResolver* textures,
+               const EmissionImage*& image);
     void addTriangles(const Scene& scene, size_t m, const TextureResolver* textures,
+                      std::vector<double>& powers);
+    void addInstances(const Scene& scene, const TextureResolver* textures,
                       std::vector<double>& powers);
     const EmissionImage& emissionImage(int texture, const TextureResolver& textures);
     // Appends triangle t's record (shared/emission_map.h) to maps_ for Emitter::map; returns
@@ -75,7 +81,11 @@ class SceneLights {
     std::vector<float> table_; // the CDF (sampled_ entries), then the light tree
     uint sampled_ = 0;
     uint treeEmitters_ = 0;
-    std::vector<int> emitterBase_; // per mesh: index of its first emitter, or -1
+    // Per mesh: the index of its first emitter (a prototype's mesh: from its instance's first),
+    // or -1; per instance: the index of its first emitter, where its prototype emits.
+    std::vector<int> emitterBase_;
+    std::vector<uint> instanceBase_;
+    std::vector<uint> mapRecords_; // where in maps_ each emission map's record starts
     float brightest_ = 0.0f;
     uint environment_ = kNoEmitter;
     uint envWidth_ = 0, envHeight_ = 0;

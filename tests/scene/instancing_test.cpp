@@ -13,6 +13,7 @@
 #include "scene/gltf_builder.h"
 #include "test_util.h"
 
+#include <OpenImageIO/imagebuf.h>
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
@@ -45,12 +46,19 @@ json boxPrimitive(GltfBuilder& b, int material) {
 
 // The box placed by four nodes (turned, stretched, one mirrored) over a floor, under the file's
 // default lighting, seen by a camera: `shared` one mesh the four name, else four meshes of the
-// same accessors (the flattened scene). `emission` makes the boxes' material emissive.
+// same accessors (the flattened scene). `emission` makes the boxes' material emissive;
+// `emissionImage` (a PNG's bytes), where not empty, is its emissiveTexture.
 std::string boxes(const TempDir& dir, const std::string& name, bool shared,
-                  vec3 emission = vec3(0.0f)) {
+                  vec3 emission = vec3(0.0f), const std::string& emissionImage = "") {
     GltfBuilder b;
-    b.doc["materials"] = json::array({material(vec3(0.8f, 0.5f, 0.25f), 0.0f, 0.5f, emission),
-                                      material(vec3(0.6f), 0.0f, 1.0f)});
+    json lamp = material(vec3(0.8f, 0.5f, 0.25f), 0.0f, 0.5f, emission);
+    if (!emissionImage.empty()) {
+        lamp["emissiveTexture"] = {{"index", 0}};
+        b.doc["textures"] = json::array({{{"source", 0}}});
+        b.doc["images"] =
+            json::array({{{"uri", "data:image/png;base64," + GltfBuilder::base64(emissionImage)}}});
+    }
+    b.doc["materials"] = json::array({lamp, material(vec3(0.6f), 0.0f, 1.0f)});
     b.doc["cameras"] =
         json::array({{{"type", "perspective"},
                       {"perspective", {{"yfov", 0.9}, {"aspectRatio", 1.25}, {"znear", 0.1}}}}});
@@ -202,54 +210,133 @@ TEST(Instancing, EveryBackendRendersTheFlattenedImage) {
     }
 }
 
-// An emitter is copied at each placement: the light table holds world-space triangles.
-TEST(Instancing, AnEmissiveMeshIsCopiedWhereItIsPlaced) {
+// An 8 x 8 PNG of coloured stripes, none of them black, for an emission map.
+std::string stripesPng(const TempDir& dir) {
+    OIIO::ImageBuf img(OIIO::ImageSpec(8, 8, 3, OIIO::TypeDesc::UINT8));
+    for (int y = 0; y < 8; ++y)
+        for (int x = 0; x < 8; ++x) {
+            const float c[3] = {x < 4 ? 1.0f : 0.2f, 0.3f + 0.1f * float(y), x % 2 ? 0.9f : 0.1f};
+            img.setpixel(x, y, c);
+        }
+    EXPECT_TRUE(img.write(dir.file("stripes.png")));
+    return readFile(dir.file("stripes.png"));
+}
+
+// An emissive mesh that four nodes name stays one prototype, its triangles lights at each
+// placement: the light table is the flattened scene's (the same count, and per emitter the same
+// area, front face, radiance and pick probability; a mirrored copy's corners come in another
+// order), each hit on an instance names the emitter its copy's hit names, and every backend
+// renders the flattened image. So it is under an emission map, whose records are made once per
+// prototype triangle and read by every instance's emitters.
+TEST(Instancing, AnEmissiveMeshLightsAtEachPlacement) {
     TempDir dir;
-    const Scene s = loadScene(boxes(dir, "lamps.gltf", true, vec3(1.0f)));
-    EXPECT_TRUE(s.prototypes.empty());
-    EXPECT_TRUE(s.instances.empty());
-    EXPECT_EQ(s.meshes.size(), 5u);
+    for (const std::string& image : {std::string(), stripesPng(dir)}) {
+        const std::string what = image.empty() ? "constant" : "emission map";
+        Scene inst = loadScene(boxes(dir, "lamps.gltf", true, vec3(1.0f), image));
+        Scene flat = loadScene(boxes(dir, "flat.gltf", false, vec3(1.0f), image));
+        ASSERT_EQ(inst.prototypes.size(), 1u);
+        ASSERT_EQ(inst.instances.size(), 4u);
+        EXPECT_EQ(emissiveTriangles(inst, inst.prototypes[0]), 12u);
+        EXPECT_EQ(bool(inst.environment), bool(flat.environment)) << what;
+        const TextureResolver ti(inst, 16.0), tf(flat, 16.0);
+        const SceneLights li(inst, &ti), lf(flat, &tf);
+        ASSERT_EQ(li.emitters().size(), lf.emitters().size());
+        EXPECT_GE(li.emitters().size(), 4 * 12u);
+        EXPECT_EQ(li.emissionImages(), image.empty() ? 0u : 1u);
+        for (size_t k = 0; k < li.emitters().size(); ++k) {
+            const Emitter &a = li.emitters()[k], &b = lf.emitters()[k];
+            ASSERT_EQ(a.type, b.type);
+            EXPECT_NEAR(a.area, b.area, 1e-5f * b.area) << what << " " << k;
+            EXPECT_NEAR(a.pickPdf, b.pickPdf, 1e-5f * b.pickPdf) << what << " " << k;
+            EXPECT_EQ(a.map != kNoEmissionMap, b.map != kNoEmissionMap);
+            if (a.type != kEmitterTriangle) continue;
+            for (int c = 0; c < 3; ++c) {
+                EXPECT_NEAR(a.p0[c], b.p0[c], 1e-5f) << what << " " << k;
+                EXPECT_NEAR(a.normal[c], b.normal[c], 1e-5f) << what << " " << k;
+                EXPECT_EQ(a.radiance[c], b.radiance[c]);
+            }
+        }
+        const EmbreeScene ei(inst), ef(flat);
+        int lit = 0;
+        for (int y = 0; y < 40; ++y)
+            for (int x = 0; x < 50; ++x) {
+                const vec3 d = glm::normalize(
+                    vec3((x - 25 + 0.3183f) / 29.7f, (y - 20 + 0.2718f) / 29.7f - 0.1f, -1.0f));
+                const HitRecord a = intersectOne(ei, vec3(0.0f), d),
+                                b = intersectOne(ef, vec3(0.0f), d);
+                if (a.instance == kNoInstance || b.mesh == kNoHit || a.prim != b.prim) continue;
+                ++lit;
+                EXPECT_EQ(li.emitterOf(a.instance, a.mesh, a.prim),
+                          lf.emitterOf(kNoInstance, b.mesh, b.prim));
+            }
+        EXPECT_GT(lit, 150);
+        // The two light trees differ where rounding moves a split (an emitter's corners are
+        // made in float from the instance's transform, a copy's in double), so their picks do:
+        // 32 iterations of one sample each, for per-pixel errors of the difference to rely on.
+        for (Scene* s : {&inst, &flat})
+            s->image = {40, 32, 1, 32};
+        for (const std::string& backend : backendsUnderTest()) {
+            RenderConfig config;
+            config.backend = backend == "reference" ? BackendKind::Reference
+                             : backend == "cpu"     ? BackendKind::Cpu
+                                                    : BackendKind::Vulkan;
+            const auto a = iterationImages(inst, config), b = iterationImages(flat, config);
+            ASSERT_FALSE(a.empty());
+            EXPECT_GT(mean(a.back()), 0.05) << backend;
+            expectNoPairedDifference(pairedDifference(a, b), 40, 32,
+                                     backend + ", " + what + ": instanced - flat",
+                                     1e-4 * mean(b.back()));
+        }
+    }
 }
 
 // A YAML object's `instances:` and a glTF file placed by several objects: prototypes, rendered
-// as the same placements written out as objects of their own.
+// as the same placements written out as objects of their own; an emissive cube's instances light
+// the scene as its copies do.
 TEST(Instancing, YamlInstancesRenderAsSeparateObjects) {
     TempDir dir;
     dir.write("floor.obj", floorObj(4.0f));
     dir.write("cube.obj", insideCubeObj());
-    const std::string head = "image: {width: 32, height: 24}\n"
-                             "camera: {translation: [0, 1.5, 6], rotation: [-10, 0, 0]}\n"
-                             "settings: {max depth: 4}\n"
-                             "shaders:\n  - {type: Lambert, colour: [0.7, 0.6, 0.5]}\n"
-                             "lights:\n  - {type: Point, position: [1, 4, 2], intensity: 20}\n"
-                             "  - {type: Environment, intensity: 0.3}\n"
-                             "objects:\n  - {filename: floor.obj}\n";
+    const std::string head =
+        "image: {width: 32, height: 24}\n"
+        "camera: {translation: [0, 1.5, 6], rotation: [-10, 0, 0]}\n"
+        "settings: {max depth: 4}\n"
+        "shaders:\n  - {type: Lambert, colour: [0.7, 0.6, 0.5]}\n"
+        "  - {type: Lambert, colour: [0.5, 0.5, 0.5], emission: [3, 2, 1], two sided: true}\n"
+        "lights:\n  - {type: Point, position: [1, 4, 2], intensity: 20}\n"
+        "  - {type: Environment, intensity: 0.3}\n"
+        "objects:\n  - {filename: floor.obj}\n";
     const std::vector<std::string> places = {
         "{translation: [-1.5, 0.5, 0], scale: 0.4}",
         "{translation: [0, 0.6, 0], rotation: [0, 30, 0], "
         "scale: [0.5, 0.6, 0.4]}",
         "{translation: [1.5, 0.5, 0], scale: [-0.4, 0.4, 0.4]}"};
-    std::string instanced = head + "  - filename: cube.obj\n    instances:\n";
-    std::string flattened = head;
-    for (const std::string& p : places) {
-        instanced += "      - " + p + "\n";
-        std::string object = p;
-        object.insert(1, "filename: cube.obj, ");
-        flattened += "  - " + object + "\n";
-    }
-    const Scene a = loadScene(dir.write("instanced.yaml", instanced));
-    const Scene b = loadScene(dir.write("flattened.yaml", flattened));
-    ASSERT_EQ(a.instances.size(), 3u);
-    EXPECT_TRUE(a.instances[2].mirrors);
-    EXPECT_TRUE(b.instances.empty());
-    for (BackendKind backend : {BackendKind::Reference, BackendKind::Cpu}) {
-        RenderConfig config;
-        config.backend = backend;
-        config.spp = 64;
-        const auto ia = iterationImages(a, config), ib = iterationImages(b, config);
-        EXPECT_GT(mean(ia.back()), 0.01);
-        expectNoPairedDifference(pairedDifference(ia, ib), 32, 24, "instances: - objects",
-                                 1e-4 * mean(ib.back()));
+    for (const std::string shader : {"0", "1"}) {
+        std::string instanced =
+            head + "  - filename: cube.obj\n    shader: " + shader + "\n    instances:\n";
+        std::string flattened = head;
+        for (const std::string& p : places) {
+            instanced += "      - " + p + "\n";
+            std::string object = p;
+            object.insert(1, "filename: cube.obj, shader: " + shader + ", ");
+            flattened += "  - " + object + "\n";
+        }
+        const Scene a = loadScene(dir.write("instanced.yaml", instanced));
+        const Scene b = loadScene(dir.write("flattened.yaml", flattened));
+        ASSERT_EQ(a.instances.size(), 3u);
+        EXPECT_TRUE(a.instances[2].mirrors);
+        EXPECT_TRUE(b.instances.empty());
+        EXPECT_EQ(SceneLights(a).emitters().size(), SceneLights(b).emitters().size());
+        for (BackendKind backend : {BackendKind::Reference, BackendKind::Cpu}) {
+            RenderConfig config;
+            config.backend = backend;
+            config.spp = 64;
+            const auto ia = iterationImages(a, config), ib = iterationImages(b, config);
+            EXPECT_GT(mean(ia.back()), 0.01);
+            expectNoPairedDifference(pairedDifference(ia, ib), 32, 24,
+                                     "shader " + shader + ", instances: - objects",
+                                     1e-4 * mean(ib.back()));
+        }
     }
 
     // One glTF file placed by three objects: one reader, its mesh a prototype of three.
@@ -330,6 +417,58 @@ TEST(Instancing, MalformedPlacementsAreRefusedWithWhere) {
     EXPECT_EQ(hidden.instances.size(), 1u);
     ASSERT_FALSE(hidden.warnings.empty());
     EXPECT_NE(hidden.warnings[0].find("singular transform"), std::string::npos);
+}
+
+// The emitters instances place are capped (kMaxInstancedEmitters: a triangle counted once per
+// instance, each a 64-byte light record): a prototype of 2^15 emissive triangles placed 2^11 + 1
+// times is refused with the YAML object's line and the glTF node's pointer, before any light is
+// made; at 2^11 placements it loads.
+TEST(Instancing, TooManyInstancedEmittersAreRefusedWithWhere) {
+    TempDir dir;
+    const int n = 128; // a grid of n x n quads, 2n^2 = 2^15 triangles
+    std::string obj;
+    std::vector<float> pos;
+    std::vector<uint16_t> idx;
+    for (int y = 0; y <= n; ++y)
+        for (int x = 0; x <= n; ++x) {
+            obj += "v " + std::to_string(x) + " " + std::to_string(y) + " 0\n";
+            pos.insert(pos.end(), {float(x), float(y), 0.0f});
+        }
+    for (int y = 0; y < n; ++y)
+        for (int x = 0; x < n; ++x) {
+            const int v = y * (n + 1) + x + 1; // OBJ's 1-based index
+            obj += "f " + std::to_string(v) + " " + std::to_string(v + 1) + " " +
+                   std::to_string(v + n + 2) + " " + std::to_string(v + n + 1) + "\n";
+            for (int c : {0, 1, n + 2, 0, n + 2, n + 1})
+                idx.push_back(uint16_t(v - 1 + c));
+        }
+    dir.write("grid.obj", obj);
+    const size_t cap = kMaxInstancedEmitters / (2 * n * n); // 2^11 placements
+    std::string places;
+    for (size_t i = 0; i <= cap; ++i)
+        places += "      - {translation: [0, 0, " + std::to_string(-1.0 - double(i)) + "]}\n";
+    const std::string head = "shaders: [{type: Emissive, emission: [1, 1, 1]}]\n"
+                             "objects:\n  - filename: grid.obj\n    instances:\n";
+    const std::string over = dir.write("over.yaml", head + places);
+    EXPECT_EQ(loadError(over), over + ":5: the emissive triangles instances place (one light each, "
+                                      "at each placement) are more than 67108864");
+    const size_t line = places.rfind("      - ");
+    const Scene at = loadScene(dir.write("at.yaml", head + places.substr(0, line)));
+    EXPECT_EQ(at.instances.size(), cap);
+
+    GltfBuilder b;
+    b.doc["materials"] = json::array({material(vec3(0.0f), 0.0f, 1.0f, vec3(1.0f))});
+    const int grid = b.mesh({{"attributes", {{"POSITION", b.accessor(pos, 5126, "VEC3")}}},
+                             {"indices", b.accessor(idx, 5123, "SCALAR")},
+                             {"material", 0}});
+    std::vector<int> roots;
+    for (size_t i = 0; i <= cap; ++i)
+        roots.push_back(b.node({{"mesh", grid}, {"translation", {0.0, 0.0, -1.0 - double(i)}}}));
+    b.scene(roots);
+    const std::string file = b.embedded(dir, "over.gltf");
+    EXPECT_EQ(loadError(file), file + ": /nodes/" + std::to_string(cap) +
+                                   "/mesh: the emissive triangles instances place (one light "
+                                   "each, at each placement) are more than 67108864");
 }
 
 } // namespace

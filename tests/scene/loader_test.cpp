@@ -309,6 +309,26 @@ TEST(Loader, UniformScaleIsANumber) {
     expectNear(m.positions[t.z], vec3(0, 0, 2), 1e-5f, "corner (0,0,1)");
 }
 
+// A mirroring transform keeps the file's front faces (as glTF's loader and a mirroring instance
+// do): the triangle's corners are taken in turned order, so cross(e1, e2) is the file's normal
+// mirrored, not its opposite. A one-sided emitter or a glass placed mirrored faces as the file
+// says.
+TEST(Loader, AMirroredObjectKeepsItsFrontFaces) {
+    TempDir dir;
+    dir.write("tri.obj", kTriangleObj); // corners (1,0,0), (0,1,0), (0,0,1): normal (1,1,1)
+    for (const char* scale : {"[1, 1, 1]", "[-1, 1, 1]", "[-1, -1, 1]", "[1, 1, -2]"}) {
+        const Scene scene = loadScene(dir.write(
+            "m.yaml", std::string("shader: {type: Lambert}\nobject: {filename: tri.obj, scale: ") +
+                          scale + "}\n"));
+        const Mesh& m = scene.meshes[0];
+        const uvec3 t = m.triangles[0];
+        const vec3 n =
+            glm::cross(m.positions[t.y] - m.positions[t.x], m.positions[t.z] - m.positions[t.x]);
+        const vec3 corner = m.positions[t.x] + m.positions[t.y] + m.positions[t.z];
+        EXPECT_GT(glm::dot(n, corner), 0.0f) << scale; // still facing away from the origin
+    }
+}
+
 // Conductor and Dielectric: their keys, defaults (colour 1, alpha 0; ior 1.5, alpha 0) and
 // the models they select.
 // YAML reads a plain `Null` as the null value: the format's Null shader must load all the same.
