@@ -219,8 +219,8 @@ void explainMissingEstimate(const RenderResult& result) {
 // The image's R, G and B, then the passes' channels (AovFilm::channelNames).
 // Where the peak resident memory went, as far as the parts can say (--stats' `memory`): the
 // process at the end of loading (the file, the parser and the scene's arrays), after the BVH,
-// at its peak; the scene's own arrays, the texture cache's and the ray batches' peaks; and the
-// peak over the stored triangles and the instances.
+// at its peak; the scene's own arrays, the lights' records, the texture cache's and the ray
+// batches' peaks; and the peak over the stored triangles and the instances.
 void reportMemory(RenderStats& stats, const Scene& scene, double loadPeakMiB) {
     auto bytes = [](const auto& v) { return double(v.size() * sizeof(v[0])); };
     double geometry = 0.0, triangles = 0.0;
@@ -235,6 +235,8 @@ void reportMemory(RenderStats& stats, const Scene& scene, double loadPeakMiB) {
         {"after_load_mib", loadPeakMiB},
         {"scene_geometry_bytes", geometry},
         {"instances_bytes", double(scene.instances.size() * sizeof(Instance))},
+        {"lights_bytes",
+         stats.extra.contains("lights") ? stats.extra["lights"].value("bytes", 0.0) : 0.0},
         {"texture_cache_peak_bytes", stats.textures ? stats.textures->peakCacheBytes : 0},
         {"ray_batches_peak_bytes", stats.spill ? stats.spill->peakRayBytesInRam : 0},
     };

@@ -252,7 +252,12 @@ void RenderSession::build() {
     textures_.emplace(scene_, scene_.settings.textureCacheMiB,
                       config_.textureFilter == TextureFilter::Cone, config_.pipeline.simdShading,
                       config_.pipeline.spillDir);
-    lights_.emplace(scene_, &*textures_);
+    {
+        StageTimer t(stats_.stages, "build lights");
+        lights_.emplace(scene_, &*textures_);
+    }
+    stats_.extra["lights"] = {{"emitters", double(lights_->emitters().size())},
+                              {"bytes", double(lights_->bytes())}};
     if (lights_->emissionImages() > 0) stats_.extra["emission_maps"] = lights_->emissionImages();
     cutouts_.emplace(scene_, *textures_);
     if (cutouts_->meshes() > 0) stats_.extra["cutout_meshes"] = cutouts_->meshes();

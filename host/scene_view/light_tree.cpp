@@ -5,7 +5,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <stdexcept>
 
 namespace spw {
 namespace {
@@ -101,43 +100,78 @@ bool sameBounds(const Bounds& a, const Bounds& b) {
 // The most emitters a leaf holds (all with the same bounds).
 constexpr size_t kMaxLeafEmitters = 8;
 
+float bits(uint u) {
+    return glm::uintBitsToFloat(u);
+}
+
+// Builds the tree over emitters [0, count), writing each node's words into `table` as it is
+// made (preorder: a node's first child follows it). Per emitter it holds only twice its box's
+// centre, its place in `order` and its leaf: a node's bounds are returned up the recursion, not
+// kept, so a forest of a million emissive triangles builds in tens of bytes each beside the table.
 struct Builder {
-    const std::vector<Bounds>& leaves;
-    std::vector<uint> order; // emitter indices, partitioned as the build goes
-    std::vector<Bounds> nodes;
-    std::vector<uint> links, parents, counts, leafOf;
+    const std::vector<Emitter>& emitters;
+    std::vector<dvec3> centres; // per emitter: lo + hi of its box
+    std::vector<uint> order;    // emitter indices, partitioned as the build goes
+    std::vector<uint> leafOf;
+    std::vector<float>& table;
+    size_t nodesStart; // where node 0's words start in the table
+    uint nodes = 0;
 
     // Whether order[begin, end) is one leaf: one emitter, or a few the tree cannot tell apart.
     bool leafOfOne(size_t begin, size_t end) const {
         if (end - begin > kMaxLeafEmitters) return false;
+        const Bounds first = emitterBounds(emitters[order[begin]]);
         for (size_t i = begin + 1; i < end; ++i)
-            if (!sameBounds(leaves[order[i]], leaves[order[begin]])) return false;
+            if (!sameBounds(emitterBounds(emitters[order[i]]), first)) return false;
         return true;
     }
 
-    // The node over order[begin, end), and its subtree after it; returns its index.
-    uint build(size_t begin, size_t end, uint parent) {
-        const uint node = uint(nodes.size());
-        nodes.emplace_back();
-        links.push_back(0u);
-        parents.push_back(parent);
-        counts.push_back(0u);
+    void write(uint node, const Bounds& nb, uint link, uint parent, uint count) {
+        const dvec3 centre = 0.5 * (nb.lo + nb.hi);
+        const double radius = 0.5 * glm::length(nb.hi - nb.lo);
+        // Rounded up, so that the float sphere still holds every emitter.
+        const float r =
+            radius > 0.0 ? std::nextafter(float(radius * (1.0 + 1e-6)), INFINITY) : 0.0f;
+        const float words[kTreeNodeWords] = {float(centre.x),
+                                             float(centre.y),
+                                             float(centre.z),
+                                             r,
+                                             float(nb.axis.x),
+                                             float(nb.axis.y),
+                                             float(nb.axis.z),
+                                             float(std::cos(nb.thetaO)),
+                                             float(std::sin(nb.thetaO)),
+                                             float(std::cos(nb.thetaE)),
+                                             float(nb.power),
+                                             bits(link),
+                                             bits(parent),
+                                             bits(count),
+                                             0.0f,
+                                             0.0f};
+        std::copy(words, words + kTreeNodeWords,
+                  table.begin() + std::ptrdiff_t(nodesStart) +
+                      std::ptrdiff_t(node) * kTreeNodeWords);
+    }
+
+    // The node over order[begin, end) and its subtree after it, `node` its index; returns its
+    // bounds.
+    Bounds build(size_t begin, size_t end, uint parent, uint& node) {
+        node = nodes++;
+        table.resize(table.size() + kTreeNodeWords);
         if (leafOfOne(begin, end)) {
             Bounds merged;
             for (size_t i = begin; i < end; ++i) {
-                merged = unite(merged, leaves[order[i]]);
+                merged = unite(merged, emitterBounds(emitters[order[i]]));
                 leafOf[order[i]] = node;
             }
-            nodes[node] = merged;
-            links[node] = kTreeLeaf | (merged.twoSided ? kTreeTwoSided : 0u) | uint(begin);
-            counts[node] = uint(end - begin);
-            return node;
+            write(node, merged, kTreeLeaf | (merged.twoSided ? kTreeTwoSided : 0u) | uint(begin),
+                  parent, uint(end - begin));
+            return merged;
         }
         dvec3 lo(std::numeric_limits<double>::max()), hi(-lo);
         for (size_t i = begin; i < end; ++i) {
-            const Bounds& b = leaves[order[i]];
-            lo = glm::min(lo, 0.5 * (b.lo + b.hi));
-            hi = glm::max(hi, 0.5 * (b.lo + b.hi));
+            lo = glm::min(lo, 0.5 * centres[order[i]]);
+            hi = glm::max(hi, 0.5 * centres[order[i]]);
         }
         const dvec3 extent = hi - lo;
         const int axis = extent.x >= extent.y && extent.x >= extent.z ? 0
@@ -146,22 +180,17 @@ struct Builder {
         const size_t mid = begin + (end - begin) / 2;
         std::nth_element(order.begin() + std::ptrdiff_t(begin), order.begin() + std::ptrdiff_t(mid),
                          order.begin() + std::ptrdiff_t(end), [&](uint a, uint b) {
-                             const double ca = leaves[a].lo[axis] + leaves[a].hi[axis];
-                             const double cb = leaves[b].lo[axis] + leaves[b].hi[axis];
+                             const double ca = centres[a][axis], cb = centres[b][axis];
                              return ca < cb || (ca == cb && a < b);
                          });
-        const uint first = build(begin, mid, node);
-        const uint second = build(mid, end, node);
-        const Bounds merged = unite(nodes[first], nodes[second]);
-        nodes[node] = merged;
-        links[node] = (merged.twoSided ? kTreeTwoSided : 0u) | second;
-        return node;
+        uint first, second;
+        const Bounds a = build(begin, mid, node, first);
+        const Bounds b = build(mid, end, node, second);
+        const Bounds merged = unite(a, b);
+        write(node, merged, (merged.twoSided ? kTreeTwoSided : 0u) | second, parent, 0u);
+        return merged;
     }
 };
-
-float bits(uint u) {
-    return glm::uintBitsToFloat(u);
-}
 
 } // namespace
 
@@ -179,33 +208,26 @@ bool lightTreeChangesPicks(const std::vector<Emitter>& emitters, uint count) {
 }
 
 void appendLightTree(const std::vector<Emitter>& emitters, uint count, std::vector<float>& table) {
-    std::vector<Bounds> leaves;
-    for (uint i = 0; i < count; ++i)
-        leaves.push_back(emitterBounds(emitters[i]));
-    Builder b{leaves, {}, {}, {}, {}, {}, std::vector<uint>(count, 0u)};
-    for (uint i = 0; i < count; ++i)
-        b.order.push_back(i);
-    b.build(0, count, kTreeRoot);
-    for (uint node : b.leafOf)
-        table.push_back(bits(node));
-    for (uint e : b.order)
-        table.insert(table.end(), {bits(e), emitters[e].pickPdf});
+    // The words: each emitter's leaf, the leaves' members (emitter, power), then the nodes, at
+    // most 2 count - 1 (a binary tree over count leaves), reserved so that no growth copies them.
     const size_t start = table.size();
-    for (size_t n = 0; n < b.nodes.size(); ++n) {
-        const Bounds& nb = b.nodes[n];
-        const dvec3 centre = 0.5 * (nb.lo + nb.hi);
-        const double radius = 0.5 * glm::length(nb.hi - nb.lo);
-        // Rounded up, so that the float sphere still holds every emitter.
-        const float r =
-            radius > 0.0 ? std::nextafter(float(radius * (1.0 + 1e-6)), INFINITY) : 0.0f;
-        table.insert(table.end(),
-                     {float(centre.x), float(centre.y), float(centre.z), r, float(nb.axis.x),
-                      float(nb.axis.y), float(nb.axis.z), float(std::cos(nb.thetaO)),
-                      float(std::sin(nb.thetaO)), float(std::cos(nb.thetaE)), float(nb.power),
-                      bits(b.links[n]), bits(b.parents[n]), bits(b.counts[n]), 0.0f, 0.0f});
+    table.reserve(start + 3 * size_t(count) + (2 * size_t(count) - 1) * kTreeNodeWords);
+    table.resize(start + 3 * size_t(count));
+    Builder b{emitters, {}, {}, std::vector<uint>(count, 0u), table, table.size()};
+    b.centres.reserve(count);
+    b.order.reserve(count);
+    for (uint i = 0; i < count; ++i) {
+        const Bounds e = emitterBounds(emitters[i]);
+        b.centres.push_back(e.lo + e.hi);
+        b.order.push_back(i);
     }
-    if (table.size() - start != b.nodes.size() * kTreeNodeWords)
-        throw std::logic_error("light tree: a node's words are not kTreeNodeWords");
+    uint root;
+    b.build(0, count, kTreeRoot, root);
+    for (uint i = 0; i < count; ++i) {
+        table[start + i] = bits(b.leafOf[i]);
+        table[start + count + 2 * i] = bits(b.order[i]);
+        table[start + count + 2 * i + 1] = emitters[b.order[i]].pickPdf;
+    }
 }
 
 } // namespace spw

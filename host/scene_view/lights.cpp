@@ -239,6 +239,12 @@ void SceneLights::addInstances(const Scene& scene, const TextureResolver* textur
         }
     }
     if (!any) return;
+    size_t count = emitters_.size(); // reserved at once: a forest's lights are most of its bytes
+    for (const Instance& inst : scene.instances)
+        for (const Emissive& em : byPrototype[inst.prototype])
+            count += em.mesh->triangles.size();
+    emitters_.reserve(count + scene.punctualLights.size() + 1);
+    powers.reserve(count + scene.punctualLights.size() + 1);
     instanceBase_.assign(scene.instances.size(), 0u);
     for (size_t i = 0; i < scene.instances.size(); ++i) {
         const Instance& inst = scene.instances[i];

@@ -39,6 +39,12 @@ class SceneLights {
     uint environmentHeight() const { return envHeight_; }
     const std::vector<float>& lightData() const { return lightData_; }
     float brightestEmission() const { return brightest_; }
+    // What the lights hold: the emitters, their CDF and tree, the environment's and emission
+    // maps' data (--stats' memory: an emissive instance's triangles are records here).
+    size_t bytes() const {
+        return emitters_.size() * sizeof(Emitter) + table_.size() * sizeof(float) +
+               lightData_.size() * sizeof(float) + shaders_.size() * sizeof(ShaderParams);
+    }
     // How many images the emission maps read (each baked once, however many meshes use it).
     size_t emissionImages() const { return emissionImages_.size(); }
     // The emitter index of a mesh's triangle where `instance` places it (kNoInstance: the mesh

@@ -353,30 +353,41 @@ TEST(Instancing, YamlInstancesRenderAsSeparateObjects) {
 
 // --stats says where the memory went: the scene's arrays to the byte (the box once, 8 vertices
 // of position, normal and uv and 12 triangles, beside the floor quad), the instances' records,
-// and the peaks in the order they are reached.
+// the lights' (with emissive boxes, an emitter per triangle per instance), and the peaks in the
+// order they are reached.
 TEST(Instancing, StatsReportTheMemoryOfTheSceneAndItsPeaks) {
     TempDir dir;
-    const std::string file = boxes(dir, "boxes.gltf", true);
-    const Scene scene = loadScene(file);
-    ASSERT_EQ(scene.instances.size(), 4u);
-    const std::string stats = dir.file("stats.json");
-    const CommandResult r =
-        runSpillway("render " + file + " --backend cpu --spp 1 --width 16 " +
-                    "--height 12 --quiet -o " + dir.file("b.exr") + " --stats " + stats);
-    ASSERT_EQ(r.status, 0) << r.output;
-    const json m = json::parse(readFile(stats))["memory"];
-    double expected = 0.0;
-    for (const Mesh& mesh : scene.meshes)
-        expected +=
-            double(mesh.positions.size() * 12 + mesh.normals.size() * 12 + mesh.uvs.size() * 8 +
-                   mesh.colours.size() * 12 + mesh.triangles.size() * 12);
-    EXPECT_EQ(m["scene_geometry_bytes"].get<double>(), expected) << m.dump();
-    EXPECT_EQ(m["instances_bytes"].get<double>(), double(4 * sizeof(Instance)));
-    EXPECT_LE(m["after_load_mib"].get<double>(), m["after_bvh_mib"].get<double>());
-    EXPECT_LE(m["after_bvh_mib"].get<double>(), m["peak_rss_mib"].get<double>());
-    EXPECT_DOUBLE_EQ(m["peak_bytes_per_instance"].get<double>(),
-                     m["peak_rss_mib"].get<double>() * 1048576.0 / 4.0);
-    EXPECT_GT(m["ray_batches_peak_bytes"].get<double>(), 0.0);
+    for (float emission : {0.0f, 1.0f}) {
+        const std::string file = boxes(dir, "boxes.gltf", true, vec3(emission));
+        const Scene scene = loadScene(file);
+        ASSERT_EQ(scene.instances.size(), 4u);
+        const std::string stats = dir.file("stats.json");
+        const CommandResult r =
+            runSpillway("render " + file + " --backend cpu --spp 1 --width 16 " +
+                        "--height 12 --quiet -o " + dir.file("b.exr") + " --stats " + stats);
+        ASSERT_EQ(r.status, 0) << r.output;
+        const json all = json::parse(readFile(stats)), m = all["memory"];
+        double expected = 0.0;
+        for (const Mesh& mesh : scene.meshes)
+            expected +=
+                double(mesh.positions.size() * 12 + mesh.normals.size() * 12 + mesh.uvs.size() * 8 +
+                       mesh.colours.size() * 12 + mesh.triangles.size() * 12);
+        EXPECT_EQ(m["scene_geometry_bytes"].get<double>(), expected) << m.dump();
+        EXPECT_EQ(m["instances_bytes"].get<double>(), double(4 * sizeof(Instance)));
+        const TextureResolver textures(scene, 16.0);
+        const SceneLights lights(scene, &textures);
+        EXPECT_EQ(m["lights_bytes"].get<double>(), double(lights.bytes()));
+        EXPECT_EQ(all["lights"]["emitters"].get<double>(), double(lights.emitters().size()));
+        if (emission > 0.0f) {
+            EXPECT_EQ(lights.emitters().size(), 4 * 12u); // the file's lights alone
+        }
+        EXPECT_GE(double(lights.bytes()), double(lights.emitters().size() * sizeof(Emitter)));
+        EXPECT_LE(m["after_load_mib"].get<double>(), m["after_bvh_mib"].get<double>());
+        EXPECT_LE(m["after_bvh_mib"].get<double>(), m["peak_rss_mib"].get<double>());
+        EXPECT_DOUBLE_EQ(m["peak_bytes_per_instance"].get<double>(),
+                         m["peak_rss_mib"].get<double>() * 1048576.0 / 4.0);
+        EXPECT_GT(m["ray_batches_peak_bytes"].get<double>(), 0.0);
+    }
 }
 
 TEST(Instancing, MalformedPlacementsAreRefusedWithWhere) {
