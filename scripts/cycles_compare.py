@@ -207,11 +207,78 @@ def render_in_cycles(file, width, height, renders, environment=None, threads=Non
     blender = shutil.which("blender")
     if not blender:
         sys.exit("blender is not installed (Debian: apt-get install blender)")
+    cached = cycles_cache(args, file, environment, blender)
+    if cached and cached.restore():
+        return
     # Blender runs its own Python: none of the caller's (a virtual environment's) paths.
     env = {k: v for k, v in os.environ.items() if not k.startswith(("PYTHON", "PYENV", "VIRTUAL_ENV"))}
     env["PATH"] = "/usr/bin:/bin:" + env.get("PATH", "")
     run([blender, "-b", "--factory-startup", "--python-exit-code", "1", "--python-expr",
          BLENDER_SCRIPT, "--", json.dumps(args)], env=env)
+    if cached:
+        cached.keep()
+
+
+class CyclesCache:
+    """Cycles' renders of one call, kept in a folder named by a hash of everything they depend
+    on: the file's and the environment's bytes, the settings, the script Blender runs and
+    Blender's binary (its path, size and time). Set by the suites (SPILLWAY_CYCLES_CACHE, scripts/test.sh), so that the
+    sanitized run reuses the Release run's renders of the same files; the benchmarks never set
+    it, since a kept render keeps the seconds it took then."""
+
+    def __init__(self, folder, outputs):
+        self.folder, self.outputs = folder, outputs
+
+    def restore(self):
+        kept = [os.path.join(self.folder, "%d" % k) for k in range(len(self.outputs))]
+        if not all(os.path.exists(k) for k in kept):
+            return False
+        for k, out in zip(kept, self.outputs):
+            shutil.copyfile(k, out)
+        return True
+
+    def keep(self):
+        part = self.folder + ".part-%d" % os.getpid()
+        os.makedirs(part, exist_ok=True)
+        for k, out in enumerate(self.outputs):
+            shutil.copyfile(out, os.path.join(part, "%d" % k))
+        try:
+            os.rename(part, self.folder)  # whole or not at all, whoever else keeps it
+        except OSError:
+            shutil.rmtree(part, ignore_errors=True)
+
+
+def gltf_references(file):
+    """The files a .gltf names beside itself (its buffers' and images' URIs other than data:)."""
+    if not file.endswith(".gltf"):
+        return []
+    from urllib.parse import unquote
+    doc = gltf_json(file)
+    return [os.path.join(os.path.dirname(file), unquote(x["uri"]))
+            for key in ("buffers", "images") for x in doc.get(key, [])
+            if "uri" in x and not x["uri"].startswith("data:")]
+
+
+def cycles_cache(args, file, environment, blender):
+    """The cache of a render_in_cycles call, or None where SPILLWAY_CYCLES_CACHE is not set."""
+    root = os.environ.get("SPILLWAY_CYCLES_CACHE")
+    if not root:
+        return None
+    import hashlib
+    h = hashlib.sha256()
+    for path in [file, environment] + gltf_references(file):
+        if path:
+            with open(path, "rb") as f:
+                for block in iter(lambda: f.read(1 << 20), b""):
+                    h.update(block)
+    st = os.stat(os.path.realpath(blender))  # Blender itself, by its binary's size and time
+    h.update(("%s %d %d" % (os.path.realpath(blender), st.st_size, st.st_mtime_ns)).encode())
+    settings = {k: v for k, v in args.items() if k not in ("file", "environment", "renders",
+                                                           "seconds")}
+    settings["renders"] = [{k: v for k, v in r.items() if k != "out"} for r in args["renders"]]
+    h.update(json.dumps(settings, sort_keys=True).encode() + BLENDER_SCRIPT.encode())
+    outputs = [r["out"] for r in args["renders"]] + ([args["seconds"]] if args["seconds"] else [])
+    return CyclesCache(os.path.join(root, h.hexdigest()), outputs)
 
 
 # --- test files: glTF written here, each with a camera ---------------------------------------

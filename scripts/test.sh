@@ -10,6 +10,10 @@ root="$(cd "$(dirname "$0")/.." && pwd)"
 mode="${1:-all}"
 # Lavapipe: as many worker threads as cores (its default can oversubscribe small machines).
 export LP_NUM_THREADS="${LP_NUM_THREADS:-$(nproc)}"
+# Cycles' renders of the suite's glTF files, kept by a hash of their inputs
+# (scripts/cycles_compare.py's CyclesCache): the sanitized run reuses the Release run's, since
+# Blender is the same program under both and only Spillway's side is sanitized.
+export SPILLWAY_CYCLES_CACHE="${SPILLWAY_CYCLES_CACHE:-$root/build/cycles-cache}"
 
 if [ "$mode" = all ] || [ "$mode" = --release ]; then
   "$root/scripts/build.sh"
