@@ -82,6 +82,13 @@ std::string boxes(const TempDir& dir, const std::string& name, bool shared,
     return b.embedded(dir, name);
 }
 
+// The direction from the camera at the origin of ray (x, y) of a 50 x 40 grid over the boxes,
+// offset so that no ray grazes a box's edge in one scene only.
+vec3 gridRay(int x, int y) {
+    return glm::normalize(
+        vec3((x - 25 + 0.3183f) / 29.7f, (y - 20 + 0.2718f) / 29.7f - 0.1f, -1.0f));
+}
+
 TEST(Instancing, AMeshNamedByManyNodesIsOnePrototype) {
     TempDir dir;
     const Scene inst = loadScene(boxes(dir, "shared.gltf", true));
@@ -119,8 +126,7 @@ TEST(Instancing, HitsSetUpInWorldSpaceAsTheirCopies) {
     int instanced = 0, mirrored = 0, rays = 0, apart = 0;
     for (int y = 0; y < 40; ++y)
         for (int x = 0; x < 50; ++x) { // off the boxes' edges: no ray grazes one in one scene only
-            const vec3 dir = glm::normalize(
-                vec3((x - 25 + 0.3183f) / 29.7f, (y - 20 + 0.2718f) / 29.7f - 0.1f, -1.0f));
+            const vec3 dir = gridRay(x, y);
             const HitRecord a = intersectOne(ei, vec3(0.0f), dir),
                             b = intersectOne(ef, vec3(0.0f), dir);
             ++rays;
@@ -171,8 +177,7 @@ TEST(Instancing, ACompactBvhFindsTheSameHits) {
     int hits = 0;
     for (int y = 0; y < 40; ++y)
         for (int x = 0; x < 50; ++x) {
-            const vec3 dir = glm::normalize(
-                vec3((x - 25 + 0.3183f) / 29.7f, (y - 20 + 0.2718f) / 29.7f - 0.1f, -1.0f));
+            const vec3 dir = gridRay(x, y);
             const HitRecord a = intersectOne(fast, vec3(0.0f), dir),
                             b = intersectOne(compact, vec3(0.0f), dir);
             ASSERT_EQ(a.mesh, b.mesh);
@@ -260,8 +265,7 @@ TEST(Instancing, AnEmissiveMeshLightsAtEachPlacement) {
         int lit = 0;
         for (int y = 0; y < 40; ++y)
             for (int x = 0; x < 50; ++x) {
-                const vec3 d = glm::normalize(
-                    vec3((x - 25 + 0.3183f) / 29.7f, (y - 20 + 0.2718f) / 29.7f - 0.1f, -1.0f));
+                const vec3 d = gridRay(x, y);
                 const HitRecord a = intersectOne(ei, vec3(0.0f), d),
                                 b = intersectOne(ef, vec3(0.0f), d);
                 if (a.instance == kNoInstance || b.mesh == kNoHit || a.prim != b.prim) continue;
