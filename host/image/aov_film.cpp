@@ -1,6 +1,9 @@
 #include "host/image/aov_film.h"
 
+#include "host/image/pixel_ranges.h"
+
 #include <algorithm>
+#include <cmath>
 #include <initializer_list>
 #include <sstream>
 #include <stdexcept>
@@ -28,72 +31,146 @@ unsigned parseAovList(const std::string& list) {
     return passes;
 }
 
+namespace {
+
+// The largest magnitude, as a power of two, that each value may take: a normal's components
+// are at most 1, a depth at most kMaxDistance (1e15, under 2^50) and an albedo at most
+// kMaxRadiance (1e20, the environment's brightest) times a specular chain's throughput (2^72).
+constexpr int kNormalBound = 1, kDepthBound = 50, kAlbedoBound = 72;
+
+} // namespace
+
 AovFilm::AovFilm(int width, int height, int samplesPerIteration, unsigned passes,
                  mat3 cameraToWorld)
-    : width_(width), spi_(samplesPerIteration), passes_(passes), cameraToWorld_(cameraToWorld),
-      viewAxis_(-glm::normalize(cameraToWorld[2])) {
+    : width_(width), spi_(samplesPerIteration), pixels_(size_t(width) * size_t(height)),
+      samples_(pixels_ * size_t(samplesPerIteration)), passes_(passes),
+      cameraToWorld_(cameraToWorld), viewAxis_(-glm::normalize(cameraToWorld[2])) {
     for (int k = 0; k < 3; ++k)
         cameraToWorld_[k] = glm::normalize(cameraToWorld_[k]);
-    const size_t pixels = size_t(width) * size_t(height);
-    slots_.resize(pixels * size_t(spi_) * kValues);
-    state_.resize(pixels * size_t(spi_));
-    if (passes_ & kAovAlbedo) chain_.resize(pixels * size_t(spi_));
-    sums_.resize(pixels * kValues);
-    hits_.resize(pixels);
-    albedoSamples_.resize(pixels);
+    auto place = [&](int& at, int count, int bound) {
+        at = values_;
+        for (int k = 0; k < count; ++k)
+            bound_[values_++] = bound;
+    };
+    if (passes_ & kAovAlbedo) place(albedoAt_, 3, kAlbedoBound);
+    if (passes_ & (kAovNormal | kAovCameraNormal)) place(normalAt_, 3, kNormalBound);
+    if (passes_ & kAovDepth) place(depthAt_, 1, kDepthBound);
+    // A pixel's iteration sum is at most samplesPerIteration values of 2^bound: 2^126 at most.
+    const int logSamples = int(std::ceil(std::log2(double(std::max(1, samplesPerIteration)))));
+    for (int k = 0; k < values_; ++k)
+        exponent_[k] = 126 - logSamples - bound_[k];
+    const size_t words = pixels_ * size_t(values_) * 2;
+    iter_.reset(new std::atomic<std::uint64_t>[words]);
+    iterCounts_.reset(new std::atomic<std::uint32_t>[pixels_ * 2]);
+    forPixels(pixels_, [&](size_t begin, size_t end) {
+        for (size_t w = begin * size_t(values_) * 2; w < end * size_t(values_) * 2; ++w)
+            iter_[w].store(0, std::memory_order_relaxed);
+        for (size_t c = begin * 2; c < end * 2; ++c)
+            iterCounts_[c].store(0, std::memory_order_relaxed);
+    });
+    if (passes_ & kAovAlbedo) {
+        pendingWords_ = (samples_ + 63) / 64;
+        pending_.reset(new std::atomic<std::uint64_t>[pendingWords_]);
+    }
+    sums_.resize(pixels_ * size_t(values_));
+    hits_.resize(pixels_);
+    albedoSamples_.resize(pixels_);
+    beginIteration();
+}
+
+size_t AovFilm::bytes() const {
+    return pixels_ * (size_t(values_) * (2 * sizeof(std::uint64_t) + sizeof(double)) +
+                      2 * sizeof(std::uint32_t) * 2) +
+           pendingWords_ * sizeof(std::uint64_t);
 }
 
 void AovFilm::beginIteration() {
-    std::fill(state_.begin(), state_.end(), std::uint8_t(kMissed));
+    if (iterDirty_) // a stopped iteration's sums: endIteration() zeroes them as it reads them
+        forPixels(pixels_, [&](size_t begin, size_t end) {
+            for (size_t w = begin * size_t(values_) * 2; w < end * size_t(values_) * 2; ++w)
+                iter_[w].store(0, std::memory_order_relaxed);
+            for (size_t c = begin * 2; c < end * 2; ++c)
+                iterCounts_[c].store(0, std::memory_order_relaxed);
+        });
+    for (size_t w = 0; w < pendingWords_; ++w)
+        pending_[w].store(0, std::memory_order_relaxed);
+    iterDirty_ = true;
 }
 
-void AovFilm::record(uint pathId, const SurfaceHit& hit) {
-    if (size_t(pathId) >= state_.size()) return; // not a camera path of this film
-    float* slot = &slots_[size_t(pathId) * kValues];
-    slot[0] = slot[1] = slot[2] = 0.0f; // until recordAlbedo
-    slot[3] = hit.ns.x, slot[4] = hit.ns.y, slot[5] = hit.ns.z;
-    slot[6] = glm::dot(hit.p, viewAxis_);
-    state_[pathId] = kHit;
+void AovFilm::add(size_t pixel, int k, float v) {
+    if (!std::isfinite(v)) return; // a sample's NaN or infinity adds nothing
+    const double limit = std::ldexp(1.0, bound_[k]);
+    // Exact: a float times a power of two is a double, and its integral part an __int128; the
+    // fraction below the value's fixed point (2^-exponent_, far below a float's precision of any
+    // value near the bound) is rounded to nearest, the same for every order of adds.
+    const double scaled = std::ldexp(std::clamp(double(v), -limit, limit), exponent_[k]);
+    const __int128 q = static_cast<__int128>(std::nearbyint(scaled));
+    const std::uint64_t lo = std::uint64_t(q);
+    std::uint64_t hi = std::uint64_t(q >> 64);
+    std::atomic<std::uint64_t>* w = &iter_[(pixel * size_t(values_) + size_t(k)) * 2];
+    const std::uint64_t before = w[0].fetch_add(lo, std::memory_order_relaxed);
+    if (before + lo < before) ++hi; // the low word's carry
+    if (hi != 0) w[1].fetch_add(hi, std::memory_order_relaxed);
 }
 
-void AovFilm::recordAlbedo(uint pathId, vec3 albedo, bool passesOn) {
-    if (!albedoPending(pathId)) return;
-    std::uint8_t& state = state_[pathId];
-    vec3& through = chain_[pathId];
-    if (state == kHit) through = vec3(1.0f);
-    if (passesOn) {
-        through *= albedo; // the specular hit's reflectance (and transmittance)
-        state = kThroughSpecular;
+void AovFilm::addAlbedo(size_t pixel, vec3 albedo) {
+    for (int c = 0; c < 3; ++c)
+        add(pixel, albedoAt_ + c, albedo[c]);
+}
+
+void AovFilm::record(const PathState& path, const SurfaceHit& hit) {
+    if (size_t(path.pathId) >= samples_) return; // not a camera path of this film
+    const size_t pixel = pixelOf(path.pathId);
+    if (normalAt_ >= 0)
+        for (int c = 0; c < 3; ++c)
+            add(pixel, normalAt_ + c, hit.ns[c]);
+    if (depthAt_ >= 0) add(pixel, depthAt_, glm::dot(hit.p, viewAxis_));
+    count(pixel, kHitCount);
+    if (albedoAt_ >= 0) count(pixel, kAlbedoCount); // its albedo 0 unless one comes
+}
+
+void AovFilm::recordAlbedo(const PathState& path, vec3 albedo, bool passesOn) {
+    if (!albedoPending(path)) return;
+    std::atomic<std::uint64_t>& word = pending_[path.pathId / 64u];
+    if (passesOn) { // the specular hit's reflectance (and transmittance) is in the throughput
+        if (path.bounce == 0u) word.fetch_or(bit(path.pathId), std::memory_order_relaxed);
         return;
     }
-    float* slot = &slots_[size_t(pathId) * kValues];
-    const vec3 a = through * albedo;
-    slot[0] = a.x, slot[1] = a.y, slot[2] = a.z;
-    state = kAlbedoDone;
+    addAlbedo(pixelOf(path.pathId), path.bounce == 0u ? albedo : path.beta * albedo);
+    if (path.bounce != 0u) word.fetch_and(~bit(path.pathId), std::memory_order_relaxed);
 }
 
-void AovFilm::recordEscape(uint pathId, vec3 radiance) {
-    if (!(passes_ & kAovAlbedo) || size_t(pathId) >= state_.size()) return;
-    std::uint8_t& state = state_[pathId];
-    if (state != kMissed && state != kThroughSpecular) return;
-    const vec3 a = state == kMissed ? radiance : chain_[pathId] * radiance;
-    float* slot = &slots_[size_t(pathId) * kValues];
-    slot[0] = a.x, slot[1] = a.y, slot[2] = a.z;
-    state = state == kMissed ? kEscaped : kAlbedoDone;
+void AovFilm::recordEscape(const PathState& path, vec3 radiance) {
+    if (!(passes_ & kAovAlbedo) || size_t(path.pathId) >= samples_) return;
+    const size_t pixel = pixelOf(path.pathId);
+    if (path.bounce == 0u) { // the camera ray missed
+        addAlbedo(pixel, radiance);
+        count(pixel, kAlbedoCount);
+        return;
+    }
+    if (!albedoPending(path)) return;
+    addAlbedo(pixel, path.beta * radiance);
+    pending_[path.pathId / 64u].fetch_and(~bit(path.pathId), std::memory_order_relaxed);
 }
 
 void AovFilm::endIteration() {
-    const size_t pixels = hits_.size();
-    for (size_t pixel = 0; pixel < pixels; ++pixel)
-        for (size_t s = 0; s < size_t(spi_); ++s) {
-            const size_t path = pixel * size_t(spi_) + s;
-            if (state_[path] == kMissed) continue;
-            ++albedoSamples_[pixel];
-            const int values = state_[path] == kEscaped ? 3 : kValues; // an escape: albedo alone
-            if (values == kValues) ++hits_[pixel];
-            for (int k = 0; k < values; ++k)
-                sums_[pixel * kValues + size_t(k)] += double(slots_[path * kValues + size_t(k)]);
+    forPixels(pixels_, [&](size_t begin, size_t end) {
+        for (size_t pixel = begin; pixel < end; ++pixel) {
+            for (int k = 0; k < values_; ++k) {
+                std::atomic<std::uint64_t>* w = &iter_[(pixel * size_t(values_) + size_t(k)) * 2];
+                const std::uint64_t lo = w[0].exchange(0, std::memory_order_relaxed);
+                const std::uint64_t hi = w[1].exchange(0, std::memory_order_relaxed);
+                if ((lo | hi) == 0) continue;
+                const __int128 q =
+                    static_cast<__int128>((static_cast<unsigned __int128>(hi) << 64) | lo);
+                sums_[pixel * size_t(values_) + size_t(k)] +=
+                    std::ldexp(static_cast<double>(q), -exponent_[k]);
+            }
+            hits_[pixel] += iterCounts_[pixel * 2 + kHitCount].exchange(0);
+            albedoSamples_[pixel] += iterCounts_[pixel * 2 + kAlbedoCount].exchange(0);
         }
+    });
+    iterDirty_ = false;
 }
 
 std::vector<std::string> AovFilm::channelNames() const {
@@ -134,15 +211,15 @@ void AovFilm::rows(int y0, int y1, float* out) const {
     for (int y = y0; y < y1; ++y)
         for (int x = 0; x < width_; ++x) {
             const size_t pixel = size_t(y) * size_t(width_) + size_t(x);
+            const double* sum = &sums_[pixel * size_t(values_)];
+            auto mean = [&](int k, std::uint32_t n) { return n == 0 ? 0.0f : float(sum[k] / n); };
             const std::uint32_t n = hits_[pixel];
-            auto mean = [&](int k) {
-                return n == 0 ? 0.0f : float(sums_[pixel * kValues + size_t(k)] / n);
-            };
-            const std::uint32_t seen = albedoSamples_[pixel];
             if (passes_ & kAovAlbedo)
                 for (int k = 0; k < 3; ++k)
-                    *out++ = seen == 0 ? 0.0f : float(sums_[pixel * kValues + size_t(k)] / seen);
-            const vec3 normal(mean(3), mean(4), mean(5));
+                    *out++ = mean(albedoAt_ + k, albedoSamples_[pixel]);
+            const vec3 normal = normalAt_ < 0 ? vec3(0.0f)
+                                              : vec3(mean(normalAt_, n), mean(normalAt_ + 1, n),
+                                                     mean(normalAt_ + 2, n));
             if (passes_ & kAovNormal)
                 for (int k = 0; k < 3; ++k)
                     *out++ = normal[k];
@@ -151,7 +228,7 @@ void AovFilm::rows(int y0, int y1, float* out) const {
                 for (int k = 0; k < 3; ++k)
                     *out++ = glm::dot(cameraToWorld_[k], normal);
             }
-            if (passes_ & kAovDepth) *out++ = n == 0 ? 1e10f : mean(6);
+            if (passes_ & kAovDepth) *out++ = n == 0 ? 1e10f : mean(depthAt_, n);
         }
 }
 

@@ -23,14 +23,20 @@
 // as does a sample whose mirror chain ends in the environment. The passes are box-filtered (each
 // sample counts in its own pixel) whatever the image's filter.
 //
-// Deterministic: each camera sample writes its own slot of the iteration (indexed by its path
-// id, as the film's per-sample buffer is), and endIteration() adds the slots pixel by pixel in
-// sample order, so the sums do not depend on threads, batches or backend.
+// Accumulated per pixel, as the film is: each sample's values are added, as they are recorded,
+// to the pixel's sums of the iteration, 128-bit fixed point with atomic integer adds (exact, so
+// the sums do not depend on threads, batches or backend), and endIteration() adds those to the
+// render's. What the passes keep a camera sample is one bit: whether its albedo is still to come
+// (its hits so far were specular); the weight of the specular hits it went through is the path's
+// throughput. Memory: 24 bytes a pixel for each value (3 the albedo, 3 the normals, 1 the depth)
+// and 16 for the counts, plus a bit a sample of an iteration (bytes()).
 #pragma once
 
 #include "shared/types.h"
 
+#include <atomic>
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <utility>
 #include <vector>
@@ -49,26 +55,27 @@ class AovFilm {
     // up, back; the world is camera-relative: the camera stands at the origin).
     AovFilm(int width, int height, int samplesPerIteration, unsigned passes, mat3 cameraToWorld);
 
-    // Clears the iteration's slots.
+    // Clears the iteration's sums (if the last was not ended) and its samples' bits.
     void beginIteration();
-    // The first hit of camera path `pathId`: thread-safe for distinct paths.
-    void record(uint pathId, const SurfaceHit& hit);
-    // Whether camera path `pathId` hit something and its denoising albedo is still to come: its
-    // hits so far were specular (host/scene_view/denoising_albedo.h).
-    bool albedoPending(uint pathId) const {
-        return (passes_ & kAovAlbedo) && size_t(pathId) < state_.size() &&
-               (state_[pathId] == kHit || state_[pathId] == kThroughSpecular);
+    // The first hit of camera path `path` (bounce 0): thread-safe for distinct paths.
+    void record(const PathState& path, const SurfaceHit& hit);
+    // Whether camera path `path` hit something and its denoising albedo is still to come: this
+    // is its first hit, or its hits so far were specular (host/scene_view/denoising_albedo.h).
+    bool albedoPending(const PathState& path) const {
+        return (passes_ & kAovAlbedo) && size_t(path.pathId) < samples_ &&
+               (path.bounce == 0u || (pending_[path.pathId / 64u].load(std::memory_order_relaxed) &
+                                      bit(path.pathId)) != 0u);
     }
-    // A hit of path `pathId` (while albedoPending) and its directional albedo: `passesOn` for a
-    // specular hit (the next hit decides, the pass weighted by this one's albedo), else it ends
-    // the pass, times the albedos of the specular hits before it.
-    void recordAlbedo(uint pathId, vec3 albedo, bool passesOn);
-    // Camera path `pathId` escaping with `radiance` from the environment along its ray: where
+    // A hit of `path` (while albedoPending) and its directional albedo: `passesOn` for a
+    // specular hit (the next hit decides), else it ends the pass with that albedo times the
+    // path's throughput through the specular hits before it.
+    void recordAlbedo(const PathState& path, vec3 albedo, bool passesOn);
+    // Camera path `path` escaping with `radiance` from the environment along its ray: where
     // the camera ray itself missed, or its hits so far were specular, the albedo pass takes
-    // that radiance (times the specular hits' albedos), as Cycles' "Denoising Albedo" takes the
+    // that radiance (times the path's throughput), as Cycles' "Denoising Albedo" takes the
     // background; the normal and depth of a missed sample stay out of the pixel's means.
-    void recordEscape(uint pathId, vec3 radiance);
-    // Adds the iteration's slots to the render's sums.
+    void recordEscape(const PathState& path, vec3 radiance);
+    // Adds the iteration's sums to the render's.
     void endIteration();
 
     // The EXR channel names of the passes asked for, in the order rows() writes them.
@@ -77,20 +84,37 @@ class AovFilm {
     std::vector<std::pair<std::string, std::string>> layerNotes() const;
     // Rows y0 .. y1 - 1, channelNames().size() floats a pixel.
     void rows(int y0, int y1, float* out) const;
+    // The bytes the passes hold.
+    size_t bytes() const;
 
   private:
-    static constexpr int kValues = 7; // albedo rgb, normal xyz, depth
-    // A camera sample's state in the iteration.
-    enum : std::uint8_t { kMissed = 0, kEscaped, kHit, kThroughSpecular, kAlbedoDone };
+    static std::uint64_t bit(uint pathId) { return std::uint64_t(1) << (pathId % 64u); }
+    size_t pixelOf(uint pathId) const { return size_t(pathId) / size_t(spi_); }
+    // Adds v, clamped to the value's bound, to value k of the pixel's iteration sums.
+    void add(size_t pixel, int k, float v);
+    void addAlbedo(size_t pixel, vec3 albedo);
+    void count(size_t pixel, int which) { iterCounts_[pixel * 2 + size_t(which)].fetch_add(1); }
+    enum { kHitCount = 0, kAlbedoCount = 1 };
+
     int width_, spi_;
+    size_t pixels_, samples_;
     unsigned passes_;
     mat3 cameraToWorld_;
-    vec3 viewAxis_;                   // -cameraToWorld_[2]: depth is along it
-    std::vector<float> slots_;        // per camera sample of the iteration: kValues
-    std::vector<vec3> chain_;         // per camera sample: its specular hits' albedos, multiplied
-    std::vector<std::uint8_t> state_; // per camera sample
-    std::vector<double> sums_;        // per pixel: kValues
-    std::vector<std::uint32_t> hits_; // per pixel: samples that hit
+    vec3 viewAxis_; // -cameraToWorld_[2]: depth is along it
+    // Where each value sits among a pixel's (-1: not asked for), how many there are, and each
+    // value's fixed point: q = v x 2^exponent_, |v| <= 2^bound_ (the scene format's limits).
+    int albedoAt_ = -1, normalAt_ = -1, depthAt_ = -1, values_ = 0;
+    int exponent_[7] = {}, bound_[7] = {};
+    // The iteration's sums: two words a value (the low 64 bits, then the high, two's
+    // complement), and two counts a pixel (samples that hit, samples that give an albedo).
+    std::unique_ptr<std::atomic<std::uint64_t>[]> iter_;
+    std::unique_ptr<std::atomic<std::uint32_t>[]> iterCounts_;
+    bool iterDirty_ = false; // an iteration began and did not end
+    // Per camera sample of the iteration, with the albedo pass: its albedo is still to come.
+    std::unique_ptr<std::atomic<std::uint64_t>[]> pending_;
+    size_t pendingWords_ = 0;
+    std::vector<double> sums_;                 // the render's, per pixel: values_
+    std::vector<std::uint32_t> hits_;          // per pixel: samples that hit
     std::vector<std::uint32_t> albedoSamples_; // per pixel: samples that hit or saw the environment
 };
 

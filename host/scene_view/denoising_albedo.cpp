@@ -36,10 +36,10 @@ DenoisingAlbedo denoisingAlbedo(const ShaderParams& sh, const SurfaceHit& hit, v
 
 void recordPasses(AovFilm& aovs, const ShaderParams& params, const PathState& path, vec3 rayDir,
                   const SurfaceHit& hit) {
-    if (path.bounce == 0) aovs.record(path.pathId, hit);
-    if (!aovs.albedoPending(path.pathId)) return;
+    if (path.bounce == 0) aovs.record(path, hit);
+    if (!aovs.albedoPending(path)) return;
     const DenoisingAlbedo a = denoisingAlbedo(shaderAtHit(params, hit), hit, -rayDir);
-    aovs.recordAlbedo(path.pathId, a.albedo, a.passesOn);
+    aovs.recordAlbedo(path, a.albedo, a.passesOn);
 }
 
 void recordEscape(AovFilm& aovs, const SceneView& view, const RenderParams& rp,
@@ -47,7 +47,7 @@ void recordEscape(AovFilm& aovs, const SceneView& view, const RenderParams& rp,
     if (rp.environment == kNoEmitter) return;
     const SceneView& scene = view; // as EMITTER() names it
     float pdf = 0.0f;
-    aovs.recordEscape(path.pathId,
+    aovs.recordEscape(path,
                       environmentLookUp(view, rp, EMITTER(rp.environment), rayDir, false, pdf));
 }
 
