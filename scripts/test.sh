@@ -14,6 +14,14 @@ export LP_NUM_THREADS="${LP_NUM_THREADS:-$(nproc)}"
 # (scripts/cycles_compare.py's CyclesCache): the sanitized run reuses the Release run's, since
 # Blender is the same program under both and only Spillway's side is sanitized.
 export SPILLWAY_CYCLES_CACHE="${SPILLWAY_CYCLES_CACHE:-$root/build/cycles-cache}"
+# What tests make once for this run and share (runCached in tests/test_util.h: the convergence
+# tests' high-spp references): one folder for this run's two suites, removed when it ends, so no
+# run reads what another tree made.
+if [ -z "${SPILLWAY_TEST_CACHE:-}" ]; then
+  SPILLWAY_TEST_CACHE="$(mktemp -d "${TMPDIR:-/tmp}/spillway-test-cache.XXXXXX")"
+  trap 'rm -rf "$SPILLWAY_TEST_CACHE"' EXIT
+fi
+export SPILLWAY_TEST_CACHE
 
 if [ "$mode" = all ] || [ "$mode" = --release ]; then
   "$root/scripts/build.sh"

@@ -7,15 +7,18 @@
 
 #include <gtest/gtest.h>
 
+#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <fcntl.h>
 #include <filesystem>
 #include <fstream>
 #include <random>
 #include <sstream>
+#include <sys/file.h>
 #include <sys/resource.h>
 #include <sys/wait.h>
 #include <thread>
@@ -86,6 +89,37 @@ std::string TempDir::write(const std::string& name, const std::string& text) con
 
 std::string sourceDir() {
     return SPILLWAY_SOURCE_DIR;
+}
+
+std::string runCached(const std::string& key, const std::function<std::string()>& make) {
+    const char* dir = std::getenv("SPILLWAY_TEST_CACHE");
+    if (!dir || !*dir) return make();
+    char name[32];
+    std::snprintf(name, sizeof name, "%016zx", std::hash<std::string>{}(key));
+    const std::string path = std::string(dir) + "/" + name;
+    // The lock is held while the value is made: a second process asking waits, then reads it.
+    const int lock = ::open((path + ".lock").c_str(), O_CREAT | O_RDWR | O_CLOEXEC, 0644);
+    if (lock < 0 || ::flock(lock, LOCK_EX) != 0) {
+        if (lock >= 0) ::close(lock);
+        ADD_FAILURE() << "cannot lock " << path << ".lock: " << std::strerror(errno);
+        return make();
+    }
+    // The file holds the key, a NUL, then the value: another key of the same hash is remade.
+    std::string kept = readFile(path), value;
+    if (kept.size() > key.size() && kept.compare(0, key.size(), key) == 0 &&
+        kept[key.size()] == '\0') {
+        value = kept.substr(key.size() + 1);
+    } else {
+        value = make();
+        const std::string partial = path + ".partial";
+        {
+            std::ofstream out(partial, std::ios::binary);
+            out << key << '\0' << value;
+        }
+        std::filesystem::rename(partial, path);
+    }
+    ::close(lock);
+    return value;
 }
 
 std::string readFile(const std::string& path) {

@@ -91,6 +91,14 @@ std::string loadError(const std::string& path);
 // Whether two image files hold the same pixels, bit for bit.
 bool samePixels(const std::string& a, const std::string& b);
 
+// What `make` returns, made once for a whole scripts/test.sh run: kept as a file named by a hash
+// of `key` in the folder SPILLWAY_TEST_CACHE names (test.sh makes one for its run and removes it
+// at the end, so both its suites share it and no run reads another's), under a lock, so that
+// tests running in parallel wait for one another rather than each making it. Without the
+// variable, make() each time. `key` must name everything the value depends on but the code
+// (one run builds one tree).
+std::string runCached(const std::string& key, const std::function<std::string()>& make);
+
 // Mean of the channel average over all pixels.
 double mean(const std::vector<float>& rgb);
 // Mean and standard error of the mean of a per-pixel quantity (channel average), treating

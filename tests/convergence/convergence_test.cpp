@@ -8,6 +8,8 @@
 #include <nlohmann/json.hpp>
 
 #include <cmath>
+#include <cstdlib>
+#include <cstring>
 #include <fstream>
 #include <map>
 #include <sstream>
@@ -16,8 +18,11 @@ namespace spw::test {
 namespace {
 
 // The Cornell box as shipped (Stratified sampler, sample base 2, min depth 3, max depth 16), small.
+std::string cornellFile() {
+    return sourceDir() + "/scenes/cornell-box.yaml";
+}
 Scene cornell(int size) {
-    Scene scene = loadScene(sourceDir() + "/scenes/cornell-box.yaml");
+    Scene scene = loadScene(cornellFile());
     scene.image.width = scene.image.height = size;
     return scene;
 }
@@ -33,16 +38,36 @@ struct Reference {
 // 16384 spp a Stratified reference's own error, 1.6e-5 by its estimate, is a third more than
 // that as the truth weighs it, pixels holding a sliver of the light, and the ratio below read
 // 0.92 at 1024 spp with any estimator; Sobol's is 4e-6 and reads as a 65536-spp Stratified
-// reference does), with a seed independent of the test renders' random numbers.
-Reference renderReference(Scene scene, int spp) {
-    RenderConfig cfg;
-    cfg.backend = BackendKind::Reference;
-    cfg.spp = spp;
+// reference does), with a seed independent of the test renders' random numbers. `file`: the
+// scene file `scene` was loaded from. Made once for a scripts/test.sh run (runCached): the
+// tests that share one, and the sanitized suite after the Release suite, read the first's.
+Reference renderReference(const std::string& file, Scene scene, int spp) {
     scene.sampler = SamplerType::Sobol;
     scene.settings.seed = 12345;
-    auto result = render(scene, cfg);
-    return Reference{ImageRGB{scene.image.width, scene.image.height, result->film->image()},
-                     result->film->halfBufferRelMse()};
+    const int w = scene.image.width, h = scene.image.height;
+    const std::string key = "convergence reference: " + file + " " + readFile(file) + " " +
+                            std::to_string(w) + "x" + std::to_string(h) + " " +
+                            std::to_string(spp) + " spp";
+    const std::string bytes = runCached(key, [&] {
+        RenderConfig cfg;
+        cfg.backend = BackendKind::Reference;
+        cfg.spp = spp;
+        auto result = render(scene, cfg);
+        const double own = result->film->halfBufferRelMse();
+        const std::vector<float> image = result->film->image();
+        std::string out(reinterpret_cast<const char*>(&own), sizeof own);
+        out.append(reinterpret_cast<const char*>(image.data()), image.size() * sizeof(float));
+        return out;
+    });
+    Reference ref{ImageRGB{w, h, std::vector<float>(size_t(w) * size_t(h) * 3)}, 0.0};
+    const size_t want = sizeof(double) + ref.image.rgb.size() * sizeof(float);
+    EXPECT_EQ(bytes.size(), want);
+    if (bytes.size() == want) {
+        std::memcpy(&ref.ownRelMse, bytes.data(), sizeof(double));
+        std::memcpy(ref.image.rgb.data(), bytes.data() + sizeof(double),
+                    ref.image.rgb.size() * sizeof(float));
+    }
+    return ref;
 }
 const Reference& highSppReference(int size) {
     static std::map<int, Reference> refs;
@@ -52,7 +77,42 @@ const Reference& highSppReference(int size) {
     // sanitizers, where the tests still reach 1024 spp (with a quarter of the samples its own
     // noise is a third of the truth there, and its estimate of that noise too rough to remove).
     // The 48^2 one serves tests that take a quarter of their samples there.
-    return refs[size] = renderReference(cornell(size), size < 48 ? 16384 : 4096 / kSanitizedFewer);
+    return refs[size] = renderReference(cornellFile(), cornell(size),
+                                        size < 48 ? 16384 : 4096 / kSanitizedFewer);
+}
+
+// The glossy small-light scene with its light out of the frame, size x size, and its 4096-spp
+// reference at 64^2 (GlintEstimate below).
+std::string glossyFile() {
+    return sourceDir() + "/scenes/glossy-small-light-out-of-frame.yaml";
+}
+Scene glossyScene(int size) {
+    Scene scene = loadScene(glossyFile());
+    scene.image.width = scene.image.height = size;
+    return scene;
+}
+const Reference& glossyReference() {
+    static const Reference ref =
+        renderReference(glossyFile(), glossyScene(64), 4096 / kSanitizedFewer);
+    return ref;
+}
+
+// The references that several tests of a run read (their processes apart), made before any of
+// them starts: ctest runs this first, as the fixture that every long-statistics test requires
+// (CMakeLists.txt), so that none waits on another for them; without scripts/test.sh's cache
+// there is nothing to share, and it skips. Each is finite, its own relMSE small (the 32^2
+// Cornell box's about 4e-6 at 16384 spp), and read back the same bit for bit.
+TEST(ConvergenceReferences, AreMadeOnceForTheRun) {
+    if (!std::getenv("SPILLWAY_TEST_CACHE")) GTEST_SKIP() << "no SPILLWAY_TEST_CACHE to share";
+    for (const Reference* ref : {&highSppReference(32), &glossyReference()}) {
+        EXPECT_GT(ref->ownRelMse, 0.0);
+        EXPECT_LT(ref->ownRelMse, 1e-3);
+        for (float v : ref->image.rgb)
+            ASSERT_TRUE(std::isfinite(v) && v >= 0.0f);
+    }
+    const Reference again = renderReference(cornellFile(), cornell(32), 16384);
+    EXPECT_EQ(again.image.rgb, highSppReference(32).image.rgb);
+    EXPECT_EQ(again.ownRelMse, highSppReference(32).ownRelMse);
 }
 
 // One render's error at five sample counts, each twice the last: the true relMSE (against the
@@ -198,12 +258,8 @@ class GlintEstimate : public ::testing::TestWithParam<SamplerType> {};
 TEST_P(GlintEstimate, TracksTrueRelMse) {
     constexpr int kSize = 64, kSeeds = kSanitizedFewer > 1 ? 4 : 8; // sanitizers: 4 seeds
     const double widen = std::sqrt(8.0 / kSeeds);
-    auto glossy = [&] {
-        Scene scene = loadScene(sourceDir() + "/scenes/glossy-small-light-out-of-frame.yaml");
-        scene.image.width = scene.image.height = kSize;
-        return scene;
-    };
-    static const Reference ref = renderReference(glossy(), 4096 / kSanitizedFewer);
+    auto glossy = [&] { return glossyScene(kSize); };
+    const Reference& ref = glossyReference();
     const int spp[2] = {64 / kSanitizedFewer, 256 / kSanitizedFewer};
     double est[2] = {}, tru[2] = {};
     for (std::uint32_t seed = 1; seed <= std::uint32_t(kSeeds); ++seed) {
