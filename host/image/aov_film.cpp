@@ -62,12 +62,6 @@ AovFilm::AovFilm(int width, int height, int samplesPerIteration, unsigned passes
     const size_t words = pixels_ * size_t(values_) * 2;
     iter_.reset(new std::atomic<std::uint64_t>[words]);
     iterCounts_.reset(new std::atomic<std::uint32_t>[pixels_ * 2]);
-    forPixels(pixels_, [&](size_t begin, size_t end) {
-        for (size_t w = begin * size_t(values_) * 2; w < end * size_t(values_) * 2; ++w)
-            iter_[w].store(0, std::memory_order_relaxed);
-        for (size_t c = begin * 2; c < end * 2; ++c)
-            iterCounts_[c].store(0, std::memory_order_relaxed);
-    });
     if (passes_ & kAovAlbedo) {
         pendingWords_ = (samples_ + 63) / 64;
         pending_.reset(new std::atomic<std::uint64_t>[pendingWords_]);
@@ -75,6 +69,7 @@ AovFilm::AovFilm(int width, int height, int samplesPerIteration, unsigned passes
     sums_.resize(pixels_ * size_t(values_));
     hits_.resize(pixels_);
     albedoSamples_.resize(pixels_);
+    iterDirty_ = true; // the sums are not yet zeroed
     beginIteration();
 }
 
@@ -85,7 +80,7 @@ size_t AovFilm::bytes() const {
 }
 
 void AovFilm::beginIteration() {
-    if (iterDirty_) // a stopped iteration's sums: endIteration() zeroes them as it reads them
+    if (iterDirty_) // new, or a stopped iteration's: endIteration() zeroes them as it reads them
         forPixels(pixels_, [&](size_t begin, size_t end) {
             for (size_t w = begin * size_t(values_) * 2; w < end * size_t(values_) * 2; ++w)
                 iter_[w].store(0, std::memory_order_relaxed);

@@ -109,7 +109,7 @@ class AovFilm {
     // complement), and two counts a pixel (samples that hit, samples that give an albedo).
     std::unique_ptr<std::atomic<std::uint64_t>[]> iter_;
     std::unique_ptr<std::atomic<std::uint32_t>[]> iterCounts_;
-    bool iterDirty_ = false; // an iteration began and did not end
+    bool iterDirty_ = false; // the sums may hold values: new, or an iteration that did not end
     // Per camera sample of the iteration, with the albedo pass: its albedo is still to come.
     std::unique_ptr<std::atomic<std::uint64_t>[]> pending_;
     size_t pendingWords_ = 0;
