@@ -220,8 +220,9 @@ void explainMissingEstimate(const RenderResult& result) {
 // Where the peak resident memory went, as far as the parts can say (--stats' `memory`): the
 // process at the end of loading (the file, the parser and the scene's arrays), after the BVH,
 // at its peak; the scene's own arrays, the lights' records, the texture cache's and the ray
-// batches' peaks; and the peak over the stored triangles and the instances.
-void reportMemory(RenderStats& stats, const Scene& scene, double loadPeakMiB) {
+// batches' peaks, the film's fine levels (film_levels.h: held where a contribution was too small
+// for its fixed point); and the peak over the stored triangles and the instances.
+void reportMemory(RenderStats& stats, const Scene& scene, const Film& film, double loadPeakMiB) {
     auto bytes = [](const auto& v) { return double(v.size() * sizeof(v[0])); };
     double geometry = 0.0, triangles = 0.0;
     for (const Mesh& m : scene.meshes) {
@@ -239,6 +240,7 @@ void reportMemory(RenderStats& stats, const Scene& scene, double loadPeakMiB) {
          stats.extra.contains("lights") ? stats.extra["lights"].value("bytes", 0.0) : 0.0},
         {"texture_cache_peak_bytes", stats.textures ? stats.textures->peakCacheBytes : 0},
         {"ray_batches_peak_bytes", stats.spill ? stats.spill->peakRayBytesInRam : 0},
+        {"film_fine_levels_bytes", double(film.levelBytes())},
     };
     if (stats.extra.contains("geometry"))
         memory["after_bvh_mib"] = stats.extra["geometry"].value("peak_rss_mib_after_bvh", 0.0);
@@ -382,7 +384,7 @@ int renderCommand(const std::vector<std::string>& args, Ranks* ranks) {
     if (errorCsv) explainMissingEstimate(*result);
     result->stats.stages.add("load scene", loadSeconds);
     result->stats.extra["peak_rss_mib_after_load"] = loadPeakMiB;
-    reportMemory(result->stats, scene, loadPeakMiB);
+    reportMemory(result->stats, scene, *result->film, loadPeakMiB);
     writeOutputs(o, scene, *result, errorCsv.get());
     return status;
 }

@@ -17,6 +17,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
 #include <new>
 #include <stdexcept>
 
@@ -68,7 +69,13 @@ Film::Film(int width, int height, const Filter& filter, float brightestRadiance,
     const int top = std::min(40, 62 - logAdds - 16); // the brightest sample's exponent
     scale_ = std::ldexp(1.0, top - e);
     weightScale_ = std::ldexp(1.0, std::min(40, 62 - logAdds - 1));
-    sampleCap_ = std::int64_t(maxAdd_);
+    // The fine levels (film_levels.h): a step as wide as an iteration's adds leave room for (a
+    // level's value is below 2^(24 + bits), and at most 2^logAdds of them land in one sum), at
+    // most 32 bits; as many levels as reach 2^-149 in radiance, the smallest float, at 2^24 units.
+    levelBits_ = std::clamp(38 - logAdds, 1, 32);
+    levelCount_ = std::max(0, (24 + 149 - (top - e) + levelBits_ - 1) / levelBits_);
+    for (int level = 0; level <= levelCount_; ++level)
+        levelScale_.push_back(std::ldexp(1.0, levelBits_ * level));
     const float sigma = filter.radius * 0.5f;
     gaussK_ = -0.5f / (sigma * sigma);
     gaussTail_ = std::exp(gaussK_ * filter.radius * filter.radius);
@@ -111,14 +118,19 @@ void Film::beginIteration() {
     accZero_ = true;
     open_ = true;
     lastIteration_ = nullptr;
+    lastLevels_ = nullptr;
+    if (iterLevels_.levels() == 0 && levelCount_ > 0)
+        iterLevels_ = FilmLevels(levelCount_, size_t(tilesX_) * size_t(tilesY_));
+    else
+        iterLevels_.zero();
     if (sumsSamples() && !samples_) {
         // Zeroed once; finishSamples() zeroes each sum it reads, discardIteration() the rest.
         const size_t n = pixels() * samplesPerIteration_;
         samples_.reset(new SampleSum[n]);
         forPixels(n, [&](size_t begin, size_t end) {
             for (size_t i = begin; i < end; ++i)
-                for (std::atomic<std::int64_t>& v : samples_[i].rgb)
-                    v.store(0, std::memory_order_relaxed);
+                for (std::atomic<double>& v : samples_[i].rgb)
+                    v.store(0.0, std::memory_order_relaxed);
         });
     }
     samplesPending_ = sumsSamples();
@@ -129,8 +141,8 @@ void Film::discardIteration() {
     if (samples_) {
         forPixels(pixels() * samplesPerIteration_, [&](size_t begin, size_t end) {
             for (size_t i = begin; i < end; ++i)
-                for (std::atomic<std::int64_t>& v : samples_[i].rgb)
-                    v.store(0, std::memory_order_relaxed);
+                for (std::atomic<double>& v : samples_[i].rgb)
+                    v.store(0.0, std::memory_order_relaxed);
         });
     }
     beginIteration();
@@ -166,30 +178,6 @@ void Film::setShare(int index, int shares) {
     share_ = index;
     shares_ = shares;
     decideTiles();
-}
-
-std::vector<std::int64_t> Film::iterationAccumulators() {
-    finishSamples();
-    const size_t n = size_t(width_) * height_;
-    std::vector<std::int64_t> out(n * 8 + 2);
-    for (size_t i = 0; i < n; ++i)
-        for (int k = 0; k < 8; ++k)
-            out[i * 8 + size_t(k)] = acc_[i].v[k].load(std::memory_order_relaxed);
-    out[n * 8] = std::int64_t(nonFinite_.load() - nonFiniteBefore_);
-    out[n * 8 + 1] = std::int64_t(saturated_.load() - saturatedBefore_);
-    return out;
-}
-
-void Film::setIterationAccumulators(const std::vector<std::int64_t>& values) {
-    const size_t n = size_t(width_) * height_;
-    if (values.size() != n * 8 + 2)
-        throw std::invalid_argument("iteration accumulators of another film size");
-    for (size_t i = 0; i < n; ++i)
-        for (int k = 0; k < 8; ++k)
-            acc_[i].v[k].store(values[i * 8 + size_t(k)], std::memory_order_relaxed);
-    accZero_ = false;
-    nonFinite_ = nonFiniteBefore_ + std::uint64_t(values[n * 8]);
-    saturated_ = saturatedBefore_ + std::uint64_t(values[n * 8 + 1]);
 }
 
 size_t Film::tileOf(size_t pixel) const {
@@ -233,10 +221,29 @@ void Film::add(int px, int py, int half, vec3 value, float weight, uint key) {
     const double in[4] = {value.x * scale_, value.y * scale_, value.z * scale_,
                           weight * weightScale_};
     const uint rnd[4] = {h.x, h.y, h.z, h.w};
+    const size_t pixel = size_t(py) * size_t(width_) + size_t(px);
     for (int c = 0; c < 4; ++c) {
+        if (c < 3 && addFine(pixel, half, c, in[c], rnd[c])) continue;
         const std::int64_t q = quantize(in[c], rnd[c]);
         if (q != 0) a[c].fetch_add(q, std::memory_order_relaxed);
     }
+}
+
+bool Film::addFine(size_t pixel, int half, int c, double v, uint u) {
+    const double m = std::fabs(v);
+    if (!(m < kHomeFloor) || m == 0.0) return false;
+    // The coarsest level at which v is 2^24 units or more: e + bits x level >= 24, e = v's
+    // binary exponent (v is a normal double: a float times the scale and a weight).
+    std::uint64_t bits;
+    std::memcpy(&bits, &m, sizeof bits);
+    const int e = int(bits >> 52) - 1023;
+    const int level = (24 - e + levelBits_ - 1) / levelBits_;
+    if (level > levelCount_) return true; // under the smallest float in radiance
+    const double x = v * levelScale_[size_t(level)], fl = std::floor(x); // exact: a power of 2
+    const std::int64_t q = std::int64_t(fl) + (double(uintToUnit(u)) < x - fl ? 1 : 0);
+    const auto [tile, slot] = levelSlot(pixel);
+    if (q != 0) iterLevels_.add(level, tile, slot + size_t(half) * 3 + size_t(c), q);
+    return true;
 }
 
 void Film::splat(uint path, vec2 filmPos, uint sampleIndex, vec3 radiance, uint key) {
@@ -246,12 +253,27 @@ void Film::splat(uint path, vec2 filmPos, uint sampleIndex, vec3 radiance, uint 
     }
     if (radiance.x == 0.0f && radiance.y == 0.0f && radiance.z == 0.0f) return;
     if (sumsSamples())
-        addToSample(path, radiance, roundingKey(key, sampleIndex));
+        addToSample(path, radiance);
     else
         filtered(filmPos, halfOf(sampleIndex), radiance, 0.0f, roundingKey(key, sampleIndex));
 }
 
-void Film::roundLanes(FootprintLanes& lanes, size_t count, FootprintAdds& adds) {
+void Film::roundLanes(FootprintLanes& lanes, size_t count, const int* halves, FootprintAdds& adds) {
+    for (size_t k = 0; k < count; ++k) {
+        double* channel[3] = {&lanes.r[k], &lanes.g[k], &lanes.b[k]};
+        const double w = double(lanes.weight.v[k]); // as roundFootprint multiplies
+        uvec4 h(0u);
+        bool hashed = false;
+        for (int c = 0; c < 3; ++c) {
+            const double v = *channel[c] * w, m = std::fabs(v);
+            if (!(m < kHomeFloor) || m == 0.0) continue;
+            if (!hashed) // roundFootprint's random numbers
+                h = pcg4d(uvec4(lanes.rgbKey.v[k], lanes.pixel.v[k], 0x5157u, 0x9E3779B9u));
+            hashed = true;
+            addFine(lanes.pixel.v[k], halves[k], c, v, c == 0 ? h.x : c == 1 ? h.y : h.z);
+            *channel[c] = 0.0;
+        }
+    }
     const size_t end = simd::wholeVectors(count);
     for (size_t k = count; k < end; ++k) { // padding: no weight, nothing added
         lanes.pixel.v[k] = lanes.weightKey.v[k] = lanes.rgbKey.v[k] = 0u;
@@ -263,13 +285,14 @@ void Film::roundLanes(FootprintLanes& lanes, size_t count, FootprintAdds& adds) 
 }
 
 void Film::splat(const Splat* splats, size_t n) {
-    // Each lane is rounded as add() (the Box filter: hashed with the pixel) or addToSample() (a
-    // sample sum: hashed with the path) rounds: the radiance at weight 1, whose double product
-    // is the value itself; the weight's add is not used.
+    // Each lane is rounded as add() rounds (the Box filter: hashed with the pixel): the radiance
+    // at weight 1, whose double product is the value itself; the weight's add is not used. A
+    // wide filter's sample sums take the values as they come (addToSample).
     static_assert(kSplatBatch <= simd::kBlock, "a batch is one block of lanes");
     const bool sums = sumsSamples();
     FootprintLanes lanes{}; // (zeroed: GCC cannot see that roundLanes reads only what is set)
     std::atomic<std::int64_t>* target[simd::kBlock]; // the three sums the splat adds to
+    int halves[simd::kBlock];
     size_t count = 0;
     for (size_t k = 0; k < n; ++k) {
         const Splat& s = splats[k];
@@ -280,31 +303,28 @@ void Film::splat(const Splat* splats, size_t n) {
         }
         if (v.x == 0.0f && v.y == 0.0f && v.z == 0.0f) continue;
         if (sums) {
-            target[count] = samples_[s.path].rgb;
-            lanes.pixel.v[count] = s.path;
-        } else { // filtered()'s pixel
-            const int px = std::min(int(s.pos.x), width_ - 1);
-            const int py = std::min(int(s.pos.y), height_ - 1);
-            target[count] = &acc_[size_t(py) * width_ + size_t(px)].v[halfOf(s.sample) * 4];
-            lanes.pixel.v[count] = uint(py * width_ + px);
+            addToSample(s.path, v);
+            continue;
         }
+        // filtered()'s pixel
+        const int px = std::min(int(s.pos.x), width_ - 1);
+        const int py = std::min(int(s.pos.y), height_ - 1);
+        halves[count] = halfOf(s.sample);
+        target[count] = &acc_[size_t(py) * width_ + size_t(px)].v[halves[count] * 4];
+        lanes.pixel.v[count] = uint(py * width_ + px);
         lanes.rgbKey.v[count] = roundingKey(s.key, s.sample);
         lanes.weightKey.v[count] = 0u;
         lanes.weight.v[count] = 1.0f;
         lanes.r[count] = v.x * scale_, lanes.g[count] = v.y * scale_, lanes.b[count] = v.z * scale_;
         ++count;
     }
+    if (count == 0) return;
     FootprintAdds adds;
-    roundLanes(lanes, count, adds);
+    roundLanes(lanes, count, halves, adds);
     for (size_t k = 0; k < count; ++k) {
         const std::int64_t q[3] = {adds.r[k], adds.g[k], adds.b[k]};
         for (int c = 0; c < 3; ++c)
-            if (q[c] != 0) {
-                if (sums)
-                    addToSum(target[k][c], q[c]);
-                else
-                    target[k][c].fetch_add(q[c], std::memory_order_relaxed);
-            }
+            if (q[c] != 0) target[k][c].fetch_add(q[c], std::memory_order_relaxed);
     }
 }
 
@@ -319,26 +339,13 @@ void Film::addSample(uint path, vec2 filmPos, uint sampleIndex) {
     sampleBase_.store(sampleIndex - sampleIndex % samplesPerIteration_, std::memory_order_relaxed);
 }
 
-void Film::addToSample(uint path, vec3 radiance, uint key) {
-    std::atomic<std::int64_t>* sum = samples_[path].rgb;
-    const uvec4 h = pcg4d(uvec4(key, path, 0x5157u, 0x9E3779B9u));
+void Film::addToSample(uint path, vec3 radiance) {
+    std::atomic<double>* sum = samples_[path].rgb;
     const float in[3] = {radiance.x, radiance.y, radiance.z};
-    const uint rnd[3] = {h.x, h.y, h.z};
-    for (int c = 0; c < 3; ++c) {
-        const std::int64_t q = quantize(double(in[c]) * scale_, rnd[c]);
-        if (q != 0) addToSum(sum[c], q);
-    }
-}
-
-void Film::addToSum(std::atomic<std::int64_t>& sum, std::int64_t q) {
-    // Saturating: the sum stays within the clamp of one film add (both terms are within it, so
-    // their sum fits 64 bits).
-    std::int64_t v = sum.load(std::memory_order_relaxed) + q;
-    if (v > sampleCap_ || v < -sampleCap_) {
-        saturated_.fetch_add(1, std::memory_order_relaxed);
-        v = v > 0 ? sampleCap_ : -sampleCap_;
-    }
-    sum.store(v, std::memory_order_relaxed);
+    for (int c = 0; c < 3; ++c)
+        if (in[c] != 0.0f)
+            sum[c].store(sum[c].load(std::memory_order_relaxed) + double(in[c]) * scale_,
+                         std::memory_order_relaxed);
 }
 
 void Film::finishSamples() {
@@ -363,6 +370,7 @@ struct FootprintBatch {
     FootprintLanes lanes;
     FootprintAdds adds;
     std::atomic<std::int64_t>* target[simd::kBlock]; // the pixel's half's four sums
+    int halves[simd::kBlock];
     size_t count = 0;
 };
 } // namespace
@@ -382,7 +390,7 @@ void Film::filterSamples(int y0, int y1) {
         halves[s] = halfOf(base + s), weightKeys[s] = roundingKey(0u, base + s);
     FootprintBatch batch;
     auto flush = [&] {
-        roundLanes(batch.lanes, batch.count, batch.adds);
+        roundLanes(batch.lanes, batch.count, batch.halves, batch.adds);
         // No other thread adds to these pixels now (finishSamples).
         auto addTo = [](std::atomic<std::int64_t>& v, std::int64_t q) {
             if (q != 0) v.store(v.load(std::memory_order_relaxed) + q, std::memory_order_relaxed);
@@ -405,8 +413,8 @@ void Film::filterSamples(int y0, int y1) {
                 SampleSum& sum = samples_[path];
                 double rgb[3];
                 for (int c = 0; c < 3; ++c) {
-                    rgb[c] = double(sum.rgb[c].load(std::memory_order_relaxed));
-                    sum.rgb[c].store(0, std::memory_order_relaxed);
+                    rgb[c] = sum.rgb[c].load(std::memory_order_relaxed);
+                    sum.rgb[c].store(0.0, std::memory_order_relaxed);
                 }
                 const int half = halves[s];
                 const uint weightKey = weightKeys[s];
@@ -419,6 +427,7 @@ void Film::filterSamples(int y0, int y1) {
                     l.weight.v[k] = w;
                     l.r[k] = rgb[0], l.g[k] = rgb[1], l.b[k] = rgb[2];
                     batch.target[k] = &acc_[at].v[half * 4];
+                    batch.halves[k] = half;
                     if (batch.count == simd::kBlock) flush();
                 });
             }
@@ -465,6 +474,10 @@ void Film::prefetch(uint path, vec2 filmPos) const {
     const int px = std::clamp(int(filmPos.x), 0, width_ - 1);
     const int py = std::clamp(int(filmPos.y), 0, height_ - 1);
     __builtin_prefetch(&acc_[size_t(py) * width_ + size_t(px)], 1);
+    // And the pixel's sums on the first fine level, where most small contributions land.
+    const size_t tile = size_t(py / kAdaptiveTile) * size_t(tilesX_) + size_t(px / kAdaptiveTile);
+    const size_t slot = size_t((py % kAdaptiveTile) * kAdaptiveTile + px % kAdaptiveTile) * 6;
+    if (const void* fine = iterLevels_.address(1, tile, slot)) __builtin_prefetch(fine, 1);
 }
 
 int Film::halfOf(uint sampleIndex) const {
@@ -475,12 +488,13 @@ int Film::halfOf(uint sampleIndex) const {
 // Converting a 64-bit integer to double is one instruction, a 128-bit one a library call: the
 // film reads the low words alone while they are the whole sums.
 void Film::pixelSums(size_t pixel, double* s) const {
-    for (int k = 0; k < 8; ++k) {
-        const double v = !sumLo_  ? 0.0
-                         : sumHi_ ? double(sumAt(pixel, k))
-                                  : double(sumLo_[pixel].v[k].load(std::memory_order_relaxed));
-        s[k] = v / (k % 4 == 3 ? weightScale_ : scale_);
-    }
+    for (int k = 0; k < 8; ++k)
+        s[k] = !sumLo_  ? 0.0
+               : sumHi_ ? double(sumAt(pixel, k))
+                        : double(sumLo_[pixel].v[k].load(std::memory_order_relaxed));
+    addLevelSums(renderLevels_, pixel, s);
+    for (int k = 0; k < 8; ++k)
+        s[k] /= k % 4 == 3 ? weightScale_ : scale_;
 }
 
 Film::Fixed Film::sumAt(size_t i, int k) const {
@@ -552,9 +566,13 @@ void Film::endIteration() {
         sumLo_ = std::move(acc_);
         sumBound_ = std::uint64_t(1) << 62; // unknown: at most the clamp
         lastIteration_ = sumLo_.get();
+        renderLevels_ = std::move(iterLevels_);
+        lastLevels_ = &renderLevels_;
     } else {
         addIterationToSums();
         lastIteration_ = acc_.get();
+        renderLevels_.add(iterLevels_);
+        lastLevels_ = &iterLevels_;
     }
     accZero_ = false;
     open_ = false;

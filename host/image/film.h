@@ -7,9 +7,16 @@
 // film is exact end to end, so sums of any iterations, added in any grouping (checkpoints,
 // partial renders merged later), give the same image bit for bit.
 //
+// Precision: a contribution is rounded where it is at least 2^24 units, so that it keeps float
+// precision relative to itself and so to its pixel: on the home grid below, or, when it is
+// smaller than that there (far below the brightest emitter), on a fine level of its own
+// magnitude (film_levels.h), down to the smallest float.
+//
 // Memory (per pixel): the iteration's sums, 64 bytes; the whole render's, 64 bytes while every
 // sum fits 64 bits, which at the usual scale of 2^40 is 2^23 samples of the brightest emitter
-// in one pixel (the high halves, 64 bytes more, are added the first time a sum could pass 2^63).
+// in one pixel (the high halves, 64 bytes more, are added the first time a sum could pass 2^63);
+// and in each 8 x 8 tile a fine level reaches, 48 bytes a pixel for the iteration and 48 (96
+// once widened) for the render.
 // Sample counts are kept per 8 x 8 tile. The first iteration's sums become the whole render's
 // without a copy, and the next iteration's are only allocated when it begins: a render of one
 // iteration holds 64 bytes a pixel, of more iterations 128.
@@ -22,12 +29,12 @@
 // times the brightest emitter. Non-finite samples are counted and dropped, never added.
 //
 // Wide filters (Tent, Gaussian): one film write per camera sample. A sample's contributions
-// (emission, shadow rays, escapes) are rounded into its own fixed-point sum, 3 x int64 in a
+// (emission, shadow rays, escapes) are summed into its own sum, 3 doubles in home units in a
 // per-iteration sample buffer indexed by the path's id, and finishSamples() filters each sum
-// once through the footprint, with the sample's filter weight, in pixel order. The sample sums
-// are exact integer sums too, and each is clamped (saturating, counted) at the clamp of one add:
-// a path's contributions arrive one bounce after another on every backend, in the same order,
-// so even a clamped sum is the same for any thread count or batch. The Box filter reaches one
+// once through the footprint, with the sample's filter weight, in pixel order, rounding each add
+// (clamped and counted at the clamp of one add). A path's contributions arrive one bounce after
+// another on every backend, in the same order, so its double sum is the same for any thread
+// count or batch. The Box filter reaches one
 // pixel, so its contributions go straight to the film, and no sample buffer is allocated.
 //
 // The samples accumulate in two half buffers, whose difference estimates the image's own error
@@ -48,6 +55,7 @@
 // that drew a few lucky samples does not stop early.
 #pragma once
 
+#include "host/image/film_levels.h"
 #include "host/image/filter.h"
 #include "shared/types.h"
 
@@ -55,6 +63,7 @@
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <utility>
 #include <vector>
 
 namespace spw {
@@ -196,12 +205,18 @@ class Film {
     // iteration. The processes' iteration accumulators are then added together
     // (iterationAccumulators, setIterationAccumulators) before endIteration().
     void setShare(int index, int shares);
+    // The fine levels' tiles the iteration reached (film_levels.h), a flag per level and tile;
+    // summed over the processes, the tiles that iterationAccumulators() must carry.
+    std::vector<std::int64_t> levelTilesReached();
     // The iteration's integer accumulators: 8 sums per pixel, then the iteration's non-finite
-    // and saturated counts. (endIteration() counts the samples of every tile still sampling, in
-    // any share: with shares, the accumulators are the sum over the shares by then.)
-    std::vector<std::int64_t> iterationAccumulators();
-    // Replaces them, with their sum over the processes (the same layout).
-    void setIterationAccumulators(const std::vector<std::int64_t>& values);
+    // and saturated counts, then each level tile flagged in `tiles` (levelTilesReached()'s
+    // layout; empty: this film's own), FilmLevels::kSlots sums each. (endIteration() counts the
+    // samples of every tile still sampling, in any share: with shares, the accumulators are the
+    // sum over the shares by then.)
+    std::vector<std::int64_t> iterationAccumulators(const std::vector<std::int64_t>& tiles = {});
+    // Replaces them, with their sum over the processes (the same layout and tiles).
+    void setIterationAccumulators(const std::vector<std::int64_t>& values,
+                                  const std::vector<std::int64_t>& tiles = {});
     // Camera samples each pixel took in whole iterations, and their total.
     std::vector<std::uint32_t> sampleCounts() const;
     std::uint64_t samplesTaken() const;
@@ -212,6 +227,14 @@ class Film {
         std::vector<std::uint32_t> samples; // per pixel
         std::uint64_t nonFinite = 0, saturated = 0;
         int scaleExponent = 0, weightExponent = 0; // the fixed point: 2^e units per 1
+        int levelBits = 0;                         // a fine level's step below the last
+        // The fine levels that hold anything: 6 sums per pixel, (r, g, b) x 2 halves, in units of
+        // 2^-(levelBits x level) of the home grid's.
+        struct Level {
+            int level = 0;
+            std::vector<Fixed> sums;
+        };
+        std::vector<Level> levels;
     };
     // The image of a film state (as image() is of the film's): for merging partial renders.
     static std::vector<float> imageOf(const State& state);
@@ -223,6 +246,10 @@ class Film {
     std::uint64_t nonFiniteSamples() const { return nonFinite_.load(); }
     std::uint64_t saturatedSamples() const { return saturated_.load(); }
     double fixedPointScale() const { return scale_; }
+    // The fine levels (film_levels.h): how many, the bits between two, and the bytes they hold.
+    int fineLevels() const { return levelCount_; }
+    int levelBits() const { return levelBits_; }
+    size_t levelBytes() const { return iterLevels_.bytes() + renderLevels_.bytes(); }
 
   private:
     size_t pixels() const { return size_t(width_) * size_t(height_); }
@@ -261,15 +288,21 @@ class Film {
     template <typename Fn> void forFootprint(vec2 filmPos, const Fn& fn) const;
     void filtered(vec2 filmPos, int half, vec3 radiance, float weight, uint key);
     void add(int px, int py, int half, vec3 value, float weight, uint key);
+    // Whether v (home units) is below the home grid's precision, 0 < |v| < 2^24: then it is
+    // rounded with u into its fine level, at channel c of pixel's half (or dropped below the
+    // finest, under the smallest float).
+    bool addFine(size_t pixel, int half, int c, double v, uint u);
+    static constexpr double kHomeFloor = 0x1p24;
     // v (fixed-point units) clamped (counted) and rounded stochastically with u: E = v.
     std::int64_t quantize(double v, uint u);
     // Sample sums (wide filters): the contribution into path's sum; the sums of rows [y0, y1)
     // filtered (not thread-safe: finishSamples() keeps the threads' footprints apart).
-    void addToSample(uint path, vec3 radiance, uint key);
-    void addToSum(std::atomic<std::int64_t>& sum, std::int64_t q); // one rounded add, saturating
+    void addToSample(uint path, vec3 radiance);
     // lanes[0, count) rounded (roundFootprint, host/simd/film_rounding.h) into adds, the
-    // padding to whole vectors adding nothing; the clamped values counted as saturated.
-    void roundLanes(FootprintLanes& lanes, size_t count, FootprintAdds& adds);
+    // padding to whole vectors adding nothing; the clamped values counted as saturated. A
+    // channel below the home grid's precision goes to its fine level instead (addFine, into the
+    // lane's half, halves[k]) and adds nothing here.
+    void roundLanes(FootprintLanes& lanes, size_t count, const int* halves, FootprintAdds& adds);
     void filterSamples(int y0, int y1);
 
     int width_, height_;
@@ -319,16 +352,31 @@ class Film {
     int share_ = 0, shares_ = 1;
     std::vector<std::uint8_t> take_; // per tile: active and in this share; empty: every tile
     // The iteration's sample sums (wide filters only; null until the first iteration begins):
-    // one per path id, and where the sample lies. A path's sum is only ever changed by one
-    // thread at a time (its contributions come in order), so each add is a load and a store.
+    // one per path id, and where the sample lies, in home units. A path's sum is only ever
+    // changed by one thread at a time, and its contributions come in the same order on every
+    // backend, so each add is a load and a store, and the double sum is the same every time.
     struct SampleSum {
-        std::atomic<std::int64_t> rgb[3];
+        std::atomic<double> rgb[3];
         float x, y;
     };
     std::unique_ptr<SampleSum[]> samples_;
     bool samplesPending_ = false;     // the iteration's sample sums are not yet filtered
     std::atomic<uint> sampleBase_{0}; // the iteration's first sample index
-    std::int64_t sampleCap_ = 0;      // the clamp of a sample sum: maxAdd_ as an integer
+    // The fine levels: their number and step, the iteration's (allocated as reached) and the
+    // render's, and the last ended iteration's (iterLevels_ or, after the first, renderLevels_).
+    int levelCount_ = 0, levelBits_ = 0;
+    std::vector<double> levelScale_; // 2^(bits x level): home units to the level's
+    FilmLevels iterLevels_, renderLevels_;
+    const FilmLevels* lastLevels_ = nullptr;
+    // The fine-level sums of pixel i's rgb channels (k = 0, 1, 2, 4, 5, 6 of pixelSums), in
+    // home units, added into s.
+    void addLevelSums(const FilmLevels& levels, size_t i, double* s) const;
+    // Pixel i's tile and the first of its six slots there (FilmLevels: (r, g, b) x 2 halves).
+    std::pair<size_t, size_t> levelSlot(size_t i) const {
+        const size_t x = i % size_t(width_), y = i / size_t(width_);
+        return {y / kAdaptiveTile * size_t(tilesX_) + x / kAdaptiveTile,
+                ((y % kAdaptiveTile) * kAdaptiveTile + x % kAdaptiveTile) * 6};
+    }
     // nonFinite_ and saturated_ when the iteration began.
     std::uint64_t nonFiniteBefore_ = 0, saturatedBefore_ = 0;
 };

@@ -22,11 +22,23 @@ namespace {
 constexpr int kSumsPerPixel = 8;
 constexpr int kWordsPerSum = 4; // a 128-bit sum as four uint32 channels, most significant first
 constexpr int kSamplesChannel = 3 + kWordsPerSum * kSumsPerPixel; // the pixel's sample count
-constexpr int kChannels = kSamplesChannel + 1;
+constexpr int kChannels = kSamplesChannel + 1;                    // without fine levels
+constexpr int kLevelSums = 6; // a fine level's sums a pixel: (r, g, b) x 2
+constexpr int kLevelChannels = kLevelSums * kWordsPerSum;
 
-// The channel of word w (0: the most significant) of sum k.
+// The channel of word w (0: the most significant) of sum k, of the home grid or of a fine level.
 std::string sumChannel(int k, int w) {
     return "state." + std::to_string(k) + "." + std::to_string(w);
+}
+std::string levelChannel(int level, int k, int w) {
+    return "state.fine" + std::to_string(level) + "." + std::to_string(k) + "." + std::to_string(w);
+}
+
+// The four uint32 words of a 128-bit sum, most significant first, and back.
+void putWords(Film::Fixed v, std::uint32_t* out) {
+    const auto bits = static_cast<unsigned __int128>(v);
+    for (int w = 0; w < kWordsPerSum; ++w)
+        out[w] = std::uint32_t(bits >> (32 * (kWordsPerSum - 1 - w)));
 }
 
 std::string fileText(const std::string& path) {
@@ -80,6 +92,10 @@ std::uint64_t checkpointChecksum(const Checkpoint& c) {
     f.value(c.film.scaleExponent).value(c.film.weightExponent);
     f.array(c.film.sums);
     f.array(c.film.samples);
+    // Only where the film has fine levels: checkpoints made before them digest as they did.
+    if (c.film.levelBits != 0) f.value(c.film.levelBits);
+    for (const Film::State::Level& l : c.film.levels)
+        f.value(l.level).array(l.sums);
     return f.h;
 }
 
@@ -245,13 +261,10 @@ std::string checkpointMismatch(const CheckpointKey& e, const CheckpointKey& f) {
     return why.str();
 }
 
-void writeCheckpoint(const std::string& path, const Checkpoint& c,
-                     const std::vector<float>& image) {
-    const size_t pixels = size_t(c.key.width) * size_t(c.key.height);
-    if (image.size() != pixels * 3 || c.film.sums.size() != pixels * kSumsPerPixel ||
-        c.film.samples.size() != pixels)
-        throw std::invalid_argument("checkpoint: image and film sizes differ from the key's");
-    OIIO::ImageSpec spec(c.key.width, c.key.height, kChannels, OIIO::TypeDesc::FLOAT);
+namespace {
+// The checkpoint's channels, as writeCheckpoint lays them out: R, G, B, the home sums' words, the
+// sample count, then each fine level's words. Returns the fine levels held, "1,2".
+std::string nameChannels(const Film::State& film, size_t pixels, OIIO::ImageSpec& spec) {
     std::vector<OIIO::TypeDesc> formats(3, OIIO::TypeDesc::FLOAT);
     std::vector<std::string> names = {"R", "G", "B"};
     for (int k = 0; k < kSumsPerPixel; ++k)
@@ -261,8 +274,32 @@ void writeCheckpoint(const std::string& path, const Checkpoint& c,
         }
     names.push_back("state.samples");
     formats.push_back(OIIO::TypeDesc::UINT);
+    std::string levels;
+    for (const Film::State::Level& l : film.levels) {
+        if (l.sums.size() != pixels * kLevelSums)
+            throw std::invalid_argument("checkpoint: a fine level of another size");
+        levels += (levels.empty() ? "" : ",") + std::to_string(l.level);
+        for (int k = 0; k < kLevelSums; ++k)
+            for (int w = 0; w < kWordsPerSum; ++w) {
+                names.push_back(levelChannel(l.level, k, w));
+                formats.push_back(OIIO::TypeDesc::UINT);
+            }
+    }
     spec.channelnames = names;
     spec.channelformats = formats;
+    return levels;
+}
+} // namespace
+
+void writeCheckpoint(const std::string& path, const Checkpoint& c,
+                     const std::vector<float>& image) {
+    const size_t pixels = size_t(c.key.width) * size_t(c.key.height);
+    if (image.size() != pixels * 3 || c.film.sums.size() != pixels * kSumsPerPixel ||
+        c.film.samples.size() != pixels)
+        throw std::invalid_argument("checkpoint: image and film sizes differ from the key's");
+    const int channels = kChannels + kLevelChannels * int(c.film.levels.size());
+    OIIO::ImageSpec spec(c.key.width, c.key.height, channels, OIIO::TypeDesc::FLOAT);
+    const std::string levels = nameChannels(c.film, pixels, spec);
     spec.attribute("oiio:ColorSpace", "Linear");
     spec.attribute("Software", "Spillway");
     // RLE: a checkpoint interrupts the render while it is written, and the 128-bit sums' high
@@ -288,23 +325,25 @@ void writeCheckpoint(const std::string& path, const Checkpoint& c,
     spec.attribute("spillway:render_seconds", std::to_string(c.renderSeconds));
     spec.attribute("spillway:fixed_point_exponent", c.film.scaleExponent);
     spec.attribute("spillway:weight_exponent", c.film.weightExponent);
+    spec.attribute("spillway:level_bits", c.film.levelBits);
+    spec.attribute("spillway:fine_levels", levels);
     spec.attribute("spillway:non_finite_samples", std::to_string(c.film.nonFinite));
     spec.attribute("spillway:saturated_samples", std::to_string(c.film.saturated));
     spec.attribute("spillway:checksum", std::to_string(checkpointChecksum(c)));
 
     // Pixels as the channels lie: 3 floats, then 32 uint32 (the sums), then the sample count,
-    // each 4 bytes.
-    std::vector<std::uint32_t> data(pixels * kChannels);
+    // then 24 uint32 a fine level, each 4 bytes.
+    std::vector<std::uint32_t> data(pixels * size_t(channels));
     for (size_t i = 0; i < pixels; ++i) {
-        std::uint32_t* px = &data[i * kChannels];
+        std::uint32_t* px = &data[i * size_t(channels)];
         std::memcpy(px, &image[i * 3], 3 * sizeof(float));
-        for (int k = 0; k < kSumsPerPixel; ++k) {
-            const unsigned __int128 bits =
-                static_cast<unsigned __int128>(c.film.sums[i * kSumsPerPixel + size_t(k)]);
-            for (int w = 0; w < kWordsPerSum; ++w)
-                px[3 + kWordsPerSum * k + w] = std::uint32_t(bits >> (32 * (kWordsPerSum - 1 - w)));
-        }
+        for (int k = 0; k < kSumsPerPixel; ++k)
+            putWords(c.film.sums[i * kSumsPerPixel + size_t(k)], px + 3 + kWordsPerSum * k);
         px[kSamplesChannel] = c.film.samples[i];
+        for (size_t l = 0; l < c.film.levels.size(); ++l)
+            for (int k = 0; k < kLevelSums; ++k)
+                putWords(c.film.levels[l].sums[i * kLevelSums + size_t(k)],
+                         px + kChannels + kLevelChannels * l + kWordsPerSum * k);
     }
     std::vector<unsigned char> bytes;
     OIIO::Filesystem::IOVecOutput proxy(bytes);
@@ -339,29 +378,58 @@ void readFilmState(OIIO::ImageInput& in, const std::string& path, const std::vec
                    Film::State& film) {
     const OIIO::ImageSpec& spec = in.spec();
     const size_t width = size_t(spec.width);
-    constexpr size_t kWords = kChannels - 3; // per pixel, as the file lists them
+    const size_t kWords = size_t(spec.nchannels) - 3; // per pixel, as the file lists them
     const int rows = int(std::max<size_t>(1, (size_t(1) << 20) / (width * kWords)));
     std::vector<std::uint32_t> words;
     for (int y0 = 0; y0 < spec.height; y0 += rows) {
         const int y1 = std::min(spec.height, y0 + rows);
         words.resize(size_t(y1 - y0) * width * kWords);
-        if (!in.read_scanlines(0, 0, spec.y + y0, spec.y + y1, 0, 3, kChannels,
+        if (!in.read_scanlines(0, 0, spec.y + y0, spec.y + y1, 0, 3, spec.nchannels,
                                OIIO::TypeDesc::UINT, words.data()))
             throw std::runtime_error("cannot read checkpoint '" + path + "': " + in.geterror());
         const size_t first = size_t(y0) * width, end = size_t(y1) * width;
         film.sums.resize(end * kSumsPerPixel);
         film.samples.resize(end);
+        for (Film::State::Level& l : film.levels)
+            l.sums.resize(end * kLevelSums);
         for (size_t p = first; p < end; ++p) {
             const std::uint32_t* w = &words[(p - first) * kWords];
-            for (size_t k = 0; k < kSumsPerPixel; ++k) {
+            // Sum k's words are word[4k .. 4k + 3]: the home sums, the fine levels' after them.
+            auto sum = [&](size_t k) {
                 unsigned __int128 bits = 0;
                 for (size_t j = 0; j < kWordsPerSum; ++j)
                     bits = bits << 32 | w[word[kWordsPerSum * k + j]];
-                film.sums[p * kSumsPerPixel + k] = static_cast<Film::Fixed>(bits);
-            }
+                return static_cast<Film::Fixed>(bits);
+            };
+            for (size_t k = 0; k < kSumsPerPixel; ++k)
+                film.sums[p * kSumsPerPixel + k] = sum(k);
             film.samples[p] = w[word.back()];
+            for (size_t l = 0; l < film.levels.size(); ++l)
+                for (size_t k = 0; k < kLevelSums; ++k)
+                    film.levels[l].sums[p * kLevelSums + k] =
+                        sum(kSumsPerPixel + l * kLevelSums + k);
         }
     }
+}
+} // namespace
+
+namespace {
+// The fine levels a checkpoint says it holds (spillway:fine_levels, "1,3": each once, ascending,
+// below 1000), their sums not yet read.
+std::vector<Film::State::Level> levelsListed(const OIIO::ImageSpec& spec, const std::string& path) {
+    std::vector<Film::State::Level> out;
+    const std::string levels = spec.get_string_attribute("spillway:fine_levels");
+    for (size_t at = 0; at < levels.size();) {
+        const size_t comma = std::min(levels.find(',', at), levels.size());
+        const std::string item = levels.substr(at, comma - at);
+        const int last = out.empty() ? 0 : out.back().level;
+        if (item.empty() || item.size() > 3 ||
+            item.find_first_not_of("0123456789") != std::string::npos || std::stoi(item) <= last)
+            notACheckpoint(path, "its spillway:fine_levels is not a list of levels");
+        out.push_back({std::stoi(item), {}});
+        at = comma + 1;
+    }
+    return out;
 }
 } // namespace
 
@@ -377,8 +445,11 @@ Checkpoint readCheckpoint(const std::string& path) {
     const OIIO::ImageSpec& spec = in->spec();
     if (spec.get_int_attribute("spillway:checkpoint") != 1)
         notACheckpoint(path, "no spillway:checkpoint attribute");
-    if (spec.nchannels != kChannels || spec.width <= 0 || spec.height <= 0)
-        notACheckpoint(path, "not " + std::to_string(kChannels) + " channels");
+    Checkpoint c;
+    c.film.levels = levelsListed(spec, path);
+    const int channels = kChannels + kLevelChannels * int(c.film.levels.size());
+    if (spec.nchannels != channels || spec.width <= 0 || spec.height <= 0)
+        notACheckpoint(path, "not " + std::to_string(channels) + " channels");
     if (const std::string why = imageSizeProblem(path, spec.width, spec.height); !why.empty())
         notACheckpoint(path, why); // before the film's 132 bytes a pixel are allocated
     // The state channels by name: OpenEXR keeps channels sorted, and OpenImageIO may list a
@@ -387,8 +458,11 @@ Checkpoint readCheckpoint(const std::string& path) {
     for (int k = 0; k < kSumsPerPixel; ++k)
         for (int w = 0; w < kWordsPerSum; ++w)
             word.push_back(size_t(stateChannel(spec, path, sumChannel(k, w)) - 3));
+    for (const Film::State::Level& l : c.film.levels)
+        for (int k = 0; k < kLevelSums; ++k)
+            for (int w = 0; w < kWordsPerSum; ++w)
+                word.push_back(size_t(stateChannel(spec, path, levelChannel(l.level, k, w)) - 3));
     word.push_back(size_t(stateChannel(spec, path, "state.samples") - 3));
-    Checkpoint c;
     c.key.version = spec.get_string_attribute("spillway:version");
     try {
         c.key.sceneHash = std::stoull(spec.get_string_attribute("spillway:scene_hash"));
@@ -415,6 +489,7 @@ Checkpoint readCheckpoint(const std::string& path) {
     c.key.adaptiveMinSamples = spec.get_int_attribute("spillway:adaptive_min_samples");
     c.film.scaleExponent = spec.get_int_attribute("spillway:fixed_point_exponent");
     c.film.weightExponent = spec.get_int_attribute("spillway:weight_exponent");
+    c.film.levelBits = spec.get_int_attribute("spillway:level_bits");
     c.iterations = spec.get_int_attribute("spillway:iterations", -1);
     c.firstIteration = spec.get_int_attribute("spillway:first_iteration", -1);
     c.totalIterations = spec.get_int_attribute("spillway:total_iterations", -1);
@@ -435,6 +510,25 @@ Checkpoint readCheckpoint(const std::string& path) {
     return c;
 }
 
+namespace {
+// to's fine levels plus from's, level by level (the union, ascending).
+void addLevels(const Film::State& from, Film::State& to) {
+    for (const Film::State::Level& l : from.levels) {
+        if (l.sums.size() * 8 != to.sums.size() * 6)
+            throw std::invalid_argument("a partial's fine level is of another film size");
+        auto at = std::lower_bound(
+            to.levels.begin(), to.levels.end(), l.level,
+            [](const Film::State::Level& a, int level) { return a.level < level; });
+        if (at == to.levels.end() || at->level != l.level) {
+            at = to.levels.insert(at, l);
+            continue;
+        }
+        for (size_t i = 0; i < l.sums.size(); ++i)
+            at->sums[i] += l.sums[i];
+    }
+}
+} // namespace
+
 Checkpoint mergePartials(const std::vector<std::pair<std::string, Checkpoint>>& partials) {
     if (partials.empty()) throw std::invalid_argument("merge needs at least one partial render");
     std::vector<const std::pair<std::string, Checkpoint>*> order;
@@ -451,6 +545,7 @@ Checkpoint mergePartials(const std::vector<std::pair<std::string, Checkpoint>>& 
     merged.iterations = 0;
     merged.renderSeconds = 0;
     std::fill(merged.film.sums.begin(), merged.film.sums.end(), 0);
+    merged.film.levels.clear();
     std::fill(merged.film.samples.begin(), merged.film.samples.end(), 0u);
     merged.film.nonFinite = merged.film.saturated = 0;
     int next = 0; // the first iteration not yet covered
@@ -462,7 +557,7 @@ Checkpoint mergePartials(const std::vector<std::pair<std::string, Checkpoint>>& 
                                         order.front()->first + ": " + why);
         if (c.film.scaleExponent != head.film.scaleExponent ||
             c.film.weightExponent != head.film.weightExponent ||
-            c.film.sums.size() != head.film.sums.size())
+            c.film.levelBits != head.film.levelBits || c.film.sums.size() != head.film.sums.size())
             throw std::invalid_argument(file + "'s film differs from " + order.front()->first +
                                         "'s");
         if (c.totalIterations != head.totalIterations)
@@ -480,6 +575,7 @@ Checkpoint mergePartials(const std::vector<std::pair<std::string, Checkpoint>>& 
                                         ", starts at " + samples(c.firstIteration) + ")");
         for (size_t i = 0; i < merged.film.sums.size(); ++i)
             merged.film.sums[i] += c.film.sums[i];
+        addLevels(c.film, merged.film);
         for (size_t i = 0; i < merged.film.samples.size(); ++i)
             merged.film.samples[i] += c.film.samples[i];
         merged.film.nonFinite += c.film.nonFinite;

@@ -74,9 +74,12 @@ bool RankSync::agreeWhole(bool whole, StageTimes& stages) {
 void RankSync::reduce(Film& film, StageTimes& stages) {
     // Every rank's share of the iteration, added exactly: the same film on every rank.
     StageTimer t(stages, "reduce");
-    std::vector<std::int64_t> sums = film.iterationAccumulators();
+    // First which fine-level tiles any rank reached (Film::levelTilesReached), then the sums.
+    std::vector<std::int64_t> tiles = film.levelTilesReached();
+    ranks_.sum(tiles);
+    std::vector<std::int64_t> sums = film.iterationAccumulators(tiles);
     ranks_.sum(sums);
-    film.setIterationAccumulators(sums);
+    film.setIterationAccumulators(sums, tiles);
 }
 
 void RankSync::finish(RenderStats& stats, double wallSeconds) {
