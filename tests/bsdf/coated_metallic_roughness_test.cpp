@@ -11,7 +11,7 @@
 namespace spw::test {
 namespace {
 
-const vec3 kBase(0.9f, 0.55f, 0.2f);
+const vec3 kCoatedBase(0.9f, 0.55f, 0.2f);
 
 BsdfUnderTest coated(float metallic, float roughness, float coat, float coatRoughness,
                      double thetaDeg, vec3 ng = vec3(0, 0, 1)) {
@@ -20,13 +20,13 @@ BsdfUnderTest coated(float metallic, float roughness, float coat, float coatRoug
     m.sh.metallic = metallic;
     m.sh.coat = coat;
     m.sh.coatAlpha = gltfAlpha(coatRoughness);
-    m.albedo = kBase;
+    m.albedo = kCoatedBase;
     m.ng = m.ns = ng;
     m.wo = directionAround(ng, thetaDeg, 0.4);
     return m;
 }
 
-ExpectedLobes lobes(const BsdfUnderTest& m) {
+ExpectedLobes coatedLobes(const BsdfUnderTest& m) {
     ExpectedLobes l;
     l.upper = glm::normalize(2.0f * glm::dot(m.wo, m.ng) * m.ng - m.wo);
     l.width =
@@ -52,14 +52,14 @@ TEST(CoatedMetallicRoughness, SampledDirectionsFollowThePdf) {
                                   "metallic %g, roughness %g, coat roughness %g, theta %g",
                                   metallic, roughness, coatRoughness, theta);
                     expectSamplingMatchesPdf(
-                        testSampling(m, lobes(m), 200000,
+                        testSampling(m, coatedLobes(m), 200000,
                                      700 + uint(theta + 10 * roughness + 100 * coatRoughness)),
                         tests, name);
                 }
     // Half a coat, in a tilted frame, wo on the back of ng (the model turns to wo's side).
     const BsdfUnderTest m =
         coated(0.3f, 0.5f, 0.5f, 0.2f, 130.0, glm::normalize(vec3(-0.2f, 0.7f, 0.4f)));
-    expectSamplingMatchesPdf(testSampling(m, lobes(m), 200000, 5), tests,
+    expectSamplingMatchesPdf(testSampling(m, coatedLobes(m), 200000, 5), tests,
                              "metallic 0.3, coat 0.5, back side, tilted");
 }
 
@@ -93,7 +93,7 @@ TEST(CoatedMetallicRoughness, NarrowLobesReflectTheClosedFormAndAFurnaceGainsNot
         BsdfUnderTest black = coated(0.0f, 0.0f, coat, 0.0f, 0.0);
         black.albedo = vec3(0.0f);
         const double fc = 0.04 * coat;
-        EXPECT_NEAR(testSampling(black, lobes(black), 50000, 31).fcosIntegral,
+        EXPECT_NEAR(testSampling(black, coatedLobes(black), 50000, 31).fcosIntegral,
                     fc + (1.0 - fc) * 0.04, 1e-3)
             << "coat " << coat;
     }
@@ -101,7 +101,7 @@ TEST(CoatedMetallicRoughness, NarrowLobesReflectTheClosedFormAndAFurnaceGainsNot
         for (float roughness : {0.0f, 0.5f, 1.0f}) {
             BsdfUnderTest m = coated(metallic, roughness, 1.0f, 0.3f, 0.0);
             m.albedo = vec3(1.0f);
-            const SamplingReport r = testSampling(m, lobes(m), 50000, 32);
+            const SamplingReport r = testSampling(m, coatedLobes(m), 50000, 32);
             EXPECT_LE(r.fcosIntegral, 1.0 + 1e-3)
                 << "metallic " << metallic << ", roughness " << roughness;
             EXPECT_GT(r.fcosIntegral, 0.3)
@@ -130,7 +130,7 @@ TEST(CoatedMetallicRoughness, WithItsOwnNormalSampledDirectionsFollowThePdf) {
                 char name[128];
                 std::snprintf(name, sizeof name, "metallic %g, coat normal (%g %g %g), theta %g",
                               metallic, tilt.x, tilt.y, tilt.z, theta);
-                ExpectedLobes l = lobes(m);
+                ExpectedLobes l = coatedLobes(m);
                 l.width = 1.0; // two lobes about two normals
                 expectSamplingMatchesPdf(
                     testSampling(m, l, 200000, 900 + uint(theta) + uint(10 * tilt.y)), tests, name);

@@ -10,7 +10,7 @@
 namespace spw::test {
 namespace {
 
-const vec3 kBase(0.2f, 0.35f, 0.7f);
+const vec3 kSheenBase(0.2f, 0.35f, 0.7f);
 const vec3 kSheen(1.0f, 0.6f, 0.3f);
 
 BsdfUnderTest sheened(float metallic, float sheenRoughness, double thetaDeg, vec3 sheen = kSheen) {
@@ -19,12 +19,12 @@ BsdfUnderTest sheened(float metallic, float sheenRoughness, double thetaDeg, vec
     m.sh.metallic = metallic;
     m.sh.sheenColour = sheen;
     m.sh.sheenRoughness = sheenRoughness;
-    m.albedo = kBase;
+    m.albedo = kSheenBase;
     m.wo = directionAround(m.ng, thetaDeg, 0.4);
     return m;
 }
 
-ExpectedLobes lobes(const BsdfUnderTest& m) {
+ExpectedLobes sheenLobes(const BsdfUnderTest& m) {
     ExpectedLobes l;
     l.upper = glm::normalize(2.0f * glm::dot(m.wo, m.ng) * m.ng - m.wo);
     l.width = 1.0;
@@ -68,7 +68,7 @@ TEST(SheenMetallicRoughness, SampledDirectionsFollowThePdf) {
                 std::snprintf(name, sizeof name, "metallic %g, sheen roughness %g, theta %g",
                               metallic, r, theta);
                 expectSamplingMatchesPdf(
-                    testSampling(m, lobes(m), 200000, 7000 + uint(theta + 10 * r + metallic)),
+                    testSampling(m, sheenLobes(m), 200000, 7000 + uint(theta + 10 * r + metallic)),
                     tests, name);
             }
 }
@@ -130,7 +130,7 @@ TEST(SheenMetallicRoughness, OverANonReflectingBaseItsAlbedoIsTheSheens) {
             m.sh.specularColour = vec3(1.0f);
             const double expected = (kSheen.x + kSheen.y + kSheen.z) / 3.0 *
                                     sheenLobeAlbedo(std::cos(theta * M_PI / 180.0), r);
-            EXPECT_NEAR(testSampling(m, lobes(m), 100000, 80).fcosIntegral, expected,
+            EXPECT_NEAR(testSampling(m, sheenLobes(m), 100000, 80).fcosIntegral, expected,
                         2e-3 + 0.01 * expected)
                 << "roughness " << r << ", theta " << theta;
         }

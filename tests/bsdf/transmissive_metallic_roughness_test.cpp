@@ -12,20 +12,20 @@ namespace spw::test {
 namespace {
 
 constexpr float kIor = 1.5f;
-const vec3 kBase(0.9f, 0.7f, 0.5f);
+const vec3 kGlassBase(0.9f, 0.7f, 0.5f);
 
 BsdfUnderTest transmissive(float transmission, float alpha, double thetaDeg, bool inside) {
     BsdfUnderTest m;
     m.sh = shaderParams(kModelTransmissiveMetallicRoughness, alpha, kIor);
     m.sh.transmission = transmission;
-    m.albedo = kBase;
+    m.albedo = kGlassBase;
     m.ng = m.ns = glm::normalize(vec3(0.1f, -0.2f, 1.0f));
     m.wo = directionAround(inside ? -m.ng : m.ng, thetaDeg, 0.9);
     return m;
 }
 
 // The glass's mirror and refracted directions (the opaque part's lobes are wider).
-ExpectedLobes lobes(const BsdfUnderTest& m) {
+ExpectedLobes glassLobes(const BsdfUnderTest& m) {
     ExpectedLobes l;
     const bool outside = glm::dot(m.wo, m.ng) > 0;
     const vec3 n = outside ? m.ng : -m.ng;
@@ -55,7 +55,7 @@ TEST(TransmissiveMetallicRoughness, SampledDirectionsFollowThePdf) {
                     std::snprintf(name, sizeof name, "transmission %g, alpha %g, theta %g, %s", t,
                                   alpha, theta, inside ? "inside" : "outside");
                     expectSamplingMatchesPdf(
-                        testSampling(m, lobes(m), 200000,
+                        testSampling(m, glassLobes(m), 200000,
                                      4000 + uint(theta + 10 * t + 100 * alpha) + inside),
                         tests, name);
                 }
@@ -72,8 +72,8 @@ TEST(TransmissiveMetallicRoughness, OnAMetalSampledDirectionsFollowThePdf) {
             char name[80];
             std::snprintf(name, sizeof name, "metallic 0.5, theta %g, %s", theta,
                           inside ? "inside" : "outside");
-            expectSamplingMatchesPdf(testSampling(m, lobes(m), 200000, 4500 + uint(theta) + inside),
-                                     4, name);
+            expectSamplingMatchesPdf(
+                testSampling(m, glassLobes(m), 200000, 4500 + uint(theta) + inside), 4, name);
         }
 }
 
@@ -176,7 +176,7 @@ TEST(TransmissiveMetallicRoughness, TheMixtureKeepsEachPartsEnergy) {
         m.albedo = vec3(1.0f);
         BsdfUnderTest opaque = transmissive(0.0f, 1e-3f, 0.0, false);
         opaque.albedo = vec3(1.0f);
-        const double aOpaque = testSampling(opaque, lobes(opaque), 100000, 61).fcosIntegral;
+        const double aOpaque = testSampling(opaque, glassLobes(opaque), 100000, 61).fcosIntegral;
         Uniform u(62);
         double sum = 0.0;
         const int n = 100000;

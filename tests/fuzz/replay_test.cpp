@@ -13,7 +13,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::vector<std::string> filesIn(const std::string& dir) {
+std::vector<std::string> keptInputs(const std::string& dir) {
     std::vector<std::string> out;
     std::error_code ec;
     for (const auto& e : fs::directory_iterator(sourceDir() + "/tests/fuzz/" + dir, ec))
@@ -36,7 +36,7 @@ TEST(FuzzCorpus, SeedsLoadAndRender) {
                                                     {"seeds/gltf", fuzz::gltf},
                                                     {"seeds/checkpoint", fuzz::checkpoint}};
     for (const auto& [dir, target] : kinds) {
-        const std::vector<std::string> files = filesIn(dir);
+        const std::vector<std::string> files = keptInputs(dir);
         EXPECT_GE(files.size(), 3u) << dir;
         for (const std::string& f : files) {
             std::string detail;
@@ -51,7 +51,7 @@ TEST(FuzzCorpus, EveryCrasherFoundIsNowRejectedCleanly) {
                                                     {"crashers/gltf", fuzz::gltf},
                                                     {"crashers/checkpoint", fuzz::checkpoint}};
     for (const auto& [dir, target] : kinds)
-        for (const std::string& f : filesIn(dir)) {
+        for (const std::string& f : keptInputs(dir)) {
             std::string detail;
             EXPECT_NE(replay(target, f, &detail), fuzz::Outcome::Unexpected) << f << " " << detail;
         }
