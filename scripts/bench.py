@@ -50,7 +50,9 @@ are noisy; ratios travel, absolute seconds do not).
                                lamps, an environment map with a sun), each renderer against its
                                own 4096-spp reference: scripts/cycles_bench.py says how.
                                --backends cpu,reference (default), --scenes NAME,... (default
-                               all), --quick (tiny, for the suite). Writes out/bench/cycles.json.
+                               all; `holdout`: five of the same kinds laid out by other draws),
+                               --quick (tiny, for the suite). Writes out/bench/cycles.json
+                               (cycles-holdout.json).
   scripts/bench.py scale       production-shaped glTF scenes at increasing sizes (an instanced
                                forest, unique geometry, many embedded images), Spillway beside
                                Cycles on each file: load, BVH, render and wall seconds, peak RSS,

@@ -19,6 +19,13 @@ scene: Cycles' seconds and relMSE at 256 spp, and per backend the samples and se
 the ratio to Cycles' seconds, and that ratio less Spillway's process start (`spillway
 --version`: loading its shared libraries), which Cycles' figure does not pay. Writes out/bench/cycles.json.
 
+Spillway renders the scene Cycles renders: where a glTF file's emitters are too dim for Spillway
+to let them light it alone (it would add a white world, as it says on stderr), it gets a black
+world (`--environment 0,0,0`), as Cycles has. `--scenes holdout` runs five scenes of the same
+kinds that nothing was tuned on: the Cornell box's room with two boxes and its light drawn anew,
+the glossy one likewise, the spheres, lamps, panel and sun of the others drawn from
+HOLDOUT_SEED (out/bench/cycles-holdout.json).
+
 --quick renders small images and few samples: it checks that the comparison runs (the
 suite's Bench.CyclesQuickRuns), its figures mean nothing.
 """
@@ -87,10 +94,32 @@ def emissive(colour, strength):
     return m
 
 
-def cornell(path, light_scale, blocks_material):
+def box(x, z, width, depth, height, yaw):
+    """A box standing on the floor (y = 0) of the Cornell box's millimetres, centred on (x, z),
+    turned by yaw radians about the vertical: 12 triangles wound outward."""
+    c, s = math.cos(yaw), math.sin(yaw)
+
+    def corner(i, j, k):  # i, j, k in {0, 1}: -x/+x, floor/top, -z/+z
+        u, v = (i - 0.5) * width, (k - 0.5) * depth
+        return (x + c * u - s * v, j * height, z + s * u + c * v)
+    faces = [((0, 0, 0), (1, 0, 0), (1, 0, 1), (0, 0, 1)),  # floor, facing down
+             ((0, 1, 0), (0, 1, 1), (1, 1, 1), (1, 1, 0)),  # top, facing up
+             ((0, 0, 0), (0, 1, 0), (1, 1, 0), (1, 0, 0)),  # -z
+             ((0, 0, 1), (1, 0, 1), (1, 1, 1), (0, 1, 1)),  # +z
+             ((0, 0, 0), (0, 0, 1), (0, 1, 1), (0, 1, 0)),  # -x
+             ((1, 0, 0), (1, 1, 0), (1, 1, 1), (1, 0, 1))]  # +x
+    tris = []
+    for a, b, d, e in faces:
+        a, b, d, e = (corner(*q) for q in (a, b, d, e))
+        tris += [(a, b, d), (a, d, e)]
+    return tris
+
+
+def cornell(path, light_scale, blocks_material, rng=None):
     """The Cornell box (scenes/cornell-box), metres, turned to face the glTF camera on +Z: its
     ceiling light scaled by light_scale in each direction, radiance 1 / light_scale^2 times, the
-    same power."""
+    same power. With rng (the held-out set): the room alone, two boxes of rng's sizes, turns and
+    places, and the light moved and reshaped on the ceiling, its power kept."""
     def place(p):  # the scene's camera at (278, 273, -800) mm comes to (0, 0.3, 0.8) m
         return ((278.0 - p[0]) / 1000, (p[1] - 273.0) / 1000 + 0.3, -p[2] / 1000)
 
@@ -98,24 +127,49 @@ def cornell(path, light_scale, blocks_material):
     materials = [cc.material(c, 0.0, 1.0) for c in
                  ((0.725, 0.71, 0.68), (0.63, 0.065, 0.05), (0.14, 0.45, 0.091))]
     materials += [blocks_material, emissive((17, 12, 4), 1.0 / light_scale ** 2)]
+    parts = (("white.obj", 0), ("red.obj", 1), ("green.obj", 2))
+    if rng is None:
+        parts += (("blocks.obj", 3),)
     meshes = [flat_mesh([tuple(place(p) for p in t) for t in obj_triangles(os.path.join(folder, f))], m)
-              for f, m in (("white.obj", 0), ("red.obj", 1), ("green.obj", 2), ("blocks.obj", 3))]
-    centre = place((278.0, 548.7, 279.5))
-    meshes.append(quad(centre, 0.065 * light_scale, 0.0525 * light_scale, 4))
+              for f, m in parts]
+    light_at, half_x, half_z = (278.0, 279.5), 0.065 * light_scale, 0.0525 * light_scale
+    if rng is not None:
+        blocks = []
+        for x0, x1 in ((90.0, 250.0), (306.0, 466.0)):  # one box in each half of the room
+            blocks += box(rng.uniform(x0, x1), rng.uniform(130.0, 420.0), rng.uniform(90.0, 170.0),
+                          rng.uniform(90.0, 170.0), rng.uniform(100.0, 360.0),
+                          rng.uniform(0.0, math.pi / 2))
+        meshes.append(flat_mesh([tuple(place(p) for p in t) for t in blocks], 3))
+        light_at = (rng.uniform(170.0, 386.0), rng.uniform(170.0, 390.0))
+        aspect = rng.uniform(0.6, 1.6)
+        half_x, half_z = half_x * math.sqrt(aspect), half_z / math.sqrt(aspect)
+    centre = place((light_at[0], 548.7, light_at[1]))
+    meshes.append(quad(centre, half_x, half_z, 4))
     fov_x = math.radians(39.3)
     cc.write_glb(path, meshes, materials, camera_z=0.8, yfov=fov_x, aspect=1.0,
                  extensions=["KHR_materials_emissive_strength"])
 
 
-def many_lights(path, count=128):
+def sphere_layout(rng, fixed):
+    """Three spheres' (x, z, radius) on the floor: `fixed`, or with rng (the held-out set) a
+    sphere in each third of the frame at rng's depth and size."""
+    if rng is None:
+        return fixed
+    return [(rng.uniform(x - 0.35, x + 0.35), rng.uniform(-1.0, 0.5), rng.uniform(0.35, 0.75))
+            for x in (-1.3, 0.1, 1.4)]
+
+
+def many_lights(path, count=128, rng=None):
     """Spheres on a floor before a wall, lit by `count` small square lamps of many colours and
-    powers (a 40:1 range) at many heights: a glTF file's dozens of lamps and emissive meshes."""
-    rng = random.Random(7)
+    powers (a 40:1 range) at many heights: a glTF file's dozens of lamps and emissive meshes.
+    rng (the held-out set) places the spheres and draws the lamps; else seed 7 draws them."""
+    spheres = sphere_layout(rng, ((-1.2, -0.6, 0.5), (0.1, 0.3, 0.45), (1.3, -0.9, 0.55)))
+    rng = rng or random.Random(7)
     s = cc.sphere()
     materials = [cc.material((0.6, 0.6, 0.6), 0.0, 0.8), cc.material((0.9, 0.6, 0.3), 1.0, 0.35),
                  cc.material((0.3, 0.5, 0.8), 0.0, 0.3)]
     meshes = [cc.floor(8.0) + (0,), cc.panel(-4.0, 4.0, -1.0, 3.0, -2.5) + (0,)]
-    for k, (x, z, r) in enumerate(((-1.2, -0.6, 0.5), (0.1, 0.3, 0.45), (1.3, -0.9, 0.55))):
+    for k, (x, z, r) in enumerate(spheres):
         meshes.append(([c * r + o for c, o in zip(s[0], [x, -1.0 + r, z] * (len(s[0]) // 3))],
                        s[1], s[2], None, 1 + k % 2))
     for _ in range(count):
@@ -127,10 +181,11 @@ def many_lights(path, count=128):
                  extensions=["KHR_materials_emissive_strength"])
 
 
-def textured(path):
+def textured(path, rng=None):
     """Textured spheres (base colour, metallic-roughness and normal images) on a checker floor
     before a checker wall, under a sun and a wide emissive panel overhead: image lookups on
-    every bounce and light bouncing between the objects."""
+    every bounce and light bouncing between the objects. rng (the held-out set) places the
+    spheres, the panel and the sun."""
     s = cc.sphere()
     images = cc.textured_images()
     textured_material = cc.material((1.0, 1.0, 1.0), 1.0, 1.0)
@@ -144,12 +199,16 @@ def textured(path):
     floor = ([-size, -1.0, -size, size, -1.0, -size, size, -1.0, size, -size, -1.0, size],
              [0, 1, 0] * 4, [0, 2, 1, 0, 3, 2], [0, 0, 4, 0, 4, 4, 0, 4], 1)
     meshes = [floor, cc.panel(-4.0, 4.0, -1.0, 3.0, -2.5) + (1,)]
-    for x, z, r in ((-1.3, -0.4, 0.6), (0.2, 0.3, 0.5), (1.5, -0.7, 0.7)):
+    for x, z, r in sphere_layout(rng, ((-1.3, -0.4, 0.6), (0.2, 0.3, 0.5), (1.5, -0.7, 0.7))):
         meshes.append(([c * r + o for c, o in zip(s[0], [x, -1.0 + r, z] * (len(s[0]) // 3))],
                        s[1], s[2], s[3], 0))
-    meshes.append(quad((0.0, 3.0, 0.0), 2.0, 1.5, 2))
+    panel_at, sun = (0.0, 3.0, 0.0), (0.5, -0.7, -0.5)
+    if rng is not None:
+        panel_at = (rng.uniform(-1.5, 1.5), rng.uniform(2.5, 3.5), rng.uniform(-1.0, 1.0))
+        sun = (rng.uniform(-0.8, 0.8), -rng.uniform(0.5, 1.0), -rng.uniform(0.2, 0.8))
+    meshes.append(quad(panel_at, 2.0, 1.5, 2))
     cc.write_glb(path, meshes, materials, camera_z=5.5, yfov=0.7, images=images,
-                 sun=((0.5, -0.7, -0.5), 2.0 * 683), extensions=["KHR_materials_emissive_strength"])
+                 sun=(sun, 2.0 * 683), extensions=["KHR_materials_emissive_strength"])
 
 
 def write_hdr(path, width, height, texel):
@@ -170,12 +229,12 @@ def write_hdr(path, width, height, texel):
         f.write(bytes(rows))
 
 
-def sky(x, y, width, height):
-    """A blue sky brightening to the horizon, a dim brown ground, and a sun 2 degrees across at
-    35 degrees of elevation, off to the camera's right, 4000 times the sky's radiance."""
+def sky(x, y, width, height, sun_theta=math.radians(55), sun_phi=math.radians(230)):
+    """A blue sky brightening to the horizon, a dim brown ground, and a sun 2 degrees across
+    (by default at 35 degrees of elevation, off to the camera's right), 4000 times the sky's
+    radiance."""
     theta = math.pi * (y + 0.5) / height  # from straight up
     phi = 2 * math.pi * (x + 0.5) / width
-    sun_theta, sun_phi = math.radians(55), math.radians(230)
     cos_angle = (math.cos(theta) * math.cos(sun_theta) +
                  math.sin(theta) * math.sin(sun_theta) * math.cos(phi - sun_phi))
     if cos_angle > math.cos(math.radians(1.0)):
@@ -186,20 +245,25 @@ def sky(x, y, width, height):
     return (0.25 + 0.6 * t, 0.45 + 0.45 * t, 1.0)
 
 
-def environment_lit(folder, quick):
+def environment_lit(folder, quick, rng=None):
     """Spheres on a floor under a sky with a sun (a lat-long map): a glTF file for Cycles, and
-    the YAML scene Spillway renders, which places it under the map with the file's camera."""
+    the YAML scene Spillway renders, which places it under the map with the file's camera.
+    rng (the held-out set) places the spheres and the sun (20 to 60 degrees up, anywhere round)."""
     glb, hdr, yaml = (os.path.join(folder, n) for n in ("outdoor.glb", "sky.hdr", "outdoor.yaml"))
     s = cc.sphere()
     materials = [cc.material((0.5, 0.5, 0.5), 0.0, 0.9), cc.material((0.95, 0.64, 0.54), 1.0, 0.3),
                  cc.material((0.8, 0.3, 0.2), 0.0, 0.4)]
     meshes = [cc.floor(12.0) + (0,)]
-    for k, (x, z, r) in enumerate(((-1.3, -0.5, 0.6), (0.2, 0.2, 0.5), (1.4, -0.6, 0.7))):
+    spheres = sphere_layout(rng, ((-1.3, -0.5, 0.6), (0.2, 0.2, 0.5), (1.4, -0.6, 0.7)))
+    for k, (x, z, r) in enumerate(spheres):
         meshes.append(([c * r + o for c, o in zip(s[0], [x, -1.0 + r, z] * (len(s[0]) // 3))],
                        s[1], s[2], None, 1 + k % 2))
     cc.write_glb(glb, meshes, materials, camera_z=5.0, yfov=0.6)
     width = 128 if quick else 512
-    write_hdr(hdr, width, width // 2, lambda x, y: sky(x, y, width, width // 2))
+    sun = (math.radians(55), math.radians(230))
+    if rng is not None:
+        sun = (math.radians(rng.uniform(30.0, 70.0)), math.radians(rng.uniform(0.0, 360.0)))
+    write_hdr(hdr, width, width // 2, lambda x, y: sky(x, y, width, width // 2, *sun))
     fov_x = math.degrees(cc.horizontal_fov(glb))
     with open(yaml, "w") as f:
         f.write("image: {width: 640, height: 480, sample base: 1, iterations: 1}\n"
@@ -213,15 +277,23 @@ def environment_lit(folder, quick):
     return glb, yaml, hdr
 
 
-def make_scenes(folder, quick):
-    """[(name, glTF file for Cycles, file for Spillway, environment map or None)]."""
+# The held-out set's seeds (--scenes holdout): scenes of the same five kinds, laid out by these
+# draws, on which nothing was tuned.
+HOLDOUT_SEED = 20261207
+
+
+def make_scenes(folder, quick, holdout=False):
+    """[(name, glTF file for Cycles, file for Spillway, environment map or None)]: the
+    benchmark's own five, or with holdout five of the same kinds laid out by HOLDOUT_SEED's
+    draws (each kind its own stream)."""
     os.makedirs(folder, exist_ok=True)
     p = lambda n: os.path.join(folder, n)  # noqa: E731
-    cornell(p("cornell.glb"), 1.0, cc.material((0.725, 0.71, 0.68), 0.0, 1.0))
-    cornell(p("glossy-small-light.glb"), 0.1, cc.material((0.95, 0.64, 0.54), 1.0, 0.28))
-    textured(p("textured.glb"))
-    many_lights(p("many-lights.glb"))
-    glb, yaml, hdr = environment_lit(folder, quick)
+    rng = (lambda k: random.Random(HOLDOUT_SEED + k)) if holdout else (lambda k: None)
+    cornell(p("cornell.glb"), 1.0, cc.material((0.725, 0.71, 0.68), 0.0, 1.0), rng(0))
+    cornell(p("glossy-small-light.glb"), 0.1, cc.material((0.95, 0.64, 0.54), 1.0, 0.28), rng(1))
+    textured(p("textured.glb"), rng(2))
+    many_lights(p("many-lights.glb"), rng=rng(3))
+    glb, yaml, hdr = environment_lit(folder, quick, rng(4))
     return [("cornell", p("cornell.glb"), p("cornell.glb"), None),
             ("glossy-small-light", p("glossy-small-light.glb"), p("glossy-small-light.glb"), None),
             ("textured", p("textured.glb"), p("textured.glb"), None),
@@ -248,6 +320,17 @@ def spillway_render(spillway, backend, file, width, spp, seed, out, extra=()):
     if r.returncode != 0:
         sys.exit("%s failed (%d): %s" % (" ".join(cmd), r.returncode, r.stderr[-2000:]))
     return seconds
+
+
+def same_scene_args(spillway, file, work):
+    """What Spillway needs to render the scene Cycles renders: where its emitters are too dim to
+    light a glTF file alone, Spillway adds a white world (and says so) where Cycles, given the
+    file's own lights, has a black one; then a black world for Spillway too."""
+    probe = os.path.join(work, "probe.exr")
+    r = subprocess.run([spillway, "render", file, "--spp", "1", "--width", "8", "--quiet", "-o",
+                        probe], capture_output=True, text=True, check=True)
+    os.remove(probe)
+    return ["--environment", "0,0,0"] if "lit by that environment as well" in r.stderr else []
 
 
 def start_seconds(spillway):
@@ -302,13 +385,15 @@ def bench_scene(spillway, backends, scene, width, cycles_spp, ref_spp, repeat, m
            "cycles_seconds": cycles[cycles_spp][0], "cycles_relmse": target,
            "cycles_curve": [(n, cycles[n][0], relmse(spillway, cycles[n][1], cycles_ref))
                             for n in levels], "backends": {}}
+    same = same_scene_args(spillway, ours, work) if env is None else []
+    row["spillway_args"] = same
     for backend in backends:
         ref = os.path.join(work, "%s-reference.exr" % backend)
-        spillway_render(spillway, backend, ours, width, ref_spp, 1, ref)
+        spillway_render(spillway, backend, ours, width, ref_spp, 1, ref, same)
         points, spp = [], 4
         while spp <= max_spp:
             out = os.path.join(work, "%s-%d.exr" % (backend, spp))
-            seconds = min(spillway_render(spillway, backend, ours, width, spp, 0, out)
+            seconds = min(spillway_render(spillway, backend, ours, width, spp, 0, out, same)
                           for _ in range(repeat))
             points.append((spp, seconds, relmse(spillway, out, ref)))
             if points[-1][2] <= target:
@@ -326,7 +411,7 @@ def bench_scene(spillway, backends, scene, width, cycles_spp, ref_spp, repeat, m
         for k, factor in enumerate((2.0, 1.0, 0.5)):
             out = os.path.join(work, "%s-target-%d.exr" % (backend, k))
             t = min(spillway_render(spillway, backend, ours, width, max_spp, 0, out,
-                                    ["--target-error", "%g" % (factor * target)])
+                                    same + ["--target-error", "%g" % (factor * target)])
                     for _ in range(repeat))
             asked.append((factor, t, relmse(spillway, out, ref)))
         asked.sort(key=lambda p: -p[2])
@@ -363,18 +448,24 @@ def print_row(row):
 
 
 def main(spillway, backends, quick, repeat, scenes=None):
+    """scenes: names of the benchmark's scenes to run (default all); "holdout" among them runs
+    the held-out set instead (the names beside it choose among its scenes), into
+    out/bench/cycles-holdout/ and out/bench/cycles-holdout.json."""
     width, cycles_spp, ref_spp, max_spp = (32, 16, 64, 256) if quick else (128, 256, 4096, 8192)
+    holdout = "holdout" in (scenes or [])
+    scenes = [n for n in (scenes or []) if n != "holdout"]
+    tag = "cycles-holdout" if holdout else "cycles"
     folder = tempfile.mkdtemp(prefix="bench-cycles-") if quick else \
-        os.path.join(ROOT, "out", "bench", "cycles")
+        os.path.join(ROOT, "out", "bench", tag)
     rows = []
-    for scene in make_scenes(os.path.join(folder, "scenes"), quick):
+    for scene in make_scenes(os.path.join(folder, "scenes"), quick, holdout):
         if scenes and scene[0] not in scenes:
             continue
         rows.append(bench_scene(spillway, backends, scene, width, cycles_spp, ref_spp, repeat,
                                 max_spp, folder))
         print_row(rows[-1])
     if not quick:
-        with open(os.path.join(ROOT, "out", "bench", "cycles.json"), "w") as f:
+        with open(os.path.join(ROOT, "out", "bench", tag + ".json"), "w") as f:
             json.dump(rows, f, indent=2)
     else:
         shutil.rmtree(folder)
