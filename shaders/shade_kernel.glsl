@@ -62,7 +62,7 @@ layout(constant_id = 3) const uint kStrategy = kStrategyMis;
 layout(constant_id = 4) const uint kEmitterKinds = 0xFFFFFFFFu; // every kind
 layout(constant_id = 5) const bool kEmissionMaps = true;
 
-layout(set = 0, binding = 0) uniform usamplerBuffer shaderTable; // 7 texels per ShaderParams
+layout(set = 0, binding = 0) uniform usamplerBuffer shaderTable; // 8 texels per ShaderParams
 layout(set = 0, binding = 1) uniform usamplerBuffer emitterTable; // 5 texels per Emitter
 layout(set = 0, binding = 2) uniform usamplerBuffer emitterCdf;
 layout(set = 0, binding = 3) uniform usamplerBuffer lightData;
@@ -74,10 +74,10 @@ uvec4 fetch(usamplerBuffer table, uint texel) { return texelFetch(table, int(tex
 
 // Layout twin of the C++ ShaderParams (shared/types.h): tests/vk/kernel_layout_test.cpp checks it field by field.
 ShaderParams kernelShader(uint i) {
-    uvec4 w0 = fetch(shaderTable, 7u * i), w1 = fetch(shaderTable, 7u * i + 1u),
-          w2 = fetch(shaderTable, 7u * i + 2u), w3 = fetch(shaderTable, 7u * i + 3u),
-          w4 = fetch(shaderTable, 7u * i + 4u), w5 = fetch(shaderTable, 7u * i + 5u),
-          w6 = fetch(shaderTable, 7u * i + 6u);
+    uvec4 w0 = fetch(shaderTable, 8u * i), w1 = fetch(shaderTable, 8u * i + 1u),
+          w2 = fetch(shaderTable, 8u * i + 2u), w3 = fetch(shaderTable, 8u * i + 3u),
+          w4 = fetch(shaderTable, 8u * i + 4u), w5 = fetch(shaderTable, 8u * i + 5u),
+          w6 = fetch(shaderTable, 8u * i + 6u), w7 = fetch(shaderTable, 8u * i + 7u);
     ShaderParams s;
     s.emission = uintBitsToFloat(w0.xyz);
     s.model = w0.w;
@@ -96,7 +96,11 @@ ShaderParams kernelShader(uint i) {
     s.sheenRoughness = uintBitsToFloat(w5.z);
     s.coatNormal = w5.w;
     s.sheenColour = uintBitsToFloat(w6.xyz);
-    s.pad1 = w6.w;
+    s.specularTint = uintBitsToFloat(w6.w);
+    s.sheen = uintBitsToFloat(w7.x);
+    s.sheenTint = uintBitsToFloat(w7.y);
+    s.pad1 = w7.z;
+    s.pad2 = w7.w;
 #ifdef SPW_KERNEL_MODEL
     s.model = SPW_KERNEL_MODEL;
 #endif

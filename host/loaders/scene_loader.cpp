@@ -140,39 +140,40 @@ class TextureReader {
 };
 
 // The metallic-roughness models' keys (shared/metallic_roughness.h,
-// shared/coated_metallic_roughness.h), and the Dielectric's absorption.
+// shared/coated_metallic_roughness.h), the Dielectric's absorption, and the Principled's keys
+// (shared/principled.h), whose defaults are Blender's.
 void readGltfParams(const Reader& rd, const YAML::Node& n, uint takes, ShaderParams& p) {
-    if (takes & kTakesMetallic) // glass that transmits part of the light is no metal unless told
-        p.metallic = n["metallic"] ? float(rd.number(n["metallic"], "metallic", 0.0, 1.0))
-                     : takes & kTakesTransmission ? 0.0f
-                                                  : 1.0f;
+    const bool blender = (takes & kTakesPrincipled) != 0u;
+    auto unitKey = [&](const char* key, float fallback) {
+        return n[key] ? float(rd.number(n[key], key, 0.0, 1.0)) : fallback;
+    };
+    // Glass that transmits part of the light is no metal unless told.
+    if (takes & kTakesMetallic)
+        p.metallic = unitKey("metallic", blender || (takes & kTakesTransmission) ? 0.0f : 1.0f);
     if (takes & kTakesRoughness) {
-        const float r =
-            n["roughness"] ? float(rd.number(n["roughness"], "roughness", 0.0, 1.0)) : 1.0f;
+        const float r = unitKey("roughness", blender ? 0.5f : 1.0f);
         // The transmissive model's glass takes alpha as it is (smooth below kGgxSmoothAlpha).
         p.alpha = takes & kTakesTransmission ? r * r : gltfAlpha(r);
     }
-    if (takes & kTakesTransmission)
-        p.transmission = n["transmission"]
-                             ? float(rd.number(n["transmission"], "transmission", 0.0, 1.0))
-                             : 1.0f;
+    if (takes & kTakesTransmission) p.transmission = unitKey("transmission", 1.0f);
     if (n["absorption"]) p.absorption = rd.vec<3>(n["absorption"], "absorption", 0.0, 1e30);
     if (takes & kTakesCoat) {
-        p.coat = n["coat"] ? float(rd.number(n["coat"], "coat", 0.0, 1.0)) : 1.0f;
-        p.coatAlpha = gltfAlpha(
-            n["coat roughness"] ? float(rd.number(n["coat roughness"], "coat roughness", 0.0, 1.0))
-                                : 0.0f);
+        p.coat = unitKey("coat", blender ? 0.0f : 1.0f);
+        p.coatAlpha = gltfAlpha(unitKey("coat roughness", blender ? 0.03f : 0.0f));
     }
     if (takes & kTakesSheen) {
         p.sheenColour =
             n["sheen colour"] ? rd.vec<3>(n["sheen colour"], "sheen colour", 0.0, 1.0) : vec3(1.0f);
-        p.sheenRoughness = n["sheen roughness"]
-                               ? float(rd.number(n["sheen roughness"], "sheen roughness", 0.0, 1.0))
-                               : 0.5f;
+        p.sheenRoughness = unitKey("sheen roughness", 0.5f);
     }
-    if (n["specular"] || n["specular colour"]) {
+    if (blender) {
+        p.specular = unitKey("specular", 0.5f);
+        p.specularTint = unitKey("specular tint", 0.0f);
+        p.sheen = unitKey("sheen", 0.0f);
+        p.sheenTint = unitKey("sheen tint", 0.5f);
+    } else if (n["specular"] || n["specular colour"]) {
         p.flags |= kShaderSpecular;
-        p.specular = n["specular"] ? float(rd.number(n["specular"], "specular", 0.0, 1.0)) : 1.0f;
+        p.specular = unitKey("specular", 1.0f);
         p.specularColour = n["specular colour"]
                                ? rd.vec<3>(n["specular colour"], "specular colour", 0.0, 1000.0)
                                : vec3(1.0f);
@@ -212,7 +213,11 @@ void readShader(const Reader& rd, const YAML::Node& n, TextureReader& textures, 
                             {kTakesSpecular, "specular colour"},
                             {kTakesTransmission, "transmission"},
                             {kTakesSheen, "sheen colour"},
-                            {kTakesSheen, "sheen roughness"}})
+                            {kTakesSheen, "sheen roughness"},
+                            {kTakesPrincipled, "specular"},
+                            {kTakesPrincipled, "specular tint"},
+                            {kTakesPrincipled, "sheen"},
+                            {kTakesPrincipled, "sheen tint"}})
         if (takes & bit) keys.push_back(key);
     rd.checkKeys(n, t + " shader", keys);
     if (t == "Emissive" && !n["emission"]) rd.fail(n, "Emissive shader needs 'emission'");
@@ -222,7 +227,7 @@ void readShader(const Reader& rd, const YAML::Node& n, TextureReader& textures, 
     s.line = n.Mark().line + 1;
     ShaderParams& p = s.params;
     p.model = model->model;
-    p.colour = vec3(1.0f);
+    p.colour = vec3(takes & kTakesPrincipled ? 0.8f : 1.0f); // Blender's base colour
     p.reflectance = 1.0f;
     p.emission = vec3(0.0f);
     p.ior = 1.5f;

@@ -41,6 +41,10 @@ enum SurfaceParam : uint {
         1u
         << 11, // sheen colour [r, g, b] ([1, 1, 1], each in [0, 1]) and sheen
                // roughness (0.5) in [0, 1] (KHR_materials_sheen, shared/sheen_metallic_roughness.h)
+    kTakesPrincipled =
+        1u << 12, // specular (0.5), specular tint (0), sheen (0) and sheen tint (0.5), each in
+                  // [0, 1]: Blender's Principled BSDF's (shared/principled.h); with it the model
+                  // takes Blender's defaults for the other keys too
 };
 
 struct SurfaceModelInfo {

@@ -7,7 +7,7 @@
 
 namespace spw {
 static_assert(sizeof(vec3) == 12 && alignof(vec3) == 4, "glm must pack vec3 as three floats");
-static_assert(sizeof(ShaderParams) == 112, "ShaderParams layout changed");
+static_assert(sizeof(ShaderParams) == 128, "ShaderParams layout changed");
 static_assert(offsetof(ShaderParams, model) == 12 && offsetof(ShaderParams, flags) == 32 &&
                   offsetof(ShaderParams, absorption) == 48 && offsetof(ShaderParams, coat) == 60 &&
                   offsetof(ShaderParams, coatAlpha) == 64 &&
@@ -15,7 +15,9 @@ static_assert(offsetof(ShaderParams, model) == 12 && offsetof(ShaderParams, flag
                   offsetof(ShaderParams, specular) == 80 &&
                   offsetof(ShaderParams, transmission) == 84 &&
                   offsetof(ShaderParams, sheenRoughness) == 88 &&
-                  offsetof(ShaderParams, sheenColour) == 96,
+                  offsetof(ShaderParams, sheenColour) == 96 &&
+                  offsetof(ShaderParams, specularTint) == 108 &&
+                  offsetof(ShaderParams, sheen) == 112 && offsetof(ShaderParams, pad2) == 124,
               "ShaderParams layout");
 static_assert(sizeof(Emitter) == 80, "Emitter layout changed");
 static_assert(offsetof(Emitter, normal) == 48 && offsetof(Emitter, type) == 60 &&

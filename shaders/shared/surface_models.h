@@ -37,6 +37,9 @@
           kTakesAbsorption | kTakesTransmission)                                                   \
     X(SheenMetallicRoughness, 7u, sheen_metallic_roughness, sheenMetallicRoughness,                \
       kTakesColour | kTakesTexture | kTakesMetallic | kTakesRoughness | kTakesSpecular |           \
-          kTakesSheen)
+          kTakesSheen)                                                                             \
+    X(Principled, 8u, principled, principled,                                                      \
+      kTakesColour | kTakesTexture | kTakesMetallic | kTakesRoughness | kTakesCoat |               \
+          kTakesPrincipled)
 
 #endif

@@ -53,8 +53,12 @@ struct ShaderParams {
     // shaderAtHit takes from SurfaceHit::extension's last two halves (octahedralEncode's point,
     // packHalf2x16); without the flag the coat shares the base's.
     uint coatNormal;
-    vec3 sheenColour; // SheenMetallicRoughness: the sheen's colour (KHR_materials_sheen)
+    vec3 sheenColour;   // SheenMetallicRoughness: the sheen's colour (KHR_materials_sheen)
+    float specularTint; // Principled: the specular reflection's tint towards the base colour's hue
+    float sheen;        // Principled: the sheen's weight
+    float sheenTint;    // Principled: the sheen's tint towards the base colour's hue
     uint pad1;
+    uint pad2;
 };
 
 // What next-event estimation picks, with probability pickPdf, proportional to its power

@@ -81,7 +81,7 @@ TEST(SurfaceModels, EveryModelYamlHoldsEveryRegisteredModel) {
 // The loader takes `type: <Name>`, gives the registry's constant, and takes each optional key
 // exactly when the registry line names it.
 TEST(SurfaceModels, TheLoaderTakesEachModelWithExactlyItsRegisteredKeys) {
-    const std::pair<SurfaceParam, std::string> keys[] = {
+    const std::pair<uint, std::string> keys[] = {
         {kTakesReflectance, "reflectance: 0.5"},
         {kTakesColour, "colour: [0.5, 0.5, 0.5]"},
         {kTakesTexture, "texture: {type: Constant, colour: [0.5, 0.5, 0.5]}"},
@@ -92,11 +92,14 @@ TEST(SurfaceModels, TheLoaderTakesEachModelWithExactlyItsRegisteredKeys) {
         {kTakesAbsorption, "absorption: [0.1, 0.2, 0.3]"},
         {kTakesCoat, "coat: 0.5"},
         {kTakesCoat, "coat roughness: 0.5"},
-        {kTakesSpecular, "specular: 0.5"},
+        {kTakesSpecular | kTakesPrincipled, "specular: 0.5"},
         {kTakesSpecular, "specular colour: [2, 1, 0.5]"},
         {kTakesTransmission, "transmission: 0.5"},
         {kTakesSheen, "sheen colour: [1, 0.5, 0.2]"},
-        {kTakesSheen, "sheen roughness: 0.3"}};
+        {kTakesSheen, "sheen roughness: 0.3"},
+        {kTakesPrincipled, "specular tint: 0.5"},
+        {kTakesPrincipled, "sheen: 0.5"},
+        {kTakesPrincipled, "sheen tint: 0.25"}};
     TempDir dir;
     for (const SurfaceModelInfo& m : kSurfaceModels) {
         const std::string type = std::string("type: ") + m.name;
@@ -141,6 +144,39 @@ TEST(SurfaceModels, MetallicRoughnessTakesGltfFactorsAndDefaults) {
     const ShaderParams colourOnly = load(", specular colour: [0.5, 0.5, 0.5]");
     EXPECT_EQ(colourOnly.specular, 1.0f);
     EXPECT_EQ(load(", specular: 0").specularColour, vec3(1.0f));
+}
+
+// The Principled model takes Blender's Principled BSDF's defaults for every key it shares with
+// the glTF models (base colour 0.8, metallic 0, roughness 0.5, clear coat 0 of roughness 0.03)
+// and its own (specular 0.5, specular tint 0, sheen 0, sheen tint 0.5).
+TEST(SurfaceModels, PrincipledTakesBlendersDefaults) {
+    TempDir dir;
+    const auto load = [&](const std::string& keys) {
+        return loadScene(dir.write("s.yaml", shaderScene("type: Principled" + keys)))
+            .shaders.at(0)
+            .params;
+    };
+    const ShaderParams plain = load("");
+    EXPECT_EQ(plain.colour, vec3(0.8f));
+    EXPECT_EQ(plain.metallic, 0.0f);
+    EXPECT_EQ(plain.alpha, 0.25f);
+    EXPECT_EQ(plain.specular, 0.5f);
+    EXPECT_EQ(plain.specularTint, 0.0f);
+    EXPECT_EQ(plain.sheen, 0.0f);
+    EXPECT_EQ(plain.sheenTint, 0.5f);
+    EXPECT_EQ(plain.coat, 0.0f);
+    EXPECT_EQ(plain.coatAlpha, gltfAlpha(0.03f));
+    EXPECT_EQ(plain.flags & kShaderSpecular, 0u);
+    const ShaderParams set = load(", specular: 1, specular tint: 0.25, sheen: 0.75, sheen tint: 1, "
+                                  "coat: 1, coat roughness: 0.5");
+    EXPECT_EQ(set.specular, 1.0f);
+    EXPECT_EQ(set.specularTint, 0.25f);
+    EXPECT_EQ(set.sheen, 0.75f);
+    EXPECT_EQ(set.sheenTint, 1.0f);
+    EXPECT_EQ(set.coat, 1.0f);
+    EXPECT_EQ(set.coatAlpha, 0.25f);
+    EXPECT_THROW(load(", sheen: 1.5"), SceneError);
+    EXPECT_THROW(load(", specular colour: [1, 1, 1]"), SceneError);
 }
 
 // The transmissive model's roughness is its glass's: alpha = roughness^2 unfloored (smooth glass

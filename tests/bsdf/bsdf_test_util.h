@@ -321,7 +321,8 @@ inline double evalTolerance(const BsdfUnderTest& m) {
     if (m.sh.model == kModelLambert) return 2e-3;
     const double c = std::max(double(std::fabs(glm::dot(m.wo, m.ng))), 1e-3);
     double alpha = m.sh.alpha;
-    if (m.sh.model == kModelCoatedMetallicRoughness) // the narrower of its two GGX lobes
+    if (m.sh.model == kModelCoatedMetallicRoughness || m.sh.model == kModelPrincipled)
+        // the narrower of its two lobes
         alpha = std::min(alpha, std::max(double(m.sh.coatAlpha), double(kGltfMinAlpha)));
     return 2e-3 + 2e-6 / (std::max(alpha, 1e-9) * c);
 }

@@ -395,9 +395,9 @@ TEST(SimdShading, RunsInTheWidestInstructionSet) {
 // order; and the cpu backend's stats say which of the scene's models were shaded a run at a
 // time and which one hit at a time (scenes/every-model.yaml holds every model: Lambert,
 // Conductor, Dielectric and MetallicRoughness wide; its quad light's emissive Null, which only
-// passes the path on, not; CoatedMetallicRoughness, TransmissiveMetallicRoughness and
-// SheenMetallicRoughness have no twin yet, and are shaded one hit at a time), all of them scalar
-// with SIMD off.
+// passes the path on, not; CoatedMetallicRoughness, TransmissiveMetallicRoughness,
+// SheenMetallicRoughness and Principled have no twin yet, and are shaded one hit at a time), all of
+// them scalar with SIMD off.
 TEST(SimdShading, EveryModelNamesItsWideTwinAndTheStatsNameTheScalarOnes) {
     for (size_t i = 0; i < kSurfaceModelCount; ++i) {
         EXPECT_EQ(kWideTwins[i].model, kSurfaceModels[i].model) << kSurfaceModels[i].name;
@@ -417,7 +417,7 @@ TEST(SimdShading, EveryModelNamesItsWideTwinAndTheStatsNameTheScalarOnes) {
               (Names{"Lambert", "Conductor", "Dielectric", "MetallicRoughness"}));
     EXPECT_EQ(stats["scalar_models"].get<Names>(),
               (Names{"Null", "CoatedMetallicRoughness", "TransmissiveMetallicRoughness",
-                     "SheenMetallicRoughness"}));
+                     "SheenMetallicRoughness", "Principled"}));
     cfg.pipeline.simdShading = false;
     const std::unique_ptr<RenderResult> scalarRun = render(scene, cfg);
     const nlohmann::json& scalar = scalarRun->stats.extra;

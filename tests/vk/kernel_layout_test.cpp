@@ -42,7 +42,9 @@ const Fields kShaderParams = {
     SPW_FIELD(ShaderParams, coatAlpha),   SPW_FIELD(ShaderParams, specularColour),
     SPW_FIELD(ShaderParams, specular),    SPW_FIELD(ShaderParams, transmission),
     SPW_FIELD(ShaderParams, sheenColour), SPW_FIELD(ShaderParams, sheenRoughness),
-    SPW_FIELD(ShaderParams, coatNormal),  SPW_FIELD(ShaderParams, pad1)};
+    SPW_FIELD(ShaderParams, coatNormal),  SPW_FIELD(ShaderParams, specularTint),
+    SPW_FIELD(ShaderParams, sheen),       SPW_FIELD(ShaderParams, sheenTint),
+    SPW_FIELD(ShaderParams, pad1),        SPW_FIELD(ShaderParams, pad2)};
 const Fields kEmitter = {SPW_FIELD(Emitter, p0),       SPW_FIELD(Emitter, area),
                          SPW_FIELD(Emitter, e1),       SPW_FIELD(Emitter, pickPdf),
                          SPW_FIELD(Emitter, e2),       SPW_FIELD(Emitter, twoSided),
