@@ -43,7 +43,8 @@ const std::set<std::string> kHonoured = {"KHR_lights_punctual",
                                          "KHR_materials_specular",
                                          "KHR_materials_transmission",
                                          "KHR_materials_volume",
-                                         "KHR_texture_transform"};
+                                         "KHR_texture_transform",
+                                         kPrincipledExtension};
 
 // The image of a `spillway render model.glb` without an aspect ratio: 640 pixels wide.
 constexpr int kDefaultWidth = 640;

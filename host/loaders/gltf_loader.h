@@ -20,6 +20,10 @@ namespace spw {
 // Whether `path` names a glTF file (by its extension: .gltf or .glb, any case).
 bool isGltfPath(const std::string& path);
 
+// The Blender add-on's material extension: the Principled BSDF's factors glTF's core lacks
+// (shared/principled.h; docs/scene-format.md, "glTF files").
+inline constexpr const char* kPrincipledExtension = "SPILLWAY_materials_principled";
+
 // A glTF scene's sample base (ImageSettings::sampleBase): 4 x 4 = 16 samples a pixel an
 // iteration.
 constexpr int kGltfSampleBase = 4;

@@ -250,4 +250,40 @@ void GltfReader::readSheen(const tinygltf::Material& mat, Shader& s, const std::
     if (tint >= 0 || rough >= 0) s.params.flags |= kShaderHitExtension;
 }
 
+void GltfReader::readPrincipled(const tinygltf::Material& mat, Shader& s, const std::string& at,
+                                const std::string& name) {
+    const auto e = mat.extensions.find(kPrincipledExtension);
+    if (e == mat.extensions.end()) return;
+    const std::string where = at + "/extensions/" + kPrincipledExtension;
+    const tinygltf::Value& v = e->second;
+    const auto factor = [&](const char* key, double fallback) {
+        return float(extensionNumber(v, key, fallback, 0.0, 1.0, where));
+    };
+    const float specular = factor("specular", 0.5), specularTint = factor("specularTint", 0.0),
+                sheen = factor("sheen", 0.0), sheenTint = factor("sheenTint", 0.5),
+                coat = factor("clearcoat", 0.0), coatRoughness = factor("clearcoatRoughness", 0.03);
+    if (s.params.model == kModelDielectric ||
+        s.params.model == kModelTransmissiveMetallicRoughness) {
+        warnOf(name, std::string(kPrincipledExtension) +
+                         " on glass is not rendered (the glass is KHR_materials_transmission's)");
+        return;
+    }
+    if ((s.params.flags & kShaderHitExtension) != 0u || s.coatNormalTexture >= 0)
+        warnOf(name, "the images of its clear coat, sheen or specular extensions are not rendered "
+                     "under " +
+                         std::string(kPrincipledExtension) + " (its factors are)");
+    s.typeName = "Principled";
+    s.params.model = kModelPrincipled;
+    s.params.flags &= ~(kShaderSpecular | kShaderHitExtension | kShaderCoatNormal);
+    s.extension = {};
+    s.coatNormalTexture = -1;
+    s.params.specular = specular;
+    s.params.specularColour = vec3(1.0f);
+    s.params.specularTint = specularTint;
+    s.params.sheen = sheen;
+    s.params.sheenTint = sheenTint;
+    s.params.coat = coat;
+    s.params.coatAlpha = gltfAlpha(coatRoughness);
+}
+
 } // namespace spw

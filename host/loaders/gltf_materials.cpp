@@ -93,7 +93,8 @@ Shader GltfReader::readMaterial(int index) {
     readVolume(mat, s, at, name);
     readClearcoat(mat, s, at, name);
     readSheen(mat, s, at, name);
-    readSpecular(mat, s, at, name); // after the models that take the extension's images
+    readSpecular(mat, s, at, name);   // after the models that take the extension's images
+    readPrincipled(mat, s, at, name); // replaces the three before it
     if (mat.alphaMode != "OPAQUE" && mat.alphaMode != "MASK" && mat.alphaMode != "BLEND")
         fail(at + "/alphaMode", "must be OPAQUE, MASK or BLEND");
     readEmission(mat, s, at, name);

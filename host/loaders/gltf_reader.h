@@ -3,6 +3,7 @@
 // each implement a part of. Internal to host/loaders/.
 #pragma once
 
+#include "host/loaders/gltf_loader.h"
 #include "host/loaders/gltf_nodes.h"
 #include "host/scene/scene.h"
 
@@ -194,6 +195,14 @@ class GltfReader {
                       const std::string& name);
     void readClearcoat(const tinygltf::Material& mat, Shader& s, const std::string& at,
                        const std::string& name);
+    // SPILLWAY_materials_principled (the Blender add-on's): Blender's Principled BSDF factors
+    // beyond glTF's core (specular, specularTint, sheen, sheenTint, clearcoat, clearcoatRoughness,
+    // each in [0, 1], Blender's defaults where absent) make an opaque material a Principled shader
+    // (shared/principled.h) of the core's base colour, metallic and roughness and their images;
+    // they replace the clear coat, sheen and specular extensions' factors, whose images are warned
+    // about. On glass it is warned about and the glass kept.
+    void readPrincipled(const tinygltf::Material& mat, Shader& s, const std::string& at,
+                        const std::string& name);
     // KHR_materials_pbrSpecularGlossiness (older assets' workflow), where `mat` has it: the
     // material converted to metallic-roughness into `converted` (returned), as the extension's
     // converters do (gltf_specular_glossiness.cpp), and where it has a specularGlossinessTexture,

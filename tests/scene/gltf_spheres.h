@@ -55,9 +55,10 @@ inline std::string sphereFile(const TempDir& dir, const json& mat,
         b.doc["images"].push_back({{"uri", images[k]}});
         b.doc["textures"].push_back({{"source", k}});
     }
-    b.doc["extensionsUsed"] = {"KHR_materials_transmission", "KHR_materials_ior",
-                               "KHR_materials_volume",       "KHR_materials_clearcoat",
-                               "KHR_materials_specular",     "KHR_materials_sheen"};
+    b.doc["extensionsUsed"] = {"KHR_materials_transmission",   "KHR_materials_ior",
+                               "KHR_materials_volume",         "KHR_materials_clearcoat",
+                               "KHR_materials_specular",       "KHR_materials_sheen",
+                               "SPILLWAY_materials_principled"};
     b.doc["cameras"] =
         json::array({{{"type", "perspective"},
                       {"perspective", {{"yfov", 0.6}, {"aspectRatio", 1.0}, {"znear", 0.1}}}}});
