@@ -1,7 +1,10 @@
 """What the add-on writes for a render: the Blender scene as Spillway reads it.
 
 The meshes and their materials go through Blender's own glTF exporter (scene.glb, Principled
-BSDFs as glTF's metallic-roughness materials, emission included). What glTF does not carry, or
+BSDFs as glTF's metallic-roughness materials, emission included); each Principled BSDF's inputs
+glTF's core lacks (specular, the tints, sheen, clear coat) are then written into its material as
+SPILLWAY_materials_principled, so that Spillway renders Blender's Principled BSDF, not glTF's
+BRDF. What glTF does not carry, or
 carries other than Cycles renders it, is written beside it into scene.yaml, which places the
 file: the camera (field of view, sensor fit, depth of field), every light (point, spot, sun and
 area lights with Cycles' power), the world (a colour, or an equirectangular image with its
@@ -15,11 +18,13 @@ a point or spot light of power P watts sends P / (4 pi) W/sr; a sun's strength i
 irradiance in W/m^2; an area light of power P and area A is one-sided with radiance P / (4 A).
 A spot's blend b puts its inner cone's cosine at cos(outer) + b (1 - cos(outer)): Spillway's
 falloff between them is glTF's t^2, not Cycles' smoothstep. Seen from behind, an area light is
-black in Spillway, where Cycles' lets the ray through.
+black in Spillway, where Cycles' lets the ray through, and it shadows the other lights, where
+Cycles' does not.
 """
 import json
 import math
 import os
+import struct
 import subprocess
 
 import bpy
@@ -203,10 +208,84 @@ def world_yaml(scene, directory, problems):
                                                                strength.default_value)
 
 
-def materials_problems(scene, problems):
-    """What glTF cannot carry of the visible objects' materials: a surface that is not a
-    Principled BSDF (or an Emission), a volume, a displacement."""
+# The Principled BSDF's inputs glTF's core lacks, as SPILLWAY_materials_principled names them
+# (docs/scene-format.md): Spillway's Principled model renders them as Cycles does.
+PRINCIPLED_FACTORS = (("Specular", "specular"), ("Specular Tint", "specularTint"),
+                      ("Sheen", "sheen"), ("Sheen Tint", "sheenTint"), ("Clearcoat", "clearcoat"),
+                      ("Clearcoat Roughness", "clearcoatRoughness"))
+PRINCIPLED_EXTENSION = "SPILLWAY_materials_principled"
+
+
+def _surface(mat):
+    """The node a material's active output takes its surface from, or None."""
+    if not mat.use_nodes:
+        return None
+    out = next((n for n in mat.node_tree.nodes
+                if n.type == "OUTPUT_MATERIAL" and n.is_active_output), None)
+    if out is None or not out.inputs["Surface"].is_linked:
+        return None
+    return out.inputs["Surface"].links[0].from_node
+
+
+def principled_factors(mat, problems):
+    """SPILLWAY_materials_principled's factors of `mat`'s Principled BSDF (None where its surface
+    is not one); what the model leaves out is added to `problems` by name."""
+    node = _surface(mat)
+    if node is None or node.type != "BSDF_PRINCIPLED":
+        return None
+    factors = {}
+    for socket, key in PRINCIPLED_FACTORS:
+        value = node.inputs[socket]
+        if value.is_linked:
+            problems.append("material %s: a linked %s (its value %g is rendered)"
+                            % (mat.name, socket, value.default_value))
+        factors[key] = min(max(float(value.default_value), 0.0), 1.0)
+    for socket in ("Subsurface", "Anisotropic", "Transmission"):
+        value = node.inputs[socket]
+        if value.is_linked or value.default_value > 0.0:
+            what = {"Subsurface": "rendered as its diffuse", "Anisotropic": "rendered isotropic",
+                    "Transmission": "rendered as glTF's glass, not the Principled BSDF's"}[socket]
+            problems.append("material %s: %s (%s)" % (mat.name, socket.lower(), what))
+    if node.distribution != "GGX":
+        problems.append("material %s: the %s distribution (rendered as GGX)"
+                        % (mat.name, node.distribution))
+    return factors
+
+
+def add_principled_extension(glb, factors):
+    """Writes SPILLWAY_materials_principled into the materials of the .glb at `glb` that
+    `factors` names (a material's name: its factors), rewriting the file's JSON chunk."""
+    with open(glb, "rb") as f:
+        data = f.read()
+    magic, version, _ = struct.unpack_from("<4sII", data, 0)
+    length, kind = struct.unpack_from("<II", data, 12)
+    if magic != b"glTF" or version != 2 or kind != 0x4E4F534A:
+        raise RuntimeError("%s: not a glTF 2.0 binary file" % glb)
+    doc = json.loads(data[20:20 + length].decode("utf-8"))
+    rest = data[20 + length:]
+    used = False
+    for m in doc.get("materials", []):
+        if m.get("name") in factors:
+            m.setdefault("extensions", {})[PRINCIPLED_EXTENSION] = factors[m["name"]]
+            used = True
+    if not used:
+        return
+    doc.setdefault("extensionsUsed", []).append(PRINCIPLED_EXTENSION)
+    text = json.dumps(doc, separators=(",", ":")).encode("utf-8")
+    text += b" " * (-len(text) % 4)
+    with open(glb, "wb") as f:
+        f.write(struct.pack("<4sII", b"glTF", 2, 12 + 8 + len(text) + len(rest)))
+        f.write(struct.pack("<II", len(text), 0x4E4F534A))
+        f.write(text)
+        f.write(rest)
+
+
+def materials(scene, problems):
+    """The visible objects' materials: what glTF cannot carry of them (a surface that is not a
+    Principled BSDF or an Emission, a volume, a displacement) added to `problems`, and the
+    Principled BSDFs' factors returned, by material name."""
     seen = set()
+    factors = {}
     for obj in scene.objects:
         if obj.type != "MESH" or not obj.visible_get():
             continue
@@ -215,18 +294,19 @@ def materials_problems(scene, problems):
             if mat is None or mat.name in seen or not mat.use_nodes:
                 continue
             seen.add(mat.name)
+            node = _surface(mat)
+            if node is not None and node.type not in ("BSDF_PRINCIPLED", "EMISSION"):
+                problems.append("material %s: a %s surface (glTF carries the Principled "
+                                "BSDF)" % (mat.name, node.bl_idname))
+            principled = principled_factors(mat, problems)
+            if principled is not None:
+                factors[mat.name] = principled
             out = next((n for n in mat.node_tree.nodes
                         if n.type == "OUTPUT_MATERIAL" and n.is_active_output), None)
-            if out is None:
-                continue
-            if out.inputs["Surface"].is_linked:
-                node = out.inputs["Surface"].links[0].from_node
-                if node.type not in ("BSDF_PRINCIPLED", "EMISSION"):
-                    problems.append("material %s: a %s surface (glTF carries the Principled "
-                                    "BSDF)" % (mat.name, node.bl_idname))
             for socket in ("Volume", "Displacement"):
-                if out.inputs[socket].is_linked:
+                if out is not None and out.inputs[socket].is_linked:
                     problems.append("material %s: a %s" % (mat.name, socket.lower()))
+    return factors
 
 
 def export(scene, directory, settings):
@@ -273,7 +353,7 @@ def export(scene, directory, settings):
                 lights.append(entry)
         elif obj.type == "VOLUME":
             problems.append("volume %s" % obj.name)
-    materials_problems(scene, problems)
+    add_principled_extension(glb, materials(scene, problems))
     environment = world_yaml(scene, directory, problems)
     if environment:
         lights.append(environment)
