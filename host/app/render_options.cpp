@@ -5,6 +5,7 @@
 #include "host/image/aov_film.h"
 #include "host/image/image_io.h"
 #include "host/image/output_file.h"
+#include "host/loaders/gltf_loader.h"
 #include "host/loaders/light_loader.h"
 #include "host/pipeline/stage_chunks.h"
 #include "host/scene/surface_models.h"
@@ -525,7 +526,16 @@ Environment commandLineEnvironment(const RenderOptions& options) {
 
 void applyOverrides(const RenderOptions& options, Scene& scene) {
     applySettingOverrides(scene.settings, options.settings);
-    if (!options.environment.empty()) scene.environment = commandLineEnvironment(options);
+    if (!options.environment.empty()) {
+        scene.environment = commandLineEnvironment(options);
+        // The loader's word that it added an environment no longer holds: this one replaced it.
+        std::vector<std::string>& w = scene.warnings;
+        w.erase(std::remove_if(w.begin(), w.end(),
+                               [](const std::string& s) {
+                                   return s.find(kAddedEnvironmentNote) != std::string::npos;
+                               }),
+                w.end());
+    }
     if (options.sampler) scene.sampler = *options.sampler;
     ImageSettings& img = scene.image;
     const double aspect = double(img.width) / double(img.height);

@@ -158,7 +158,7 @@ void GltfReader::lightByDefault() {
     warn("has no light but its emissive materials, whose power is " + std::string(percent) +
          " of a white environment's at the scene's size (under " +
          std::to_string(int(100 * kEmittersLightAlone)) +
-         " %): lit by that environment as well, radiance 1 (--environment chooses another)");
+         " %): lit by that environment as well, radiance 1 " + kAddedEnvironmentNote);
 }
 
 void GltfReader::readObject(const std::vector<glm::dmat4>& transforms, int shader) {

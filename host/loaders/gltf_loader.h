@@ -24,6 +24,11 @@ bool isGltfPath(const std::string& path);
 // (shared/principled.h; docs/scene-format.md, "glTF files").
 inline constexpr const char* kPrincipledExtension = "SPILLWAY_materials_principled";
 
+// The end of the warning that a glTF file whose emitters are too dim to light it alone is lit by
+// a white environment as well: the command line's --environment, which replaces that
+// environment, drops the warning (applyOverrides).
+inline constexpr const char* kAddedEnvironmentNote = "(--environment chooses another)";
+
 // A glTF scene's sample base (ImageSettings::sampleBase): 4 x 4 = 16 samples a pixel an
 // iteration.
 constexpr int kGltfSampleBase = 4;

@@ -112,7 +112,9 @@ TEST(GltfLighting, TheDecalsFloorIsLitOnEveryBackend) {
 }
 
 // --environment replaces the scene's environment on every format: a constant R,G,B or an image,
-// times --environment-strength; what cannot be one is a usage error naming the option.
+// times --environment-strength; what cannot be one is a usage error naming the option. The
+// warning that a glTF file's dim emitters are helped by a white environment goes with the
+// environment it speaks of.
 TEST(GltfLighting, EnvironmentOptionReplacesTheScenesOwn) {
     TempDir dir;
     const std::string gltf = floorAndPanel(dir, 4.0, 30.0);
@@ -130,6 +132,12 @@ TEST(GltfLighting, EnvironmentOptionReplacesTheScenesOwn) {
         applyOverrides(o, s);
         return s;
     };
+    const std::string dim = floorAndPanel(dir, 0.1, 1000.0);
+    ASSERT_EQ(loadScene(dim).warnings.size(), 1u);
+    EXPECT_EQ(withOptions(dim, {}).warnings.size(), 1u);
+    const Scene replaced = withOptions(dim, {"--environment", "0,0,0"});
+    EXPECT_TRUE(replaced.warnings.empty()) << replaced.warnings.at(0);
+    EXPECT_EQ(replaced.environment->radiance, vec3(0.0f));
     for (const std::string& file : {gltf, yaml}) {
         SCOPED_TRACE(file);
         const Scene constant = withOptions(file, {"--environment", "0.5,1,2"});
