@@ -20,11 +20,12 @@
 //     ((a^2 - 1) / (pi ln(a^2) (1 + (a^2 - 1) cos^2))), G2' the Smith G2 of GGX at alpha 0.25
 //     (Burley's fixed clear-coat masking), about the same shading normal.
 //   Left out (the Blender add-on reports them by name): subsurface, anisotropy, transmission.
-//   Sampling: one lobe, chosen by its weight seen from wo as Cycles weights its closures (the
-//   cosine lobe: mean(c (1 - m)) + mean(sheen colour) W(co) co; the specular one: mean(F) at
-//   h = n; the coat's: coat / 4 Fr(co, 1.5)), cosine-weighted for the diffuse and sheen, GGX's
-//   visible normals for the specular, GTR1's normals (Burley's inversion) for the coat; pdf = the
-//   mixture's, weight = f cos / pdf, so the estimator is unbiased whatever the choice.
+//   Sampling: one lobe, chosen by its weight seen from wo much as Cycles weights its closures (the
+//   cosine lobe: (1 - m)(mean(c) + sheen W(co) co); the specular one: Schlick's F(co) of the
+//   untinted F0; the coat's: coat / 4 Schlick(0.04, co)), cosine-weighted for the diffuse and
+//   sheen, GGX's visible normals for the specular, GTR1's normals (Burley's inversion) for the
+//   coat; pdf = the mixture's, weight = f cos / pdf, so the estimator is unbiased whatever the
+//   choice.
 #ifndef SPILLWAY_SHARED_PRINCIPLED_H
 #define SPILLWAY_SHARED_PRINCIPLED_H
 #include "dielectric.h"
@@ -95,15 +96,17 @@ SHARED_FN vec3 principledGtr1Sample(float alpha, vec2 u) {
     return vec3(sinH * cos(phi), sinH * sin(phi), cosH);
 }
 
-// The probabilities of the cosine, specular and coat lobes seen from wo at cosine cosO.
+// The probabilities of the cosine, specular and coat lobes seen from wo at cosine cosO: each
+// lobe's weight there, by Schlick's approximation of its Fresnel and without the tints (any
+// choice that depends on wo alone keeps the estimator unbiased; this one costs no division but
+// the last and no square root).
 SHARED_FN vec3 principledLobeChoice(ShaderParams sh, vec3 c, float cosO) {
-    vec3 diffuse = c * (1.0f - sh.metallic);
-    vec3 sheen = principledSheenColour(sh, c) * (principledW(cosO) * cosO);
-    float wCos = (diffuse.x + diffuse.y + diffuse.z + sheen.x + sheen.y + sheen.z) / 3.0f;
-    vec3 F = principledFresnel(principledSpecularF0(sh, c), sh.specular, cosO);
-    float wSpec = (F.x + F.y + F.z) / 3.0f;
-    float cosT;
-    float wCoat = 0.25f * sh.coat * fresnelDielectric(cosO, kPrincipledCoatIor, cosT);
+    float w5 = principledW(cosO);
+    float mean = (c.x + c.y + c.z) / 3.0f;
+    float wCos = (1.0f - sh.metallic) * (mean + sh.sheen * w5 * cosO);
+    float f0 = 0.08f * sh.specular * (1.0f - sh.metallic) + mean * sh.metallic;
+    float wSpec = sh.specular > 0.0f || sh.metallic > 0.0f ? f0 + (1.0f - f0) * w5 : 0.0f;
+    float wCoat = 0.25f * sh.coat * (0.04f + 0.96f * w5);
     float sum = wCos + wSpec + wCoat;
     if (!(sum > 0.0f)) return vec3(1.0f, 0.0f, 0.0f);
     return vec3(wCos, wSpec, wCoat) / sum;
@@ -132,7 +135,7 @@ SHARED_FN vec3 principledEval(ShaderParams sh, vec3 c, vec3 ng, vec3 ns, vec3 wo
     float fd = (1.0f - 0.5f * wi5) * (1.0f - 0.5f * wo5) +
                retro * (wi5 + wo5 + wi5 * wo5 * (retro - 1.0f));
     vec3 sum = c * (1.0f - sh.metallic) * (fd * kInvPi * li.z);
-    sum += principledSheenColour(sh, c) * (principledW(ih) * li.z);
+    if (sh.sheen > 0.0f) sum += principledSheenColour(sh, c) * (principledW(ih) * li.z);
     float d = ggxD(h, alpha);
     float denom = ggxG2Denominator(lo, li, alpha);
     if (denom > 0.0f)
