@@ -239,7 +239,11 @@ def principled_factors(mat, problems):
         if value.is_linked:
             problems.append("material %s: a linked %s (its value %g is rendered)"
                             % (mat.name, socket, value.default_value))
-        factors[key] = min(max(float(value.default_value), 0.0), 1.0)
+        factor = float(value.default_value)
+        factors[key] = min(max(factor, 0.0), 1.0)
+        if factors[key] != factor:
+            problems.append("material %s: %s %g (rendered as %g)"
+                            % (mat.name, socket, factor, factors[key]))
     for socket in ("Subsurface", "Anisotropic", "Transmission"):
         value = node.inputs[socket]
         if value.is_linked or value.default_value > 0.0:

@@ -10,8 +10,8 @@ user's own add-ons are left as they are). It checks:
 - the add-on's image is `spillway render` of the scene the add-on exported, bit for bit;
 - what that scene carries of what glTF drops: the area light as a quad, the sun, the world as
   an environment, the camera's depth of field, the resolution and percentage;
-- a feature it cannot carry (a disc area light, a subsurface) is reported by name, and the rest
-  still renders;
+- a feature it cannot carry (a disc area light, a subsurface, a specular above the model's 1) is
+  reported by name, and the rest still renders;
 - a missing binary is Blender's error report, naming it;
 - a world of an equirectangular image, seen by the camera alone, is Cycles' image: relMSE
   below 0.01 and every channel's mean within 3 % (the map's orientation, strength and the field
@@ -68,6 +68,7 @@ if disc == "1":
     skin = bpy.data.materials.new("Skin")
     skin.use_nodes = True
     skin.node_tree.nodes["Principled BSDF"].inputs["Subsurface"].default_value = 0.3
+    skin.node_tree.nodes["Principled BSDF"].inputs["Specular"].default_value = 1.5
     bpy.data.objects["Cube"].data.materials.append(skin)
     d = bpy.data.lights.new("Disc", "AREA")
     d.shape = "DISK"
@@ -413,7 +414,8 @@ def main():
             said = r.stdout + r.stderr
             if disc == "1":
                 for what in ("light Disc: a disk area light",
-                             "material Skin: subsurface (rendered as its diffuse)"):
+                             "material Skin: subsurface (rendered as its diffuse)",
+                             "material Skin: Specular 1.5 (rendered as 1)"):
                     if "Spillway cannot carry: " + what not in said:
                         failures.append("%r is not reported by name:\n%s" % (what, said))
                 continue
