@@ -369,6 +369,16 @@ def blender(args, env=None, check=True, timeout=600):
     return r
 
 
+def both_engines(blend, addon, tmp, prefix, env):
+    """Renders `blend` with Spillway and with Cycles; returns the two images' paths."""
+    out = []
+    for engine in ("SPILLWAY", "CYCLES"):
+        blender([blend] + addon + ["-E", engine, "-o", os.path.join(tmp, prefix + engine + "_"),
+                                   "-F", "OPEN_EXR", "-f", "1"], env=env)
+        out.append(os.path.join(tmp, prefix + engine + "_0001.exr"))
+    return out
+
+
 def agreement(what, spillway, ours, cycles):
     """Spillway's image `ours` against Cycles' `cycles`: relMSE below 0.01 and every channel's
     mean within 3 %; the failures, described."""
@@ -439,19 +449,13 @@ def main():
         world = os.path.join(tmp, "world.blend")
         blender(addon + ["--python-expr", MAKE_WORLD, "--", world, os.path.join(tmp, "map.exr")],
                 env=env)
-        for engine in ("SPILLWAY", "CYCLES"):
-            blender([world] + addon + ["-E", engine, "-o", os.path.join(tmp, engine + "_"), "-F",
-                                       "OPEN_EXR", "-f", "1"], env=env)
-        failures += agreement("the world map", spillway, os.path.join(tmp, "SPILLWAY_0001.exr"),
-                              os.path.join(tmp, "CYCLES_0001.exr"))
+        failures += agreement("the world map", spillway,
+                              *both_engines(world, addon, tmp, "", env))
         for kind in ("POINT", "SPOT", "AREA", "SUN"):
             blend = os.path.join(tmp, kind + ".blend")
             blender(addon + ["--python-expr", MAKE_LIGHT, "--", kind, blend], env=env)
-            for engine in ("SPILLWAY", "CYCLES"):
-                blender([blend] + addon + ["-E", engine, "-o", os.path.join(tmp, kind + engine + "_"),
-                                           "-F", "OPEN_EXR", "-f", "1"], env=env)
-            c = subprocess.run([spillway, "compare", os.path.join(tmp, kind + "SPILLWAY_0001.exr"),
-                                os.path.join(tmp, kind + "CYCLES_0001.exr"), "--json"],
+            ours, cycles = both_engines(blend, addon, tmp, kind, env)
+            c = subprocess.run([spillway, "compare", ours, cycles, "--json"],
                                capture_output=True, text=True, check=True)
             a, b = json.loads(c.stdout)["mean_a"][0], json.loads(c.stdout)["mean_b"][0]
             print("%s light, Spillway against Cycles: %.5f and %.5f" % (kind.lower(), a, b))
@@ -462,25 +466,15 @@ def main():
         blender(addon + ["--python-expr", MAKE_PRINCIPLED, "--", principled,
                          os.path.join(tmp, "sky.exr"), os.path.join(tmp, "checker.png")], env=env)
         keep = os.path.join(tmp, "principled-export")
-        for engine in ("SPILLWAY", "CYCLES"):
-            blender([principled] + addon + ["-E", engine, "-o",
-                                            os.path.join(tmp, "principled" + engine + "_"), "-F",
-                                            "OPEN_EXR", "-f", "1"],
-                    env=dict(env, SPILLWAY_KEEP_EXPORT=keep))
+        images = both_engines(principled, addon, tmp, "principled",
+                              dict(env, SPILLWAY_KEEP_EXPORT=keep))
         with open(os.path.join(keep, "scene.glb"), "rb") as f:
             if b'"SPILLWAY_materials_principled":{"specular":0.5,"specularTint":0.5' not in f.read():
                 failures.append("the glossy material's Principled factors are not in scene.glb")
-        failures += agreement("Principled materials", spillway,
-                              os.path.join(tmp, "principledSPILLWAY_0001.exr"),
-                              os.path.join(tmp, "principledCYCLES_0001.exr"))
+        failures += agreement("Principled materials", spillway, *images)
         dof = os.path.join(tmp, "dof.blend")
         blender(addon + ["--python-expr", MAKE_DOF, "--", dof], env=env)
-        for engine in ("SPILLWAY", "CYCLES"):
-            blender([dof] + addon + ["-E", engine, "-o", os.path.join(tmp, "dof" + engine + "_"),
-                                     "-F", "OPEN_EXR", "-f", "1"], env=env)
-        failures += agreement("depth of field", spillway,
-                              os.path.join(tmp, "dofSPILLWAY_0001.exr"),
-                              os.path.join(tmp, "dofCYCLES_0001.exr"))
+        failures += agreement("depth of field", spillway, *both_engines(dof, addon, tmp, "dof", env))
         r = blender([os.path.join(tmp, "scene0.blend")] + addon +
                     ["--python-expr", PRESS_ESC, "-E", "SPILLWAY", "-o",
                      os.path.join(tmp, "esc_"), "-F", "OPEN_EXR", "-f", "1"], env=env, timeout=120)
