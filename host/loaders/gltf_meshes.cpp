@@ -261,8 +261,8 @@ void GltfReader::placeMeshes() {
             fail(p.at(), "more than " + std::to_string(kMaxInstances) + " instances");
         instancedEmitters_ += emissiveTriangles(scene_, prototype);
         if (instancedEmitters_ > kMaxInstancedEmitters)
-            fail(p.at(), "the emissive triangles instances place (one light each, at each "
-                         "placement) are more than " +
+            fail(p.at(), "the emissive triangles instances place, counted at each placement, "
+                         "are more than " +
                              std::to_string(kMaxInstancedEmitters));
         for (int k = 0; k < 8; ++k) { // the bounds a camera framing the scene sees
             const glm::dvec3 corner(k & 1 ? prototype.hi.x : prototype.lo.x,

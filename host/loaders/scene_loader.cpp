@@ -493,8 +493,8 @@ void SceneReader::placeInstances() {
             rd_.fail(o.line, "more than " + std::to_string(kMaxInstances) + " instances");
         emitters += emissiveTriangles(scene_, scene_.prototypes.back()) * o.transforms.size();
         if (emitters > kMaxInstancedEmitters)
-            rd_.fail(o.line, "the emissive triangles instances place (one light each, at each "
-                             "placement) are more than " +
+            rd_.fail(o.line, "the emissive triangles instances place, counted at each placement, "
+                             "are more than " +
                                  std::to_string(kMaxInstancedEmitters));
         for (const glm::dmat4& t : o.transforms) {
             glm::dmat4 world = t;

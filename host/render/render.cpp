@@ -257,6 +257,7 @@ void RenderSession::build() {
         lights_.emplace(scene_, &*textures_);
     }
     stats_.extra["lights"] = {{"emitters", double(lights_->emitters().size())},
+                              {"instances", double(lights_->instanceLightCount())},
                               {"bytes", double(lights_->bytes())}};
     if (lights_->emissionImages() > 0) stats_.extra["emission_maps"] = lights_->emissionImages();
     cutouts_.emplace(scene_, *textures_);
@@ -279,6 +280,8 @@ void RenderSession::build() {
     params.strategy = config_.strategy;
     params.emitterCount = lights_->sampledEmitters();
     params.treeEmitters = lights_->treeEmitters();
+    params.instanceLights = lights_->instanceLights();
+    params.instanceLightCount = lights_->instanceLightCount();
     stats_.extra["light_tree_emitters"] = double(lights_->treeEmitters());
     params.environment = lights_->environment();
     params.envWidth = lights_->environmentWidth();

@@ -11,6 +11,7 @@
 
 #include <cstddef>
 #include <string>
+#include <vector>
 
 namespace spw {
 
@@ -36,19 +37,23 @@ inline const EmitterKindInfo* emitterKind(uint kind) {
     return nullptr;
 }
 
-// The registry entry a scene's light `type:` names, or nullptr.
+// The registry entry a scene's light `type:` names, or nullptr (a kind the lights make for
+// instances, kLightInstanced, is named by no scene).
 inline const EmitterKindInfo* emitterKindNamed(const std::string& scene) {
     for (const EmitterKindInfo& k : kEmitterKindTable)
-        if (scene == k.scene) return &k;
+        if (scene == k.scene && !(k.flags & kLightInstanced)) return &k;
     return nullptr;
 }
 
 // "Quad, Point, Environment or Directional": the light types a scene may name.
 inline std::string lightTypeList() {
+    std::vector<const char*> named;
+    for (const EmitterKindInfo& k : kEmitterKindTable)
+        if (!(k.flags & kLightInstanced)) named.push_back(k.scene);
     std::string out;
-    for (size_t i = 0; i < kEmitterKindCount; ++i) {
-        if (i > 0) out += i + 1 == kEmitterKindCount ? " or " : ", ";
-        out += kEmitterKindTable[i].scene;
+    for (size_t i = 0; i < named.size(); ++i) {
+        if (i > 0) out += i + 1 == named.size() ? " or " : ", ";
+        out += named[i];
     }
     return out;
 }

@@ -60,10 +60,9 @@ constexpr int kMaxObjects = 1 << 20;
 // memory a glTF placement costs (docs/performance.md, "Production scale") 2^26 instances are
 // over 100 GB, past any machine this renders on.
 constexpr int kMaxInstances = 1 << 26;
-// Emitters (SceneLights' light table), an emissive prototype's triangles counted once for each
-// instance placing it: 2^26 records of 64 bytes are 4 GiB, about 14 GiB with their CDF and light
-// tree (221 bytes an emitter, docs/performance.md "Emissive instances").
-constexpr size_t kMaxInstancedEmitters = size_t(1) << 26;
+// An emissive prototype's triangles counted once for each instance placing it: a hit on one
+// names it by that count in 31 bits (shared/instance_light.h's kInstanceTriangle).
+constexpr size_t kMaxInstancedEmitters = (size_t(1) << 31) - 1;
 // A glTF accessor holds at most this many values (elements x components): 2 GiB as the doubles
 // the loader reads them into, and 2^28 / 3 vertices a primitive, far past what one mesh needs.
 constexpr size_t kMaxGltfAccessorValues = size_t(1) << 28;

@@ -36,6 +36,13 @@ Bounds emitterBounds(const Emitter& e) {
         b.twoSided = e.twoSided != 0u;
         return b;
     }
+    if (e.type == kEmitterInstance) { // its world bounds; its triangles face every way
+        b.lo = dvec3(e.p0);
+        b.hi = dvec3(e.e1);
+        b.thetaO = kPiD;
+        b.thetaE = kPiD / 2;
+        return b;
+    }
     b.lo = b.hi = dvec3(e.p0);
     if (e.type == kEmitterSpot) { // e1: (cos outer, cos inner)
         const double inner = std::acos(std::clamp(double(e.e1.y), -1.0, 1.0));
@@ -196,7 +203,7 @@ struct Builder {
 
 bool inLightTree(const Emitter& e) {
     const EmitterKindInfo* kind = emitterKind(e.type);
-    return kind && (kind->flags & (kLightSurface | kLightTakesPosition)) != 0u;
+    return kind && (kind->flags & (kLightSurface | kLightTakesPosition | kLightInstanced)) != 0u;
 }
 
 bool lightTreeChangesPicks(const std::vector<Emitter>& emitters, uint count) {

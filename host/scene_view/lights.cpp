@@ -6,10 +6,12 @@
 #include "host/textures/textures.h"
 
 #include "shared/emission_map.h"
+#include "shared/instance_light.h"
 #include "shared/sampling.h"
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 
 namespace spw {
@@ -47,7 +49,9 @@ double sceneRadius(const Scene& scene) {
 
 } // namespace
 
-SceneLights::SceneLights(const Scene& scene, const TextureResolver* textures) {
+SceneLights::SceneLights(const Scene& scene, const TextureResolver* textures,
+                         size_t copiedEmitterLimit)
+    : copiedEmitterLimit_(copiedEmitterLimit) {
     for (const Shader& s : scene.shaders)
         shaders_.push_back(s.params);
 
@@ -84,6 +88,7 @@ SceneLights::SceneLights(const Scene& scene, const TextureResolver* textures) {
         environment_ = uint(emitters_.size());
         emitters_.push_back(e); // pickPdf 0, after the CDF: never picked
     }
+    placeInstanceLights();
 }
 
 // The emission maps go behind the environment's data, which starts at 0.
@@ -94,8 +99,9 @@ void SceneLights::placeEmissionMaps() {
         float& image = maps_[record + 6]; // the record's image offset (emission_map.h)
         image = glm::uintBitsToFloat(glm::floatBitsToUint(image) + base);
     }
-    for (Emitter& e : emitters_)
-        if (e.map != kNoEmissionMap) e.map += base;
+    for (std::vector<Emitter>* list : {&emitters_, &prototypeTriangles_})
+        for (Emitter& e : *list)
+            if (e.map != kNoEmissionMap) e.map += base;
     lightData_.insert(lightData_.end(), maps_.begin(), maps_.end());
     maps_.clear();
 }
@@ -129,6 +135,7 @@ void SceneLights::buildCdf(const std::vector<double>& powers, size_t meshes) {
         emitters_.clear(); // nothing emits: nothing to sample
         emitterBase_.assign(meshes, -1);
         instanceBase_.clear();
+        instanceLightCount_ = 0;
     }
 }
 
@@ -167,6 +174,11 @@ Emitter triangleEmitter(const ShaderParams& sp, const vec3& p0, const vec3& p1, 
     return e;
 }
 
+// A triangle's corners as a mirroring instance takes them: the second and third swapped.
+uvec3 cornersOf(const uvec3& t, bool mirrors) {
+    return mirrors ? uvec3(t.x, t.z, t.y) : t;
+}
+
 // Power = L * area * pi per emitting side, L the emission times its map's mean over the triangle.
 double trianglePower(const ShaderParams& sp, const Emitter& e, double mapped) {
     return double(luminance(sp.emission)) * mapped * double(e.area) * kPi *
@@ -195,68 +207,84 @@ void SceneLights::addTriangles(const Scene& scene, size_t m, const TextureResolv
     }
 }
 
-// Every emissive triangle of a prototype, at each instance placing it: a world-space emitter per
-// triangle per instance, as Cycles 3.x lists an instanced mesh's triangles once per object. The
-// geometry stays one; the emission maps' records and means are made once per prototype triangle
-// and corner order. A mirroring instance takes its triangles' corners as a copy of it does (the
-// loaders turn a mirrored copy's winding, keeping its front faces the file's), so its emitters
-// are the copy's, corner for corner.
+// Every emissive triangle of a prototype, at each instance placing it. A prototype placed few
+// enough times (kMostCopiedEmitters) has a world-space emitter per triangle per instance, as
+// Cycles 3.x lists an instanced mesh's triangles once per object (addCopies); one placed more
+// often is one emitter per instance, whose triangles are the prototype's, held once
+// (addInstanceLights, shared/instance_light.h). Either way a triangle's offset in its prototype's
+// emissive triangles (emitterBase_) names it within an instance.
 void SceneLights::addInstances(const Scene& scene, const TextureResolver* textures,
                                std::vector<double>& powers) {
-    struct Emissive {
-        const Mesh* mesh;
-        const EmissionImage* image;
-        // Per corner order (0: the prototype's, 1: a mirroring instance's) and triangle, where
-        // there is an image: its record in maps_, and the map's mean over it.
-        std::vector<uint> maps[2];
-        std::vector<double> mapped[2];
-    };
-    auto corners = [](const uvec3& t, bool mirrors) { return mirrors ? uvec3(t.x, t.z, t.y) : t; };
+    std::vector<size_t> placements(scene.prototypes.size(), 0);
     std::vector<int> orders(scene.prototypes.size(), 0); // bit k: an instance of order k
-    for (const Instance& inst : scene.instances)
+    for (const Instance& inst : scene.instances) {
+        ++placements[inst.prototype];
         orders[inst.prototype] |= inst.mirrors ? 2 : 1;
-    std::vector<std::vector<Emissive>> byPrototype(scene.prototypes.size());
-    bool any = false;
+    }
+    std::vector<std::vector<EmissiveMesh>> copied(scene.prototypes.size());
+    std::vector<PrototypeLight> lit(scene.prototypes.size());
     for (size_t p = 0; p < scene.prototypes.size(); ++p) {
+        const bool copies =
+            emissiveTriangles(scene, scene.prototypes[p]) * placements[p] <= copiedEmitterLimit_;
         int offset = 0;
         for (uint m : scene.prototypes[p].meshes) {
-            Emissive em{&scene.meshes[m], nullptr, {}, {}};
+            EmissiveMesh em{&scene.meshes[m], nullptr, {}, {}};
             if (!emits(scene, *em.mesh, textures, em.image)) continue;
             emitterBase_[m] = offset;
             offset += int(em.mesh->triangles.size());
+            if (!copies) {
+                addPrototypeTriangles(scene, em, lit[p]);
+                continue;
+            }
             const int map = scene.shaders[size_t(em.mesh->shader)].emissionTexture;
             const Texture* texture = em.image ? &scene.textures[size_t(map)] : nullptr;
             for (int order = 0; texture && order < 2; ++order)
                 if (orders[p] & (1 << order))
                     for (const uvec3& t : em.mesh->triangles) {
                         Emitter e{};
-                        em.mapped[order].push_back(addEmissionMap(*em.mesh, corners(t, order == 1),
-                                                                  *texture, *em.image, e));
+                        em.mapped[order].push_back(addEmissionMap(
+                            *em.mesh, cornersOf(t, order == 1), *texture, *em.image, e));
                         em.maps[order].push_back(e.map);
                     }
-            byPrototype[p].push_back(std::move(em));
-            any = true;
+            copied[p].push_back(std::move(em));
         }
+        finishPrototypeLight(lit[p]);
+        if (!copies && lit[p].count == 0) // no power: no triangle to hit either
+            for (uint m : scene.prototypes[p].meshes)
+                emitterBase_[m] = -1;
     }
-    if (!any) return;
-    size_t count = emitters_.size(); // reserved at once: a forest's lights are most of its bytes
-    for (const Instance& inst : scene.instances)
-        for (const Emissive& em : byPrototype[inst.prototype])
-            count += em.mesh->triangles.size();
-    emitters_.reserve(count + scene.punctualLights.size() + 1);
-    powers.reserve(count + scene.punctualLights.size() + 1);
     instanceBase_.assign(scene.instances.size(), 0u);
+    addCopies(scene, copied, powers);
+    addInstanceLights(scene, lit, powers);
+}
+
+// The world-space emitters of the copied prototypes' instances (reserved at once: a forest's
+// lights are most of its bytes).
+void SceneLights::addCopies(const Scene& scene,
+                            const std::vector<std::vector<EmissiveMesh>>& byPrototype,
+                            std::vector<double>& powers) {
+    size_t count = emitters_.size();
+    for (const Instance& inst : scene.instances)
+        for (const EmissiveMesh& em : byPrototype[inst.prototype])
+            count += em.mesh->triangles.size();
+    if (count == emitters_.size()) return;
+    emitters_.reserve(count + scene.instances.size() + scene.punctualLights.size() + 1);
+    powers.reserve(count + scene.instances.size() + scene.punctualLights.size() + 1);
     for (size_t i = 0; i < scene.instances.size(); ++i) {
         const Instance& inst = scene.instances[i];
+        if (byPrototype[inst.prototype].empty()) continue;
         instanceBase_[i] = uint(emitters_.size());
         const int order = inst.mirrors ? 1 : 0;
-        for (const Emissive& em : byPrototype[inst.prototype]) {
+        for (const EmissiveMesh& em : byPrototype[inst.prototype]) {
             const ShaderParams& sp = scene.shaders[size_t(em.mesh->shader)].params;
             auto world = [&](uint v) {
                 return vec3(inst.toWorld * vec4(em.mesh->positions[v], 1.0f));
             };
             for (size_t k = 0; k < em.mesh->triangles.size(); ++k) {
-                const uvec3 t = corners(em.mesh->triangles[k], inst.mirrors);
+                // A mirroring instance takes its triangles' corners as a copy of it does (the
+                // loaders turn a mirrored copy's winding, keeping its front faces the file's),
+                // so its emitters are the copy's, corner for corner.
+                const uvec3 t = cornersOf(em.mesh->triangles[k], inst.mirrors);
                 Emitter e = triangleEmitter(sp, world(t.x), world(t.y), world(t.z));
                 if (em.image) e.map = em.maps[order][k];
                 powers.push_back(trianglePower(sp, e, em.image ? em.mapped[order][k] : 1.0));
@@ -264,6 +292,111 @@ void SceneLights::addInstances(const Scene& scene, const TextureResolver* textur
             }
         }
     }
+}
+
+// Mesh em's triangles in its prototype's object space, appended to the prototype's light, each
+// with its power in pickPdf until finishPrototypeLight makes it a share.
+void SceneLights::addPrototypeTriangles(const Scene& scene, const EmissiveMesh& em,
+                                        PrototypeLight& light) {
+    const Shader& shader = scene.shaders[size_t(em.mesh->shader)];
+    if (light.count == 0) light.first = uint(prototypeTriangles_.size());
+    for (const uvec3& t : em.mesh->triangles) {
+        const vec3 &p0 = em.mesh->positions[t.x], &p1 = em.mesh->positions[t.y],
+                   &p2 = em.mesh->positions[t.z];
+        Emitter e = triangleEmitter(shader.params, p0, p1, p2);
+        if (!(e.area > 0.0f)) e.normal = vec3(0.0f, 0.0f, 1.0f); // never picked: no power
+        double mapped = 1.0;
+        if (em.image)
+            mapped = addEmissionMap(*em.mesh, t, scene.textures[size_t(shader.emissionTexture)],
+                                    *em.image, e);
+        const double power = trianglePower(shader.params, e, mapped);
+        e.pickPdf = float(power);
+        light.power += power;
+        for (const vec3& p : {p0, p1, p2}) {
+            light.lo = glm::min(light.lo, p);
+            light.hi = glm::max(light.hi, p);
+        }
+        prototypeTriangles_.push_back(e);
+        ++light.count;
+    }
+}
+
+// The prototype's triangles' shares of its power, and their CDF in instanceTable_.
+void SceneLights::finishPrototypeLight(PrototypeLight& light) {
+    if (light.count == 0 || !(light.power > 0.0)) {
+        light.count = 0;
+        return;
+    }
+    light.cdf = uint(instanceTable_.size());
+    double running = 0.0;
+    for (uint k = 0; k < light.count; ++k) {
+        Emitter& e = prototypeTriangles_[light.first + k];
+        running += double(e.pickPdf);
+        e.pickPdf = float(double(e.pickPdf) / light.power);
+        instanceTable_.push_back(float(running / light.power));
+    }
+    instanceTable_.back() = 1.0f;
+}
+
+// One emitter per instance of a prototype not copied (shared/instance_light.h's words; the
+// offsets relative to prototypeTriangles_ and instanceTable_ until placeInstanceLights), with
+// its power: the prototype's, times the transform's scale of area (|det|^(2/3), exact for a
+// similarity; otherwise an estimate, which only makes the pick less apt).
+void SceneLights::addInstanceLights(const Scene& scene, const std::vector<PrototypeLight>& lit,
+                                    std::vector<double>& powers) {
+    instanceLights_ = uint(emitters_.size());
+    uint numbered = 0; // the instances' triangles so far: the next one's hit index
+    for (size_t i = 0; i < scene.instances.size(); ++i) {
+        const Instance& inst = scene.instances[i];
+        const PrototypeLight& light = lit[inst.prototype];
+        if (light.count == 0) continue;
+        if (numbered > kInstanceTriangle - 1u - light.count)
+            throw std::runtime_error("the emissive triangles of instances are more than 2^31");
+        instanceBase_[i] = kInstanceTriangle | numbered;
+        Emitter e{};
+        e.type = kEmitterInstance;
+        e.p0 = vec3(std::numeric_limits<float>::max());
+        e.e1 = -e.p0;
+        for (int c = 0; c < 8; ++c) {
+            const vec3 corner(c & 1 ? light.hi.x : light.lo.x, c & 2 ? light.hi.y : light.lo.y,
+                              c & 4 ? light.hi.z : light.lo.z);
+            const vec3 w = vec3(inst.toWorld * vec4(corner, 1.0f));
+            e.p0 = glm::min(e.p0, w);
+            e.e1 = glm::max(e.e1, w);
+        }
+        e.area = glm::uintBitsToFloat(uint(instanceTable_.size()));
+        for (int col = 0; col < 4; ++col)
+            for (int r = 0; r < 3; ++r)
+                instanceTable_.push_back(inst.toWorld[col][r]);
+        e.e2 = glm::uintBitsToFloat(uvec3(light.first, light.count, light.cdf));
+        e.twoSided = numbered;
+        e.normal = vec3(inst.mirrors ? -1.0f : 1.0f, 0.0f, 0.0f);
+        const double det = std::fabs(glm::determinant(glm::dmat3(mat3(inst.toWorld))));
+        powers.push_back(light.power * std::cbrt(det * det));
+        emitters_.push_back(e);
+        numbered += light.count;
+        ++instanceLightCount_;
+    }
+}
+
+// The prototypes' triangles go behind every other emitter, their CDFs and the instances'
+// transforms behind the light tree: the instances' offsets become the tables' own.
+void SceneLights::placeInstanceLights() {
+    if (instanceLightCount_ == 0) return;
+    const uint first = uint(emitters_.size()), words = uint(table_.size());
+    auto moved = [](float& word, uint by) {
+        word = glm::uintBitsToFloat(glm::floatBitsToUint(word) + by);
+    };
+    for (uint i = instanceLights_; i < instanceLights_ + instanceLightCount_; ++i) {
+        Emitter& e = emitters_[i];
+        moved(e.area, words);
+        moved(e.e2.x, first);
+        moved(e.e2.z, words);
+    }
+    emitters_.insert(emitters_.end(), prototypeTriangles_.begin(), prototypeTriangles_.end());
+    table_.insert(table_.end(), instanceTable_.begin(), instanceTable_.end());
+    prototypeTriangles_.clear();
+    instanceTable_.clear();
 }
 
 // An emission map's image, read once into maps_ (linear RGB, row by row); one larger than

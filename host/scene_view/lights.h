@@ -9,6 +9,7 @@
 #include "host/scene/scene.h"
 #include "shared/scene_access.h"
 
+#include <limits>
 #include <map>
 #include <vector>
 
@@ -20,7 +21,14 @@ class SceneLights {
   public:
     // `textures` reads the images of emission maps (Shader::emissionTexture); a scene with one
     // needs it.
-    explicit SceneLights(const Scene& scene, const TextureResolver* textures = nullptr);
+    // A prototype whose emissive triangles times its instances are more than
+    // `copiedEmitterLimit` is lit as one emitter per instance (shared/instance_light.h), not as
+    // a world-space copy of each triangle per instance.
+    explicit SceneLights(const Scene& scene, const TextureResolver* textures = nullptr,
+                         size_t copiedEmitterLimit = kMostCopiedEmitters);
+    // 4096 copies of a 221-byte emitter (its record, CDF entry and share of the tree) are
+    // 0.9 MB: a few lamps placed a few times keep the per-triangle light tree.
+    static constexpr size_t kMostCopiedEmitters = 4096;
 
     // The shading view: shaders, emitters and their CDF.
     SceneView view() const;
@@ -30,6 +38,9 @@ class SceneLights {
     uint sampledEmitters() const { return sampled_; }
     // How many emitters, from the first, the light tree holds (0: the scene has no tree).
     uint treeEmitters() const { return treeEmitters_; }
+    // The emitters that are instances (kEmitterInstance): the first, and how many follow it.
+    uint instanceLights() const { return instanceLights_; }
+    uint instanceLightCount() const { return instanceLightCount_; }
     // What the kernels read as the emitter CDF (SceneView::emitterCdf): the CDF, then the
     // light tree (shared/light_tree.h).
     const std::vector<float>& emitterTable() const { return table_; }
@@ -48,7 +59,8 @@ class SceneLights {
     // How many images the emission maps read (each baked once, however many meshes use it).
     size_t emissionImages() const { return emissionImages_.size(); }
     // The emitter index of a mesh's triangle where `instance` places it (kNoInstance: the mesh
-    // is in world space), or kNoEmitter.
+    // is in world space), or kNoEmitter; an instance lit as one emitter numbers its triangles
+    // (SurfaceHit::emitter, shared/instance_light.h).
     uint emitterOf(uint instance, uint mesh, uint triangle) const {
         const int base = emitterBase_[mesh];
         if (base < 0) return kNoEmitter;
@@ -64,12 +76,35 @@ class SceneLights {
         double meanLuminance = 0.0;
         float brightest = 0.0f;
     };
+    // An emissive mesh of a prototype; where its instances are copied, per corner order (0: the
+    // prototype's, 1: a mirroring instance's) and triangle, where there is an image: its record
+    // in maps_, and the map's mean over it.
+    struct EmissiveMesh {
+        const Mesh* mesh;
+        const EmissionImage* image;
+        std::vector<uint> maps[2];
+        std::vector<double> mapped[2];
+    };
+    // A prototype lit through its instances: its triangles in prototypeTriangles_, their CDF in
+    // instanceTable_, their power and object-space bounds.
+    struct PrototypeLight {
+        uint first = 0, count = 0, cdf = 0;
+        double power = 0.0;
+        vec3 lo{std::numeric_limits<float>::max()}, hi{-std::numeric_limits<float>::max()};
+    };
     bool emits(const Scene& scene, const Mesh& mesh, const TextureResolver* textures,
                const EmissionImage*& image);
     void addTriangles(const Scene& scene, size_t m, const TextureResolver* textures,
                       std::vector<double>& powers);
     void addInstances(const Scene& scene, const TextureResolver* textures,
                       std::vector<double>& powers);
+    void addCopies(const Scene& scene, const std::vector<std::vector<EmissiveMesh>>& byPrototype,
+                   std::vector<double>& powers);
+    void addPrototypeTriangles(const Scene& scene, const EmissiveMesh& em, PrototypeLight& light);
+    void finishPrototypeLight(PrototypeLight& light);
+    void addInstanceLights(const Scene& scene, const std::vector<PrototypeLight>& lit,
+                           std::vector<double>& powers);
+    void placeInstanceLights();
     const EmissionImage& emissionImage(int texture, const TextureResolver& textures);
     // Appends triangle t's record (shared/emission_map.h) to maps_ for Emitter::map; returns
     // the map's mean luminance over the triangle, as the power estimate weighs it.
@@ -88,9 +123,16 @@ class SceneLights {
     uint sampled_ = 0;
     uint treeEmitters_ = 0;
     // Per mesh: the index of its first emitter (a prototype's mesh: from its instance's first),
-    // or -1; per instance: the index of its first emitter, where its prototype emits.
+    // or -1; per instance: the index of its first emitter, where its prototype emits (an
+    // instance lit as one emitter: kInstanceTriangle and its first triangle's number).
     std::vector<int> emitterBase_;
     std::vector<uint> instanceBase_;
+    size_t copiedEmitterLimit_;
+    uint instanceLights_ = 0, instanceLightCount_ = 0;
+    // The instanced prototypes' triangles and the instances' CDFs and transforms, until
+    // placeInstanceLights puts them behind the emitters and the light tree.
+    std::vector<Emitter> prototypeTriangles_;
+    std::vector<float> instanceTable_;
     std::vector<uint> mapRecords_; // where in maps_ each emission map's record starts
     float brightest_ = 0.0f;
     uint environment_ = kNoEmitter;

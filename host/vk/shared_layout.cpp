@@ -25,7 +25,7 @@ static_assert(offsetof(Emitter, normal) == 48 && offsetof(Emitter, type) == 60 &
               "Emitter layout");
 static_assert(sizeof(SurfaceHit) == 80, "SurfaceHit layout changed");
 static_assert(sizeof(PathState) == 32, "PathState layout changed");
-static_assert(sizeof(RenderParams) == 52, "RenderParams layout changed");
+static_assert(sizeof(RenderParams) == 60, "RenderParams layout changed");
 // What the shading kernels read and write (shaders/shared/shade_io.h, shaders/shade_kernel.glsl).
 static_assert(offsetof(SurfaceHit, shader) == 28 && offsetof(SurfaceHit, emitter) == 44 &&
                   offsetof(SurfaceHit, albedo) == 48 && offsetof(SurfaceHit, material) == 64 &&
@@ -41,8 +41,8 @@ static_assert(offsetof(ShadeResult, emitted) == 4 && offsetof(ShadeResult, shado
 static_assert(sizeof(ShadeInput) == 128, "ShadeInput layout changed");
 static_assert(offsetof(ShadeInput, path) == 80 && offsetof(ShadeInput, rayDir) == 112,
               "ShadeInput layout");
-static_assert(sizeof(ShadePush) == 64 && offsetof(ShadePush, offset) == 52 &&
-                  offsetof(ShadePush, count) == 56,
+static_assert(sizeof(ShadePush) == 72 && offsetof(ShadePush, offset) == 60 &&
+                  offsetof(ShadePush, count) == 64,
               "ShadePush layout changed");
 static_assert(sizeof(ShadePush) <= 128,
               "push constants beyond the 128 bytes every device guarantees");

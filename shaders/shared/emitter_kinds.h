@@ -22,6 +22,8 @@
 //   kLightDelta          a delta light: never hit, never found by BSDF sampling
 //   kLightTakesPosition  punctual, at `position`: power 4 pi I
 //   kLightTakesDirection punctual, shining along `direction` from infinity: power pi r^2 E
+//   kLightInstanced      an emissive prototype's triangles where one instance places them,
+//                        made by host/scene_view/lights.cpp; no scene names it
 #ifndef SPILLWAY_SHARED_EMITTER_KINDS_H
 #define SPILLWAY_SHARED_EMITTER_KINDS_H
 
@@ -30,6 +32,7 @@
     X(Point, 1u, point_light, Point, kLightDelta | kLightTakesPosition)                            \
     X(Environment, 2u, environment_light, Environment, kLightAtInfinity)                           \
     X(Directional, 3u, directional_light, Directional, kLightDelta | kLightTakesDirection)         \
-    X(Spot, 4u, spot_light, Spot, kLightDelta | kLightTakesPosition | kLightTakesDirection)
+    X(Spot, 4u, spot_light, Spot, kLightDelta | kLightTakesPosition | kLightTakesDirection)        \
+    X(Instance, 5u, instance_light, InstancedMesh, kLightInstanced)
 
 #endif

@@ -29,18 +29,24 @@ SHARED_FN LightSample noLightSample() {
     return ls;
 }
 
-// Index of the emitter whose CDF interval holds u: the first cdf > u (the last entry is 1 > u).
+// Index k < count of the interval of the CDF at EMITTER_CDF(first ..) that holds u: the first
+// entry > u (the last entry is 1 > u).
 // A binary search whose steps depend on the count alone and whose halving is a select, not a
 // branch: which half u falls in is a coin flip the CPU would mispredict half the time.
-SHARED_FN uint pickEmitter(SCENE_PARAM uint count, float u) {
+SHARED_FN uint pickInCdf(SCENE_PARAM uint first, uint count, float u) {
     uint base = 0u;
     uint len = count;
     while (len > 1u) {
         uint step = len >> 1u;
-        base = EMITTER_CDF(base + step) <= u ? base + step : base;
+        base = EMITTER_CDF(first + base + step) <= u ? base + step : base;
         len -= step;
     }
-    return base + uint(EMITTER_CDF(base) <= u);
+    return base + uint(EMITTER_CDF(first + base) <= u);
+}
+
+// Index of the emitter whose CDF interval holds u.
+SHARED_FN uint pickEmitter(SCENE_PARAM uint count, float u) {
+    return pickInCdf(SCENE_ARG 0u, count, u);
 }
 
 // Cosine at the emitter between its normal and the direction back to the receiver, 0 if the

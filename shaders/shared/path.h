@@ -56,7 +56,8 @@ SHARED_FN vec3 escapedRadiance(SCENE_PARAM RenderParams rp, vec3 rayDir, PathSta
 SHARED_FN void addEmission(SCENE_PARAM RenderParams rp, SurfaceHit hit, vec3 wo, PathState st,
                            INOUT(ShadeResult) r) {
     if (hit.emitter == kNoEmitter) return;
-    Emitter e = EMITTER(hit.emitter);
+    uint light;
+    Emitter e = hitEmitter(SCENE_ARG rp, hit.emitter, light);
     float cosLight = emitterCosine(e, wo);
     if (!(cosLight > 0.0f)) return;
     float w = 1.0f;
@@ -64,7 +65,7 @@ SHARED_FN void addEmission(SCENE_PARAM RenderParams rp, SurfaceHit hit, vec3 wo,
     if (sampledByBsdf && rp.strategy == kStrategyLight) w = 0.0f;
     if (sampledByBsdf && rp.strategy == kStrategyMis) {
         // The pick probability from the ray's origin, the previous vertex.
-        e.pickPdf = lightPickPdf(SCENE_ARG rp, hit.emitter, hit.p + hit.t * wo);
+        e.pickPdf *= lightPickPdf(SCENE_ARG rp, light, hit.p + hit.t * wo);
         float lightPdf = emitterSolidAnglePdf(e, hit.t, cosLight);
         w = powerHeuristic(st.prevPdf, lightPdf);
     }

@@ -69,6 +69,7 @@ const uint kLightAtInfinity = 2u;
 const uint kLightDelta = 4u;
 const uint kLightTakesPosition = 8u;
 const uint kLightTakesDirection = 16u;
+const uint kLightInstanced = 32u; // made by the lights for an instanced mesh, named by no scene
 #define SPW_EMITTER_CONSTANT(Name, id, stem, Scene, flags) const uint kEmitter##Name = id;
 SPW_EMITTER_KINDS(SPW_EMITTER_CONSTANT)
 #undef SPW_EMITTER_CONSTANT
@@ -76,6 +77,9 @@ SPW_EMITTER_KINDS(SPW_EMITTER_CONSTANT)
 const uint kEmitterKindCount = 0u SPW_EMITTER_KINDS(SPW_EMITTER_ONE);
 #undef SPW_EMITTER_ONE
 
+// An instance (kEmitterInstance, shared/instance_light.h) keeps its own fields in these words:
+// p0 and e1 the low and high corners of its world bounds, area and e2 word offsets and counts
+// as float bits, twoSided its triangles' first hit index, normal.x -1 where it mirrors.
 struct Emitter {
     vec3 p0; // triangle: vertex 0; point: the position
     float area;
@@ -148,8 +152,10 @@ struct RenderParams {
     uint environment; // the environment's emitter index, or kNoEmitter
     uint envWidth;    // its lat-long map's size in texels; 0 x 0 for a constant environment
     uint envHeight;
-    uint treeEmitters; // emitters 0 .. treeEmitters - 1 are picked through the light tree
-                       // (shared/light_tree.h); 0: no tree
+    uint treeEmitters;       // emitters 0 .. treeEmitters - 1 are picked through the light tree
+                             // (shared/light_tree.h); 0: no tree
+    uint instanceLights;     // the first of the emitters that are instances (kEmitterInstance)
+    uint instanceLightCount; // how many there are, one after another; 0: none
 };
 
 const uint kShadeEmitted = 1u;

@@ -1,7 +1,8 @@
 // An emitter kind is one registry line (shaders/shared/emitter_kinds.h), its shared header and
 // its tests: docs/adding-a-light.md. Everything else is derived from the registry, and this test
 // checks both halves: it fails for a registered kind that lacks its header, the header's
-// <stem>Sample, or its TEST(<Scene>Light, ...), and for a loader that does not take each
+// <stem>Sample, or its TEST(<Scene>Light, ...) (in lights_test.cpp, reference_test.cpp or its own
+// tests/scene/<stem>_test.cpp), and for a loader that does not take each
 // punctual kind by its scene name with exactly the keys its flags name. (That the Vulkan kernels
 // agree with the cpu on every kind: VulkanVsCpu.EveryEmitterKindAgreesUpToFloatRounding.)
 #include "host/loaders/scene_loader.h"
@@ -18,10 +19,13 @@ namespace spw::test {
 namespace {
 
 TEST(EmitterKinds, EveryRegisteredKindHasItsHeaderItsSampleAndItsTest) {
-    const std::string tests = readFile(sourceDir() + "/tests/scene/lights_test.cpp") +
-                              readFile(sourceDir() + "/tests/render/reference_test.cpp");
+    const std::string common = readFile(sourceDir() + "/tests/scene/lights_test.cpp") +
+                               readFile(sourceDir() + "/tests/render/reference_test.cpp");
     for (const EmitterKindInfo& k : kEmitterKindTable) {
         const std::string stem = k.stem, scene = k.scene;
+        // Its tests in those two files, or in a file of its own, tests/scene/<stem>_test.cpp.
+        const std::string own = sourceDir() + "/tests/scene/" + stem + "_test.cpp";
+        const std::string tests = common + (std::filesystem::exists(own) ? readFile(own) : "");
         const std::string header = sourceDir() + "/shaders/shared/" + stem + ".h";
         ASSERT_TRUE(std::filesystem::exists(header))
             << k.name << ": no shaders/shared/" << stem << ".h";
@@ -29,9 +33,11 @@ TEST(EmitterKinds, EveryRegisteredKindHasItsHeaderItsSampleAndItsTest) {
                   std::string::npos)
             << k.name << ": shaders/shared/" << stem << ".h defines no " << stem << "Sample";
         EXPECT_NE(tests.find("TEST(" + scene + "Light,"), std::string::npos)
-            << k.name << ": no TEST(" << scene << "Light, ...) in tests/scene/lights_test.cpp";
+            << k.name << ": no TEST(" << scene
+            << "Light, ...) in tests/scene/lights_test.cpp or tests/scene/" << stem << "_test.cpp";
         EXPECT_EQ(emitterKind(k.kind), &k);
-        EXPECT_EQ(emitterKindNamed(scene), &k);
+        // A kind the lights make for instances is named by no scene.
+        EXPECT_EQ(emitterKindNamed(scene), k.flags & kLightInstanced ? nullptr : &k);
     }
 }
 

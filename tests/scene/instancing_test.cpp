@@ -434,16 +434,16 @@ TEST(Instancing, MalformedPlacementsAreRefusedWithWhere) {
     EXPECT_NE(hidden.warnings[0].find("singular transform"), std::string::npos);
 }
 
-// The emitters instances place are capped (kMaxInstancedEmitters: a triangle counted once per
-// instance, each a 64-byte light record): a prototype of 2^15 emissive triangles placed 2^11 + 1
-// times is refused with the YAML object's line and the glTF node's pointer, before any light is
-// made; at 2^11 placements it loads.
+// The emissive triangles instances place are capped (kMaxInstancedEmitters: a triangle counted
+// once per instance, numbered in 31 bits for the hits that find it): a prototype of 2^17
+// emissive triangles placed 2^14 times is refused with the YAML object's line and the glTF
+// node's pointer, before any light is made; at 2^14 - 1 placements it loads.
 TEST(Instancing, TooManyInstancedEmittersAreRefusedWithWhere) {
     TempDir dir;
-    const int n = 128; // a grid of n x n quads, 2n^2 = 2^15 triangles
+    const int n = 256; // a grid of n x n quads, 2n^2 = 2^17 triangles
     std::string obj;
     std::vector<float> pos;
-    std::vector<uint16_t> idx;
+    std::vector<uint32_t> idx;
     for (int y = 0; y <= n; ++y)
         for (int x = 0; x <= n; ++x) {
             obj += "v " + std::to_string(x) + " " + std::to_string(y) + " 0\n";
@@ -455,18 +455,18 @@ TEST(Instancing, TooManyInstancedEmittersAreRefusedWithWhere) {
             obj += "f " + std::to_string(v) + " " + std::to_string(v + 1) + " " +
                    std::to_string(v + n + 2) + " " + std::to_string(v + n + 1) + "\n";
             for (int c : {0, 1, n + 2, 0, n + 2, n + 1})
-                idx.push_back(uint16_t(v - 1 + c));
+                idx.push_back(uint32_t(v - 1 + c));
         }
     dir.write("grid.obj", obj);
-    const size_t cap = kMaxInstancedEmitters / (2 * n * n); // 2^11 placements
+    const size_t cap = kMaxInstancedEmitters / (2 * n * n); // 2^14 - 1 placements
     std::string places;
     for (size_t i = 0; i <= cap; ++i)
         places += "      - {translation: [0, 0, " + std::to_string(-1.0 - double(i)) + "]}\n";
     const std::string head = "shaders: [{type: Emissive, emission: [1, 1, 1]}]\n"
                              "objects:\n  - filename: grid.obj\n    instances:\n";
     const std::string over = dir.write("over.yaml", head + places);
-    EXPECT_EQ(loadError(over), over + ":5: the emissive triangles instances place (one light each, "
-                                      "at each placement) are more than 67108864");
+    EXPECT_EQ(loadError(over), over + ":5: the emissive triangles instances place, counted at each "
+                                      "placement, are more than 2147483647");
     const size_t line = places.rfind("      - ");
     const Scene at = loadScene(dir.write("at.yaml", head + places.substr(0, line)));
     EXPECT_EQ(at.instances.size(), cap);
@@ -474,7 +474,7 @@ TEST(Instancing, TooManyInstancedEmittersAreRefusedWithWhere) {
     GltfBuilder b;
     b.doc["materials"] = json::array({material(vec3(0.0f), 0.0f, 1.0f, vec3(1.0f))});
     const int grid = b.mesh({{"attributes", {{"POSITION", b.accessor(pos, 5126, "VEC3")}}},
-                             {"indices", b.accessor(idx, 5123, "SCALAR")},
+                             {"indices", b.accessor(idx, 5125, "SCALAR")},
                              {"material", 0}});
     std::vector<int> roots;
     for (size_t i = 0; i <= cap; ++i)
@@ -482,8 +482,8 @@ TEST(Instancing, TooManyInstancedEmittersAreRefusedWithWhere) {
     b.scene(roots);
     const std::string file = b.embedded(dir, "over.gltf");
     EXPECT_EQ(loadError(file), file + ": /nodes/" + std::to_string(cap) +
-                                   "/mesh: the emissive triangles instances place (one light "
-                                   "each, at each placement) are more than 67108864");
+                                   "/mesh: the emissive triangles instances place, counted at "
+                                   "each placement, are more than 2147483647");
 }
 
 } // namespace
