@@ -180,9 +180,12 @@ uvec3 cornersOf(const uvec3& t, bool mirrors) {
 }
 
 // Power = L * area * pi per emitting side, L the emission times its map's mean over the triangle.
+double trianglePower(const ShaderParams& sp, double area, bool twoSided, double mapped) {
+    return double(luminance(sp.emission)) * mapped * area * kPi * (twoSided ? 2.0 : 1.0);
+}
+
 double trianglePower(const ShaderParams& sp, const Emitter& e, double mapped) {
-    return double(luminance(sp.emission)) * mapped * double(e.area) * kPi *
-           (e.twoSided ? 2.0 : 1.0);
+    return trianglePower(sp, double(e.area), e.twoSided != 0u, mapped);
 }
 
 } // namespace
@@ -294,8 +297,9 @@ void SceneLights::addCopies(const Scene& scene,
     }
 }
 
-// Mesh em's triangles in its prototype's object space, appended to the prototype's light, each
-// with its power in pickPdf until finishPrototypeLight makes it a share.
+// Mesh em's triangles in its prototype's object space, appended to the prototype's light with
+// their powers (in double: radiance up to 1e20 times an area can pass float's range), which
+// finishPrototypeLight makes their shares.
 void SceneLights::addPrototypeTriangles(const Scene& scene, const EmissiveMesh& em,
                                         PrototypeLight& light) {
     const Shader& shader = scene.shaders[size_t(em.mesh->shader)];
@@ -309,9 +313,10 @@ void SceneLights::addPrototypeTriangles(const Scene& scene, const EmissiveMesh& 
         if (em.image)
             mapped = addEmissionMap(*em.mesh, t, scene.textures[size_t(shader.emissionTexture)],
                                     *em.image, e);
-        const double power = trianglePower(shader.params, e, mapped);
-        e.pickPdf = float(power);
-        light.power += power;
+        // The area in double: a prototype modelled large and placed small can pass float's.
+        const double area = 0.5 * glm::length(glm::cross(glm::dvec3(e.e1), glm::dvec3(e.e2)));
+        light.powers.push_back(trianglePower(shader.params, area, e.twoSided != 0u, mapped));
+        light.power += light.powers.back();
         for (const vec3& p : {p0, p1, p2}) {
             light.lo = glm::min(light.lo, p);
             light.hi = glm::max(light.hi, p);
@@ -330,12 +335,12 @@ void SceneLights::finishPrototypeLight(PrototypeLight& light) {
     light.cdf = uint(instanceTable_.size());
     double running = 0.0;
     for (uint k = 0; k < light.count; ++k) {
-        Emitter& e = prototypeTriangles_[light.first + k];
-        running += double(e.pickPdf);
-        e.pickPdf = float(double(e.pickPdf) / light.power);
+        running += light.powers[k];
+        prototypeTriangles_[light.first + k].pickPdf = float(light.powers[k] / light.power);
         instanceTable_.push_back(float(running / light.power));
     }
     instanceTable_.back() = 1.0f;
+    light.powers = {};
 }
 
 // One emitter per instance of a prototype not copied (shared/instance_light.h's words; the

@@ -86,9 +86,10 @@ class SceneLights {
         std::vector<double> mapped[2];
     };
     // A prototype lit through its instances: its triangles in prototypeTriangles_, their CDF in
-    // instanceTable_, their power and object-space bounds.
+    // instanceTable_, their powers (until the CDF is made) and total, their object-space bounds.
     struct PrototypeLight {
         uint first = 0, count = 0, cdf = 0;
+        std::vector<double> powers;
         double power = 0.0;
         vec3 lo{std::numeric_limits<float>::max()}, hi{-std::numeric_limits<float>::max()};
     };

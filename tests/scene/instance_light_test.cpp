@@ -91,12 +91,12 @@ RenderParams paramsOf(const SceneLights& lights) {
 // The lights of six placements as instances (no copies allowed) and as copies: the pdf of each
 // light sample from points over the floor is the pdf that a ray toward the sampled point reports
 // from the triangle it hits, and the instances' picks add up to one at every point.
-TEST(InstancedMeshLight, ALightSamplesPdfIsTheOneItsHitReports) {
-    TempDir dir;
-    Scene scene = loadScene(lampGrid(dir, "six.gltf", 3, 2, true));
-    scene.environment.reset(); // the lamps alone
-    ASSERT_EQ(scene.instances.size(), 6u);
+void expectSamplePdfsAreHitPdfs(const Scene& scene, const std::string& what) {
+    SCOPED_TRACE(what);
     const SceneLights inst(scene, nullptr, 0), copies(scene);
+    for (const Emitter& e : inst.emitters())
+        ASSERT_TRUE(std::isfinite(e.pickPdf) && e.pickPdf >= 0.0f && e.pickPdf <= 1.0f)
+            << &e - inst.emitters().data() << ": " << e.pickPdf;
     EXPECT_EQ(inst.instanceLightCount(), 6u);
     EXPECT_EQ(copies.instanceLightCount(), 0u);
     EXPECT_EQ(copies.sampledEmitters(), 6u * 12u);
@@ -148,6 +148,31 @@ TEST(InstancedMeshLight, ALightSamplesPdfIsTheOneItsHitReports) {
     }
     EXPECT_GT(checked, 1000);
     EXPECT_GT(mirrored, 50); // instance 2 mirrors, and is checked as well
+}
+
+TEST(InstancedMeshLight, ALightSamplesPdfIsTheOneItsHitReports) {
+    TempDir dir;
+    Scene scene = loadScene(lampGrid(dir, "six.gltf", 3, 2, true));
+    scene.environment.reset(); // the lamps alone
+    ASSERT_EQ(scene.instances.size(), 6u);
+    expectSamplePdfsAreHitPdfs(scene, "emission 1");
+    // Radiance at the film's limit on a lamp modelled 1e10 times larger and placed 1e-10 times
+    // smaller (the same world): its triangles' powers, radiance times their area in the
+    // prototype's frame, pass float's range.
+    const Prototype& proto = scene.prototypes[0];
+    scene.shaders[scene.meshes[proto.meshes[0]].shader].params.emission = vec3(1e20f);
+    for (uint m : proto.meshes)
+        for (vec3& p : scene.meshes[m].positions)
+            p *= 1e10f;
+    scene.prototypes[0].lo *= 1e10f;
+    scene.prototypes[0].hi *= 1e10f;
+    mat4 shrink(1e-10f);
+    shrink[3][3] = 1.0f;
+    for (Instance& i : scene.instances) {
+        i.toWorld = i.toWorld * shrink;
+        i.normalToWorld *= 1e10f;
+    }
+    expectSamplePdfsAreHitPdfs(scene, "emission 1e20, a lamp 1e10 large placed 1e-10 small");
 }
 
 // Per instance the light table grows by its record, its CDF entry, its transform and its
