@@ -5,6 +5,7 @@
 #include "host/scene/camera.h"
 #include "host/vk/context.h"
 
+#include <OpenImageIO/imagebuf.h>
 #include <gtest/gtest.h>
 
 #include <cerrno>
@@ -291,6 +292,23 @@ std::string insideCubeObj() {
            "f 2 6 7 3\n"  // x = +1, normal -x
            "f 1 5 6 2\n"  // y = -1, normal +y
            "f 4 3 7 8\n"; // y = +1, normal -y
+}
+
+std::string stripesPng(const TempDir& dir) {
+    OIIO::ImageBuf img(OIIO::ImageSpec(8, 8, 3, OIIO::TypeDesc::UINT8));
+    for (int y = 0; y < 8; ++y)
+        for (int x = 0; x < 8; ++x) {
+            const float c[3] = {x < 4 ? 1.0f : 0.2f, 0.3f + 0.1f * float(y), x % 2 ? 0.9f : 0.1f};
+            img.setpixel(x, y, c);
+        }
+    EXPECT_TRUE(img.write(dir.file("stripes.png")));
+    return readFile(dir.file("stripes.png"));
+}
+
+BackendKind backendNamed(const std::string& name) {
+    return name == "reference" ? BackendKind::Reference
+           : name == "cpu"     ? BackendKind::Cpu
+                               : BackendKind::Vulkan;
 }
 
 std::string floorObj(float h) {

@@ -155,6 +155,11 @@ void expectNoPairedDifference(const PixelStats& d, int width, int height, const 
 std::string insideCubeObj();
 // A square [-h,h]^2 at y = 0 facing +Y, as OBJ text.
 std::string floorObj(float halfSize);
+// An 8 x 8 PNG of coloured stripes, none of them black (for an emission map), as its bytes;
+// written to dir/stripes.png on the way.
+std::string stripesPng(const TempDir& dir);
+// The backend a name of backendsUnderTest() names.
+BackendKind backendNamed(const std::string& name);
 
 // The scene of the per-pixel closed-form tests: a Lambert floor of albedo 0.5 (floorObj(4)) seen
 // from 0.6 above by a 90-degree camera looking down, 16 x 16 pixels, the Grid sampler (every

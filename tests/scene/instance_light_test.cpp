@@ -15,7 +15,6 @@
 #include "shared/lights.h"
 #include "test_util.h"
 
-#include <OpenImageIO/imagebuf.h>
 #include <gtest/gtest.h>
 
 #include <random>
@@ -191,23 +190,11 @@ TEST(InstancedMeshLight, AnInstanceCostsARecordNotItsTriangles) {
     EXPECT_LT(perInstance, double(12 * sizeof(Emitter)));
 }
 
-// An 8 x 8 PNG of coloured stripes for the lamps' emission map.
-std::string lampStripes(const TempDir& dir) {
-    OIIO::ImageBuf img(OIIO::ImageSpec(8, 8, 3, OIIO::TypeDesc::UINT8));
-    for (int y = 0; y < 8; ++y)
-        for (int x = 0; x < 8; ++x) {
-            const float c[3] = {x < 4 ? 1.0f : 0.3f, 0.2f + 0.1f * float(y), x % 2 ? 0.8f : 0.2f};
-            img.setpixel(x, y, c);
-        }
-    EXPECT_TRUE(img.write(dir.file("lamp.png")));
-    return readFile(dir.file("lamp.png"));
-}
-
 // 360 placements of a 12-triangle lamp (instances, as the default limit makes them) against a
 // mesh per placement (copies): the same image on every backend, with and without an emission map.
 TEST(InstancedMeshLight, AGridOfLampsRendersAsItsCopiesOnEveryBackend) {
     TempDir dir;
-    for (const std::string& image : {std::string(), lampStripes(dir)}) {
+    for (const std::string& image : {std::string(), stripesPng(dir)}) {
         const std::string what = image.empty() ? "constant" : "emission map";
         Scene inst = loadScene(lampGrid(dir, "inst.gltf", 20, 18, true, image));
         Scene flat = loadScene(lampGrid(dir, "flat.gltf", 20, 18, false, image));
@@ -220,9 +207,7 @@ TEST(InstancedMeshLight, AGridOfLampsRendersAsItsCopiesOnEveryBackend) {
             s->image = {40, 32, 1, 128};
         for (const std::string& backend : backendsUnderTest()) {
             RenderConfig config;
-            config.backend = backend == "reference" ? BackendKind::Reference
-                             : backend == "cpu"     ? BackendKind::Cpu
-                                                    : BackendKind::Vulkan;
+            config.backend = backendNamed(backend);
             const auto a = iterationImages(inst, config), b = iterationImages(flat, config);
             ASSERT_FALSE(a.empty());
             EXPECT_GT(mean(a.back()), 0.05) << backend;
